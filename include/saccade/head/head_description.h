@@ -1,0 +1,102 @@
+#pragma once
+// The stereo head's description: geometry (seed appendix A), joint limits, cameras, pose.
+// Immutable once loaded; joint angles live apart in JointState (description vs state).
+//
+// Frames. W: world, z up. B: head base (REP 103: x forward, y left, z up), placed in W by
+// X_WB. The paper's frames {b, n, c, l, r} use x left, y up, z forward; saccade keeps the
+// paper's equations in those frames and maps them into B with a fixed rotation. The eye
+// cameras' optical frames are OpenCV's (x right, y down, z forward): eqs. 7-8.
+//
+// Joints (radians, signs as the paper's and REP 103's):
+//   pan   > 0 turns the head to the left (about up),
+//   tilt  > 0 tilts it down (about left),
+//   left, right > 0 turn that eye to the left (about up). Converging eyes: left < 0 < right;
+//   symmetric vergence: left = -right (paper's assumption).
+
+#include <array>
+#include <filesystem>
+#include <optional>
+#include <string>
+
+#include "saccade/geometry/camera_model.h"
+#include "saccade/geometry/pose.h"
+
+namespace saccade::head {
+
+enum class Joint { kPan = 0, kTilt = 1, kLeft = 2, kRight = 3 };
+inline constexpr std::array<Joint, 4> kAllJoints = {Joint::kPan, Joint::kTilt, Joint::kLeft,
+                                                    Joint::kRight};
+/// "pan", "tilt", "left", "right".
+const char* JointName(Joint joint);
+
+/// Joint angles in radians.
+struct JointState {
+  double pan = 0.0;
+  double tilt = 0.0;
+  double left = 0.0;
+  double right = 0.0;
+  double& operator[](Joint joint);
+  double operator[](Joint joint) const;
+  bool operator==(const JointState&) const = default;
+};
+
+/// Range of one joint: position (rad), velocity (rad/s) and acceleration (rad/s^2) limits.
+struct JointLimits {
+  double min = 0.0;
+  double max = 0.0;
+  double max_velocity = 0.0;
+  double max_acceleration = 0.0;
+  bool Contains(double angle) const { return angle >= min && angle <= max; }
+};
+
+/// Lengths of appendix A, in metres.
+struct HeadGeometry {
+  double B = 0.1;        ///< half baseline: each eye's rotation axis is B from the cyclopean point
+  double D = 0.0;        ///< eq. 4: height of the cyclopean point above the pan/neck origin
+  double H = 0.0;        ///< extension: the eye baseline sits H above the tilt axis and turns
+                         ///< with it (0 in the paper, where the tilt axis passes through it)
+  double delta_l = 0.0;  ///< eq. 7: left optical centre ahead of its eye's rotation axis
+  double delta_r = 0.0;  ///< eq. 8: right optical centre ahead of its eye's rotation axis
+};
+
+/// A stereo head. Construct with FromYamlFile/FromYamlString or the validating constructor.
+class HeadDescription {
+ public:
+  /// Throws InvalidArgument naming the field when B <= 0, a length is not finite, a limit range
+  /// is empty or does not contain 0, or a velocity/acceleration limit is not positive.
+  HeadDescription(std::string name, const HeadGeometry& geometry,
+                  const std::array<JointLimits, 4>& limits, const geometry::Pose& X_WB,
+                  const geometry::CameraModel& left_camera,
+                  const geometry::CameraModel& right_camera);
+
+  /// Loads a head description YAML (robots/popeye.yaml documents the format). Throws
+  /// saccade::FileError with file, line and key on a missing, malformed or invalid entry,
+  /// and on unknown keys.
+  static HeadDescription FromYamlFile(const std::filesystem::path& path);
+  /// Same from text; `source` names it in errors.
+  static HeadDescription FromYamlString(const std::string& text, const std::string& source);
+
+  const std::string& name() const { return name_; }
+  const HeadGeometry& geometry() const { return geometry_; }
+  const JointLimits& limits(Joint joint) const { return limits_[static_cast<int>(joint)]; }
+  /// The head base in the world.
+  const geometry::Pose& X_WB() const { return X_WB_; }
+  const geometry::CameraModel& left_camera() const { return left_camera_; }
+  const geometry::CameraModel& right_camera() const { return right_camera_; }
+
+  /// Whether every joint is within its limits.
+  bool WithinLimits(const JointState& joints) const;
+  /// Throws InvalidArgument naming the first joint outside its limits, its value and range
+  /// (in degrees). For commands from users before they reach a motor.
+  void CheckLimits(const JointState& joints) const;
+
+ private:
+  std::string name_;
+  HeadGeometry geometry_;
+  std::array<JointLimits, 4> limits_;
+  geometry::Pose X_WB_;
+  geometry::CameraModel left_camera_;
+  geometry::CameraModel right_camera_;
+};
+
+}  // namespace saccade::head

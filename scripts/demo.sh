@@ -1,0 +1,6 @@
+#!/usr/bin/env bash
+# The README's first command: set up, build, and run saccade's main job.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+bash scripts/setup.sh build
+exec build/bin/saccade demo "$@"

@@ -1,0 +1,182 @@
+// The `saccade` program used as a script would: run it, parse its --json output, and check the
+// numbers against the geometry they describe.
+
+#include <fmt/format.h>
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <Eigen/Core>
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <opencv2/calib3d.hpp>
+#include <opencv2/core.hpp>
+#include <string>
+
+namespace {
+
+using nlohmann::json;
+using ::testing::HasSubstr;
+
+struct CommandRun {
+  int status = -1;
+  std::string output;  // stdout and stderr together
+};
+
+CommandRun Saccade(const std::string& args) {
+  const std::string command = std::string(SACCADE_BINARY) + " " + args + " 2>&1";
+  CommandRun run;
+  FILE* pipe = popen(command.c_str(), "r");
+  if (pipe == nullptr) return run;
+  std::array<char, 4096> buffer{};
+  size_t n = 0;
+  while ((n = fread(buffer.data(), 1, buffer.size(), pipe)) > 0)
+    run.output.append(buffer.data(), n);
+  const int raw = pclose(pipe);
+  run.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
+  return run;
+}
+
+const std::string kHead = std::string(SACCADE_SOURCE_DIR) + "/robots/popeye.yaml";
+
+std::filesystem::path TempDir() {
+  const auto dir =
+      std::filesystem::temp_directory_path() / ("saccade_cli_test_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  return dir;
+}
+
+Eigen::Vector3d Vec(const json& j) {
+  return {j[0].get<double>(), j[1].get<double>(), j[2].get<double>()};
+}
+
+TEST(Cli, IkThenFkFixatesTheTarget) {
+  // The joints `ik` prints, fed to `fk`, must put the fixation point on the target.
+  const CommandRun ik = Saccade("ik --head " + kHead + " --target 1.8 0.3 0.9 --json");
+  ASSERT_EQ(ik.status, 0) << ik.output;
+  const json solution = json::parse(ik.output);
+  ASSERT_TRUE(solution["reachable"].get<bool>()) << ik.output;
+  const json& q = solution["joints"];
+  const CommandRun fk = Saccade(fmt::format(
+      "fk --head {} --joints {:.17g} {:.17g} {:.17g} {:.17g} --json", kHead, q["pan"].get<double>(),
+      q["tilt"].get<double>(), q["left"].get<double>(), q["right"].get<double>()));
+  ASSERT_EQ(fk.status, 0) << fk.output;
+  const json frames = json::parse(fk.output);
+  ASSERT_FALSE(frames["fixation"].is_null());
+  // Joint angles printed with 17 significant digits: the fixation moves by rounding only.
+  EXPECT_LT((Vec(frames["fixation"]) - Eigen::Vector3d(1.8, 0.3, 0.9)).norm(), 1e-9);
+  EXPECT_TRUE(frames["within_limits"].get<bool>());
+  // Symmetric vergence by default.
+  EXPECT_DOUBLE_EQ(q["left"].get<double>(), -q["right"].get<double>());
+}
+
+TEST(Cli, FkDegreesAndRadiansAgree) {
+  const CommandRun deg = Saccade("fk --head " + kHead + " --joints 10 -5 -3 3 --deg --json");
+  const CommandRun rad =
+      Saccade(fmt::format("fk --head {} --joints {:.17g} {:.17g} {:.17g} {:.17g} --json", kHead,
+                          10 * M_PI / 180, -5 * M_PI / 180, -3 * M_PI / 180, 3 * M_PI / 180));
+  ASSERT_EQ(deg.status, 0) << deg.output;
+  ASSERT_EQ(rad.status, 0) << rad.output;
+  const json a = json::parse(deg.output), b = json::parse(rad.output);
+  EXPECT_LT((Vec(a["cameras"]["left"]["position"]) - Vec(b["cameras"]["left"]["position"])).norm(),
+            1e-12);
+  // The right camera sits 2B from the left one whatever the joints.
+  const double baseline =
+      (Vec(a["cameras"]["left"]["position"]) - Vec(a["cameras"]["right"]["position"])).norm();
+  EXPECT_GT(baseline, 0.0);
+}
+
+TEST(Cli, UnreachableTargetIsFlaggedAndJointsStayWithinLimits) {
+  const CommandRun ik =
+      Saccade("ik --head " + kHead + " --target -2 0 1.2 --json");  // behind the head
+  ASSERT_EQ(ik.status, 0) << ik.output;
+  const json solution = json::parse(ik.output);
+  EXPECT_FALSE(solution["reachable"].get<bool>());
+  EXPECT_NE(solution["reachability"].get<std::string>(), "reachable");
+  EXPECT_FALSE(solution["message"].get<std::string>().empty());
+  const json& q = solution["joints_deg"];
+  EXPECT_LE(std::abs(q["pan"].get<double>()), 90.0 + 1e-9);
+}
+
+TEST(Cli, CameraDescribesAnOpenCvCalibrationFile) {
+  const auto dir = TempDir();
+  const std::string path = (dir / "camera.yml").string();
+  const cv::Matx33d K(800.5, 0, 330.25, 0, 790.75, 250.5, 0, 0, 1);
+  const cv::Mat D = (cv::Mat_<double>(1, 5) << -0.2, 0.05, 0.001, -0.002, 0.01);
+  {
+    cv::FileStorage fs(path, cv::FileStorage::WRITE);
+    fs << "image_width" << 640 << "image_height" << 480 << "camera_matrix" << cv::Mat(K)
+       << "distortion_coefficients" << D;
+  }
+  const CommandRun run = Saccade("camera --calibration " + path + " --json");
+  ASSERT_EQ(run.status, 0) << run.output;
+  const json c = json::parse(run.output);
+  EXPECT_EQ(c["width"].get<int>(), 640);
+  EXPECT_EQ(c["fx"].get<double>(), 800.5);
+  EXPECT_EQ(c["cy"].get<double>(), 250.5);
+  EXPECT_EQ(c["distortion"]["model"].get<std::string>(), "radtan");
+  EXPECT_EQ(c["distortion"]["coefficients"][0].get<double>(), -0.2);
+
+  // The printed OpenGL matrix puts a point where cv::projectPoints (no distortion) does.
+  Eigen::Matrix4d P;
+  for (int r = 0; r < 4; ++r)
+    for (int col = 0; col < 4; ++col) P(r, col) = c["gl_projection"][r][col].get<double>();
+  const cv::Point3d p(0.3, -0.2, 2.5);
+  std::vector<cv::Point2d> reference;
+  cv::projectPoints(std::vector<cv::Point3d>{p}, cv::Vec3d(0, 0, 0), cv::Vec3d(0, 0, 0), K,
+                    cv::noArray(), reference);
+  const Eigen::Vector4d clip = P * Eigen::Vector4d(p.x, -p.y, -p.z, 1.0);
+  const double u = (clip.x() / clip.w() + 1) * 640 / 2 - 0.5;
+  const double v = 480 - (clip.y() / clip.w() + 1) * 480 / 2 - 0.5;
+  // JSON carries doubles with full precision (nlohmann prints 17 digits).
+  EXPECT_NEAR(u, reference[0].x, 1e-9);
+  EXPECT_NEAR(v, reference[0].y, 1e-9);
+  std::filesystem::remove_all(dir);
+}
+
+TEST(Cli, BadInputsGiveClearErrors) {
+  const CommandRun missing = Saccade("camera --calibration /nonexistent/calib.yml");
+  EXPECT_NE(missing.status, 0);
+  EXPECT_THAT(missing.output, HasSubstr("/nonexistent/calib.yml"));
+
+  const CommandRun three_joints = Saccade("fk --head " + kHead + " --joints 1 2 3");
+  EXPECT_NE(three_joints.status, 0);
+  EXPECT_THAT(three_joints.output, HasSubstr("--joints"));
+
+  const auto dir = TempDir();
+  const std::string bad_head = (dir / "bad_head.yaml").string();
+  {
+    std::ifstream in(kHead);
+    std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    const std::string key = "\n  half_baseline:";  // the entry, not the format comment
+    const auto at = text.find(key);
+    ASSERT_NE(at, std::string::npos) << "robots/popeye.yaml has no half_baseline";
+    text.replace(at, key.size(), key + " -0.1 #");
+    std::ofstream(bad_head) << text;
+  }
+  const CommandRun bad = Saccade("ik --head " + bad_head + " --target 1 0 1");
+  EXPECT_EQ(bad.status, 1);
+  EXPECT_THAT(bad.output, HasSubstr("bad_head.yaml:"));
+  EXPECT_THAT(bad.output, HasSubstr("half_baseline"));
+  std::filesystem::remove_all(dir);
+}
+
+TEST(Cli, EverySubcommandHasHelp) {
+  for (const char* sub : {"fk", "ik", "camera", "demo"}) {
+    const CommandRun help = Saccade(std::string(sub) + " --help");
+    EXPECT_EQ(help.status, 0) << sub;
+    EXPECT_THAT(help.output, HasSubstr("Usage")) << sub;
+  }
+}
+
+TEST(Cli, DemoSolvesItsFixation) {
+  const CommandRun demo = Saccade("demo --head " + kHead);
+  ASSERT_EQ(demo.status, 0) << demo.output;
+  EXPECT_THAT(demo.output, HasSubstr("reachable      yes"));
+}
+
+}  // namespace
