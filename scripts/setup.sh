@@ -16,10 +16,14 @@ packages=(
   libeigen3-dev libyaml-cpp-dev nlohmann-json3-dev libcli11-dev libfmt-dev libspdlog-dev
   libopencv-core-dev libopencv-imgproc-dev libopencv-calib3d-dev libopencv-imgcodecs-dev
   libopencv-objdetect-dev libopencv-video-dev libopencv-features2d-dev
-  # tests and benchmarks
-  libgtest-dev libgmock-dev libbenchmark-dev
-  # reference data: OpenCV's sample calibration files
-  opencv-doc
+  libassimp-dev libpng-dev libstb-dev libepoxy-dev libegl-dev libgl-dev
+  # OpenGL without a display or GPU: Mesa's EGL and llvmpipe
+  libegl-mesa0 libgl1-mesa-dri
+  # tests, benchmarks, the scene fuzzer (clang's libFuzzer)
+  libgtest-dev libgmock-dev libbenchmark-dev clang libclang-rt-14-dev
+  # reference data and demo assets: OpenCV's sample calibration files, Assimp's test models
+  # (broken ones included), MuJoCo's mug
+  opencv-doc assimp-testmodels libmujoco-samples
 )
 
 missing=()
@@ -40,6 +44,27 @@ if ((${#missing[@]})); then
 else
   echo "setup: all ${#packages[@]} Debian packages present"
 fi
+
+# Demo assets into assets/ (gitignored): the portraits astronaut.png and chelsea.png from
+# python3-skimage's data folder (unpacked from the .deb: the package itself would pull in
+# SciPy), and MuJoCo's mug.
+mkdir -p assets
+if [ ! -s assets/astronaut.png ] || [ ! -s assets/chelsea.png ]; then
+  echo "setup: unpacking the portraits from python3-skimage into assets/"
+  tmp=$(mktemp -d)
+  chmod 755 "$tmp"  # apt's sandbox user must be able to write the download
+  if ! (cd "$tmp" && apt-get download -qq python3-skimage 2>/dev/null); then
+    apt-get update -qq
+    (cd "$tmp" && apt-get download -qq python3-skimage)
+  fi
+  dpkg-deb -x "$tmp"/python3-skimage_*.deb "$tmp/x"
+  for f in astronaut.png chelsea.png; do
+    cp "$tmp/x/usr/lib/python3/dist-packages/skimage/data/$f" "assets/.$f.tmp"
+    mv "assets/.$f.tmp" "assets/$f"
+  done
+  rm -rf "$tmp"
+fi
+ln -sfn /usr/share/mujoco/model/mug assets/mug
 
 build_dir="${1:-build}"
 shift || true

@@ -1,0 +1,42 @@
+#pragma once
+// The subcommands of `saccade`. Each Add* function registers one subcommand with its options
+// and returns the function that runs it (returning the exit status); main() runs the one the
+// user chose and turns saccade::Error into "saccade: error: ..." with status 1.
+
+#include <functional>
+#include <string>
+
+#include <CLI/CLI.hpp>
+#include <Eigen/Core>
+#include <nlohmann/json.hpp>
+
+#include "saccade/geometry/pose.h"
+#include "saccade/head/head_description.h"
+
+namespace saccade::app {
+
+using Runner = std::function<int()>;
+
+Runner AddFkCommand(CLI::App& app);
+Runner AddIkCommand(CLI::App& app);
+Runner AddCameraCommand(CLI::App& app);
+Runner AddDemoCommand(CLI::App& app);
+Runner AddRenderCommand(CLI::App& app);
+Runner AddBenchCommand(CLI::App& app);
+
+// Shared helpers.
+inline constexpr double kRadToDeg = 180.0 / M_PI;
+inline constexpr double kDegToRad = M_PI / 180.0;
+
+/// A file shipped with saccade (robots/popeye.yaml, scenes/...): from the working directory if
+/// it is there, else from the source tree saccade was built from.
+std::string ShippedFile(const std::string& relative);
+
+nlohmann::json JointsJson(const head::JointState& q);
+nlohmann::json VectorJson(const Eigen::Vector3d& v);
+/// {"position": [...], "rotation": [[...]x3], "quaternion_wxyz": [...]}.
+nlohmann::json PoseJson(const geometry::Pose& X);
+/// Joint angles from 4 command-line values, radians or degrees.
+head::JointState JointsFromArgs(const std::vector<double>& values, bool degrees);
+
+}  // namespace saccade::app

@@ -1,0 +1,34 @@
+#include <filesystem>
+
+#include "commands.h"
+
+namespace saccade::app {
+
+using nlohmann::json;
+
+std::string ShippedFile(const std::string& relative) {
+  if (std::filesystem::exists(relative)) return relative;
+  return (std::filesystem::path(SACCADE_SOURCE_DIR) / relative).string();
+}
+
+json JointsJson(const head::JointState& q) {
+  return {{"pan", q.pan}, {"tilt", q.tilt}, {"left", q.left}, {"right", q.right}};
+}
+
+json VectorJson(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()}; }
+
+json PoseJson(const geometry::Pose& X) {
+  json rotation = json::array();
+  for (int r = 0; r < 3; ++r) rotation.push_back({X(r, 0), X(r, 1), X(r, 2)});
+  const Eigen::Quaterniond q(X.linear());
+  return {{"position", VectorJson(X.translation())},
+          {"rotation", rotation},
+          {"quaternion_wxyz", {q.w(), q.x(), q.y(), q.z()}}};
+}
+
+head::JointState JointsFromArgs(const std::vector<double>& values, bool degrees) {
+  const double s = degrees ? kDegToRad : 1.0;
+  return {values[0] * s, values[1] * s, values[2] * s, values[3] * s};
+}
+
+}  // namespace saccade::app

@@ -1,0 +1,100 @@
+#pragma once
+// Images: an owning Image and a borrowing ImageView, with the metadata every frame carries.
+// Row 0 is the top row (OpenCV's convention); rows are tightly packed unless a stride says
+// otherwise. Pixel (u, v) has its centre at integer coordinates.
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace saccade {
+
+enum class PixelFormat {
+  kGray8,    ///< 1 x uint8
+  kRgb8,     ///< 3 x uint8, R G B
+  kRgba8,    ///< 4 x uint8, R G B A
+  kGray16,   ///< 1 x uint16 (depth in mm, 16-bit PNG)
+  kFloat32,  ///< 1 x float (depth in metres)
+  kUint32,   ///< 1 x uint32 (instance ids)
+};
+
+/// Bytes of one pixel of the format.
+int BytesPerPixel(PixelFormat format);
+/// "gray8", "rgb8", ...
+const char* ToString(PixelFormat format);
+
+/// What a frame is and where it came from (DESIGN.md): plain numbers, no geometry types, so
+/// that every layer can carry it. Frames are named as in DESIGN.md: X_WC is the camera's
+/// optical frame in the world.
+struct ImageMetadata {
+  std::string camera;       ///< camera name ("left", "right", ...)
+  double time = 0.0;        ///< simulation (or capture) time, seconds
+  int64_t frame_index = 0;  ///< 0, 1, 2, ... per camera
+  std::array<double, 9> K{};           ///< row-major 3x3 camera matrix, pixels
+  std::string distortion_model;        ///< "none", "radtan" or "fisheye"
+  std::vector<double> distortion;      ///< OpenCV order
+  std::array<double, 16> X_WC{};       ///< row-major 4x4 pose of the optical frame in W
+  bool has_joints = false;             ///< whether the camera rides on a head
+  std::array<double, 4> joints{};      ///< pan, tilt, left, right (rad) at capture
+};
+
+/// A borrowed, read-only image: pointer, size, format, row stride. Cheap to copy.
+class ImageView {
+ public:
+  ImageView() = default;
+  ImageView(const uint8_t* data, int width, int height, PixelFormat format,
+            std::size_t stride_bytes = 0, const ImageMetadata* metadata = nullptr);
+
+  const uint8_t* data() const { return data_; }
+  int width() const { return width_; }
+  int height() const { return height_; }
+  PixelFormat format() const { return format_; }
+  std::size_t stride() const { return stride_; }
+  const uint8_t* row(int y) const { return data_ + static_cast<std::size_t>(y) * stride_; }
+  /// nullptr when the view carries none.
+  const ImageMetadata* metadata() const { return metadata_; }
+  bool empty() const { return data_ == nullptr || width_ == 0 || height_ == 0; }
+
+ private:
+  const uint8_t* data_ = nullptr;
+  int width_ = 0;
+  int height_ = 0;
+  PixelFormat format_ = PixelFormat::kRgb8;
+  std::size_t stride_ = 0;
+  const ImageMetadata* metadata_ = nullptr;
+};
+
+/// An owning image with tightly packed rows and its metadata. Moves cheaply; in a process,
+/// frames travel as std::shared_ptr<const Image> (never copied, DESIGN.md).
+class Image {
+ public:
+  Image() = default;
+  /// Zero-filled. Throws InvalidArgument when width or height is negative.
+  Image(int width, int height, PixelFormat format);
+
+  int width() const { return width_; }
+  int height() const { return height_; }
+  PixelFormat format() const { return format_; }
+  std::size_t stride() const { return static_cast<std::size_t>(width_) * BytesPerPixel(format_); }
+  uint8_t* data() { return pixels_.data(); }
+  const uint8_t* data() const { return pixels_.data(); }
+  std::size_t size_bytes() const { return pixels_.size(); }
+  uint8_t* row(int y) { return pixels_.data() + static_cast<std::size_t>(y) * stride(); }
+  const uint8_t* row(int y) const { return pixels_.data() + static_cast<std::size_t>(y) * stride(); }
+  ImageMetadata& metadata() { return metadata_; }
+  const ImageMetadata& metadata() const { return metadata_; }
+  ImageView view() const { return {data(), width_, height_, format_, stride(), &metadata_}; }
+  bool empty() const { return pixels_.empty(); }
+
+ private:
+  int width_ = 0;
+  int height_ = 0;
+  PixelFormat format_ = PixelFormat::kRgb8;
+  std::vector<uint8_t> pixels_;
+  ImageMetadata metadata_;
+};
+
+}  // namespace saccade

@@ -1,0 +1,21 @@
+#pragma once
+// Reading and writing image files. PNG (8 and 16 bit) through libpng; JPEG, BMP, TGA and the
+// rest stb_image reads, for textures.
+
+#include <filesystem>
+
+#include "saccade/core/image.h"
+
+namespace saccade {
+
+/// Reads an image file: 8-bit gray, RGB or RGBA as they are stored (gray+alpha becomes RGBA),
+/// 16-bit gray PNG as kGray16. Throws FileError (file and reason) when the file is missing,
+/// unreadable or not an image.
+Image ReadImage(const std::filesystem::path& path);
+
+/// Writes a PNG (kGray8, kRgb8, kRgba8, kGray16). Writes a temporary file in the same
+/// directory and renames it, so a failed or interrupted write leaves no partial file.
+/// Throws FileError on failure, InvalidArgument on a format PNG cannot hold.
+void WritePng(const ImageView& image, const std::filesystem::path& path);
+
+}  // namespace saccade

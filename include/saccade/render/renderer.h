@@ -1,0 +1,78 @@
+#pragma once
+// Rendering a scene through its calibrated cameras, headless. The public interface hides the
+// backend (OpenGL 3.3 core through EGL, surfaceless: Mesa llvmpipe without a GPU, the vendor
+// driver with one); no GL or EGL header appears here.
+//
+// Each camera renders through its own framebuffer with the projection built from its K
+// (geometry/gl_projection.h), at its exact size; the rows are flipped on the GPU so that the
+// frames come back with row 0 at the top; pixels come back through pixel buffer objects,
+// asynchronously and double buffered.
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "saccade/core/image.h"
+#include "saccade/scene/scene.h"
+
+namespace saccade::render {
+
+/// Options of a renderer. Defaults in-class; IsValid says what is wrong.
+struct RendererOptions {
+  /// Multisample anti-aliasing samples per pixel: 0 (off), 2, 4 or 8.
+  int msaa_samples = 0;
+  /// Draw the robot's body (its own cameras never see the inside of it: near plane).
+  bool draw_robot = true;
+  /// Cameras to render, by name; empty: all of the scene's cameras, in scene order.
+  std::vector<std::string> cameras;
+  bool IsValid(std::string* error) const;
+};
+
+/// One camera's image of one state: kRgb8 pixels, row 0 at the top, with its metadata
+/// (camera, time, frame index, K, distortion, X_WC, joints). Shared, never copied.
+struct Frame {
+  std::shared_ptr<const Image> color;
+};
+
+/// Cumulative time spent per stage, for `saccade bench` (milliseconds, wall clock).
+struct RenderStats {
+  int64_t frames = 0;          ///< states rendered (each with every camera)
+  double scene_update_ms = 0;  ///< poses, uniforms
+  double draw_ms = 0;          ///< issuing draw calls (and, on llvmpipe, rasterising)
+  double readback_ms = 0;      ///< waiting for and copying pixels out of the PBOs
+  double total_ms = 0;
+};
+
+/// Renders the cameras of one scene. Not thread-safe: use from one thread (it owns a GL
+/// context). Create with MakeRenderer.
+class Renderer {
+ public:
+  virtual ~Renderer() = default;
+
+  /// Renders every selected camera in `state` and returns one frame per camera, pixels in CPU
+  /// memory. Equivalent to Submit followed by Retrieve.
+  virtual std::vector<Frame> Render(const scene::SceneState& state, int64_t frame_index) = 0;
+
+  /// Pipelined use: Submit starts drawing and the asynchronous readback of a state; Retrieve
+  /// returns the frames of the oldest submitted state, waiting for them if needed. Keeping
+  /// two states in flight overlaps the GPU's work with the caller's.
+  virtual void Submit(const scene::SceneState& state, int64_t frame_index) = 0;
+  virtual std::vector<Frame> Retrieve() = 0;
+  /// Submitted states not yet retrieved (0, 1 or 2). Submit with 2 in flight throws Error.
+  virtual int InFlight() const = 0;
+
+  /// The names of the cameras rendered, in frame order.
+  virtual const std::vector<std::string>& camera_names() const = 0;
+  /// "OpenGL 4.5 (Core Profile) Mesa 22.3.6, llvmpipe (LLVM 15.0.6, 256 bits)" or similar.
+  virtual std::string DeviceDescription() const = 0;
+  virtual const RenderStats& stats() const = 0;
+};
+
+/// Creates the OpenGL renderer for a scene: opens a surfaceless EGL display, uploads every
+/// model and texture once. Throws saccade::Error with what EGL or GL said when no context can
+/// be made, InvalidArgument on invalid options (naming the option) or an unknown camera name.
+std::unique_ptr<Renderer> MakeRenderer(const scene::Scene& scene,
+                                       const RendererOptions& options = {});
+
+}  // namespace saccade::render

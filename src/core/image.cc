@@ -1,0 +1,63 @@
+#include "saccade/core/image.h"
+
+#include <fmt/format.h>
+
+#include "saccade/core/error.h"
+
+namespace saccade {
+
+int BytesPerPixel(PixelFormat format) {
+  switch (format) {
+    case PixelFormat::kGray8:
+      return 1;
+    case PixelFormat::kRgb8:
+      return 3;
+    case PixelFormat::kRgba8:
+      return 4;
+    case PixelFormat::kGray16:
+      return 2;
+    case PixelFormat::kFloat32:
+    case PixelFormat::kUint32:
+      return 4;
+  }
+  return 0;
+}
+
+const char* ToString(PixelFormat format) {
+  switch (format) {
+    case PixelFormat::kGray8:
+      return "gray8";
+    case PixelFormat::kRgb8:
+      return "rgb8";
+    case PixelFormat::kRgba8:
+      return "rgba8";
+    case PixelFormat::kGray16:
+      return "gray16";
+    case PixelFormat::kFloat32:
+      return "float32";
+    case PixelFormat::kUint32:
+      return "uint32";
+  }
+  return "unknown";
+}
+
+ImageView::ImageView(const uint8_t* data, int width, int height, PixelFormat format,
+                     std::size_t stride_bytes, const ImageMetadata* metadata)
+    : data_(data),
+      width_(width),
+      height_(height),
+      format_(format),
+      stride_(stride_bytes != 0 ? stride_bytes
+                                : static_cast<std::size_t>(width) * BytesPerPixel(format)),
+      metadata_(metadata) {}
+
+Image::Image(int width, int height, PixelFormat format)
+    : width_(width), height_(height), format_(format) {
+  if (width < 0 || height < 0) {
+    throw InvalidArgument(
+        fmt::format("Image: width and height must be >= 0, got {} x {}", width, height));
+  }
+  pixels_.assign(static_cast<std::size_t>(width) * height * BytesPerPixel(format), 0);
+}
+
+}  // namespace saccade

@@ -1,0 +1,210 @@
+#include "internal_yaml.h"
+
+#include <fmt/format.h>
+
+#include <cmath>
+#include <set>
+#include <utility>
+
+#include "saccade/core/error.h"
+
+namespace saccade::scene::internal {
+
+Entry::Entry(YAML::Node node, std::string path, const std::string* file, int fallback_line)
+    : node_(std::move(node)), path_(std::move(path)), file_(file), fallback_line_(fallback_line) {}
+
+int Entry::line() const {
+  if (!node_.IsDefined()) return fallback_line_;
+  const YAML::Mark mark = node_.Mark();
+  return mark.is_null() ? fallback_line_ : mark.line + 1;
+}
+
+void Entry::Fail(const std::string& what) const { throw FileError(*file_, line(), path_, what); }
+
+std::string Entry::Describe() const {
+  if (!node_.IsDefined()) return "nothing";
+  switch (node_.Type()) {
+    case YAML::NodeType::Null:
+      return "nothing (null)";
+    case YAML::NodeType::Scalar: {
+      // Long scalars are cut: messages stay one readable line.
+      constexpr std::size_t kMaxShown = 60;
+      std::string text = node_.Scalar();
+      if (text.size() > kMaxShown) text = text.substr(0, kMaxShown) + "...";
+      return "'" + text + "'";
+    }
+    case YAML::NodeType::Sequence:
+      return fmt::format("a list of {}", node_.size());
+    case YAML::NodeType::Map:
+      return "a map";
+    default:
+      return "nothing";
+  }
+}
+
+void Entry::ExpectMap(const std::vector<std::string>& allowed, const char* what) const {
+  if (!node_.IsMap()) Fail(std::string("expected ") + what + ", got " + Describe());
+  std::set<std::string> seen;
+  for (auto it = node_.begin(); it != node_.end(); ++it) {
+    const int key_line = it->first.Mark().is_null() ? line() : it->first.Mark().line + 1;
+    if (!it->first.IsScalar()) {
+      throw FileError(*file_, key_line, path_, "expected a key name, got a list or a map as key");
+    }
+    const std::string key = it->first.Scalar();
+    bool known = false;
+    std::string expected;
+    for (const std::string& name : allowed) {
+      known = known || key == name;
+      expected += (expected.empty() ? "" : ", ") + name;
+    }
+    if (!known) {
+      throw FileError(*file_, key_line, Join(key),
+                      "unknown key '" + key + "'; expected one of: " + expected);
+    }
+    if (!seen.insert(key).second) {
+      throw FileError(*file_, key_line, Join(key), "duplicate key '" + key + "'");
+    }
+  }
+}
+
+void Entry::ExpectMap(std::initializer_list<const char*> allowed, const char* what) const {
+  std::vector<std::string> names;
+  for (const char* name : allowed) names.emplace_back(name);
+  ExpectMap(names, what);
+}
+
+bool Entry::Has(const char* key) const { return node_.IsMap() && node_[key].IsDefined(); }
+
+Entry Entry::Get(const char* key) const {
+  if (!Has(key)) Fail(std::string("missing key '") + key + "'");
+  return Entry(node_[key], Join(key), file_, line());
+}
+
+std::optional<Entry> Entry::Find(const char* key) const {
+  if (!Has(key)) return std::nullopt;
+  return Entry(node_[key], Join(key), file_, line());
+}
+
+std::vector<Entry> Entry::AsSequence(const char* what) const {
+  if (!node_.IsSequence()) Fail(std::string("expected a list of ") + what + ", got " + Describe());
+  std::vector<Entry> entries;
+  entries.reserve(node_.size());
+  for (std::size_t i = 0; i < node_.size(); ++i) {
+    entries.emplace_back(node_[i], fmt::format("{}[{}]", path_, i), file_, line());
+  }
+  return entries;
+}
+
+double Entry::AsDouble() const {
+  if (!node_.IsScalar()) Fail("expected a number, got " + Describe());
+  double value = 0.0;
+  try {
+    value = node_.as<double>();
+  } catch (const YAML::Exception&) {
+    Fail("expected a number, got " + Describe());
+  }
+  if (!std::isfinite(value)) Fail("expected a finite number, got " + Describe());
+  return value;
+}
+
+double Entry::AsPositive() const {
+  const double value = AsDouble();
+  if (!(value > 0.0)) Fail(fmt::format("expected a positive number, got {}", value));
+  return value;
+}
+
+double Entry::AsNonNegative() const {
+  const double value = AsDouble();
+  if (!(value >= 0.0)) Fail(fmt::format("expected a number >= 0, got {}", value));
+  return value;
+}
+
+int64_t Entry::AsInteger(int64_t min, int64_t max) const {
+  const std::string expected = fmt::format("expected an integer in [{}, {}]", min, max);
+  if (!node_.IsScalar()) Fail(expected + ", got " + Describe());
+  long long value = 0;
+  try {
+    value = node_.as<long long>();
+  } catch (const YAML::Exception&) {
+    Fail(expected + ", got " + Describe());
+  }
+  if (value < min || value > max) Fail(expected + ", got " + Describe());
+  return value;
+}
+
+bool Entry::AsBool() const {
+  if (!node_.IsScalar()) Fail("expected true or false, got " + Describe());
+  bool value = false;
+  try {
+    value = node_.as<bool>();
+  } catch (const YAML::Exception&) {
+    Fail("expected true or false, got " + Describe());
+  }
+  return value;
+}
+
+std::string Entry::AsString() const {
+  if (!node_.IsScalar()) Fail("expected a string, got " + Describe());
+  return node_.Scalar();
+}
+
+std::string Entry::AsNonEmptyString() const {
+  std::string value = AsString();
+  if (value.empty()) Fail("expected a non-empty string, got ''");
+  return value;
+}
+
+std::vector<double> Entry::AsDoubles(int size, const char* names) const {
+  const std::string expected =
+      fmt::format("expected {} numbers{}{}", size, *names != '\0' ? " " : "", names);
+  if (!node_.IsSequence()) Fail(expected + ", got " + Describe());
+  if (static_cast<int>(node_.size()) != size) {
+    Fail(fmt::format("{}, got {}", expected, node_.size()));
+  }
+  std::vector<double> values;
+  for (std::size_t i = 0; i < node_.size(); ++i) {
+    values.push_back(Entry(node_[i], fmt::format("{}[{}]", path_, i), file_, line()).AsDouble());
+  }
+  return values;
+}
+
+Eigen::Vector3d Entry::AsVector3(const char* names) const {
+  const std::vector<double> v = AsDoubles(3, names);
+  return {v[0], v[1], v[2]};
+}
+
+Eigen::Vector4f Entry::AsColor(bool allow_alpha) const {
+  const char* expected = allow_alpha ? "expected a colour [r, g, b] or [r, g, b, a], each in [0, 1]"
+                                     : "expected a colour [r, g, b], each in [0, 1]";
+  const bool length_ok =
+      node_.IsSequence() && (node_.size() == 3 || (allow_alpha && node_.size() == 4));
+  if (!length_ok) {
+    Fail(fmt::format("{}, got {}", expected,
+                     node_.IsSequence() ? fmt::format("{} numbers", node_.size()) : Describe()));
+  }
+  Eigen::Vector4f color(0.0f, 0.0f, 0.0f, 1.0f);
+  for (std::size_t i = 0; i < node_.size(); ++i) {
+    const Entry channel(node_[i], fmt::format("{}[{}]", path_, i), file_, line());
+    const double value = channel.AsDouble();
+    if (value < 0.0 || value > 1.0) {
+      channel.Fail(fmt::format("{}, got {}", expected, value));
+    }
+    color[static_cast<int>(i)] = static_cast<float>(value);
+  }
+  return color;
+}
+
+std::string Entry::Join(const std::string& key) const {
+  return path_.empty() ? key : path_ + "." + key;
+}
+
+YAML::Node ParseYaml(const std::string& text, const std::string& source) {
+  try {
+    return YAML::Load(text);
+  } catch (const YAML::Exception& error) {
+    throw FileError(source, error.mark.is_null() ? 0 : error.mark.line + 1, "",
+                    "YAML syntax error: " + error.msg);
+  }
+}
+
+}  // namespace saccade::scene::internal

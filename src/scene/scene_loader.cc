@@ -1,0 +1,709 @@
+// Scene files: YAML to a validated Scene (the format is documented at the top of
+// scenes/portraits.yaml). Every error is a FileError "file:line: key.path: what", including
+// those of the files a scene refers to (their own message follows, naming their path).
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <fstream>
+#include <map>
+#include <numbers>
+#include <sstream>
+#include <system_error>
+#include <utility>
+
+#include "internal_assets.h"
+#include "internal_robot_body.h"
+#include "internal_yaml.h"
+#include "saccade/core/error.h"
+#include "saccade/geometry/calibration_io.h"
+#include "saccade/scene/scene.h"
+
+namespace saccade::scene {
+namespace {
+
+namespace fs = std::filesystem;
+using internal::Entry;
+
+constexpr double kDegToRad = std::numbers::pi / 180.0;
+// Instance ids stay exact in a float (2^24) for renderers that pass them through one.
+constexpr int64_t kMaxId = (int64_t{1} << 24) - 1;
+// Default clip planes of every camera (metres): the robot's body is built for near = 0.05.
+constexpr double kDefaultNear = 0.05;
+constexpr double kDefaultFar = 50.0;
+// Files a scene refers to (models, images, calibrations) larger than this are refused.
+constexpr std::uintmax_t kMaxFileBytes = std::uintmax_t{4} << 30;
+// A look_at `up` within this sine of the viewing direction leaves the roll undefined.
+constexpr double kMinUpSine = 1e-6;
+
+const Eigen::Vector4f kDefaultPrimitiveColor(0.7f, 0.7f, 0.7f, 1.0f);
+
+// An angle triple given as `<key>_deg` (degrees) or `<key>` (radians): at most one of them.
+std::optional<Eigen::Vector3d> FindAngles(const Entry& parent, const std::string& key,
+                                          const char* names) {
+  const std::string deg_key = key + "_deg";
+  const auto rad = parent.Find(key.c_str());
+  const auto deg = parent.Find(deg_key.c_str());
+  if (rad && deg) deg->Fail("give either '" + key + "' (radians) or '" + deg_key + "', not both");
+  if (deg) return deg->AsVector3(names) * kDegToRad;
+  if (rad) return rad->AsVector3(names);
+  return std::nullopt;
+}
+
+geometry::Pose PoseFrom(const Eigen::Vector3d& position, const Eigen::Vector3d& rpy) {
+  return geometry::MakePose(geometry::RotationFromRpy(rpy.x(), rpy.y(), rpy.z()), position);
+}
+
+// {position, rpy | rpy_deg}; rpy defaults to 0.
+geometry::Pose ReadPose(const Entry& e) {
+  e.ExpectMap({"position", "rpy", "rpy_deg"}, "a pose {position, rpy_deg}");
+  const Eigen::Vector3d position = e.Get("position").AsVector3();
+  const Eigen::Vector3d rpy =
+      FindAngles(e, "rpy", "[roll, pitch, yaw]").value_or(Eigen::Vector3d::Zero());
+  return PoseFrom(position, rpy);
+}
+
+// A positive number (uniform) or `n` positive numbers.
+Eigen::Vector3d ReadPositiveSizes(const Entry& e, int n, const char* names) {
+  const std::string expected =
+      fmt::format("expected a positive number or {} positive numbers {}", n, names);
+  Eigen::Vector3d out = Eigen::Vector3d::Ones();
+  if (e.IsScalar()) {
+    out.head(n).setConstant(e.AsPositive());
+    return out;
+  }
+  if (!e.IsSequence() || static_cast<int>(e.node().size()) != n) {
+    e.Fail(fmt::format("{}, got {}", expected,
+                       e.IsSequence() ? fmt::format("{} numbers", e.node().size()) : e.Describe()));
+  }
+  for (int i = 0; i < n; ++i) {
+    const Entry item(e.node()[i], fmt::format("{}[{}]", e.path(), i), &e.file(), e.line());
+    out[i] = item.AsPositive();
+  }
+  return out;
+}
+
+Eigen::Vector3f Rgb(const Eigen::Vector4f& rgba) { return rgba.head<3>(); }
+
+class SceneReader {
+ public:
+  SceneReader(std::string source, fs::path base_dir)
+      : source_(std::move(source)), base_dir_(std::move(base_dir)) {}
+
+  Scene Read(const YAML::Node& root) {
+    const Entry top(root, "", &source_, 1);
+    if (!root.IsMap()) {
+      top.Fail(
+          "expected a scene (a map with background, lights, ground, objects, robot, cameras), "
+          "got " +
+          top.Describe());
+    }
+    top.ExpectMap({"background", "lights", "ground", "objects", "robot", "cameras"}, "a scene");
+
+    Eigen::Vector3f background(0.62f, 0.72f, 0.82f);
+    if (const auto e = top.Find("background")) background = Rgb(e->AsColor(false));
+
+    std::vector<Light> lights;
+    if (const auto e = top.Find("lights")) {
+      for (const Entry& item : e->AsSequence("lights")) lights.push_back(ReadLight(item));
+    } else {
+      lights = DefaultLights();
+    }
+
+    Ground ground;
+    if (const auto e = top.Find("ground")) ground = ReadGround(*e);
+
+    std::vector<Object> objects;
+    std::vector<std::optional<Entry>> id_entries;
+    std::map<std::string, std::string> object_names;  // name -> key path
+    if (const auto e = top.Find("objects")) {
+      for (const Entry& item : e->AsSequence("objects")) {
+        std::optional<Entry> id_entry;
+        objects.push_back(ReadObject(item, &id_entry, object_names));
+        id_entries.push_back(id_entry);
+      }
+    }
+
+    std::vector<CameraSpec> cameras;
+    std::map<std::string, std::string> camera_names;  // name -> key path
+    std::optional<Robot> robot;
+    std::optional<Entry> robot_id_entry;
+    if (const auto e = top.Find("robot")) {
+      robot = ReadRobot(*e, &cameras, &robot_id_entry);
+      for (const CameraSpec& camera : cameras) {
+        camera_names.emplace(camera.name, "the robot's " + camera.name + " eye camera");
+      }
+    }
+    if (const auto e = top.Find("cameras")) {
+      for (const Entry& item : e->AsSequence("cameras")) {
+        cameras.push_back(ReadWorldCamera(item, camera_names));
+      }
+    }
+
+    AssignIds(objects, id_entries, robot ? &*robot : nullptr, robot_id_entry);
+    try {
+      return Scene(background, std::move(lights), std::move(ground), std::move(objects),
+                   std::move(cameras), std::move(robot));
+    } catch (const InvalidArgument& error) {
+      // Everything was checked above with its line; this is a safety net naming the file.
+      throw FileError(source_, 0, "", error.what());
+    }
+  }
+
+ private:
+  // --- files --------------------------------------------------------------------------
+  // A path relative to the scene's folder, to an existing regular file; canonical.
+  fs::path ResolveFile(const Entry& e, const char* what) const {
+    const std::string text = e.AsNonEmptyString();
+    if (text.find('\0') != std::string::npos) e.Fail("a path cannot contain a NUL character");
+    fs::path path(text);
+    if (path.is_relative()) path = base_dir_ / path;
+    path = path.lexically_normal();
+    std::error_code ec;
+    const fs::file_status status = fs::status(path, ec);
+    if (!fs::exists(status)) {
+      e.Fail(fmt::format("{} not found: '{}' (looked for {})", what, text, path.string()));
+    }
+    if (!fs::is_regular_file(status)) {
+      e.Fail(fmt::format("{} '{}' is not a regular file ({})", what, text, path.string()));
+    }
+    // /proc/kcore and the like claim to be huge regular files: never hand them to a parser.
+    const std::uintmax_t size = fs::file_size(path, ec);
+    if (ec || size > kMaxFileBytes) {
+      e.Fail(fmt::format("{} '{}' is not readable or larger than {} bytes ({})", what, text,
+                         kMaxFileBytes, path.string()));
+    }
+    const fs::path canonical = fs::canonical(path, ec);
+    return ec ? path : canonical;
+  }
+
+  std::shared_ptr<const Texture> ReadTexture(const Entry& e, const char* what) {
+    const fs::path path = ResolveFile(e, what);
+    try {
+      return internal::LoadTexture(path, cache_);
+    } catch (const Error& error) {
+      e.Fail(fmt::format("cannot read {} '{}': {}", what, e.AsString(), error.what()));
+    }
+  }
+
+  // --- lights and ground --------------------------------------------------------------
+  static std::vector<Light> DefaultLights() {
+    Light ambient;
+    ambient.type = Light::Type::kAmbient;
+    ambient.intensity = 0.35f;
+    Light sun;
+    sun.type = Light::Type::kDirectional;
+    sun.intensity = 0.8f;
+    sun.direction_W = Eigen::Vector3d(-0.4, -0.3, -1.0).normalized();
+    return {ambient, sun};
+  }
+
+  Light ReadLight(const Entry& e) {
+    if (!e.IsMap()) e.Fail("expected a light (a map with type, ...), got " + e.Describe());
+    const Entry type_entry = e.Get("type");
+    const std::string type = type_entry.AsString();
+    Light light;
+    if (type == "ambient") {
+      light.type = Light::Type::kAmbient;
+      e.ExpectMap({"type", "color", "intensity"}, "an ambient light");
+    } else if (type == "directional") {
+      light.type = Light::Type::kDirectional;
+      e.ExpectMap({"type", "color", "intensity", "direction"}, "a directional light");
+      const Entry direction = e.Get("direction");
+      const Eigen::Vector3d d = direction.AsVector3();
+      if (!(d.norm() > 0.0)) direction.Fail("expected a non-zero direction, got [0, 0, 0]");
+      light.direction_W = d.normalized();
+    } else if (type == "point") {
+      light.type = Light::Type::kPoint;
+      e.ExpectMap({"type", "color", "intensity", "position", "attenuation"}, "a point light");
+      light.position_W = e.Get("position").AsVector3();
+      if (const auto a = e.Find("attenuation")) light.attenuation = a->AsNonNegative();
+    } else {
+      type_entry.Fail("expected 'ambient', 'directional' or 'point', got " + type_entry.Describe());
+    }
+    if (const auto c = e.Find("color")) light.color = Rgb(c->AsColor(false));
+    if (const auto i = e.Find("intensity"))
+      light.intensity = static_cast<float>(i->AsNonNegative());
+    return light;
+  }
+
+  Ground ReadGround(const Entry& e) {
+    e.ExpectMap({"enabled", "size", "pattern", "cell", "line_width", "color", "color2"},
+                "a ground {size, pattern, cell, ...}");
+    Ground g;
+    if (const auto x = e.Find("enabled")) g.enabled = x->AsBool();
+    if (const auto x = e.Find("size")) g.size = x->AsPositive();
+    if (const auto x = e.Find("pattern")) {
+      const std::string pattern = x->AsString();
+      if (pattern == "plain") {
+        g.pattern = Ground::Pattern::kPlain;
+      } else if (pattern == "grid") {
+        g.pattern = Ground::Pattern::kGrid;
+      } else if (pattern == "checker") {
+        g.pattern = Ground::Pattern::kChecker;
+      } else {
+        x->Fail("expected 'plain', 'grid' or 'checker', got " + x->Describe());
+      }
+    }
+    if (const auto x = e.Find("cell")) g.cell = x->AsPositive();
+    if (const auto x = e.Find("line_width")) g.line_width = x->AsPositive();
+    if (!(g.line_width < g.cell)) {
+      (e.Find("line_width") ? *e.Find("line_width") : e.Get("cell"))
+          .Fail(fmt::format("expected line_width < cell, got line_width {} m and cell {} m",
+                            g.line_width, g.cell));
+    }
+    if (const auto x = e.Find("color")) g.color = Rgb(x->AsColor(false));
+    if (const auto x = e.Find("color2")) g.color2 = Rgb(x->AsColor(false));
+    return g;
+  }
+
+  // --- objects ------------------------------------------------------------------------
+  std::shared_ptr<const Model> Primitive(const std::string& kind, const Eigen::Vector4f& color) {
+    const std::string key =
+        fmt::format("{} {} {} {} {}", kind, color[0], color[1], color[2], color[3]);
+    auto& model = primitives_[key];
+    if (model == nullptr) {
+      model = kind == "box"      ? MakeBox(color)
+              : kind == "sphere" ? MakeSphere(color)
+                                 : MakePlane(color);
+    }
+    return model;
+  }
+
+  Object ReadObject(const Entry& e, std::optional<Entry>* id_entry,
+                    std::map<std::string, std::string>& names) {
+    if (!e.IsMap()) e.Fail("expected an object (a map with name, kind, ...), got " + e.Describe());
+    const Entry kind_entry = e.Get("kind");
+    const std::string kind = kind_entry.AsString();
+    std::vector<std::string> keys = {"name", "kind", "id", "pose", "scale", "motion"};
+    if (kind == "model") {
+      keys.insert(keys.end(), {"file", "unit_scale", "texture"});
+    } else if (kind == "picture") {
+      keys.insert(keys.end(), {"image", "height"});
+    } else if (kind == "box" || kind == "plane") {
+      keys.insert(keys.end(), {"size", "color"});
+    } else if (kind == "sphere") {
+      keys.insert(keys.end(), {"radius", "color"});
+    } else {
+      kind_entry.Fail("expected 'model', 'picture', 'box', 'sphere' or 'plane', got " +
+                      kind_entry.Describe());
+    }
+    const std::string what = "a " + kind + " object";
+    e.ExpectMap(keys, what.c_str());
+
+    Object object;
+    const Entry name_entry = e.Get("name");
+    object.name = name_entry.AsNonEmptyString();
+    if (const auto [it, inserted] = names.emplace(object.name, e.path()); !inserted) {
+      name_entry.Fail(fmt::format("duplicate object name '{}' (also {})", object.name, it->second));
+    }
+    if (const auto id = e.Find("id")) {
+      object.id = static_cast<uint32_t>(id->AsInteger(1, kMaxId));
+      *id_entry = id;
+    }
+    Eigen::Vector3d scale = Eigen::Vector3d::Ones();
+    if (const auto s = e.Find("scale")) scale = ReadPositiveSizes(*s, 3, "[sx, sy, sz]");
+
+    if (kind == "model") {
+      std::shared_ptr<const Texture> texture;
+      if (const auto t = e.Find("texture")) texture = ReadTexture(*t, "texture");
+      const Entry file = e.Get("file");
+      const fs::path path = ResolveFile(file, "model file");
+      try {
+        object.model = internal::LoadModelFile(path, texture, cache_);
+      } catch (const Error& error) {
+        file.Fail(fmt::format("cannot load model '{}': {}", file.AsString(), error.what()));
+      }
+      // The unit scale goes to the object, so that one loaded model serves every scale.
+      if (const auto u = e.Find("unit_scale")) scale *= u->AsPositive();
+    } else if (kind == "picture") {
+      const auto texture = ReadTexture(e.Get("image"), "image");
+      const Entry height = e.Get("height");
+      const std::string key = fmt::format("{}\n{}", texture->source, height.AsPositive());
+      auto& model = pictures_[key];
+      if (model == nullptr) model = MakePicture(texture, height.AsPositive());
+      object.model = model;
+    } else {
+      Eigen::Vector4f color = kDefaultPrimitiveColor;
+      if (const auto c = e.Find("color")) color = c->AsColor(true);
+      object.model = Primitive(kind, color);
+      if (kind == "box") {
+        scale = scale.cwiseProduct(ReadPositiveSizes(e.Get("size"), 3, "[x, y, z]"));
+      } else if (kind == "plane") {
+        scale = scale.cwiseProduct(ReadPositiveSizes(e.Get("size"), 2, "[x, y]"));
+      } else {
+        scale *= 2.0 * e.Get("radius").AsPositive();  // the unit sphere has radius 0.5
+      }
+    }
+    // Products of valid scales can still overflow or underflow.
+    if (!(scale.allFinite() && scale.minCoeff() > 0.0)) {
+      e.Fail(
+          "the object's total scale (scale x size x unit_scale) is not a positive finite number");
+    }
+    object.scale = scale;
+
+    const auto pose = e.Find("pose");
+    const geometry::Pose X_WO = pose ? ReadPose(*pose) : geometry::Pose::Identity();
+    if (const auto motion = e.Find("motion")) {
+      object.motion = ReadMotion(*motion, X_WO, pose);
+    } else {
+      object.motion = Motion::Static(X_WO);
+    }
+    return object;
+  }
+
+  Motion ReadMotion(const Entry& e, const geometry::Pose& X_WO, const std::optional<Entry>& pose) {
+    if (!e.IsMap()) e.Fail("expected a motion (a map with type, ...), got " + e.Describe());
+    const Entry type_entry = e.Get("type");
+    const std::string type = type_entry.AsString();
+    if (type == "waypoints") {
+      e.ExpectMap({"type", "waypoints", "loop"}, "a waypoint motion");
+      if (pose) {
+        pose->Fail(
+            "give either 'pose' or a waypoint motion, not both (the waypoints place the object)");
+      }
+      const Entry list = e.Get("waypoints");
+      std::vector<Motion::Waypoint> waypoints;
+      for (const Entry& item : list.AsSequence("waypoints {time, position, rpy_deg}")) {
+        item.ExpectMap({"time", "position", "rpy", "rpy_deg"},
+                       "a waypoint {time, position, rpy_deg}");
+        const Entry time = item.Get("time");
+        Motion::Waypoint waypoint;
+        waypoint.time = time.AsNonNegative();
+        if (!waypoints.empty() && !(waypoint.time > waypoints.back().time)) {
+          time.Fail(fmt::format("expected a time after the previous waypoint's ({} s), got {} s",
+                                waypoints.back().time, waypoint.time));
+        }
+        waypoint.pose = PoseFrom(
+            item.Get("position").AsVector3(),
+            FindAngles(item, "rpy", "[roll, pitch, yaw]").value_or(Eigen::Vector3d::Zero()));
+        waypoints.push_back(waypoint);
+      }
+      if (waypoints.empty()) list.Fail("expected at least one waypoint, got an empty list");
+      bool loop = false;
+      if (const auto l = e.Find("loop")) {
+        loop = l->AsBool();
+        if (loop && !(waypoints.back().time > 0.0)) {
+          l->Fail("a loop needs the last waypoint's time (the period) > 0");
+        }
+      }
+      try {
+        return Motion::Waypoints(std::move(waypoints), loop);
+      } catch (const InvalidArgument& error) {
+        e.Fail(error.what());
+      }
+    }
+    if (type == "constant_velocity") {
+      e.ExpectMap({"type", "linear", "angular", "angular_deg"}, "a constant-velocity motion");
+      Eigen::Vector3d v = Eigen::Vector3d::Zero();
+      if (const auto l = e.Find("linear")) v = l->AsVector3("[vx, vy, vz] (m/s)");
+      const Eigen::Vector3d w = FindAngles(e, "angular", "[wx, wy, wz] (about world axes)")
+                                    .value_or(Eigen::Vector3d::Zero());
+      try {
+        return Motion::ConstantVelocity(X_WO, v, w);
+      } catch (const InvalidArgument& error) {
+        e.Fail(error.what());
+      }
+    }
+    type_entry.Fail("expected 'waypoints' or 'constant_velocity', got " + type_entry.Describe());
+  }
+
+  // --- cameras ------------------------------------------------------------------------
+  static void CheckCameraName(const Entry& e, const std::string& name,
+                              std::map<std::string, std::string>& names) {
+    const bool safe = std::all_of(name.begin(), name.end(), [](char c) {
+      return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') ||
+             c == '_' || c == '-' || c == '.';
+    });
+    if (!safe || name == "." || name == "..") {
+      e.Fail(
+          "expected a camera name of letters, digits, '_', '-' and '.' (it names output "
+          "folders), got " +
+          e.Describe());
+    }
+    if (const auto [it, inserted] = names.emplace(name, e.path()); !inserted) {
+      e.Fail(fmt::format("duplicate camera name '{}' (also {})", name, it->second));
+    }
+  }
+
+  // A calibration: a file name, {file, width, height}, or inline intrinsics.
+  geometry::CameraModel ReadCalibration(const Entry& e) {
+    if (e.IsScalar()) return ReadCalibrationFile(e, std::nullopt);
+    if (!e.IsMap()) {
+      e.Fail("expected a calibration file name or a map of intrinsics, got " + e.Describe());
+    }
+    if (const auto file = e.Find("file")) {
+      e.ExpectMap({"file", "width", "height"}, "a calibration {file, width, height}");
+      std::optional<geometry::ImageSize> size;
+      if (e.Has("width") || e.Has("height")) {
+        size = geometry::ImageSize{static_cast<int>(e.Get("width").AsInteger(1, 1'000'000)),
+                                   static_cast<int>(e.Get("height").AsInteger(1, 1'000'000))};
+      }
+      return ReadCalibrationFile(*file, size);
+    }
+    e.ExpectMap({"width", "height", "fx", "fy", "focal_length_mm", "pixel_size_um", "cx", "cy",
+                 "skew", "distortion"},
+                "intrinsics {width, height, fx, fy, cx, cy, skew, distortion}");
+    const int width = static_cast<int>(e.Get("width").AsInteger(1, 1'000'000));
+    const int height = static_cast<int>(e.Get("height").AsInteger(1, 1'000'000));
+    double fx = 0.0, fy = 0.0;
+    if (e.Has("focal_length_mm") || e.Has("pixel_size_um")) {
+      for (const char* key : {"fx", "fy"}) {
+        if (const auto x = e.Find(key)) {
+          x->Fail("give either fx and fy, or focal_length_mm and pixel_size_um, not both");
+        }
+      }
+      fx = fy =
+          e.Get("focal_length_mm").AsPositive() / (e.Get("pixel_size_um").AsPositive() * 1e-3);
+    } else {
+      fx = e.Get("fx").AsPositive();
+      fy = e.Get("fy").AsPositive();
+    }
+    const auto cx = e.Find("cx");
+    const auto cy = e.Find("cy");
+    const auto skew = e.Find("skew");
+    geometry::Distortion distortion;
+    if (const auto d = e.Find("distortion")) {
+      d->ExpectMap({"model", "coefficients"}, "a distortion {model, coefficients}");
+      const Entry model_entry = d->Get("model");
+      const std::string name = model_entry.AsString();
+      geometry::DistortionModel model = geometry::DistortionModel::kNone;
+      if (name == "radtan") {
+        model = geometry::DistortionModel::kRadialTangential;
+      } else if (name == "fisheye") {
+        model = geometry::DistortionModel::kFisheye;
+      } else if (name != "none") {
+        model_entry.Fail("expected 'none', 'radtan' or 'fisheye', got " + model_entry.Describe());
+      }
+      std::vector<double> coefficients;
+      const auto c = d->Find("coefficients");
+      if (c) {
+        for (const Entry& k : c->AsSequence("coefficients")) coefficients.push_back(k.AsDouble());
+      }
+      try {
+        distortion = geometry::Distortion::FromCoefficients(model, coefficients);
+      } catch (const Error& error) {
+        (c ? *c : model_entry).Fail(error.what());
+      }
+    }
+    try {
+      return geometry::CameraModel(
+          geometry::Intrinsics(width, height, fx, fy, cx ? cx->AsDouble() : 0.5 * (width - 1),
+                               cy ? cy->AsDouble() : 0.5 * (height - 1),
+                               skew ? skew->AsDouble() : 0.0),
+          distortion);
+    } catch (const InvalidArgument& error) {
+      e.Fail(error.what());
+    }
+  }
+
+  geometry::CameraModel ReadCalibrationFile(const Entry& e,
+                                            std::optional<geometry::ImageSize> size) const {
+    const fs::path path = ResolveFile(e, "calibration file");
+    try {
+      return geometry::ReadCameraCalibration(path, size).model;
+    } catch (const Error& error) {
+      e.Fail(fmt::format("cannot read calibration '{}': {}", e.AsString(), error.what()));
+    }
+  }
+
+  static geometry::ClipPlanes ReadClip(const Entry& e) {
+    e.ExpectMap({"near", "far"}, "clip planes {near, far}");
+    geometry::ClipPlanes clip{kDefaultNear, kDefaultFar};
+    if (const auto n = e.Find("near")) clip.near = n->AsPositive();
+    if (const auto f = e.Find("far")) clip.far = f->AsPositive();
+    if (!(clip.near < clip.far)) {
+      (e.Find("far") ? *e.Find("far") : *e.Find("near"))
+          .Fail(
+              fmt::format("expected near < far, got near {} m and far {} m", clip.near, clip.far));
+    }
+    return clip;
+  }
+
+  // The optical frame (x right, y down, z forward) at `eye` looking at `target`.
+  static geometry::Pose ReadLookAt(const Entry& e) {
+    e.ExpectMap({"eye", "target", "up"}, "a look_at {eye, target, up}");
+    const Eigen::Vector3d eye = e.Get("eye").AsVector3();
+    const Entry target_entry = e.Get("target");
+    const Eigen::Vector3d target = target_entry.AsVector3();
+    Eigen::Vector3d up = Eigen::Vector3d::UnitZ();
+    const auto up_entry = e.Find("up");
+    if (up_entry) up = up_entry->AsVector3();
+    const Eigen::Vector3d forward = target - eye;
+    if (!(forward.norm() > 0.0) || !forward.allFinite()) {
+      target_entry.Fail("expected a target apart from the eye");
+    }
+    const Eigen::Vector3d z = forward.normalized();
+    if (!(up.norm() > 0.0) || !(z.cross(up.normalized()).norm() > kMinUpSine)) {
+      (up_entry ? *up_entry : e)
+          .Fail("expected an up direction not parallel to the viewing direction (eye to target)");
+    }
+    const Eigen::Vector3d x = z.cross(up).normalized();  // right
+    const Eigen::Vector3d y = z.cross(x);                // down
+    Eigen::Matrix3d R;
+    R << x, y, z;
+    return geometry::MakePose(R, eye);
+  }
+
+  CameraSpec ReadWorldCamera(const Entry& e, std::map<std::string, std::string>& names) {
+    e.ExpectMap({"name", "calibration", "pose", "look_at", "clip"},
+                "a camera {name, calibration, pose | look_at, clip}");
+    const Entry name_entry = e.Get("name");
+    const std::string name = name_entry.AsNonEmptyString();
+    CheckCameraName(name_entry, name, names);
+    const auto pose = e.Find("pose");
+    const auto look_at = e.Find("look_at");
+    if (pose && look_at) look_at->Fail("give either 'pose' or 'look_at', not both");
+    if (!pose && !look_at) e.Fail("missing the camera's placement: give 'pose' or 'look_at'");
+    CameraSpec camera{name, ReadCalibration(e.Get("calibration")), CameraMount::kWorld,
+                      pose ? ReadPose(*pose) : ReadLookAt(*look_at),
+                      geometry::ClipPlanes{kDefaultNear, kDefaultFar}};
+    if (const auto clip = e.Find("clip")) camera.clip = ReadClip(*clip);
+    return camera;
+  }
+
+  // --- robot --------------------------------------------------------------------------
+  Robot ReadRobot(const Entry& e, std::vector<CameraSpec>* cameras,
+                  std::optional<Entry>* id_entry) {
+    e.ExpectMap({"head", "id", "pose", "joints", "joints_deg", "visible", "cameras"},
+                "a robot {head, joints_deg, pose, visible, cameras}");
+    const Entry head_entry = e.Get("head");
+    const fs::path head_path = ResolveFile(head_entry, "head description");
+    std::optional<head::HeadDescription> description;
+    try {
+      description = head::HeadDescription::FromYamlFile(head_path);
+    } catch (const Error& error) {
+      head_entry.Fail(fmt::format("cannot load head description '{}': {}", head_entry.AsString(),
+                                  error.what()));
+    }
+    geometry::Pose X_WB = description->X_WB();
+    if (const auto pose = e.Find("pose")) X_WB = ReadPose(*pose);
+
+    geometry::CameraModel left = description->left_camera();
+    geometry::CameraModel right = description->right_camera();
+    geometry::ClipPlanes clips[2] = {{kDefaultNear, kDefaultFar}, {kDefaultNear, kDefaultFar}};
+    if (const auto c = e.Find("cameras")) {
+      c->ExpectMap({"left", "right"}, "the eye cameras {left, right}");
+      for (int i = 0; i < 2; ++i) {
+        const auto camera = c->Find(i == 0 ? "left" : "right");
+        if (!camera) continue;
+        camera->ExpectMap({"calibration", "clip"}, "an eye camera {calibration, clip}");
+        if (const auto calibration = camera->Find("calibration")) {
+          (i == 0 ? left : right) = ReadCalibration(*calibration);
+        }
+        if (const auto clip = camera->Find("clip")) clips[i] = ReadClip(*clip);
+      }
+    }
+    // The description again, with the scene's pose and calibrations in place of its own.
+    std::optional<head::HeadDescription> placed;
+    try {
+      placed.emplace(description->name(), description->geometry(),
+                     std::array<head::JointLimits, 4>{description->limits(head::Joint::kPan),
+                                                      description->limits(head::Joint::kTilt),
+                                                      description->limits(head::Joint::kLeft),
+                                                      description->limits(head::Joint::kRight)},
+                     X_WB, left, right);
+    } catch (const InvalidArgument& error) {
+      e.Fail(error.what());
+    }
+    Robot robot{*placed, {}, true, {}, 0};
+
+    const auto rad = e.Find("joints");
+    const auto deg = e.Find("joints_deg");
+    if (rad && deg) deg->Fail("give either 'joints' (radians) or 'joints_deg', not both");
+    if (rad || deg) {
+      const Entry& joints = rad ? *rad : *deg;
+      const std::vector<double> q = joints.AsDoubles(4, "[pan, tilt, left, right]");
+      const double k = deg ? kDegToRad : 1.0;
+      robot.initial_joints = {q[0] * k, q[1] * k, q[2] * k, q[3] * k};
+      try {
+        robot.head.CheckLimits(robot.initial_joints);
+      } catch (const InvalidArgument& error) {
+        joints.Fail(error.what());
+      }
+    }
+    if (const auto v = e.Find("visible")) robot.visible = v->AsBool();
+    if (const auto id = e.Find("id")) {
+      robot.id = static_cast<uint32_t>(id->AsInteger(1, kMaxId));
+      *id_entry = id;
+    }
+    robot.parts = internal::BuildRobotBody(robot.head);
+    cameras->push_back(
+        CameraSpec{"left", left, CameraMount::kLeftEye, geometry::Pose::Identity(), clips[0]});
+    cameras->push_back(
+        CameraSpec{"right", right, CameraMount::kRightEye, geometry::Pose::Identity(), clips[1]});
+    return robot;
+  }
+
+  // --- instance ids -------------------------------------------------------------------
+  // Explicit ids first (unique), then the smallest free ids in file order, the robot last.
+  static void AssignIds(std::vector<Object>& objects,
+                        const std::vector<std::optional<Entry>>& id_entries, Robot* robot,
+                        const std::optional<Entry>& robot_id_entry) {
+    std::map<uint32_t, std::string> used;
+    for (std::size_t i = 0; i < objects.size(); ++i) {
+      if (objects[i].id == 0) continue;
+      const std::string owner = fmt::format("objects[{}] '{}'", i, objects[i].name);
+      if (const auto [it, inserted] = used.emplace(objects[i].id, owner); !inserted) {
+        id_entries[i]->Fail(fmt::format("duplicate id {} (also {})", objects[i].id, it->second));
+      }
+    }
+    if (robot != nullptr && robot->id != 0) {
+      if (const auto [it, inserted] = used.emplace(robot->id, "robot"); !inserted) {
+        robot_id_entry->Fail(fmt::format("duplicate id {} (also {})", robot->id, it->second));
+      }
+    }
+    uint32_t next = 1;
+    const auto take = [&used, &next](const std::string& owner) {
+      while (used.count(next) != 0) ++next;
+      used.emplace(next, owner);
+      return next;
+    };
+    for (Object& object : objects) {
+      if (object.id == 0) object.id = take(object.name);
+    }
+    if (robot != nullptr && robot->id == 0) robot->id = take("robot");
+  }
+
+  std::string source_;
+  fs::path base_dir_;
+  internal::AssetCache cache_;
+  std::map<std::string, std::shared_ptr<const Model>> primitives_;
+  std::map<std::string, std::shared_ptr<const Model>> pictures_;
+};
+
+}  // namespace
+
+Scene Scene::Load(const std::filesystem::path& path) {
+  const std::string name = path.string();
+  std::error_code ec;
+  if (!fs::exists(path, ec)) throw FileError(name, 0, "", "scene file not found");
+  if (!fs::is_regular_file(path, ec))
+    throw FileError(name, 0, "", "the scene is not a regular file");
+  std::ifstream stream(path, std::ios::binary);
+  if (!stream) throw FileError(name, 0, "", "cannot open the scene file");
+  std::stringstream text;
+  text << stream.rdbuf();
+  if (stream.bad()) throw FileError(name, 0, "", "cannot read the scene file");
+  fs::path base_dir = path.parent_path();
+  if (base_dir.empty()) base_dir = ".";
+  return FromYamlString(text.str(), name, base_dir);
+}
+
+Scene Scene::FromYamlString(const std::string& text, const std::string& source,
+                            const std::filesystem::path& base_dir) {
+  const YAML::Node root = internal::ParseYaml(text, source);
+  try {
+    return SceneReader(source, base_dir).Read(root);
+  } catch (const FileError&) {
+    throw;
+  } catch (const YAML::Exception& error) {
+    // Every access is checked; never let a YAML exception escape all the same.
+    throw FileError(source, error.mark.is_null() ? 0 : error.mark.line + 1, "", error.msg);
+  }
+}
+
+}  // namespace saccade::scene

@@ -1,0 +1,566 @@
+// Scene files: what a valid file gives, and the message of every kind of bad input (file,
+// line, key path, what was expected).
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+#include <string>
+
+#include "saccade/core/error.h"
+#include "saccade/core/image_io.h"
+#include "saccade/geometry/calibration_io.h"
+#include "saccade/scene/scene.h"
+#include "scene/scene_test_util.h"
+
+namespace saccade::scene {
+namespace {
+
+using testing::ExpectMessageHas;
+using testing::LineOf;
+using testing::LoadError;
+using testing::Replace;
+using testing::TempDir;
+
+constexpr double kDeg = std::numbers::pi / 180.0;
+// Values read from YAML go through at most a multiplication (deg -> rad): a few ulps.
+constexpr double kParseTolerance = 1e-12;
+
+// A tetrahedron: 4 vertices, 4 triangles.
+const char* const kTetrahedron = R"(v 0 0 0
+v 1 0 0
+v 0 1 0
+v 0 0 1
+f 1 3 2
+f 1 2 4
+f 1 4 3
+f 2 3 4
+)";
+
+// A valid scene using every section; tests break one entry at a time. Files live in a
+// temporary folder: photo.png (40 x 20), tetra.obj, and the POPEYE head description.
+const std::string kValid = R"(background: [0.1, 0.2, 0.3]
+lights:
+  - type: ambient
+    intensity: 0.25
+  - type: directional
+    direction: [0, 0, -2]
+    color: [1, 0.9, 0.8]
+  - type: point
+    position: [1, 2, 3]
+    attenuation: 0.5
+ground:
+  size: 8
+  pattern: checker
+  cell: 0.25
+  color: [0.9, 0.9, 0.9]
+  color2: [0.1, 0.1, 0.1]
+objects:
+  - name: photo
+    kind: picture
+    image: photo.png
+    height: 0.5
+    pose:
+      position: [2, 0, 1.2]
+      rpy_deg: [0, 0, 180]
+  - name: tetra
+    kind: model
+    file: tetra.obj
+    unit_scale: 0.1
+    scale: [1, 2, 3]
+    pose:
+      position: [1, 1, 0]
+  - name: crate
+    kind: box
+    size: [0.2, 0.3, 0.4]
+    color: [0.5, 0.4, 0.3, 1.0]
+    pose:
+      position: [1, -1, 0.2]
+      rpy: [0, 0, 0.5]
+  - name: ball
+    kind: sphere
+    radius: 0.1
+    motion:
+      type: waypoints
+      loop: true
+      waypoints:
+        - {time: 0, position: [1, 0, 1]}
+        - {time: 2, position: [1, 1, 1], rpy_deg: [0, 0, 90]}
+  - name: mat
+    kind: plane
+    size: 0.5
+    motion:
+      type: constant_velocity
+      linear: [0.1, 0, 0]
+      angular_deg: [0, 0, 10]
+robot:
+  head: popeye.yaml
+  joints_deg: [10, -5, -3, 3]
+  visible: false
+cameras:
+  - name: rig
+    calibration: {width: 640, height: 480, fx: 500, fy: 510, cx: 320, cy: 240}
+    look_at: {eye: [0, -2, 2], target: [2, 0, 1]}
+    clip: {near: 0.1, far: 20}
+  - name: top
+    calibration:
+      width: 320
+      height: 240
+      focal_length_mm: 4
+      pixel_size_um: 5
+      distortion: {model: radtan, coefficients: [-0.1, 0.01, 0.001, -0.001]}
+    pose:
+      position: [0, 0, 5]
+      rpy_deg: [180, 0, 0]
+)";
+
+class SceneLoaderTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    Image photo(40, 20, PixelFormat::kRgb8);
+    WritePng(photo.view(), dir_.path() / "photo.png");
+    dir_.Write("tetra.obj", kTetrahedron);
+    std::filesystem::copy_file(testing::kPopeye, dir_.path() / "popeye.yaml");
+  }
+
+  Scene Load(const std::string& text) const {
+    return Scene::FromYamlString(text, "test.yaml", dir_.path());
+  }
+  // The error of `text`, expecting "test.yaml:<line of needle>: <key>: ..." and `parts`.
+  void ExpectError(const std::string& text, const std::string& needle, const std::string& key,
+                   std::initializer_list<std::string> parts) const {
+    const FileError error = LoadError(text, dir_.path());
+    EXPECT_EQ(error.file(), "test.yaml") << error.what();
+    EXPECT_EQ(error.line(), LineOf(text, needle)) << error.what();
+    EXPECT_EQ(error.key(), key) << error.what();
+    ExpectMessageHas(error, parts);
+    ExpectMessageHas(error, {"test.yaml:" + std::to_string(LineOf(text, needle)) + ": " + key});
+  }
+
+  TempDir dir_;
+};
+
+TEST_F(SceneLoaderTest, ValidSceneLoadsEverySection) {
+  const Scene scene = Load(kValid);
+  EXPECT_TRUE(scene.background().isApprox(Eigen::Vector3f(0.1f, 0.2f, 0.3f)));
+  ASSERT_EQ(scene.lights().size(), 3u);
+  EXPECT_EQ(scene.lights()[0].type, Light::Type::kAmbient);
+  EXPECT_FLOAT_EQ(scene.lights()[0].intensity, 0.25f);
+  EXPECT_EQ(scene.lights()[1].type, Light::Type::kDirectional);
+  EXPECT_TRUE(scene.lights()[1].direction_W.isApprox(Eigen::Vector3d(0, 0, -1)));  // normalised
+  EXPECT_EQ(scene.lights()[2].type, Light::Type::kPoint);
+  EXPECT_EQ(scene.lights()[2].position_W, Eigen::Vector3d(1, 2, 3));
+  EXPECT_EQ(scene.lights()[2].attenuation, 0.5);
+
+  EXPECT_EQ(scene.ground().pattern, Ground::Pattern::kChecker);
+  EXPECT_EQ(scene.ground().size, 8.0);
+  EXPECT_EQ(scene.ground().cell, 0.25);
+
+  ASSERT_EQ(scene.objects().size(), 5u);
+  const auto& objects = scene.objects();
+  // Ids 1..N in file order, the robot next.
+  for (std::size_t i = 0; i < objects.size(); ++i) EXPECT_EQ(objects[i].id, i + 1);
+  ASSERT_TRUE(scene.robot().has_value());
+  EXPECT_EQ(scene.robot()->id, 6u);
+
+  // The picture: 40 x 20 pixels, 0.5 m high -> 1 m wide; turned to face -x.
+  const Model& photo = *objects[0].model;
+  EXPECT_NEAR(photo.bounds.sizes().y(), 1.0f, 1e-6f);
+  EXPECT_NEAR(photo.bounds.sizes().z(), 0.5f, 1e-6f);
+  const geometry::Pose X_WPhoto = scene.ObjectPose(objects[0], scene.InitialState());
+  EXPECT_TRUE((X_WPhoto.linear() * Eigen::Vector3d::UnitX()).isApprox(-Eigen::Vector3d::UnitX()));
+  EXPECT_TRUE(X_WPhoto.translation().isApprox(Eigen::Vector3d(2, 0, 1.2)));
+
+  // The model: the unit scale times the object's scale.
+  EXPECT_TRUE(objects[1].scale.isApprox(Eigen::Vector3d(0.1, 0.2, 0.3)));
+  EXPECT_EQ(objects[1].model->meshes.size(), 1u);
+  EXPECT_EQ(objects[1].model->meshes[0].indices.size(), 12u);
+
+  // Primitives: the size is the object's scale of the unit primitive.
+  EXPECT_EQ(objects[2].model->source, "box");
+  EXPECT_TRUE(objects[2].scale.isApprox(Eigen::Vector3d(0.2, 0.3, 0.4)));
+  EXPECT_TRUE(
+      objects[2].model->materials[0].base_color.isApprox(Eigen::Vector4f(0.5, 0.4, 0.3, 1)));
+  EXPECT_NEAR(geometry::RpyFromRotation(scene.ObjectPose(objects[2], {}).linear()).z(), 0.5,
+              kParseTolerance);
+  EXPECT_TRUE(objects[3].scale.isApprox(Eigen::Vector3d::Constant(0.2)));  // radius 0.1
+  EXPECT_TRUE(objects[4].scale.isApprox(Eigen::Vector3d(0.5, 0.5, 1.0)));
+
+  // Motions.
+  EXPECT_FALSE(objects[3].motion.IsStatic());
+  SceneState state;
+  state.time = 1.0;
+  EXPECT_TRUE(
+      scene.ObjectPose(objects[3], state).translation().isApprox(Eigen::Vector3d(1, 0.5, 1)));
+  state.time = 2.0;  // the loop's period: back to the start
+  EXPECT_TRUE(scene.ObjectPose(objects[3], state).translation().isApprox(Eigen::Vector3d(1, 0, 1)));
+  state.time = 3.0;
+  EXPECT_TRUE(
+      scene.ObjectPose(objects[4], state).translation().isApprox(Eigen::Vector3d(0.3, 0, 0)));
+  EXPECT_NEAR(geometry::RpyFromRotation(scene.ObjectPose(objects[4], state).linear()).z(),
+              30 * kDeg, kParseTolerance);
+
+  // The robot.
+  EXPECT_FALSE(scene.robot()->visible);
+  EXPECT_NEAR(scene.robot()->initial_joints.pan, 10 * kDeg, kParseTolerance);
+  EXPECT_NEAR(scene.robot()->initial_joints.tilt, -5 * kDeg, kParseTolerance);
+  EXPECT_NEAR(scene.robot()->initial_joints.left, -3 * kDeg, kParseTolerance);
+  EXPECT_NEAR(scene.robot()->initial_joints.right, 3 * kDeg, kParseTolerance);
+  EXPECT_EQ(scene.InitialState().joints, scene.robot()->initial_joints);
+  EXPECT_EQ(scene.InitialState().time, 0.0);
+  EXPECT_FALSE(scene.robot()->parts.empty());
+
+  // Cameras: the eyes first, then the file's, in order.
+  ASSERT_EQ(scene.cameras().size(), 4u);
+  EXPECT_EQ(scene.cameras()[0].name, "left");
+  EXPECT_EQ(scene.cameras()[0].mount, CameraMount::kLeftEye);
+  EXPECT_EQ(scene.cameras()[1].name, "right");
+  EXPECT_EQ(scene.cameras()[1].mount, CameraMount::kRightEye);
+  EXPECT_EQ(scene.cameras()[0].model, scene.robot()->head.left_camera());
+  const CameraSpec* rig = scene.FindCamera("rig");
+  ASSERT_NE(rig, nullptr);
+  EXPECT_EQ(rig->mount, CameraMount::kWorld);
+  EXPECT_EQ(rig->model.intrinsics(), geometry::Intrinsics(640, 480, 500, 510, 320, 240));
+  EXPECT_EQ(rig->clip.near, 0.1);
+  EXPECT_EQ(rig->clip.far, 20.0);
+  const CameraSpec* top = scene.FindCamera("top");
+  ASSERT_NE(top, nullptr);
+  EXPECT_NEAR(top->model.intrinsics().fx(), 800.0, kParseTolerance);  // 4 mm / 5 um
+  EXPECT_EQ(top->model.intrinsics().cx(), 159.5);                     // (320 - 1) / 2
+  EXPECT_EQ(top->model.distortion().model(), geometry::DistortionModel::kRadialTangential);
+  EXPECT_EQ(top->clip.near, 0.05);  // defaults
+  EXPECT_EQ(top->clip.far, 50.0);
+  // Looking straight down: the optical axis is -z.
+  EXPECT_TRUE((top->X_WC.linear() * Eigen::Vector3d::UnitZ()).isApprox(-Eigen::Vector3d::UnitZ()));
+  EXPECT_EQ(scene.FindCamera("nope"), nullptr);
+}
+
+TEST_F(SceneLoaderTest, DefaultsForAnEmptyMap) {
+  const Scene scene = Load("{}");
+  EXPECT_TRUE(scene.objects().empty());
+  EXPECT_TRUE(scene.cameras().empty());
+  EXPECT_FALSE(scene.robot().has_value());
+  EXPECT_EQ(scene.lights().size(), 2u);  // ambient + directional
+  EXPECT_TRUE(scene.ground().enabled);
+  EXPECT_EQ(scene.ground().pattern, Ground::Pattern::kGrid);
+  EXPECT_TRUE(scene.models().empty());
+  EXPECT_TRUE(Load("lights: []").lights().empty());
+}
+
+TEST_F(SceneLoaderTest, ExplicitIdsAreKeptAndTheOthersTakeTheSmallestFreeOnes) {
+  const std::string text = R"(objects:
+  - {name: a, kind: box, size: 1}
+  - {name: b, kind: box, size: 1, id: 1}
+  - {name: c, kind: box, size: 1}
+  - {name: d, kind: box, size: 1, id: 3}
+robot: {head: popeye.yaml}
+)";
+  const Scene scene = Load(text);
+  EXPECT_EQ(scene.objects()[0].id, 2u);
+  EXPECT_EQ(scene.objects()[1].id, 1u);
+  EXPECT_EQ(scene.objects()[2].id, 4u);
+  EXPECT_EQ(scene.objects()[3].id, 3u);
+  EXPECT_EQ(scene.robot()->id, 5u);
+  const Scene with_robot_id =
+      Load(Replace(text, "{head: popeye.yaml}", "{head: popeye.yaml, id: 2}"));
+  EXPECT_EQ(with_robot_id.robot()->id, 2u);
+  EXPECT_EQ(with_robot_id.objects()[0].id, 4u);
+  EXPECT_EQ(with_robot_id.objects()[2].id, 5u);
+}
+
+TEST_F(SceneLoaderTest, PrimitivesOfOneColourShareAModel) {
+  const Scene scene = Load(R"(objects:
+  - {name: a, kind: box, size: 1, color: [1, 0, 0]}
+  - {name: b, kind: box, size: 2, color: [1, 0, 0]}
+  - {name: c, kind: box, size: 1, color: [0, 1, 0]}
+)");
+  EXPECT_EQ(scene.objects()[0].model, scene.objects()[1].model);
+  EXPECT_NE(scene.objects()[0].model, scene.objects()[2].model);
+  EXPECT_EQ(scene.models().size(), 2u);
+}
+
+TEST_F(SceneLoaderTest, LoadResolvesPathsAgainstTheScenesFolder) {
+  const auto path = dir_.Write("sub/../scene.yaml", kValid);
+  const Scene scene = Scene::Load(path);
+  EXPECT_EQ(scene.objects().size(), 5u);
+  // A missing scene file names itself.
+  try {
+    Scene::Load(dir_.path() / "missing.yaml");
+    ADD_FAILURE() << "loaded a missing file";
+  } catch (const FileError& error) {
+    ExpectMessageHas(error, {"missing.yaml", "not found"});
+  }
+  EXPECT_THROW(Scene::Load(dir_.path()), FileError);  // a folder
+}
+
+// --- Bad input: one test per kind, each checking file, line, key and what. ---------------
+
+TEST_F(SceneLoaderTest, SyntaxErrorNamesTheLine) {
+  const std::string text = Replace(kValid, "  size: 8\n", "  size: [8\n");
+  const FileError error = LoadError(text, dir_.path());
+  EXPECT_GT(error.line(), 0);
+  ExpectMessageHas(error, {"test.yaml:", "YAML syntax error"});
+}
+
+TEST_F(SceneLoaderTest, EmptyFileOrNotAMap) {
+  ExpectMessageHas(LoadError("", dir_.path()), {"test.yaml", "expected a scene", "got nothing"});
+  ExpectMessageHas(LoadError("- 1\n- 2\n", dir_.path()), {"expected a scene", "a list of 2"});
+}
+
+TEST_F(SceneLoaderTest, UnknownKeys) {
+  ExpectError(kValid + "objectz: []\n", "objectz", "objectz", {"unknown key 'objectz'", "objects"});
+  ExpectError(Replace(kValid, "    height: 0.5\n", "    height: 0.5\n    heigth: 2\n"), "heigth",
+              "objects[0].heigth", {"unknown key 'heigth'", "height"});
+  // A key of another kind of object.
+  ExpectError(Replace(kValid, "    radius: 0.1\n", "    radius: 0.1\n    size: 2\n"), "    size: 2",
+              "objects[3].size", {"unknown key 'size'", "radius"});
+}
+
+TEST_F(SceneLoaderTest, DuplicateKeys) {
+  ExpectError(Replace(kValid, "  size: 8\n", "  size: 8\n  size: 9\n"), "size: 9", "ground.size",
+              {"duplicate key 'size'"});
+}
+
+TEST_F(SceneLoaderTest, MissingRequiredKeys) {
+  ExpectError(Replace(kValid, "    kind: box\n", ""), "name: crate", "objects[2]",
+              {"missing key 'kind'"});
+  ExpectError(Replace(kValid, "    height: 0.5\n", ""), "name: photo", "objects[0]",
+              {"missing key 'height'"});
+  ExpectError(Replace(kValid, "    direction: [0, 0, -2]\n", ""), "type: directional", "lights[1]",
+              {"missing key 'direction'"});
+  ExpectError(Replace(kValid, "  head: popeye.yaml\n", ""), "joints_deg", "robot",
+              {"missing key 'head'"});
+}
+
+TEST_F(SceneLoaderTest, WrongTypesAndLengths) {
+  ExpectError(Replace(kValid, "position: [1, -1, 0.2]", "position: [1, -1]"), "position: [1, -1]",
+              "objects[2].pose.position", {"expected 3 numbers", "got 2"});
+  ExpectError(Replace(kValid, "position: [1, -1, 0.2]", "position: one"), "position: one",
+              "objects[2].pose.position", {"expected 3 numbers", "got 'one'"});
+  ExpectError(Replace(kValid, "position: [1, -1, 0.2]", "position: [1, x, 0.2]"), "position: [1, x",
+              "objects[2].pose.position[1]", {"expected a number", "'x'"});
+  ExpectError(Replace(kValid, "  visible: false", "  visible: maybe"), "visible: maybe",
+              "robot.visible", {"expected true or false"});
+  ExpectError("objects: {a: 1}\n", "objects", "objects", {"expected a list of objects", "a map"});
+  ExpectError(Replace(kValid, "    kind: box\n", "    kind: cube\n"), "kind: cube",
+              "objects[2].kind",
+              {"expected 'model', 'picture', 'box', 'sphere' or 'plane'", "'cube'"});
+  ExpectError(Replace(kValid, "pattern: checker", "pattern: stripes"), "pattern: stripes",
+              "ground.pattern", {"'plain', 'grid' or 'checker'", "'stripes'"});
+  ExpectError(Replace(kValid, "type: point", "type: spot"), "type: spot", "lights[2].type",
+              {"'ambient', 'directional' or 'point'", "'spot'"});
+}
+
+TEST_F(SceneLoaderTest, NonFiniteNumbers) {
+  ExpectError(Replace(kValid, "position: [1, -1, 0.2]", "position: [1, .nan, 0.2]"),
+              "position: [1, .nan", "objects[2].pose.position[1]", {"expected a finite number"});
+  ExpectError(Replace(kValid, "    height: 0.5", "    height: .inf"), "height: .inf",
+              "objects[0].height", {"expected a finite number"});
+  ExpectError(Replace(kValid, "scale: [1, 2, 3]", "scale: [1, -.inf, 3]"), "scale: [1, -.inf",
+              "objects[1].scale[1]", {"expected a finite number"});
+  ExpectError(Replace(kValid, "attenuation: 0.5", "attenuation: .NaN"), "attenuation: .NaN",
+              "lights[2].attenuation", {"expected a finite number"});
+  ExpectError(Replace(kValid, "{time: 2,", "{time: .inf,"), "{time: .inf",
+              "objects[3].motion.waypoints[1].time", {"expected a finite number"});
+}
+
+TEST_F(SceneLoaderTest, NonPositiveSizes) {
+  ExpectError(Replace(kValid, "scale: [1, 2, 3]", "scale: [1, 0, 3]"), "scale: [1, 0",
+              "objects[1].scale[1]", {"expected a positive number", "got 0"});
+  ExpectError(Replace(kValid, "scale: [1, 2, 3]", "scale: -2"), "scale: -2", "objects[1].scale",
+              {"expected a positive number", "-2"});
+  ExpectError(Replace(kValid, "scale: [1, 2, 3]", "scale: [1, 2]"), "scale: [1, 2]",
+              "objects[1].scale", {"3 positive numbers", "got 2 numbers"});
+  ExpectError(Replace(kValid, "size: [0.2, 0.3, 0.4]", "size: [0.2, 0.0, 0.4]"), "size: [0.2, 0.0",
+              "objects[2].size[1]", {"expected a positive number"});
+  ExpectError(Replace(kValid, "radius: 0.1", "radius: -0.1"), "radius: -0.1", "objects[3].radius",
+              {"expected a positive number", "-0.1"});
+  ExpectError(Replace(kValid, "    height: 0.5", "    height: 0"), "height: 0", "objects[0].height",
+              {"expected a positive number"});
+  ExpectError(Replace(kValid, "unit_scale: 0.1", "unit_scale: 0"), "unit_scale: 0",
+              "objects[1].unit_scale", {"expected a positive number"});
+  ExpectError(Replace(kValid, "  size: 8\n", "  size: -8\n"), "size: -8", "ground.size",
+              {"expected a positive number"});
+  ExpectError(Replace(kValid, "  cell: 0.25\n", "  cell: 0.25\n  line_width: 0.3\n"),
+              "line_width: 0.3", "ground.line_width", {"line_width < cell"});
+  ExpectError(Replace(kValid, "intensity: 0.25", "intensity: -1"), "intensity: -1",
+              "lights[0].intensity", {"expected a number >= 0"});
+  ExpectError(Replace(kValid, "direction: [0, 0, -2]", "direction: [0, 0, 0]"), "direction: [0",
+              "lights[1].direction", {"non-zero direction"});
+}
+
+TEST_F(SceneLoaderTest, ColoursOutsideTheUnitRange) {
+  ExpectError(Replace(kValid, "background: [0.1, 0.2, 0.3]", "background: [0.1, 2, 0.3]"),
+              "background", "background[1]", {"each in [0, 1]", "got 2"});
+  ExpectError(Replace(kValid, "background: [0.1, 0.2, 0.3]", "background: [0.1, 0.2, 0.3, 1]"),
+              "background", "background", {"expected a colour [r, g, b]", "got 4 numbers"});
+  ExpectError(Replace(kValid, "color: [0.5, 0.4, 0.3, 1.0]", "color: [0.5, 0.4]"),
+              "color: [0.5, 0.4]", "objects[2].color", {"[r, g, b] or [r, g, b, a]"});
+}
+
+TEST_F(SceneLoaderTest, DuplicateNamesAndIds) {
+  ExpectError(Replace(kValid, "name: crate", "name: tetra"), "name: tetra\n    kind: box",
+              "objects[2].name", {"duplicate object name 'tetra'", "objects[1]"});
+  const std::string ids = R"(objects:
+  - {name: a, kind: box, size: 1, id: 4}
+  - {name: b, kind: box, size: 1, id: 4}
+)";
+  ExpectError(ids, "{name: b", "objects[1].id", {"duplicate id 4", "objects[0] 'a'"});
+  ExpectError(Replace(ids, "id: 4}\n  - {name: b", "id: 0}\n  - {name: b"), "id: 0",
+              "objects[0].id", {"expected an integer in [1, 16777215]", "'0'"});
+  const std::string robot_id = Replace(ids, "id: 4}\n  - {name: b, kind: box, size: 1, id: 4}",
+                                       "id: 4}\nrobot: {head: popeye.yaml, id: 4}");
+  ExpectError(robot_id, "robot:", "robot.id", {"duplicate id 4", "objects[0] 'a'"});
+  ExpectError(Replace(kValid, "name: top", "name: rig"), "name: rig\n    calibration:\n",
+              "cameras[1].name", {"duplicate camera name 'rig'", "cameras[0]"});
+  ExpectError(Replace(kValid, "name: top", "name: left"), "name: left", "cameras[1].name",
+              {"duplicate camera name 'left'", "the robot's left eye camera"});
+  ExpectError(Replace(kValid, "name: top", "name: ../top"), "name: ../top", "cameras[1].name",
+              {"letters, digits"});
+}
+
+TEST_F(SceneLoaderTest, MissingFilesNameTheKeyAndThePath) {
+  const auto expect_missing = [&](const std::string& from, const std::string& to,
+                                  const std::string& key, const std::string& what) {
+    const std::string text = Replace(kValid, from, to);
+    ExpectError(text, to, key,
+                {what + " not found", "'" + to.substr(to.find(": ") + 2) + "'",
+                 (dir_.path() / "nothere").string()});
+  };
+  expect_missing("image: photo.png", "image: nothere.png", "objects[0].image", "image");
+  expect_missing("file: tetra.obj", "file: nothere.obj", "objects[1].file", "model file");
+  expect_missing("head: popeye.yaml", "head: nothere.yaml", "robot.head", "head description");
+  const std::string calibration =
+      Replace(kValid, "calibration: {width: 640, height: 480, fx: 500, fy: 510, cx: 320, cy: 240}",
+              "calibration: nothere_calib.yaml");
+  ExpectError(calibration, "nothere_calib", "cameras[0].calibration",
+              {"calibration file not found", "nothere_calib.yaml"});
+  // A folder is not a file.
+  std::filesystem::create_directory(dir_.path() / "folder.png");
+  ExpectError(Replace(kValid, "image: photo.png", "image: folder.png"), "image: folder.png",
+              "objects[0].image", {"not a regular file"});
+}
+
+TEST_F(SceneLoaderTest, UnreadableReferencedFilesGiveTheirOwnErrorBehindTheKey) {
+  dir_.Write("bad.png", "not a png");
+  ExpectError(Replace(kValid, "image: photo.png", "image: bad.png"), "image: bad.png",
+              "objects[0].image",
+              {"cannot read image 'bad.png'", "bad.png", "not a readable image"});
+  dir_.Write("bad_head.yaml", "name: x\n");
+  ExpectError(Replace(kValid, "head: popeye.yaml", "head: bad_head.yaml"), "head: bad_head",
+              "robot.head",
+              {"cannot load head description 'bad_head.yaml'", "bad_head.yaml:", "missing key"});
+  dir_.Write("bad_calib.yaml", "%YAML:1.0\nimage_width: 640\n");
+  ExpectError(
+      Replace(kValid, "calibration: {width: 640, height: 480, fx: 500, fy: 510, cx: 320, cy: 240}",
+              "calibration: bad_calib.yaml"),
+      "bad_calib", "cameras[0].calibration",
+      {"cannot read calibration 'bad_calib.yaml'", "bad_calib.yaml"});
+}
+
+TEST_F(SceneLoaderTest, AnglesGivenTwiceOrJointsOutsideTheirLimits) {
+  ExpectError(
+      Replace(kValid, "      rpy: [0, 0, 0.5]", "      rpy: [0, 0, 0.5]\n      rpy_deg: [0, 0, 1]"),
+      "rpy_deg: [0, 0, 1]", "objects[2].pose.rpy_deg", {"either 'rpy'", "not both"});
+  ExpectError(Replace(kValid, "joints_deg: [10, -5, -3, 3]", "joints_deg: [100, -5, -3, 3]"),
+              "joints_deg", "robot.joints_deg", {"joint pan", "outside its limits"});
+  ExpectError(Replace(kValid, "joints_deg: [10, -5, -3, 3]", "joints_deg: [10, -5, -3]"),
+              "joints_deg", "robot.joints_deg", {"expected 4 numbers [pan, tilt, left, right]"});
+}
+
+TEST_F(SceneLoaderTest, BadMotions) {
+  ExpectError(Replace(kValid, "{time: 2,", "{time: 0,"), "{time: 0, position: [1, 1",
+              "objects[3].motion.waypoints[1].time", {"after the previous waypoint's (0 s)"});
+  ExpectError(Replace(kValid, "{time: 0, position: [1, 0, 1]}", "{time: -1, position: [1, 0, 1]}"),
+              "time: -1", "objects[3].motion.waypoints[0].time", {"expected a number >= 0"});
+  ExpectError(
+      Replace(kValid, "    radius: 0.1\n", "    radius: 0.1\n    pose: {position: [0, 0, 0]}\n"),
+      "pose: {position: [0, 0, 0]}", "objects[3].pose", {"either 'pose' or a waypoint motion"});
+  // One waypoint at time 0: a loop of period 0.
+  ExpectError(
+      Replace(kValid, "        - {time: 2, position: [1, 1, 1], rpy_deg: [0, 0, 90]}\n", ""),
+      "loop: true", "objects[3].motion.loop", {"a loop needs the last waypoint's time"});
+  ExpectError(Replace(kValid, "type: waypoints", "type: spline"), "type: spline",
+              "objects[3].motion.type", {"'waypoints' or 'constant_velocity'"});
+  ExpectError(Replace(kValid,
+                      "      waypoints:\n        - {time: 0, position: [1, 0, 1]}\n"
+                      "        - {time: 2, position: [1, 1, 1], rpy_deg: [0, 0, 90]}\n",
+                      "      waypoints: []\n"),
+              "waypoints: []", "objects[3].motion.waypoints", {"at least one waypoint"});
+  ExpectError(Replace(kValid, "linear: [0.1, 0, 0]", "linear: [0.1, 0, 0]\n      loop: true"),
+              "      loop: true\n      angular", "objects[4].motion.loop", {"unknown key 'loop'"});
+}
+
+TEST_F(SceneLoaderTest, BadCameras) {
+  ExpectError(Replace(kValid, "look_at: {eye: [0, -2, 2], target: [2, 0, 1]}",
+                      "look_at: {eye: [0, -2, 2], target: [0, -2, 2]}"),
+              "look_at", "cameras[0].look_at.target", {"apart from the eye"});
+  ExpectError(Replace(kValid, "look_at: {eye: [0, -2, 2], target: [2, 0, 1]}",
+                      "look_at: {eye: [0, 0, 2], target: [0, 0, 0]}"),
+              "look_at", "cameras[0].look_at", {"not parallel"});
+  ExpectError(Replace(kValid, "    look_at: {eye: [0, -2, 2], target: [2, 0, 1]}\n", ""),
+              "- name: rig", "cameras[0]", {"give 'pose' or 'look_at'"});
+  ExpectError(
+      Replace(kValid, "look_at: {eye: [0, -2, 2], target: [2, 0, 1]}",
+              "look_at: {eye: [0, -2, 2], target: [2, 0, 1]}\n    pose: {position: [0, 0, 0]}"),
+      "look_at", "cameras[0].look_at", {"either 'pose' or 'look_at'"});
+  ExpectError(Replace(kValid, "fx: 500", "fx: -500"), "fx: -500", "cameras[0].calibration.fx",
+              {"expected a positive number"});
+  ExpectError(Replace(kValid, "model: radtan", "model: pinhole"), "model: pinhole",
+              "cameras[1].calibration.distortion.model", {"'none', 'radtan' or 'fisheye'"});
+  ExpectError(Replace(kValid, "clip: {near: 0.1, far: 20}", "clip: {near: 2, far: 1}"),
+              "clip:", "cameras[0].clip.far", {"near < far"});
+  ExpectError(
+      Replace(kValid, "calibration: {width: 640, height: 480,", "calibration: {width: 640,"),
+      "calibration: {width: 640,", "cameras[0].calibration", {"missing key 'height'"});
+}
+
+TEST_F(SceneLoaderTest, CalibrationsFromFilesInEveryFormat) {
+  const geometry::CameraModel model(
+      geometry::Intrinsics(800, 600, 700.5, 702.25, 401.5, 299.0),
+      geometry::Distortion::RadialTangential(std::vector<double>{-0.2, 0.05, 0.001, -0.002, 0.01}));
+  const std::pair<const char*, geometry::CalibrationFormat> formats[] = {
+      {"calib.yaml", geometry::CalibrationFormat::kOpenCvYaml},
+      {"calib.xml", geometry::CalibrationFormat::kOpenCvXml},
+      {"ros.yaml", geometry::CalibrationFormat::kRosYaml}};
+  for (const auto& [name, format] : formats) {
+    geometry::WriteCameraCalibration({model, "cam"}, dir_.path() / name, format);
+    const std::string text = Replace(
+        Replace(kValid,
+                "calibration: {width: 640, height: 480, fx: 500, fy: 510, cx: 320, cy: 240}",
+                std::string("calibration: ") + name),
+        "  visible: false\n",
+        std::string("  visible: false\n  cameras:\n    right:\n") +
+            "      calibration: {file: " + name + "}\n" + "      clip: {near: 0.02, far: 10}\n");
+    const Scene scene = Load(text);
+    const CameraSpec* rig = scene.FindCamera("rig");
+    ASSERT_NE(rig, nullptr);
+    EXPECT_EQ(rig->model.intrinsics(), model.intrinsics()) << name;
+    EXPECT_EQ(rig->model.distortion().model(), model.distortion().model()) << name;
+    for (std::size_t k = 0; k < model.distortion().coefficients().size(); ++k) {
+      EXPECT_NEAR(rig->model.distortion().coefficients()[k], model.distortion().coefficients()[k],
+                  kParseTolerance);
+    }
+    // The right eye's calibration is replaced, in the camera and in the head description.
+    const CameraSpec* right = scene.FindCamera("right");
+    ASSERT_NE(right, nullptr);
+    EXPECT_EQ(right->model.intrinsics(), model.intrinsics());
+    EXPECT_EQ(scene.robot()->head.right_camera().intrinsics(), model.intrinsics());
+    EXPECT_EQ(right->clip.near, 0.02);
+    EXPECT_EQ(scene.FindCamera("left")->model, scene.robot()->head.left_camera());
+  }
+}
+
+TEST_F(SceneLoaderTest, RobotPoseReplacesTheDescriptions) {
+  const Scene scene =
+      Load(Replace(kValid, "  visible: false\n",
+                   "  visible: false\n  pose: {position: [1, 2, 0.5], rpy_deg: [0, 0, 90]}\n"));
+  const geometry::Pose& X_WB = scene.robot()->head.X_WB();
+  EXPECT_TRUE(X_WB.translation().isApprox(Eigen::Vector3d(1, 2, 0.5)));
+  EXPECT_TRUE((X_WB.linear() * Eigen::Vector3d::UnitX()).isApprox(Eigen::Vector3d::UnitY()));
+  // Without it, the description's (POPEYE: 1.2 m up).
+  EXPECT_TRUE(Load(kValid).robot()->head.X_WB().translation().isApprox(Eigen::Vector3d(0, 0, 1.2)));
+}
+
+}  // namespace
+}  // namespace saccade::scene
