@@ -36,9 +36,9 @@ GLsizei UploadIndices(const std::vector<uint32_t>& indices) {
   return static_cast<GLsizei>(indices.size());
 }
 
-// Whether the mesh is closed and consistently wound (GpuMesh::closed). Vertices are welded by
-// exact position first, since seams (uv, normals) duplicate them; degenerate triangles, which
-// draw nothing, are ignored.
+// Whether the mesh is closed, consistently wound and outward facing (GpuMesh::closed). Vertices are
+// welded by exact position first, since seams (uv, normals) duplicate them; degenerate triangles,
+// which draw nothing, are ignored.
 bool IsClosed(const scene::Mesh& mesh) {
   std::map<std::array<float, 3>, uint32_t> welded;
   std::vector<uint32_t> id(mesh.positions.size());
@@ -66,7 +66,16 @@ bool IsClosed(const scene::Mesh& mesh) {
     const uint64_t reverse = edge << 32 | edge >> 32;
     if (!std::binary_search(edges.begin(), edges.end(), reverse)) return false;
   }
-  return true;
+  // Wound counter-clockwise seen from outside: positive enclosed volume (divergence theorem).
+  // An inside-out mesh would lose its visible side to culling; it stays two-sided.
+  double volume6 = 0.0;
+  for (std::size_t t = 0; t + 2 < mesh.indices.size(); t += 3) {
+    const Eigen::Vector3d a = mesh.positions[mesh.indices[t]].cast<double>();
+    const Eigen::Vector3d b = mesh.positions[mesh.indices[t + 1]].cast<double>();
+    const Eigen::Vector3d c = mesh.positions[mesh.indices[t + 2]].cast<double>();
+    volume6 += a.dot(b.cross(c));
+  }
+  return volume6 > 0.0;
 }
 
 GpuMesh UploadMesh(const scene::Mesh& mesh) {
