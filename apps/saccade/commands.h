@@ -3,12 +3,11 @@
 // and returns the function that runs it (returning the exit status); main() runs the one the
 // user chose and turns saccade::Error into "saccade: error: ..." with status 1.
 
-#include <functional>
-#include <string>
-
 #include <CLI/CLI.hpp>
 #include <Eigen/Core>
+#include <functional>
 #include <nlohmann/json.hpp>
+#include <string>
 
 #include "saccade/geometry/pose.h"
 #include "saccade/head/head_description.h"

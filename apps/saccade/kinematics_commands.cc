@@ -1,12 +1,12 @@
 // fk, ik, camera, demo: the kinematics and camera-model subcommands.
 
+#include <fmt/format.h>
+
 #include <cmath>
 #include <iostream>
 #include <memory>
 #include <string>
 #include <vector>
-
-#include <fmt/format.h>
 
 #include "commands.h"
 #include "saccade/core/error.h"
@@ -23,18 +23,12 @@ using saccade::geometry::Pose;
 using saccade::head::HeadDescription;
 using saccade::head::JointState;
 
-
-
-
-
 json JointsDegJson(const JointState& q) {
   return {{"pan", q.pan * kRadToDeg},
           {"tilt", q.tilt * kRadToDeg},
           {"left", q.left * kRadToDeg},
           {"right", q.right * kRadToDeg}};
 }
-
-
 
 std::string FormatVector(const Eigen::Vector3d& v) {
   return fmt::format("[{:+.6f}, {:+.6f}, {:+.6f}]", v.x(), v.y(), v.z());
@@ -79,7 +73,6 @@ void PrintFrames(const saccade::head::HeadFrames& frames) {
     fmt::print("  fixation       none (optical axes parallel or diverging)\n");
   }
 }
-
 
 int RunFk(const std::string& head_path, const std::vector<double>& joint_values, bool degrees,
           bool as_json) {
@@ -236,12 +229,15 @@ Runner AddFkCommand(CLI::App& app) {
     bool degrees = false, json = false;
   };
   auto o = std::make_shared<Options>();
-  auto* fk = app.add_subcommand("fk", "Forward kinematics: camera poses and fixation point for "
-                                      "joint angles (seed appendix A, eqs. 4-9).");
-  fk->add_option("--head", o->head, "Head description YAML")->check(CLI::ExistingFile)
+  auto* fk = app.add_subcommand("fk",
+                                "Forward kinematics: camera poses and fixation point for "
+                                "joint angles (seed appendix A, eqs. 4-9).");
+  fk->add_option("--head", o->head, "Head description YAML")
+      ->check(CLI::ExistingFile)
       ->capture_default_str();
   fk->add_option("--joints", o->joints, "PAN TILT LEFT RIGHT (radians, or degrees with --deg)")
-      ->expected(4)->required();
+      ->expected(4)
+      ->required();
   fk->add_flag("--deg", o->degrees, "Joint angles are in degrees");
   fk->add_flag("--json", o->json, "Print JSON (stable interface, see README)");
   return [o] { return RunFk(o->head, o->joints, o->degrees, o->json); };
@@ -255,14 +251,18 @@ Runner AddIkCommand(CLI::App& app) {
     bool json = false;
   };
   auto o = std::make_shared<Options>();
-  auto* ik = app.add_subcommand("ik", "Inverse kinematics: joint angles that fixate a 3D point "
-                                      "with both optical axes (eqs. 10-13, general solver).");
-  ik->add_option("--head", o->head, "Head description YAML")->check(CLI::ExistingFile)
+  auto* ik = app.add_subcommand("ik",
+                                "Inverse kinematics: joint angles that fixate a 3D point "
+                                "with both optical axes (eqs. 10-13, general solver).");
+  ik->add_option("--head", o->head, "Head description YAML")
+      ->check(CLI::ExistingFile)
       ->capture_default_str();
   ik->add_option("--target", o->target, "X Y Z of the point to fixate, in metres, world frame")
-      ->expected(3)->required();
+      ->expected(3)
+      ->required();
   ik->add_option("--mode", o->mode, "symmetric (left = -right) or independent (pan held at 0)")
-      ->check(CLI::IsMember({"symmetric", "independent"}))->capture_default_str();
+      ->check(CLI::IsMember({"symmetric", "independent"}))
+      ->capture_default_str();
   ik->add_flag("--json", o->json, "Print JSON (stable interface, see README)");
   return [o] { return RunIk(o->head, o->target, o->mode, o->json); };
 }
@@ -274,11 +274,14 @@ Runner AddCameraCommand(CLI::App& app) {
     bool json = false;
   };
   auto o = std::make_shared<Options>();
-  auto* camera = app.add_subcommand("camera", "Describe a calibration file: intrinsics, "
-                                              "distortion, field of view, OpenGL projection.");
-  camera->add_option("--calibration", o->calibration,
-                     "OpenCV YAML/XML or ROS camera_info YAML calibration file")
-      ->check(CLI::ExistingFile)->required();
+  auto* camera = app.add_subcommand("camera",
+                                    "Describe a calibration file: intrinsics, "
+                                    "distortion, field of view, OpenGL projection.");
+  camera
+      ->add_option("--calibration", o->calibration,
+                   "OpenCV YAML/XML or ROS camera_info YAML calibration file")
+      ->check(CLI::ExistingFile)
+      ->required();
   camera->add_option("--near", o->near, "Near clip plane of the OpenGL projection (m)")
       ->capture_default_str();
   camera->add_option("--far", o->far, "Far clip plane of the OpenGL projection (m)")
@@ -289,9 +292,11 @@ Runner AddCameraCommand(CLI::App& app) {
 
 Runner AddDemoCommand(CLI::App& app) {
   auto head = std::make_shared<std::string>(ShippedFile("robots/popeye.yaml"));
-  auto* demo = app.add_subcommand("demo", "The main job: the POPEYE head's kinematics and a "
-                                          "fixation solved for a sample target.");
-  demo->add_option("--head", *head, "Head description YAML")->check(CLI::ExistingFile)
+  auto* demo = app.add_subcommand("demo",
+                                  "The main job: the POPEYE head's kinematics and a "
+                                  "fixation solved for a sample target.");
+  demo->add_option("--head", *head, "Head description YAML")
+      ->check(CLI::ExistingFile)
       ->capture_default_str();
   return [head] { return RunDemo(*head); };
 }

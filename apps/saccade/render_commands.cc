@@ -1,5 +1,6 @@
 // render and bench: headless stereo capture to files, and the frames-per-second benchmark.
 
+#include <fmt/format.h>
 #include <unistd.h>
 
 #include <atomic>
@@ -13,8 +14,6 @@
 #include <memory>
 #include <string>
 #include <vector>
-
-#include <fmt/format.h>
 
 #include "commands.h"
 #include "saccade/core/error.h"
@@ -75,8 +74,10 @@ json FrameJson(int64_t index, double time, const std::vector<render::Frame>& fra
                   {"distortion", {{"model", m.distortion_model}, {"coefficients", m.distortion}}},
                   {"X_WC", MatrixJson(m.X_WC.data(), 4, 4)}};
     if (m.has_joints) {
-      entry["joints"] = {
-          {"pan", m.joints[0]}, {"tilt", m.joints[1]}, {"left", m.joints[2]}, {"right", m.joints[3]}};
+      entry["joints"] = {{"pan", m.joints[0]},
+                         {"tilt", m.joints[1]},
+                         {"left", m.joints[2]},
+                         {"right", m.joints[3]}};
     }
     cameras[m.camera] = entry;
   }
@@ -88,7 +89,8 @@ json FrameJson(int64_t index, double time, const std::vector<render::Frame>& fra
 void PrepareOutput(const fs::path& out, const std::vector<std::string>& cameras, bool force) {
   std::error_code error;
   if (fs::exists(out) && !fs::is_directory(out)) {
-    throw InvalidArgument(fmt::format("render: --out {}: exists and is not a folder", out.string()));
+    throw InvalidArgument(
+        fmt::format("render: --out {}: exists and is not a folder", out.string()));
   }
   std::vector<fs::path> existing;
   if (fs::exists(out / "frames.jsonl")) existing.push_back(out / "frames.jsonl");
@@ -98,9 +100,9 @@ void PrepareOutput(const fs::path& out, const std::vector<std::string>& cameras,
   }
   if (fs::exists(out / "stereo.yaml")) existing.push_back(out / "stereo.yaml");
   if (!existing.empty() && !force) {
-    throw InvalidArgument(fmt::format(
-        "render: --out {} already holds output ({}); pass --force to replace it", out.string(),
-        existing.front().filename().string()));
+    throw InvalidArgument(
+        fmt::format("render: --out {} already holds output ({}); pass --force to replace it",
+                    out.string(), existing.front().filename().string()));
   }
   for (const auto& path : existing) {
     if (fs::is_directory(path)) {
@@ -114,16 +116,26 @@ void PrepareOutput(const fs::path& out, const std::vector<std::string>& cameras,
   }
   fs::create_directories(out, error);
   if (error) {
-    throw FileError(out.string(), 0, "", fmt::format("cannot create the folder: {}", error.message()));
+    throw FileError(out.string(), 0, "",
+                    fmt::format("cannot create the folder: {}", error.message()));
   }
   for (const auto& camera : cameras) fs::create_directories(out / camera);
 }
 
 void WriteCalibrations(const scene::Scene& scene, const scene::SceneState& state,
                        const std::vector<std::string>& cameras, const fs::path& out) {
+  // Frames are pinhole images for now (lens distortion is not rendered yet): the files
+  // written describe the images as they are, with the camera's K and no distortion.
   for (const auto& name : cameras) {
     const scene::CameraSpec* camera = scene.FindCamera(name);
-    geometry::WriteCameraCalibration({camera->model, name}, out / (name + ".yaml"),
+    if (!camera->model.distortion().IsIdentity()) {
+      fmt::print(stderr,
+                 "warning: camera {}: {} distortion is not rendered yet; its images and "
+                 "calibration file are pinhole (K only)\n",
+                 name, geometry::ToString(camera->model.distortion().model()));
+    }
+    geometry::WriteCameraCalibration({geometry::CameraModel(camera->model.intrinsics()), name},
+                                     out / (name + ".yaml"),
                                      geometry::CalibrationFormat::kOpenCvYaml);
   }
   // The stereo pair's extrinsics at these joints (cv::stereoCalibrate's R, T).
@@ -131,13 +143,16 @@ void WriteCalibrations(const scene::Scene& scene, const scene::SceneState& state
   const scene::CameraSpec* right = scene.FindCamera("right");
   if (left == nullptr || right == nullptr) return;
   if (left->model.intrinsics().width() != right->model.intrinsics().width() ||
-      left->model.intrinsics().height() != right->model.intrinsics().height() ||
-      left->model.distortion().model() != right->model.distortion().model()) {
-    return;  // OpenCV's stereo files hold one image size and one model
+      left->model.intrinsics().height() != right->model.intrinsics().height()) {
+    return;  // OpenCV's stereo files hold one image size
   }
-  const geometry::Pose X_RL = scene.CameraPose(*right, state).inverse() * scene.CameraPose(*left, state);
-  geometry::StereoCalibration stereo{left->model, right->model, X_RL.linear(), X_RL.translation()};
-  geometry::WriteStereoCalibration(stereo, out / "stereo.yaml", geometry::CalibrationFormat::kOpenCvYaml);
+  const geometry::Pose X_RL =
+      scene.CameraPose(*right, state).inverse() * scene.CameraPose(*left, state);
+  geometry::StereoCalibration stereo{geometry::CameraModel(left->model.intrinsics()),
+                                     geometry::CameraModel(right->model.intrinsics()),
+                                     X_RL.linear(), X_RL.translation()};
+  geometry::WriteStereoCalibration(stereo, out / "stereo.yaml",
+                                   geometry::CalibrationFormat::kOpenCvYaml);
 }
 
 struct RenderOptions {
@@ -149,6 +164,7 @@ struct RenderOptions {
   bool degrees = false;
   bool force = false;
   int msaa = 0;
+  double lod_max_error = 0.25;
   std::vector<std::string> cameras;
 };
 
@@ -168,6 +184,7 @@ int RunRender(const RenderOptions& o) {
   const scene::SceneState initial = StateFor(scene, o.joints, o.degrees);
   render::RendererOptions options;
   options.msaa_samples = o.msaa;
+  options.lod_max_error_px = o.lod_max_error;
   options.cameras = o.cameras;
   auto renderer = render::MakeRenderer(scene, options);
   const std::vector<std::string>& cameras = renderer->camera_names();
@@ -227,6 +244,7 @@ struct BenchOptions {
   int frames = 200;
   int warmup = 10;
   int msaa = 0;
+  double lod_max_error = 0.25;
   bool json = false;
 };
 
@@ -234,6 +252,7 @@ int RunBench(const BenchOptions& o) {
   const scene::Scene scene = scene::Scene::Load(o.scene);
   render::RendererOptions options;
   options.msaa_samples = o.msaa;
+  options.lod_max_error_px = o.lod_max_error;
   auto renderer = render::MakeRenderer(scene, options);
   const scene::SceneState initial = scene.InitialState();
   auto state_at = [&](int i) {
@@ -253,7 +272,8 @@ int RunBench(const BenchOptions& o) {
       pixels += static_cast<int64_t>(frame.color->width()) * frame.color->height();
     }
     if (i % 10 == 9) {
-      const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      const double s =
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
       progress.Update(i + 1, (i + 1) / s);
     }
   }
@@ -275,24 +295,31 @@ int RunBench(const BenchOptions& o) {
                 {"width", first->model.intrinsics().width()},
                 {"height", first->model.intrinsics().height()},
                 {"msaa", o.msaa},
+                {"lod_max_error_px", o.lod_max_error},
                 {"frames", o.frames},
                 {"seconds", seconds},
                 {"frames_per_second", fps},
                 {"megapixels_per_second", pixels / seconds / 1e6},
                 {"ms_per_frame",
-                 {{"total", 1000.0 / fps}, {"scene_update", update}, {"draw", draw}, {"readback", readback}}}};
+                 {{"total", 1000.0 / fps},
+                  {"scene_update", update},
+                  {"draw", draw},
+                  {"readback", readback}}}};
     std::cout << out.dump(2) << "\n";
     return 0;
   }
   fmt::print("scene    {}\ndevice   {}\n", o.scene, renderer->DeviceDescription());
-  fmt::print("cameras  {} x {}x{}, msaa {}\n", cameras.size(), first->model.intrinsics().width(),
-             first->model.intrinsics().height(), o.msaa);
-  fmt::print("{} frames ({} cameras each, pixels in CPU memory) in {:.3f} s: {:.1f} frames/s, "
-             "{:.1f} Mpixel/s\n",
-             o.frames, cameras.size(), seconds, fps, pixels / seconds / 1e6);
-  fmt::print("per frame: {:.2f} ms total; stages (CPU wall time, overlapping with the GPU):\n"
-             "  scene update {:.2f} ms, draw {:.2f} ms, readback {:.2f} ms\n",
-             1000.0 / fps, update, draw, readback);
+  fmt::print("cameras  {} x {}x{}, msaa {}, lod max error {} px\n", cameras.size(),
+             first->model.intrinsics().width(), first->model.intrinsics().height(), o.msaa,
+             o.lod_max_error);
+  fmt::print(
+      "{} frames ({} cameras each, pixels in CPU memory) in {:.3f} s: {:.1f} frames/s, "
+      "{:.1f} Mpixel/s\n",
+      o.frames, cameras.size(), seconds, fps, pixels / seconds / 1e6);
+  fmt::print(
+      "per frame: {:.2f} ms total; stages (CPU wall time, overlapping with the GPU):\n"
+      "  scene update {:.2f} ms, draw {:.2f} ms, readback {:.2f} ms\n",
+      1000.0 / fps, update, draw, readback);
   return 0;
 }
 
@@ -307,20 +334,32 @@ Runner AddRenderCommand(CLI::App& app) {
       "DIR/frames.jsonl with every frame's metadata. Ctrl-C stops after the frame in hand: "
       "only whole frames are left.");
   render->add_option("--scene", o->scene, "Scene YAML (scenes/portraits.yaml, ...)")
-      ->check(CLI::ExistingFile)->required();
+      ->check(CLI::ExistingFile)
+      ->required();
   render->add_option("--out", o->out, "Output folder")->required();
-  render->add_option("--frames", o->frames, "Number of frames")->check(CLI::Range(1, 100000000))
+  render->add_option("--frames", o->frames, "Number of frames")
+      ->check(CLI::Range(1, 100000000))
       ->capture_default_str();
   render->add_option("--fps", o->fps, "Simulated frames per second (frame i at time i / fps)")
-      ->check(CLI::PositiveNumber)->capture_default_str();
-  render->add_option("--joints", o->joints,
-                     "PAN TILT LEFT RIGHT of the head (radians, or degrees with --deg); "
-                     "default: the scene's")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  render
+      ->add_option("--joints", o->joints,
+                   "PAN TILT LEFT RIGHT of the head (radians, or degrees with --deg); "
+                   "default: the scene's")
       ->expected(4);
   render->add_flag("--deg", o->degrees, "--joints are in degrees");
   render->add_option("--camera", o->cameras, "Render only this camera (repeatable)");
   render->add_option("--msaa", o->msaa, "Multisample anti-aliasing: 0, 2, 4 or 8")
-      ->check(CLI::IsMember({0, 2, 4, 8}))->capture_default_str();
+      ->check(CLI::IsMember({0, 2, 4, 8}))
+      ->capture_default_str();
+  render
+      ->add_option("--lod-max-error", o->lod_max_error,
+                   "Levels of detail: draw dense meshes (1024+ triangles) simplified as long as "
+                   "their geometric error stays within this many pixels on the image (PX); "
+                   "0: full detail always")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
   render->add_flag("--force", o->force, "Replace output already in --out");
   return [o] { return RunRender(*o); };
 }
@@ -328,16 +367,28 @@ Runner AddRenderCommand(CLI::App& app) {
 Runner AddBenchCommand(CLI::App& app) {
   auto o = std::make_shared<BenchOptions>();
   auto* bench = app.add_subcommand(
-      "bench", "Stereo frames per second: every camera rendered and its pixels in CPU memory, "
-               "with the time per stage.");
-  bench->add_option("--scene", o->scene, "Scene YAML")->check(CLI::ExistingFile)
+      "bench",
+      "Stereo frames per second: every camera rendered and its pixels in CPU memory, "
+      "with the time per stage.");
+  bench->add_option("--scene", o->scene, "Scene YAML")
+      ->check(CLI::ExistingFile)
       ->capture_default_str();
-  bench->add_option("--frames", o->frames, "Frames to time")->check(CLI::Range(1, 1000000))
+  bench->add_option("--frames", o->frames, "Frames to time")
+      ->check(CLI::Range(1, 1000000))
       ->capture_default_str();
   bench->add_option("--warmup", o->warmup, "Frames rendered before timing")
-      ->check(CLI::Range(0, 100000))->capture_default_str();
+      ->check(CLI::Range(0, 100000))
+      ->capture_default_str();
   bench->add_option("--msaa", o->msaa, "Multisample anti-aliasing: 0, 2, 4 or 8")
-      ->check(CLI::IsMember({0, 2, 4, 8}))->capture_default_str();
+      ->check(CLI::IsMember({0, 2, 4, 8}))
+      ->capture_default_str();
+  bench
+      ->add_option("--lod-max-error", o->lod_max_error,
+                   "Levels of detail: draw dense meshes (1024+ triangles) simplified as long as "
+                   "their geometric error stays within this many pixels on the image (PX); "
+                   "0: full detail always")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
   bench->add_flag("--json", o->json, "Print JSON");
   return [o] { return RunBench(*o); };
 }

@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <cmath>
 #include <set>
 
 #include "render/gl/internal_gl_renderer.h"
@@ -13,6 +14,10 @@ bool RendererOptions::IsValid(std::string* error) const {
   std::string message;
   if (msaa_samples != 0 && msaa_samples != 2 && msaa_samples != 4 && msaa_samples != 8) {
     message = fmt::format("msaa_samples must be 0 (off), 2, 4 or 8, got {}", msaa_samples);
+  } else if (!std::isfinite(lod_max_error_px) || lod_max_error_px < 0.0) {
+    message =
+        fmt::format("lod_max_error_px must be finite and >= 0 (0: full detail always), got {}",
+                    lod_max_error_px);
   } else {
     std::set<std::string> seen;
     for (const std::string& name : cameras) {

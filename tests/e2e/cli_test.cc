@@ -17,29 +17,15 @@
 #include <opencv2/core.hpp>
 #include <string>
 
+#include "e2e/run_saccade.h"
+
 namespace {
 
 using nlohmann::json;
 using ::testing::HasSubstr;
 
-struct CommandRun {
-  int status = -1;
-  std::string output;  // stdout and stderr together
-};
-
-CommandRun Saccade(const std::string& args) {
-  const std::string command = std::string(SACCADE_BINARY) + " " + args + " 2>&1";
-  CommandRun run;
-  FILE* pipe = popen(command.c_str(), "r");
-  if (pipe == nullptr) return run;
-  std::array<char, 4096> buffer{};
-  size_t n = 0;
-  while ((n = fread(buffer.data(), 1, buffer.size(), pipe)) > 0)
-    run.output.append(buffer.data(), n);
-  const int raw = pclose(pipe);
-  run.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
-  return run;
-}
+using saccade::e2e::CommandRun;
+using saccade::e2e::Saccade;
 
 const std::string kHead = std::string(SACCADE_SOURCE_DIR) + "/robots/popeye.yaml";
 

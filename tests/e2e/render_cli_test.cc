@@ -1,8 +1,10 @@
 // `saccade render` used as a person would: files on disk, in real formats, read back by OpenCV.
 
+#include <fcntl.h>
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
 #include <signal.h>
 #include <sys/wait.h>
-#include <fcntl.h>
 #include <unistd.h>
 
 #include <array>
@@ -10,15 +12,14 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <nlohmann/json.hpp>
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
 #include <set>
 #include <string>
 #include <thread>
 
-#include <gmock/gmock.h>
-#include <gtest/gtest.h>
-#include <nlohmann/json.hpp>
-#include <opencv2/core.hpp>
-#include <opencv2/imgcodecs.hpp>
+#include "e2e/run_saccade.h"
 
 namespace {
 
@@ -26,23 +27,8 @@ namespace fs = std::filesystem;
 using nlohmann::json;
 using ::testing::HasSubstr;
 
-struct CommandRun {
-  int status = -1;
-  std::string output;
-};
-
-CommandRun Saccade(const std::string& args) {
-  const std::string command = std::string(SACCADE_BINARY) + " " + args + " 2>&1";
-  CommandRun run;
-  FILE* pipe = popen(command.c_str(), "r");
-  if (pipe == nullptr) return run;
-  std::array<char, 4096> buffer{};
-  size_t n = 0;
-  while ((n = fread(buffer.data(), 1, buffer.size(), pipe)) > 0) run.output.append(buffer.data(), n);
-  const int raw = pclose(pipe);
-  run.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
-  return run;
-}
+using saccade::e2e::CommandRun;
+using saccade::e2e::Saccade;
 
 const std::string kScene = std::string(SACCADE_SOURCE_DIR) + "/scenes/portraits.yaml";
 
@@ -67,8 +53,8 @@ class RenderCli : public ::testing::Test {
 
 TEST_F(RenderCli, WritesFramesCalibrationsAndMetadata) {
   const fs::path out = dir_ / "out";
-  const CommandRun run = Saccade("render --scene " + kScene + " --frames 3 --fps 10 --out " +
-                                 out.string());
+  const CommandRun run =
+      Saccade("render --scene " + kScene + " --frames 3 --fps 10 --out " + out.string());
   ASSERT_EQ(run.status, 0) << run.output;
   const std::vector<json> index = Index(out);
   ASSERT_EQ(index.size(), 3u);
@@ -78,8 +64,8 @@ TEST_F(RenderCli, WritesFramesCalibrationsAndMetadata) {
     for (const char* camera : {"left", "right"}) {
       const json& c = index[i]["cameras"][camera];
       ASSERT_FALSE(c.is_null()) << camera;
-      const cv::Mat image = cv::imread((out / c["file"].get<std::string>()).string(),
-                                       cv::IMREAD_UNCHANGED);
+      const cv::Mat image =
+          cv::imread((out / c["file"].get<std::string>()).string(), cv::IMREAD_UNCHANGED);
       ASSERT_FALSE(image.empty()) << c["file"];
       EXPECT_EQ(image.cols, c["width"].get<int>());
       EXPECT_EQ(image.rows, c["height"].get<int>());
@@ -112,7 +98,8 @@ TEST_F(RenderCli, RefusesToOverwriteWithoutForce) {
   const fs::path out = dir_ / "out";
   ASSERT_EQ(Saccade("render --scene " + kScene + " --frames 1 --out " + out.string()).status, 0);
   const auto before = fs::last_write_time(out / "left" / "000000.png");
-  const CommandRun again = Saccade("render --scene " + kScene + " --frames 1 --out " + out.string());
+  const CommandRun again =
+      Saccade("render --scene " + kScene + " --frames 1 --out " + out.string());
   EXPECT_EQ(again.status, 1);
   EXPECT_THAT(again.output, HasSubstr("--force"));
   EXPECT_EQ(fs::last_write_time(out / "left" / "000000.png"), before);
@@ -130,8 +117,8 @@ TEST_F(RenderCli, InterruptedRunLeavesOnlyWholeFrames) {
     const int devnull = open("/dev/null", O_WRONLY);
     dup2(devnull, STDOUT_FILENO);
     dup2(devnull, STDERR_FILENO);
-    execl(SACCADE_BINARY, SACCADE_BINARY, "render", "--scene", kScene.c_str(), "--frames",
-          "100000", "--out", out.c_str(), static_cast<char*>(nullptr));
+    execl(SACCADE_BINARY, SACCADE_BINARY, "render", "--scene", kScene.c_str(), "--frames", "100000",
+          "--out", out.c_str(), static_cast<char*>(nullptr));
     _exit(127);
   }
   // Wait until a few frames are out, then interrupt as Ctrl-C would.
@@ -165,7 +152,8 @@ TEST_F(RenderCli, InterruptedRunLeavesOnlyWholeFrames) {
 TEST_F(RenderCli, BadSceneAndJointsGiveClearErrors) {
   const fs::path bad = dir_ / "bad.yaml";
   std::ofstream(bad) << "objects:\n  - name: box\n    kind: box\n    size: [1, 1]\n";
-  const CommandRun run = Saccade("render --scene " + bad.string() + " --out " + (dir_ / "o").string());
+  const CommandRun run =
+      Saccade("render --scene " + bad.string() + " --out " + (dir_ / "o").string());
   EXPECT_EQ(run.status, 1);
   EXPECT_THAT(run.output, HasSubstr("bad.yaml:"));
   EXPECT_FALSE(fs::exists(dir_ / "o" / "frames.jsonl"));

@@ -26,6 +26,13 @@ struct RendererOptions {
   bool draw_robot = true;
   /// Cameras to render, by name; empty: all of the scene's cameras, in scene order.
   std::vector<std::string> cameras;
+  /// Levels of detail: dense meshes (1024 triangles or more) are drawn, per object and camera,
+  /// at the coarsest precomputed simplification whose geometric error, projected to the image
+  /// at the object's nearest point, is at most this many pixels. 0: full detail always. Finite,
+  /// >= 0. The simplification keeps positions, not normals, so shading drifts faster than
+  /// silhouettes: the default, a quarter pixel, keeps the bench scene's images within
+  /// tests/render/lod_test.cc's tolerances and draws it about 2.5 times as fast on llvmpipe.
+  double lod_max_error_px = 0.25;
   bool IsValid(std::string* error) const;
 };
 

@@ -21,6 +21,7 @@
 #include "render/gl/internal_egl_context.h"
 #include "render/gl/internal_gl_util.h"
 #include "render/gl/internal_gpu_resources.h"
+#include "render/gl/internal_lod.h"
 #include "render/gl/internal_shaders.h"
 #include "saccade/core/error.h"
 #include "saccade/geometry/gl_projection.h"
@@ -507,9 +508,11 @@ void GlRenderer::DrawCamera(int camera, const geometry::Pose& X_WC) {
     bool matrices_set = false;
     for (const GpuMesh& mesh : item.model->meshes) {
       const GpuMaterial& material = item.model->materials[mesh.material];
+      const GpuLod& lod =
+          mesh.levels[ChooseLod(mesh.errors, px_per_model_unit, options_.lod_max_error_px)];
       const bool shiny = material.specular > 0.0f;
       const bool per_vertex = (mesh.flat && !shiny && point_lights_.empty()) ||
-                              mesh.mean_edge * px_per_model_unit <= kPerVertexMaxEdgePx;
+                              lod.mean_edge * px_per_model_unit <= kPerVertexMaxEdgePx;
       const int variant = (material.texture != 0 ? kTextured : 0) | (shiny ? kShiny : 0) |
                           (per_vertex ? kPerVertex | (mesh.closed ? 0 : kTwoSided) : 0);
       MeshProgram& wanted = GetMeshProgram(variant);
@@ -544,7 +547,8 @@ void GlRenderer::DrawCamera(int camera, const geometry::Pose& X_WC) {
         culling ? glEnable(GL_CULL_FACE) : glDisable(GL_CULL_FACE);
       }
       glBindVertexArray(mesh.vao);
-      glDrawElements(GL_TRIANGLES, mesh.index_count, mesh.index_type, nullptr);
+      glDrawElements(GL_TRIANGLES, lod.index_count, mesh.index_type,
+                     reinterpret_cast<const void*>(lod.offset_bytes));
     }
   }
   if (culling) glDisable(GL_CULL_FACE);
@@ -649,8 +653,10 @@ std::vector<Frame> GlRenderer::Retrieve() {
     for (int r = 0; r < 3; ++r) {
       for (int c = 0; c < 3; ++c) meta.K[3 * r + c] = K(r, c);
     }
-    meta.distortion_model = geometry::ToString(camera.model.distortion().model());
-    meta.distortion = camera.model.distortion().coefficients();
+    // The metadata describes the image as rendered: lens distortion is not applied yet (the
+    // lens-effects issue), so every frame is a pinhole image and says so.
+    meta.distortion_model = geometry::ToString(geometry::DistortionModel::kNone);
+    meta.distortion.clear();
     const Eigen::Matrix4d X_WC = pending.X_WC[i].matrix();
     for (int r = 0; r < 4; ++r) {
       for (int c = 0; c < 4; ++c) meta.X_WC[4 * r + c] = X_WC(r, c);

@@ -9,6 +9,7 @@
 #include <limits>
 
 #include "render/gl/internal_gl_util.h"
+#include "render/gl/internal_lod.h"
 #include "saccade/core/error.h"
 
 namespace saccade::render::gl {
@@ -23,7 +24,7 @@ struct Vertex {
 static_assert(sizeof(Vertex) == 32);
 
 template <typename Index>
-GLsizei UploadIndices(const std::vector<uint32_t>& indices) {
+void UploadIndices(const std::vector<uint32_t>& indices) {
   if constexpr (sizeof(Index) == sizeof(uint32_t)) {
     glBufferData(GL_ELEMENT_ARRAY_BUFFER,
                  static_cast<GLsizeiptr>(indices.size() * sizeof(uint32_t)), indices.data(),
@@ -33,7 +34,6 @@ GLsizei UploadIndices(const std::vector<uint32_t>& indices) {
     glBufferData(GL_ELEMENT_ARRAY_BUFFER, static_cast<GLsizeiptr>(narrow.size() * sizeof(Index)),
                  narrow.data(), GL_STATIC_DRAW);
   }
-  return static_cast<GLsizei>(indices.size());
 }
 
 // Whether the mesh is closed, consistently wound and outward facing (GpuMesh::closed). Vertices are
@@ -83,21 +83,33 @@ GpuMesh UploadMesh(const scene::Mesh& mesh) {
   gpu.material = mesh.material;
   gpu.closed = IsClosed(mesh);
   gpu.flat = !mesh.normals.empty();
-  double edge_sum = 0.0;
-  for (std::size_t t = 0; t + 2 < mesh.indices.size(); t += 3) {
+  for (std::size_t t = 0; gpu.flat && t + 2 < mesh.indices.size(); t += 3) {
     for (int k = 0; k < 3; ++k) {
       const uint32_t a = mesh.indices[t + k], b = mesh.indices[t + (k + 1) % 3];
-      edge_sum += (mesh.positions[a] - mesh.positions[b]).norm();
-      if (gpu.flat && mesh.normals[a] != mesh.normals[b]) gpu.flat = false;
+      if (mesh.normals[a] != mesh.normals[b]) gpu.flat = false;
     }
   }
-  gpu.mean_edge = static_cast<float>(edge_sum / std::max<std::size_t>(mesh.indices.size(), 1));
-  std::vector<Vertex> vertices(mesh.positions.size());
+  const MeshLods lods = BuildMeshLods(mesh);
+  std::vector<uint32_t> indices;  // every level, one after the other
+  for (const LodLevel& level : lods.levels) {
+    GpuLod lod;
+    lod.index_count = static_cast<GLsizei>(level.indices.size());
+    lod.offset_bytes = indices.size();  // in indices until the index type is known
+    lod.error = level.error;
+    lod.mean_edge = level.mean_edge;
+    gpu.levels.push_back(lod);
+    gpu.errors.push_back(level.error);
+    indices.insert(indices.end(), level.indices.begin(), level.indices.end());
+  }
+  std::vector<Vertex> vertices(lods.vertex_order.size());
   for (std::size_t i = 0; i < vertices.size(); ++i) {
+    const uint32_t source = lods.vertex_order[i];
     Vertex& v = vertices[i];
-    const Eigen::Vector3f& p = mesh.positions[i];
-    const Eigen::Vector3f n = i < mesh.normals.size() ? mesh.normals[i] : Eigen::Vector3f::UnitZ();
-    const Eigen::Vector2f uv = i < mesh.uvs.size() ? mesh.uvs[i] : Eigen::Vector2f::Zero();
+    const Eigen::Vector3f& p = mesh.positions[source];
+    const Eigen::Vector3f n =
+        source < mesh.normals.size() ? mesh.normals[source] : Eigen::Vector3f::UnitZ();
+    const Eigen::Vector2f uv =
+        source < mesh.uvs.size() ? mesh.uvs[source] : Eigen::Vector2f::Zero();
     v = Vertex{{p.x(), p.y(), p.z()}, {n.x(), n.y(), n.z()}, {uv.x(), uv.y()}};
   }
   glGenVertexArrays(1, &gpu.vao);
@@ -120,11 +132,13 @@ GpuMesh UploadMesh(const scene::Mesh& mesh) {
   // 16-bit indices halve the index traffic of meshes with at most 65536 vertices.
   if (vertices.size() <= std::numeric_limits<uint16_t>::max() + std::size_t{1}) {
     gpu.index_type = GL_UNSIGNED_SHORT;
-    gpu.index_count = UploadIndices<uint16_t>(mesh.indices);
+    UploadIndices<uint16_t>(indices);
   } else {
     gpu.index_type = GL_UNSIGNED_INT;
-    gpu.index_count = UploadIndices<uint32_t>(mesh.indices);
+    UploadIndices<uint32_t>(indices);
   }
+  const std::size_t index_size = gpu.index_type == GL_UNSIGNED_SHORT ? 2 : 4;
+  for (GpuLod& lod : gpu.levels) lod.offset_bytes *= index_size;
   glBindVertexArray(0);
   glBindBuffer(GL_ARRAY_BUFFER, 0);
   return gpu;

@@ -1,12 +1,14 @@
 #pragma once
 // Models and textures on the GPU, uploaded once each (DESIGN.md: a model file is loaded once
 // and drawn as many times as it appears): one VAO + vertex buffer + index buffer per mesh,
-// one mipmapped texture per scene::Texture however many materials use it.
+// one mipmapped texture per scene::Texture however many materials use it. Meshes are reordered
+// for the vertex cache and dense ones get levels of detail (internal_lod.h).
 
 #include <epoxy/gl.h>
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <cstddef>
 #include <map>
 #include <memory>
 #include <vector>
@@ -15,12 +17,26 @@
 
 namespace saccade::render::gl {
 
-/// One uploaded mesh: interleaved position, normal, uv (32 bytes a vertex) and indices.
+/// One level of detail of a GpuMesh (internal_lod.h): a range of its index buffer.
+struct GpuLod {
+  GLsizei index_count = 0;
+  std::size_t offset_bytes = 0;  ///< into the index buffer
+  /// Geometric error in the model frame (metres): 0 for the full mesh, never decreasing.
+  float error = 0.0f;
+  /// Mean edge length in the model frame (metres), to tell how large triangles are on screen.
+  float mean_edge = 0.0f;
+};
+
+/// One uploaded mesh: interleaved position, normal, uv (32 bytes a vertex), reordered for the
+/// vertex cache, and the indices of its levels of detail one after the other.
 struct GpuMesh {
   GLuint vao = 0;
   GLuint vertex_buffer = 0;
   GLuint index_buffer = 0;
-  GLsizei index_count = 0;
+  /// levels[0] is the full mesh; coarser levels follow (none for small meshes).
+  std::vector<GpuLod> levels;
+  /// levels[i].error, for ChooseLod.
+  std::vector<float> errors;
   GLenum index_type = GL_UNSIGNED_INT;  ///< GL_UNSIGNED_SHORT when the mesh allows it
   int material = 0;
   /// Closed and consistently wound (every edge shared by exactly two triangles that run it in
@@ -29,8 +45,6 @@ struct GpuMesh {
   bool closed = false;
   /// Every triangle has one normal at its three vertices (a faceted mesh: boxes, planes).
   bool flat = false;
-  /// Mean edge length in the model frame (metres), to tell how large triangles are on screen.
-  float mean_edge = 0.0f;
 };
 
 struct GpuMaterial {
