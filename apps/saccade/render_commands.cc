@@ -163,8 +163,7 @@ struct RenderOptions {
   std::vector<double> joints;
   bool degrees = false;
   bool force = false;
-  int msaa = 0;
-  double lod_max_error = 0.25;
+  render::RendererOptions renderer;  ///< --msaa, --lod-max-error
   std::vector<std::string> cameras;
 };
 
@@ -182,9 +181,7 @@ scene::SceneState StateFor(const scene::Scene& scene, const std::vector<double>&
 int RunRender(const RenderOptions& o) {
   const scene::Scene scene = scene::Scene::Load(o.scene);
   const scene::SceneState initial = StateFor(scene, o.joints, o.degrees);
-  render::RendererOptions options;
-  options.msaa_samples = o.msaa;
-  options.lod_max_error_px = o.lod_max_error;
+  render::RendererOptions options = o.renderer;
   options.cameras = o.cameras;
   auto renderer = render::MakeRenderer(scene, options);
   const std::vector<std::string>& cameras = renderer->camera_names();
@@ -243,17 +240,13 @@ struct BenchOptions {
   std::string scene = ShippedFile("scenes/bench.yaml");
   int frames = 200;
   int warmup = 10;
-  int msaa = 0;
-  double lod_max_error = 0.25;
+  render::RendererOptions renderer;  ///< --msaa, --lod-max-error
   bool json = false;
 };
 
 int RunBench(const BenchOptions& o) {
   const scene::Scene scene = scene::Scene::Load(o.scene);
-  render::RendererOptions options;
-  options.msaa_samples = o.msaa;
-  options.lod_max_error_px = o.lod_max_error;
-  auto renderer = render::MakeRenderer(scene, options);
+  auto renderer = render::MakeRenderer(scene, o.renderer);
   const scene::SceneState initial = scene.InitialState();
   auto state_at = [&](int i) {
     scene::SceneState state = initial;
@@ -294,8 +287,8 @@ int RunBench(const BenchOptions& o) {
                 {"cameras", cameras},
                 {"width", first->model.intrinsics().width()},
                 {"height", first->model.intrinsics().height()},
-                {"msaa", o.msaa},
-                {"lod_max_error_px", o.lod_max_error},
+                {"msaa", o.renderer.msaa_samples},
+                {"lod_max_error_px", o.renderer.lod_max_error_px},
                 {"frames", o.frames},
                 {"seconds", seconds},
                 {"frames_per_second", fps},
@@ -310,8 +303,8 @@ int RunBench(const BenchOptions& o) {
   }
   fmt::print("scene    {}\ndevice   {}\n", o.scene, renderer->DeviceDescription());
   fmt::print("cameras  {} x {}x{}, msaa {}, lod max error {} px\n", cameras.size(),
-             first->model.intrinsics().width(), first->model.intrinsics().height(), o.msaa,
-             o.lod_max_error);
+             first->model.intrinsics().width(), first->model.intrinsics().height(),
+             o.renderer.msaa_samples, o.renderer.lod_max_error_px);
   fmt::print(
       "{} frames ({} cameras each, pixels in CPU memory) in {:.3f} s: {:.1f} frames/s, "
       "{:.1f} Mpixel/s\n",
@@ -321,6 +314,20 @@ int RunBench(const BenchOptions& o) {
       "  scene update {:.2f} ms, draw {:.2f} ms, readback {:.2f} ms\n",
       1000.0 / fps, update, draw, readback);
   return 0;
+}
+
+/// --msaa and --lod-max-error, shared by render and bench, straight into the renderer's options.
+void AddRendererOptions(CLI::App* command, render::RendererOptions* options) {
+  command->add_option("--msaa", options->msaa_samples, "Multisample anti-aliasing: 0, 2, 4 or 8")
+      ->check(CLI::IsMember({0, 2, 4, 8}))
+      ->capture_default_str();
+  command
+      ->add_option("--lod-max-error", options->lod_max_error_px,
+                   "Levels of detail: draw dense meshes (1024+ triangles) simplified as long as "
+                   "their geometric error stays within this many pixels on the image (PX); "
+                   "0: full detail always")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
 }
 
 }  // namespace
@@ -350,16 +357,7 @@ Runner AddRenderCommand(CLI::App& app) {
       ->expected(4);
   render->add_flag("--deg", o->degrees, "--joints are in degrees");
   render->add_option("--camera", o->cameras, "Render only this camera (repeatable)");
-  render->add_option("--msaa", o->msaa, "Multisample anti-aliasing: 0, 2, 4 or 8")
-      ->check(CLI::IsMember({0, 2, 4, 8}))
-      ->capture_default_str();
-  render
-      ->add_option("--lod-max-error", o->lod_max_error,
-                   "Levels of detail: draw dense meshes (1024+ triangles) simplified as long as "
-                   "their geometric error stays within this many pixels on the image (PX); "
-                   "0: full detail always")
-      ->check(CLI::NonNegativeNumber)
-      ->capture_default_str();
+  AddRendererOptions(render, &o->renderer);
   render->add_flag("--force", o->force, "Replace output already in --out");
   return [o] { return RunRender(*o); };
 }
@@ -379,16 +377,7 @@ Runner AddBenchCommand(CLI::App& app) {
   bench->add_option("--warmup", o->warmup, "Frames rendered before timing")
       ->check(CLI::Range(0, 100000))
       ->capture_default_str();
-  bench->add_option("--msaa", o->msaa, "Multisample anti-aliasing: 0, 2, 4 or 8")
-      ->check(CLI::IsMember({0, 2, 4, 8}))
-      ->capture_default_str();
-  bench
-      ->add_option("--lod-max-error", o->lod_max_error,
-                   "Levels of detail: draw dense meshes (1024+ triangles) simplified as long as "
-                   "their geometric error stays within this many pixels on the image (PX); "
-                   "0: full detail always")
-      ->check(CLI::NonNegativeNumber)
-      ->capture_default_str();
+  AddRendererOptions(bench, &o->renderer);
   bench->add_flag("--json", o->json, "Print JSON");
   return [o] { return RunBench(*o); };
 }
