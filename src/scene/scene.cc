@@ -144,6 +144,27 @@ Scene::Scene(Eigen::Vector3f background, std::vector<Light> lights, Ground groun
     if (camera.mount != CameraMount::kWorld && !robot_) {
       Invalid(owner + ": mounted on an eye, but the scene has no robot");
     }
+    try {
+      camera.sensor.Validate();
+    } catch (const InvalidArgument& e) {
+      Invalid(owner + ": " + e.what());
+    }
+  }
+}
+
+void SensorSpec::Validate() const {
+  const auto check = [](const char* field, double value, double max, const char* what) {
+    if (!(std::isfinite(value) && value >= 0.0 && value <= max)) {
+      throw InvalidArgument(
+          fmt::format("SensorSpec: {} must be {} in [0, {}], got {}", field, what, max, value));
+    }
+  };
+  check("exposure", exposure, 1.0, "seconds");
+  check("read_noise_dn", read_noise_dn, 64.0, "a standard deviation in DN");
+  check("gain_dn_per_e", gain_dn_per_e, 64.0, "DN per electron");
+  if (blur_samples < 1 || blur_samples > 64) {
+    throw InvalidArgument(
+        fmt::format("SensorSpec: blur_samples must be in [1, 64], got {}", blur_samples));
   }
 }
 

@@ -558,9 +558,12 @@ class SceneReader {
     const auto look_at = e.Find("look_at");
     if (pose && look_at) look_at->Fail("give either 'pose' or 'look_at', not both");
     if (!pose && !look_at) e.Fail("missing the camera's placement: give 'pose' or 'look_at'");
-    CameraSpec camera{name, ReadCalibration(e.Get("calibration")), CameraMount::kWorld,
+    CameraSpec camera{name,
+                      ReadCalibration(e.Get("calibration")),
+                      CameraMount::kWorld,
                       pose ? ReadPose(*pose) : ReadLookAt(*look_at),
-                      geometry::ClipPlanes{kDefaultNear, kDefaultFar}};
+                      geometry::ClipPlanes{kDefaultNear, kDefaultFar},
+                      SensorSpec{}};
     if (const auto clip = e.Find("clip")) camera.clip = ReadClip(*clip);
     return camera;
   }
@@ -585,6 +588,7 @@ class SceneReader {
     geometry::CameraModel left = description->left_camera();
     geometry::CameraModel right = description->right_camera();
     geometry::ClipPlanes clips[2] = {{kDefaultNear, kDefaultFar}, {kDefaultNear, kDefaultFar}};
+    SensorSpec sensors[2];
     if (const auto c = e.Find("cameras")) {
       c->ExpectMap({"left", "right"}, "the eye cameras {left, right}");
       for (int i = 0; i < 2; ++i) {
@@ -631,10 +635,10 @@ class SceneReader {
       *id_entry = id;
     }
     robot.parts = internal::BuildRobotBody(robot.head);
-    cameras->push_back(
-        CameraSpec{"left", left, CameraMount::kLeftEye, geometry::Pose::Identity(), clips[0]});
-    cameras->push_back(
-        CameraSpec{"right", right, CameraMount::kRightEye, geometry::Pose::Identity(), clips[1]});
+    cameras->push_back(CameraSpec{"left", left, CameraMount::kLeftEye, geometry::Pose::Identity(),
+                                  clips[0], sensors[0]});
+    cameras->push_back(CameraSpec{"right", right, CameraMount::kRightEye,
+                                  geometry::Pose::Identity(), clips[1], sensors[1]});
     return robot;
   }
 

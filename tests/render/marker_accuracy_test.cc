@@ -211,8 +211,8 @@ TEST_P(MarkerAccuracyTest, CentroidsMatchOpenCvProjection) {
   const std::vector<Vector2d> expected = OpenCvProject(K, X_WC, points_W);
   for (std::size_t i = 0; i < markers.size(); ++i) markers[i].expected = expected[i];
 
-  scene::CameraSpec camera{"world", geometry::CameraModel(K), scene::CameraMount::kWorld, X_WC,
-                           geometry::ClipPlanes{0.1, 20.0}};
+  scene::CameraSpec camera{"world", geometry::CameraModel(K),        scene::CameraMount::kWorld,
+                           X_WC,    geometry::ClipPlanes{0.1, 20.0}, scene::SensorSpec{}};
   scene::Light ambient;
   ambient.type = scene::Light::Type::kAmbient;
   ambient.intensity = 1.0f;

@@ -48,7 +48,7 @@ scene::CameraSpec WorldCamera(const std::string& name, const geometry::Intrinsic
                               const geometry::Pose& X_WC,
                               const geometry::Distortion& distortion = geometry::Distortion()) {
   return scene::CameraSpec{name, geometry::CameraModel(K, distortion), scene::CameraMount::kWorld,
-                           X_WC, geometry::ClipPlanes{0.05, 50.0}};
+                           X_WC, geometry::ClipPlanes{0.05, 50.0},     scene::SensorSpec{}};
 }
 
 scene::Light Ambient(float intensity) {
@@ -330,9 +330,9 @@ scene::Scene RichScene() {
   const std::vector<double> radtan = {-0.1, 0.01, 0.001, -0.002, 0.0};
   std::vector<scene::CameraSpec> cameras = {
       {"left", head.left_camera(), scene::CameraMount::kLeftEye, geometry::Pose::Identity(),
-       geometry::ClipPlanes{0.05, 50.0}},
+       geometry::ClipPlanes{0.05, 50.0}, scene::SensorSpec{}},
       {"right", head.right_camera(), scene::CameraMount::kRightEye, geometry::Pose::Identity(),
-       geometry::ClipPlanes{0.05, 50.0}},
+       geometry::ClipPlanes{0.05, 50.0}, scene::SensorSpec{}},
       WorldCamera(
           "rig", geometry::Intrinsics(320, 240, 260.0, 255.0, 161.0, 118.0),
           LookPose(Vector3d(-1.0, -1.5, 1.6), Vector3d(0.8, 0.6, 0.0), Vector3d(0.6, -0.8, 0.0)),

@@ -305,8 +305,12 @@ class SceneConstructorTest : public ::testing::Test {
   SceneConstructorTest() : head_(head::HeadDescription::FromYamlFile(testing::kPopeye)) {
     objects_.push_back(Object{"a", 1, MakeBox({1, 0, 0, 1}), {1, 1, 1}, Motion()});
     objects_.push_back(Object{"b", 2, MakeSphere({0, 1, 0, 1}), {1, 1, 1}, Motion()});
-    cameras_.push_back(CameraSpec{
-        "rig", head_.left_camera(), CameraMount::kWorld, geometry::Pose::Identity(), {0.05, 50.0}});
+    cameras_.push_back(CameraSpec{"rig",
+                                  head_.left_camera(),
+                                  CameraMount::kWorld,
+                                  geometry::Pose::Identity(),
+                                  {0.05, 50.0},
+                                  SensorSpec{}});
   }
   Scene Make() const {
     return Scene({0.5f, 0.5f, 0.5f}, lights_, ground_, objects_, cameras_, robot_);

@@ -8,6 +8,7 @@
 // frames come back with row 0 at the top; pixels come back through pixel buffer objects,
 // asynchronously and double buffered.
 
+#include <Eigen/Core>
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -33,13 +34,58 @@ struct RendererOptions {
   /// silhouettes: the default, a quarter pixel, keeps the bench scene's images within
   /// tests/render/lod_test.cc's tolerances and draws it about 2.5 times as fast on llvmpipe.
   double lod_max_error_px = 0.25;
+
+  // Effects (seed section 4.3), each applied where the camera's description asks for it and
+  // switched off here for every camera at once. They run on the GPU in one remap pass after
+  // the scene is drawn (plus the extra scene passes motion blur needs).
+  /// Lens distortion of the cameras' calibrations (geometry/lens_map.h: a wider pinhole view,
+  /// or a cube for lenses beyond 120 degrees, remapped). Off: every camera renders as the
+  /// pinhole of its K, and the frames' metadata says distortion "none".
+  bool distortion = true;
+  /// Sensor noise (SensorSpec: read and shot noise, seeded per camera and frame).
+  bool noise = true;
+  /// Motion blur over the exposure (SensorSpec::exposure, blur_samples).
+  bool motion_blur = true;
+
+  /// Ground truth per frame (Frame::depth, ids, objects), consistent with the distortion:
+  /// drawn at the frame's time (the middle of the exposure), without blur or noise.
+  bool truth_depth = false;
+  bool truth_ids = false;
+  /// Objects' poses and 2D boxes (the boxes come from the id image: asking for them renders
+  /// ids too).
+  bool truth_objects = false;
+
   bool IsValid(std::string* error) const;
 };
 
+/// Ground truth of one object (or of the robot's body) in one frame of one camera.
+struct ObjectTruth {
+  uint32_t id = 0;
+  std::string name;  ///< the object's name, or "robot"
+  /// X_WO at the frame's time (the robot: its base frame B).
+  Eigen::Matrix4d X_WO = Eigen::Matrix4d::Identity();
+  /// X_CO: the object in the camera's optical frame.
+  Eigen::Matrix4d X_CO = Eigen::Matrix4d::Identity();
+  /// Pixels of the id image that show it (0: not visible; the box is then meaningless).
+  int64_t pixels = 0;
+  /// Its visible 2D box in the (distorted) image, inclusive pixel indices: the smallest
+  /// rectangle holding every pixel whose id is this object's.
+  int x_min = 0, y_min = 0, x_max = -1, y_max = -1;
+};
+
 /// One camera's image of one state: kRgb8 pixels, row 0 at the top, with its metadata
-/// (camera, time, frame index, K, distortion, X_WC, joints). Shared, never copied.
+/// (camera, time, frame index, K, distortion, X_WC, joints). Shared, never copied. Ground
+/// truth is present when RendererOptions asked for it, null or empty otherwise.
 struct Frame {
   std::shared_ptr<const Image> color;
+  /// kFloat32, metres: the z of the surface point in the camera's optical frame (not the
+  /// distance along the ray); 0 where the pixel sees no surface (sky, or no ray).
+  std::shared_ptr<const Image> depth;
+  /// kUint32: the instance id of the object each pixel sees (scene::Object::id, the robot's
+  /// id), 0 for the background, the ground and pixels with no ray.
+  std::shared_ptr<const Image> ids;
+  /// Every object and the robot (when drawn), in scene order then the robot.
+  std::vector<ObjectTruth> objects;
 };
 
 /// Cumulative time spent per stage, for `saccade bench` (milliseconds, wall clock).
@@ -47,6 +93,7 @@ struct RenderStats {
   int64_t frames = 0;          ///< states rendered (each with every camera)
   double scene_update_ms = 0;  ///< poses, uniforms
   double draw_ms = 0;          ///< issuing draw calls (and, on llvmpipe, rasterising)
+  double effects_ms = 0;       ///< issuing the remap / noise / truth passes
   double readback_ms = 0;      ///< waiting for and copying pixels out of the PBOs
   double total_ms = 0;
 };

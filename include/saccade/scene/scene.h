@@ -8,15 +8,14 @@
 // in metres in their own frame, after the file's unit scale. Texture coordinates follow
 // OpenGL and Assimp: uv (0, 0) is the bottom-left corner of the texture image.
 
+#include <Eigen/Core>
+#include <Eigen/Geometry>
 #include <cstdint>
 #include <filesystem>
 #include <memory>
 #include <optional>
 #include <string>
 #include <vector>
-
-#include <Eigen/Core>
-#include <Eigen/Geometry>
 
 #include "saccade/core/image.h"
 #include "saccade/geometry/camera_model.h"
@@ -117,12 +116,38 @@ struct Light {
 struct Ground {
   enum class Pattern { kPlain, kGrid, kChecker };
   bool enabled = true;
-  double size = 10.0;        ///< side length, metres
+  double size = 10.0;  ///< side length, metres
   Pattern pattern = Pattern::kGrid;
   double cell = 0.5;         ///< grid spacing or checker square, metres
   double line_width = 0.01;  ///< grid lines, metres
   Eigen::Vector3f color{0.55f, 0.55f, 0.55f};
   Eigen::Vector3f color2{0.25f, 0.25f, 0.25f};  ///< grid lines / the other checker squares
+};
+
+/// What the sensor does after the lens: exposure (motion blur) and noise, in digital numbers
+/// (DN: the 0..255 scale of the 8-bit image). All off by default.
+struct SensorSpec {
+  /// Exposure time, seconds, >= 0 (at most 1). The frame of time t integrates the scene over
+  /// [t - exposure / 2, t + exposure / 2]: moving objects and a moving head blur; a still
+  /// scene renders exactly as with no exposure. 0: an instant.
+  double exposure = 0.0;
+  /// Sub-frames rendered over the exposure when something moves during it, 1 .. 64 (1: no
+  /// blur whatever the exposure).
+  int blur_samples = 8;
+  /// Read noise: Gaussian, standard deviation in DN, >= 0 (at most 64).
+  double read_noise_dn = 0.0;
+  /// Shot noise as EMVA 1288's overall system gain K, DN per electron, >= 0 (at most 64): a
+  /// signal of S DN has shot-noise variance K * S DN^2 (Gaussian approximation of Poisson).
+  /// 0: no shot noise.
+  double gain_dn_per_e = 0.0;
+  /// Seed of the noise. Each camera and frame draws its own stream from the seed, the
+  /// camera's name and the frame index: the same seed gives the same frames.
+  uint64_t seed = 0;
+
+  bool HasNoise() const { return read_noise_dn > 0.0 || gain_dn_per_e > 0.0; }
+  bool HasBlur() const { return exposure > 0.0 && blur_samples > 1; }
+  /// Throws InvalidArgument naming the field and the value when one is out of range.
+  void Validate() const;
 };
 
 /// Where a camera is mounted.
@@ -136,6 +161,7 @@ struct CameraSpec {
   /// kWorld: the optical frame in the world. Eye mounts take their pose from the head.
   geometry::Pose X_WC = geometry::Pose::Identity();
   geometry::ClipPlanes clip{0.05, 50.0};
+  SensorSpec sensor;
 };
 
 /// A piece of the robot's drawn body, rigidly attached to one frame of the head.
@@ -161,6 +187,9 @@ struct Robot {
 struct SceneState {
   double time = 0.0;  ///< seconds
   head::JointState joints;
+  /// Joint velocities (rad/s) at `time`: during a camera's exposure the joints move at this
+  /// constant rate, which blurs the eye cameras' images (SensorSpec::exposure). Zero: still.
+  head::JointState joint_velocities{0.0, 0.0, 0.0, 0.0};
 };
 
 /// A loaded, validated world. Immutable; cheap to share by reference.
