@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "saccade/geometry/camera_model.h"
+#include "saccade/geometry/lens_map.h"
 #include "saccade/head/head_description.h"
 #include "saccade/head/kinematics.h"
 
@@ -80,6 +81,28 @@ void BM_UnprojectFisheye(benchmark::State& state) {
   state.SetItemsProcessed(state.iterations() * pixels.size());
 }
 BENCHMARK(BM_UnprojectFisheye);
+
+void BM_MakeLensMapRadTan(benchmark::State& state) {
+  // Strong barrel at 1024 x 768 (one wider pinhole view): one undistortion per pixel.
+  const CameraModel camera(
+      Intrinsics(1024, 768, 800.0, 795.0, 517.3, 379.6),
+      Distortion::RadialTangential(std::vector<double>{-0.35, 0.12, 0.001, -0.0015, -0.02}));
+  for (auto _ : state) benchmark::DoNotOptimize(saccade::geometry::MakeLensMap(camera).map.data());
+  state.SetItemsProcessed(state.iterations() * 1024 * 768);
+}
+BENCHMARK(BM_MakeLensMapRadTan)->Unit(benchmark::kMillisecond);
+
+void BM_MakeLensMapFisheye190(benchmark::State& state) {
+  // 190 degrees across a 1280 x 960 image (five cube faces).
+  const std::vector<double> k = {-0.01, 0.002, -0.0003, 0.00002};
+  const double theta = 95.0 * 3.14159265358979323846 / 180.0, t2 = theta * theta;
+  const double f = 641.3 / (theta * (1.0 + t2 * (k[0] + t2 * (k[1] + t2 * (k[2] + t2 * k[3])))));
+  const CameraModel camera(Intrinsics(1280, 960, f, 0.997 * f, 641.3, 478.9, 0.8),
+                           Distortion::Fisheye(k));
+  for (auto _ : state) benchmark::DoNotOptimize(saccade::geometry::MakeLensMap(camera).map.data());
+  state.SetItemsProcessed(state.iterations() * 1280 * 960);
+}
+BENCHMARK(BM_MakeLensMapFisheye190)->Unit(benchmark::kMillisecond);
 
 void BM_SolveFixation(benchmark::State& state) {
   const auto head = saccade::head::HeadDescription::FromYamlFile(std::string(SACCADE_SOURCE_DIR) +

@@ -383,10 +383,16 @@ TEST(RendererTest, SubmitAndRetrieveReturnFramesInOrderWithTheirMetadata) {
       for (int k = 0; k < 16; ++k) EXPECT_EQ(meta.X_WC[k], X_WC(k / 4, k % 4)) << k;
       const Eigen::Matrix3d K = camera.model.intrinsics().Matrix();
       for (int k = 0; k < 9; ++k) EXPECT_EQ(meta.K[k], K(k / 3, k % 3)) << k;
-      // Lens distortion is not rendered yet: the metadata says the image is a pinhole one,
-      // whatever the camera's calibration holds (camera 2 has radtan distortion).
-      EXPECT_EQ(meta.distortion_model, "none");
-      EXPECT_TRUE(meta.distortion.empty());
+      // The metadata describes the lens as rendered: camera 2's radtan distortion, the
+      // eyes' pinholes.
+      EXPECT_EQ(meta.distortion_model, geometry::ToString(camera.model.distortion().IsIdentity()
+                                                              ? geometry::DistortionModel::kNone
+                                                              : camera.model.distortion().model()));
+      if (!camera.model.distortion().IsIdentity()) {
+        EXPECT_EQ(meta.distortion, camera.model.distortion().coefficients());
+      } else {
+        EXPECT_TRUE(meta.distortion.empty());
+      }
       const bool eye = camera.mount != scene::CameraMount::kWorld;
       EXPECT_EQ(meta.has_joints, eye);
       if (eye) {

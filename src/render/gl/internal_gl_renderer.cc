@@ -18,6 +18,7 @@
 #endif
 
 #include "render/gl/internal_camera_target.h"
+#include "render/gl/internal_effects.h"
 #include "render/gl/internal_egl_context.h"
 #include "render/gl/internal_gl_util.h"
 #include "render/gl/internal_gpu_resources.h"
@@ -25,6 +26,7 @@
 #include "render/gl/internal_shaders.h"
 #include "saccade/core/error.h"
 #include "saccade/geometry/gl_projection.h"
+#include "saccade/geometry/lens_map.h"
 #include "saccade/head/kinematics.h"
 
 namespace saccade::render::gl {
@@ -170,6 +172,31 @@ void RgbaToRgb(const uint8_t* rgba, uint8_t* rgb, std::size_t pixels) {
   RgbaToRgbPortable(rgba, rgb, pixels);
 }
 
+// SplitMix64's finaliser (S. Vigna): a bijective 64-bit mix.
+uint64_t Mix64(uint64_t x) {
+  x += 0x9e3779b97f4a7c15ull;
+  x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ull;
+  x = (x ^ (x >> 27)) * 0x94d049bb133111ebull;
+  return x ^ (x >> 31);
+}
+
+// The noise stream of one camera and frame: its seed, its name (FNV-1a) and the frame index.
+uint32_t NoiseKey(uint64_t seed, const std::string& camera, int64_t frame_index) {
+  uint64_t name = 0xcbf29ce484222325ull;
+  for (const char c : camera) name = (name ^ static_cast<uint8_t>(c)) * 0x100000001b3ull;
+  const uint64_t key = Mix64(Mix64(Mix64(seed) ^ name) ^ static_cast<uint64_t>(frame_index));
+  return static_cast<uint32_t>(key ^ (key >> 32));
+}
+
+// One camera's source view as drawn: projection, focal length (for levels of detail), the
+// view's orientation in the camera, and the camera's +z in the view's OpenGL eye frame.
+struct ViewSetup {
+  Eigen::Matrix4d projection;
+  double focal = 0.0;
+  Eigen::Matrix3d R_CV = Eigen::Matrix3d::Identity();
+  Eigen::Vector3f depth_axis{0.0f, 0.0f, -1.0f};
+};
+
 class GlRenderer final : public Renderer {
  public:
   GlRenderer(const scene::Scene& scene, const RendererOptions& options,
@@ -193,11 +220,31 @@ class GlRenderer final : public Renderer {
     GLsync fence = nullptr;
   };
 
+  // How one camera renders.
+  struct CameraSetup {
+    std::vector<ViewSetup> views;
+    std::unique_ptr<EffectTarget> effects;  // null: the plain path (CameraTarget only)
+    bool distorted = false;                 // the frames carry the lens's distortion
+    bool noise = false;
+    bool blur = false;  // blur configured (it renders sub-frames only when something moves)
+  };
+
   MeshProgram& GetMeshProgram(int variant);
   void BuildGroundProgram();
   void AddItem(const scene::Model& model, const Eigen::Vector3d& scale, int object, int part);
   void UpdatePoses(const scene::SceneState& state);
-  void DrawCamera(int camera, const geometry::Pose& X_WC);
+  void DrawScene(const ViewSetup& view, double near, const geometry::Pose& X_WV);
+  void DrawTruth(const ViewSetup& view, double near, const geometry::Pose& X_WV);
+  void DrawEffects(int camera, const scene::SceneState& state, int64_t frame_index,
+                   const geometry::Pose& X_WC, int slot);
+  bool MovesDuringExposure(int camera, const scene::SceneState& state,
+                           const std::vector<scene::SceneState>& sub_states) const;
+  // Eye frame from world, and the pixels per model unit at an item's nearest point.
+  static Eigen::Isometry3d EyeFromWorld(const geometry::Pose& X_WV);
+  void SortItems(const Eigen::Isometry3d& X_EW);
+  double PixelsPerModelUnit(const DrawItem& item, double depth, double focal, double near) const;
+  void FillTruth(int camera, const Pending& pending, int slot, Frame* frame);
+  uint32_t ItemId(const DrawItem& item) const;
   void SetLights(const LightUniforms& uniforms, const Eigen::Isometry3d& X_EW) const;
   std::shared_ptr<Image> NewImage(int camera);
 
@@ -208,7 +255,10 @@ class GlRenderer final : public Renderer {
   std::vector<std::string> camera_names_;
   std::vector<Eigen::Matrix4d> projections_;
   std::unique_ptr<GpuResources> resources_;
-  std::vector<std::unique_ptr<CameraTarget>> targets_;
+  std::vector<std::unique_ptr<CameraTarget>> targets_;  // plain path, per camera (or null)
+  std::vector<CameraSetup> setups_;                     // per camera
+  std::unique_ptr<EffectPrograms> effect_programs_;
+  bool truth_ = false;  // ids and depth rendered
   std::map<int, MeshProgram> mesh_programs_;
   GroundProgram ground_;
   GLuint ground_vao_ = 0;
@@ -216,13 +266,13 @@ class GlRenderer final : public Renderer {
   bool draw_robot_ = false;
   std::vector<DrawItem> items_;
   std::vector<Eigen::Isometry3d> item_poses_;  // X_WO (X_WLink X_LinkPart) per item, this state
-  std::vector<std::pair<double, int>> order_;  // per camera: depth, item
+  std::vector<std::pair<double, int>> order_;  // per view: depth, item
   Eigen::Vector3f ambient_ = Eigen::Vector3f::Zero();
   std::vector<const scene::Light*> directional_lights_;
   std::vector<const scene::Light*> point_lights_;
   std::array<Pending, CameraTarget::kSlots> pending_;
   std::vector<std::vector<std::shared_ptr<Image>>> image_pools_;  // per camera
-  int64_t camera_pass_ = 0;                                       // counts DrawCamera calls
+  int64_t camera_pass_ = 0;                                       // counts DrawScene calls
   int oldest_ = 0;
   int in_flight_ = 0;
   int samples_ = 0;
@@ -289,11 +339,40 @@ GlRenderer::GlRenderer(const scene::Scene& scene, const RendererOptions& options
     BuildGroundProgram();
   }
 
+  truth_ = options_.truth_depth || options_.truth_ids || options_.truth_objects;
   for (const scene::CameraSpec* camera : cameras_) {
+    CameraSetup setup;
     const geometry::Intrinsics& K = camera->model.intrinsics();
-    projections_.push_back(
-        geometry::GlProjectionFromIntrinsics(K, camera->clip, /*flip_rows=*/true));
-    targets_.push_back(std::make_unique<CameraTarget>(K.width(), K.height(), samples_, GL_RGBA));
+    // The lens: distortion as calibrated, or the pinhole of K when switched off.
+    const geometry::CameraModel model =
+        options_.distortion ? camera->model : geometry::CameraModel(K);
+    geometry::LensMap lens = geometry::MakeLensMap(model);
+    setup.distorted = lens.kind != geometry::LensMap::Kind::kIdentity;
+    setup.noise = options_.noise && camera->sensor.HasNoise();
+    setup.blur = options_.motion_blur && camera->sensor.HasBlur();
+    for (const geometry::SourceView& source : lens.views) {
+      ViewSetup view;
+      view.projection =
+          geometry::GlProjectionFromIntrinsics(source.intrinsics, camera->clip, /*flip_rows=*/true);
+      view.focal = std::max(source.intrinsics.fx(), source.intrinsics.fy());
+      view.R_CV = source.R_CV;
+      // The camera's +z in the view's optical frame, then in its OpenGL eye frame.
+      view.depth_axis =
+          (geometry::OpticalToGlEye() * source.R_CV.transpose() * Eigen::Vector3d::UnitZ())
+              .cast<float>();
+      setup.views.push_back(view);
+    }
+    if (setup.distorted || setup.noise || setup.blur || truth_) {
+      if (!effect_programs_) effect_programs_ = std::make_unique<EffectPrograms>();
+      setup.effects = std::make_unique<EffectTarget>(lens, samples_, setup.blur, truth_);
+      // Build the programs now, not in the first frame.
+      effect_programs_->GetFinal(!setup.distorted, setup.noise);
+      if (truth_) effect_programs_->GetTruthRemap(!setup.distorted);
+      targets_.push_back(nullptr);
+    } else {
+      targets_.push_back(std::make_unique<CameraTarget>(K.width(), K.height(), samples_, GL_RGBA));
+    }
+    setups_.push_back(std::move(setup));
   }
   for (Pending& pending : pending_) pending.X_WC.resize(cameras_.size());
   image_pools_.resize(cameras_.size());
@@ -331,6 +410,8 @@ GlRenderer::~GlRenderer() {
     // The context is gone (or current on another thread): no GL call may be made, so the GL
     // objects' owners are leaked rather than destroyed (the context's end frees the objects).
     for (auto& target : targets_) static_cast<void>(target.release());
+    for (CameraSetup& setup : setups_) static_cast<void>(setup.effects.release());
+    static_cast<void>(effect_programs_.release());
     static_cast<void>(resources_.release());
     return;
   }
@@ -338,6 +419,8 @@ GlRenderer::~GlRenderer() {
     if (pending.fence != nullptr) glDeleteSync(pending.fence);
   }
   targets_.clear();
+  setups_.clear();
+  effect_programs_.reset();
   resources_.reset();
   for (auto& [variant, program] : mesh_programs_) glDeleteProgram(program.program);
   if (ground_.program != 0) glDeleteProgram(ground_.program);
@@ -463,21 +546,26 @@ void GlRenderer::UpdatePoses(const scene::SceneState& state) {
   }
 }
 
-void GlRenderer::DrawCamera(int camera, const geometry::Pose& X_WC) {
-  CameraTarget& target = *targets_[camera];
-  const Eigen::Matrix4d& P = projections_[camera];
-  const geometry::Intrinsics& K = cameras_[camera]->model.intrinsics();
-  const double focal = std::max(K.fx(), K.fy());
-  const double near = cameras_[camera]->clip.near;
-  ++camera_pass_;
-  // X_EW: OpenGL eye frame from world = OpticalToGlEye * X_WC^-1, in double.
-  Eigen::Isometry3d X_EW = X_WC.inverse();
+Eigen::Isometry3d GlRenderer::EyeFromWorld(const geometry::Pose& X_WV) {
+  // X_EW: OpenGL eye frame from world = OpticalToGlEye * X_WV^-1, in double.
+  Eigen::Isometry3d X_EW = X_WV.inverse();
   X_EW.linear() = geometry::OpticalToGlEye() * X_EW.linear();
   X_EW.translation() = geometry::OpticalToGlEye() * X_EW.translation();
+  return X_EW;
+}
 
-  target.BindForDrawing();
-  glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+double GlRenderer::PixelsPerModelUnit(const DrawItem& item, double depth, double focal,
+                                      double near) const {
+  // Pixels per metre at the item's nearest point, for the size of its triangles on screen.
+  const double nearest = depth - item.radius_model;
+  return nearest > near ? focal * item.scale.maxCoeff() / nearest : 1e300;
+}
 
+uint32_t GlRenderer::ItemId(const DrawItem& item) const {
+  return item.object >= 0 ? scene_.objects()[item.object].id : scene_.robot()->id;
+}
+
+void GlRenderer::SortItems(const Eigen::Isometry3d& X_EW) {
   // Objects front to back (the depth test then spares hidden fragments their shading).
   order_.clear();
   for (std::size_t i = 0; i < items_.size(); ++i) {
@@ -486,6 +574,14 @@ void GlRenderer::DrawCamera(int camera, const geometry::Pose& X_WC) {
     order_.emplace_back(-c.z(), static_cast<int>(i));
   }
   std::sort(order_.begin(), order_.end());
+}
+
+void GlRenderer::DrawScene(const ViewSetup& view, double near, const geometry::Pose& X_WV) {
+  const Eigen::Matrix4d& P = view.projection;
+  const double focal = view.focal;
+  ++camera_pass_;
+  const Eigen::Isometry3d X_EW = EyeFromWorld(X_WV);
+  SortItems(X_EW);
 
   MeshProgram* program = nullptr;
   const GpuMaterial* material_set = nullptr;
@@ -501,10 +597,7 @@ void GlRenderer::DrawCamera(int camera, const geometry::Pose& X_WC) {
     const auto mvp_f = ToFloat<4>(mvp);
     const auto mv_f = ToFloat<4>(MV.matrix());
     const auto normal_f = ToFloat<3>(Eigen::Matrix3d(MV.linear().inverse().transpose()));
-    // Pixels per metre at the item's nearest point, for the size of its triangles on screen.
-    const double nearest = depth - item.radius_model;
-    const double px_per_model_unit =
-        nearest > near ? focal * item.scale.maxCoeff() / nearest : 1e300;
+    const double px_per_model_unit = PixelsPerModelUnit(item, depth, focal, near);
     bool matrices_set = false;
     for (const GpuMesh& mesh : item.model->meshes) {
       const GpuMaterial& material = item.model->materials[mesh.material];
@@ -568,6 +661,54 @@ void GlRenderer::DrawCamera(int camera, const geometry::Pose& X_WC) {
   glBindVertexArray(0);
 }
 
+void GlRenderer::DrawTruth(const ViewSetup& view, double near, const geometry::Pose& X_WV) {
+  const Eigen::Matrix4d& P = view.projection;
+  const Eigen::Isometry3d X_EW = EyeFromWorld(X_WV);
+  SortItems(X_EW);
+  const EffectPrograms::Truth& truth = effect_programs_->truth();
+  glUseProgram(truth.program);
+  glUniform3fv(truth.depth_axis, 1, view.depth_axis.data());
+  bool culling = false;
+  glDisable(GL_CULL_FACE);
+  for (const auto& [depth, index] : order_) {
+    const DrawItem& item = items_[index];
+    Eigen::Affine3d MV = X_EW * item_poses_[index];
+    MV.linear() = MV.linear() * item.scale.asDiagonal();
+    const Eigen::Matrix4d mvp = P * MV.matrix();
+    if (!item.model->bounds.isEmpty() && OutsideFrustum(mvp, item.model->bounds)) continue;
+    const auto mvp_f = ToFloat<4>(mvp);
+    const auto mv_f = ToFloat<4>(MV.matrix());
+    glUniformMatrix4fv(truth.mvp, 1, GL_FALSE, mvp_f.data());
+    glUniformMatrix4fv(truth.mv, 1, GL_FALSE, mv_f.data());
+    glUniform1ui(truth.id, ItemId(item));
+    const double px_per_model_unit = PixelsPerModelUnit(item, depth, view.focal, near);
+    for (const GpuMesh& mesh : item.model->meshes) {
+      // The same level of detail as the colour pass: the same silhouettes.
+      const GpuLod& lod =
+          mesh.levels[ChooseLod(mesh.errors, px_per_model_unit, options_.lod_max_error_px)];
+      if (mesh.closed != culling) {
+        culling = mesh.closed;
+        culling ? glEnable(GL_CULL_FACE) : glDisable(GL_CULL_FACE);
+      }
+      glBindVertexArray(mesh.vao);
+      glDrawElements(GL_TRIANGLES, lod.index_count, mesh.index_type,
+                     reinterpret_cast<const void*>(lod.offset_bytes));
+    }
+  }
+  if (culling) glDisable(GL_CULL_FACE);
+  if (draw_ground_) {
+    // The ground is a surface (it has depth) but not an object (id 0).
+    const auto mvp_f = ToFloat<4>(Eigen::Matrix4d(P * X_EW.matrix()));
+    const auto mv_f = ToFloat<4>(X_EW.matrix());
+    glUniformMatrix4fv(truth.mvp, 1, GL_FALSE, mvp_f.data());
+    glUniformMatrix4fv(truth.mv, 1, GL_FALSE, mv_f.data());
+    glUniform1ui(truth.id, 0u);
+    glBindVertexArray(ground_vao_);
+    glDrawArrays(GL_TRIANGLE_STRIP, 0, 4);
+  }
+  glBindVertexArray(0);
+}
+
 void GlRenderer::Submit(const scene::SceneState& state, int64_t frame_index) {
   if (in_flight_ >= CameraTarget::kSlots) {
     throw Error(fmt::format(
@@ -591,20 +732,118 @@ void GlRenderer::Submit(const scene::SceneState& state, int64_t frame_index) {
   // Every camera first, then every readback: the rasteriser works on one camera while the
   // next is being submitted.
   for (std::size_t i = 0; i < cameras_.size(); ++i) {
-    DrawCamera(static_cast<int>(i), pending.X_WC[i]);
+    if (setups_[i].effects) continue;
+    targets_[i]->BindForDrawing();
+    glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+    DrawScene(setups_[i].views[0], cameras_[i]->clip.near, pending.X_WC[i]);
   }
-  for (std::size_t i = 0; i < cameras_.size(); ++i) targets_[i]->StartReadback(slot);
+  for (std::size_t i = 0; i < cameras_.size(); ++i) {
+    if (!setups_[i].effects) targets_[i]->StartReadback(slot);
+  }
+  const Clock::time_point drawn = Clock::now();
+  for (std::size_t i = 0; i < cameras_.size(); ++i) {
+    if (setups_[i].effects) {
+      DrawEffects(static_cast<int>(i), state, frame_index, pending.X_WC[i], slot);
+    }
+  }
   pending.fence = glFenceSync(GL_SYNC_GPU_COMMANDS_COMPLETE, 0);
   glFlush();
   ++in_flight_;
   const Clock::time_point end = Clock::now();
   stats_.scene_update_ms += Milliseconds(start, posed);
-  stats_.draw_ms += Milliseconds(posed, end);
+  stats_.draw_ms += Milliseconds(posed, drawn);
+  stats_.effects_ms += Milliseconds(drawn, end);
   stats_.total_ms += Milliseconds(start, end);
 }
 
+bool GlRenderer::MovesDuringExposure(int camera, const scene::SceneState& state,
+                                     const std::vector<scene::SceneState>& sub_states) const {
+  const geometry::Pose X_WC = scene_.CameraPose(*cameras_[camera], state);
+  const head::JointState& v = state.joint_velocities;
+  const bool joints_move = v.pan != 0.0 || v.tilt != 0.0 || v.left != 0.0 || v.right != 0.0;
+  if (joints_move && draw_robot_) return true;
+  for (const scene::SceneState& sub : sub_states) {
+    if (!scene_.CameraPose(*cameras_[camera], sub).isApprox(X_WC, 0.0)) return true;
+    for (const DrawItem& item : items_) {
+      if (item.object < 0) continue;
+      const scene::Object& object = scene_.objects()[item.object];
+      if (object.motion.IsStatic()) continue;
+      if (!(object.motion.PoseAt(sub.time).matrix() == object.motion.PoseAt(state.time).matrix())) {
+        return true;
+      }
+    }
+  }
+  return false;
+}
+
+void GlRenderer::DrawEffects(int camera, const scene::SceneState& state, int64_t frame_index,
+                             const geometry::Pose& X_WC, int slot) {
+  const CameraSetup& setup = setups_[camera];
+  const EffectTarget& effects = *setup.effects;
+  const scene::CameraSpec& spec = *cameras_[camera];
+  const double near = spec.clip.near;
+  const auto view_pose = [&](const geometry::Pose& X_WCk, int view) {
+    geometry::Pose X_WV = X_WCk;
+    X_WV.linear() = X_WCk.linear() * setup.views[view].R_CV;
+    return X_WV;
+  };
+
+  // Motion blur: sub-frames at the midpoints of n equal slices of the exposure, centred on the
+  // frame's time, the joints moving at their velocities; only when something moves.
+  std::vector<scene::SceneState> sub_states;
+  if (setup.blur) {
+    const int n = spec.sensor.blur_samples;
+    for (int k = 0; k < n; ++k) {
+      const double dt = spec.sensor.exposure * ((k + 0.5) / n - 0.5);
+      scene::SceneState sub = state;
+      sub.time += dt;
+      sub.joints.pan += state.joint_velocities.pan * dt;
+      sub.joints.tilt += state.joint_velocities.tilt * dt;
+      sub.joints.left += state.joint_velocities.left * dt;
+      sub.joints.right += state.joint_velocities.right * dt;
+      sub_states.push_back(sub);
+    }
+    if (!MovesDuringExposure(camera, state, sub_states)) sub_states.clear();
+  }
+  const int views = static_cast<int>(setup.views.size());
+  if (sub_states.empty()) {
+    for (int v = 0; v < views; ++v) {
+      effects.BindViewForDrawing(v);
+      glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+      DrawScene(setup.views[v], near, view_pose(X_WC, v));
+      effects.FinishView(v);
+    }
+  } else {
+    effects.ClearAccumulation();
+    const float weight = 1.0f / static_cast<float>(sub_states.size());
+    for (const scene::SceneState& sub : sub_states) {
+      UpdatePoses(sub);
+      const geometry::Pose X_WCk = scene_.CameraPose(spec, sub);
+      for (int v = 0; v < views; ++v) {
+        effects.BindViewForDrawing(v);
+        glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+        DrawScene(setup.views[v], near, view_pose(X_WCk, v));
+        effects.FinishView(v);
+        effects.Accumulate(*effect_programs_, v, weight);
+      }
+    }
+    UpdatePoses(state);
+  }
+  if (effects.has_truth()) {
+    for (int v = 0; v < views; ++v) {
+      effects.BindTruthForDrawing(v);
+      DrawTruth(setup.views[v], near, view_pose(X_WC, v));
+    }
+  }
+  NoiseParams noise;
+  noise.read_sigma_dn = static_cast<float>(spec.sensor.read_noise_dn);
+  noise.gain_dn_per_e = static_cast<float>(spec.sensor.gain_dn_per_e);
+  noise.key = NoiseKey(spec.sensor.seed, spec.name, frame_index);
+  effects.Finish(*effect_programs_, !sub_states.empty(), setup.noise ? &noise : nullptr, slot);
+}
+
 std::shared_ptr<Image> GlRenderer::NewImage(int camera) {
-  const CameraTarget& target = *targets_[camera];
+  const geometry::Intrinsics& K = cameras_[camera]->model.intrinsics();
   std::vector<std::shared_ptr<Image>>& pool = image_pools_[camera];
   for (std::shared_ptr<Image>& image : pool) {
     // Only the pool holds it: the caller has let go of every frame that shared it.
@@ -613,7 +852,7 @@ std::shared_ptr<Image> GlRenderer::NewImage(int camera) {
       return image;
     }
   }
-  auto image = std::make_shared<Image>(target.width(), target.height(), PixelFormat::kRgb8);
+  auto image = std::make_shared<Image>(K.width(), K.height(), PixelFormat::kRgb8);
   if (pool.size() < kPooledImagesPerCamera) pool.push_back(image);
   return image;
 }
@@ -643,7 +882,7 @@ std::vector<Frame> GlRenderer::Retrieve() {
   frames.reserve(cameras_.size());
   for (std::size_t i = 0; i < cameras_.size(); ++i) {
     const scene::CameraSpec& camera = *cameras_[i];
-    const CameraTarget& target = *targets_[i];
+    const CameraSetup& setup = setups_[i];
     std::shared_ptr<Image> image = NewImage(static_cast<int>(i));
     ImageMetadata& meta = image->metadata();
     meta.camera = camera.name;
@@ -653,10 +892,15 @@ std::vector<Frame> GlRenderer::Retrieve() {
     for (int r = 0; r < 3; ++r) {
       for (int c = 0; c < 3; ++c) meta.K[3 * r + c] = K(r, c);
     }
-    // The metadata describes the image as rendered: lens distortion is not applied yet (the
-    // lens-effects issue), so every frame is a pinhole image and says so.
-    meta.distortion_model = geometry::ToString(geometry::DistortionModel::kNone);
-    meta.distortion.clear();
+    // The metadata describes the image as rendered: the lens's distortion, or a pinhole when
+    // distortion is off (or the lens has none).
+    if (setup.distorted) {
+      meta.distortion_model = geometry::ToString(camera.model.distortion().model());
+      meta.distortion = camera.model.distortion().coefficients();
+    } else {
+      meta.distortion_model = geometry::ToString(geometry::DistortionModel::kNone);
+      meta.distortion.clear();
+    }
     const Eigen::Matrix4d X_WC = pending.X_WC[i].matrix();
     for (int r = 0; r < 4; ++r) {
       for (int c = 0; c < 4; ++c) meta.X_WC[4 * r + c] = X_WC(r, c);
@@ -666,27 +910,115 @@ std::vector<Frame> GlRenderer::Retrieve() {
                       ? std::array<double, 4>{pending.state.joints.pan, pending.state.joints.tilt,
                                               pending.state.joints.left, pending.state.joints.right}
                       : std::array<double, 4>{};
-    const uint8_t* pixels = target.Map(slot);
-    if (pixels == nullptr) {
-      const GLenum error = glGetError();
-      target.Unmap();
-      throw Error("Renderer::Retrieve: glMapBufferRange failed: " + GlErrorName(error));
-    }
-    if (target.row_bytes() == static_cast<int>(image->stride())) {
-      std::memcpy(image->data(), pixels, image->size_bytes());
+    const std::size_t pixel_count =
+        static_cast<std::size_t>(image->width()) * static_cast<std::size_t>(image->height());
+    if (setup.effects) {
+      const PixelBuffers& buffers = setup.effects->color_buffers();
+      const auto* pixels = static_cast<const uint8_t*>(buffers.Map(slot));
+      if (pixels == nullptr) {
+        const GLenum error = glGetError();
+        buffers.Unmap();
+        throw Error("Renderer::Retrieve: glMapBufferRange failed: " + GlErrorName(error));
+      }
+      RgbaToRgb(pixels, image->data(), pixel_count);
+      buffers.Unmap();
     } else {
-      RgbaToRgb(
-          pixels, image->data(),
-          static_cast<std::size_t>(target.width()) * static_cast<std::size_t>(target.height()));
+      const CameraTarget& target = *targets_[i];
+      const uint8_t* pixels = target.Map(slot);
+      if (pixels == nullptr) {
+        const GLenum error = glGetError();
+        target.Unmap();
+        throw Error("Renderer::Retrieve: glMapBufferRange failed: " + GlErrorName(error));
+      }
+      if (target.row_bytes() == static_cast<int>(image->stride())) {
+        std::memcpy(image->data(), pixels, image->size_bytes());
+      } else {
+        RgbaToRgb(pixels, image->data(), pixel_count);
+      }
+      target.Unmap();
     }
-    target.Unmap();
-    frames.push_back(Frame{std::move(image)});
+    Frame frame{std::move(image), nullptr, nullptr, {}};
+    if (truth_) FillTruth(static_cast<int>(i), pending, slot, &frame);
+    frames.push_back(std::move(frame));
   }
   ++stats_.frames;
   const Clock::time_point end = Clock::now();
   stats_.readback_ms += Milliseconds(start, end);
   stats_.total_ms += Milliseconds(start, end);
   return frames;
+}
+
+void GlRenderer::FillTruth(int camera, const Pending& pending, int slot, Frame* frame) {
+  const EffectTarget& effects = *setups_[camera].effects;
+  const int width = frame->color->width();
+  const int height = frame->color->height();
+  const std::size_t bytes = static_cast<std::size_t>(width) * height * 4;
+  const auto copy = [&](const PixelBuffers& buffers, PixelFormat format) {
+    auto image = std::make_shared<Image>(width, height, format);
+    image->metadata() = frame->color->metadata();
+    const void* pixels = buffers.Map(slot);
+    if (pixels == nullptr) {
+      const GLenum error = glGetError();
+      buffers.Unmap();
+      throw Error("Renderer::Retrieve: glMapBufferRange failed (truth): " + GlErrorName(error));
+    }
+    std::memcpy(image->data(), pixels, bytes);
+    buffers.Unmap();
+    return image;
+  };
+  std::shared_ptr<Image> ids = copy(effects.id_buffers(), PixelFormat::kUint32);
+  if (options_.truth_depth) frame->depth = copy(effects.depth_buffers(), PixelFormat::kFloat32);
+  if (options_.truth_ids || options_.truth_objects) frame->ids = ids;
+  if (!options_.truth_objects) return;
+
+  // Poses at the frame's time, and boxes from the id image.
+  const geometry::Pose X_CW = pending.X_WC[camera].inverse();
+  std::map<uint32_t, std::size_t> index;  // id -> entry
+  for (const scene::Object& object : scene_.objects()) {
+    ObjectTruth truth;
+    truth.id = object.id;
+    truth.name = object.name;
+    const geometry::Pose X_WO = scene_.ObjectPose(object, pending.state);
+    truth.X_WO = X_WO.matrix();
+    truth.X_CO = (X_CW * X_WO).matrix();
+    index.emplace(truth.id, frame->objects.size());
+    frame->objects.push_back(truth);
+  }
+  if (draw_robot_) {
+    ObjectTruth truth;
+    truth.id = scene_.robot()->id;
+    truth.name = "robot";
+    const geometry::Pose X_WB =
+        head::ForwardKinematics(scene_.robot()->head, pending.state.joints).X_WB;
+    truth.X_WO = X_WB.matrix();
+    truth.X_CO = (X_CW * X_WB).matrix();
+    index.emplace(truth.id, frame->objects.size());
+    frame->objects.push_back(truth);
+  }
+  uint32_t last_id = 0;
+  ObjectTruth* last = nullptr;
+  for (int y = 0; y < height; ++y) {
+    const auto* row = reinterpret_cast<const uint32_t*>(ids->row(y));
+    for (int x = 0; x < width; ++x) {
+      const uint32_t id = row[x];
+      if (id == 0) continue;
+      if (id != last_id || last == nullptr) {
+        const auto found = index.find(id);
+        if (found == index.end()) continue;  // cannot happen: every drawn id is listed
+        last_id = id;
+        last = &frame->objects[found->second];
+      }
+      if (last->pixels == 0) {
+        last->x_min = last->x_max = x;
+        last->y_min = last->y_max = y;
+      }
+      ++last->pixels;
+      last->x_min = std::min(last->x_min, x);
+      last->x_max = std::max(last->x_max, x);
+      last->y_min = std::min(last->y_min, y);
+      last->y_max = std::max(last->y_max, y);
+    }
+  }
 }
 
 std::vector<Frame> GlRenderer::Render(const scene::SceneState& state, int64_t frame_index) {

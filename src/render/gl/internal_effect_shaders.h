@@ -1,0 +1,188 @@
+#pragma once
+// GLSL 330 core sources of the effect passes (internal_effects.h): the lens remap, sensor
+// noise and quantisation in one pass; the motion-blur accumulation; the ground-truth scene
+// program and its remap.
+//
+// Every full-screen pass draws one triangle from gl_VertexID (no attributes) covering the
+// viewport, and addresses pixels by gl_FragCoord: framebuffer row y is image row y
+// everywhere (the scene passes flip rows through their projection), so no pass flips.
+
+namespace saccade::render::gl {
+
+/// One triangle covering the viewport: (-1, -1), (3, -1), (-1, 3).
+inline constexpr const char* kFullscreenVertexSource = R"(#version 330 core
+void main() {
+  vec2 p = vec2(float((gl_VertexID << 1) & 2), float(gl_VertexID & 2));
+  gl_Position = vec4(2.0 * p - 1.0, 0.0, 1.0);
+}
+)";
+
+/// Motion blur: adds one sub-frame's layer, times its weight, into the accumulation layer
+/// (additive blending into RGBA32F).
+inline constexpr const char* kAccumulateFragmentSource = R"(#version 330 core
+uniform sampler2DArray u_source;
+uniform int u_layer;
+uniform float u_weight;
+out vec4 o_color;
+void main() {
+  o_color = u_weight * texelFetch(u_source, ivec3(ivec2(gl_FragCoord.xy), u_layer), 0);
+}
+)";
+
+/// The camera's image: lens remap, sensor noise, quantisation to 8 bits.
+/// IDENTITY 1: the source is the image itself (no distortion), one layer at the image's size.
+/// Otherwise u_map holds, per pixel, (x, y, view) in the source views (geometry/lens_map.h),
+/// sampled bilinearly by hand (exact float weights on every device, unlike fixed-point
+/// texture filtering); view < 0: no ray, black.
+/// NOISE 1: signal S in DN (0..255), plus Gaussian noise of variance
+///   u_read_sigma^2 + u_gain * S   (read noise; EMVA 1288 shot noise, gain K in DN/e-),
+/// drawn by Box-Muller from a 32-bit integer hash (lowbias32, C. Wellons) of the pixel and
+/// u_key (the camera's seed, name and frame index, mixed on the CPU): the same key gives the
+/// same noise on the same device, and no state is carried between frames.
+inline constexpr const char* kFinalFragmentSource = R"(
+uniform sampler2DArray u_source;
+#if !IDENTITY
+uniform sampler2D u_map;
+#endif
+#if NOISE
+uniform float u_read_sigma;
+uniform float u_gain;
+uniform uint u_key;
+#endif
+out vec4 o_color;
+
+#if NOISE
+uint Hash(uint x) {
+  x ^= x >> 16;
+  x *= 0x7feb352du;
+  x ^= x >> 15;
+  x *= 0x846ca68bu;
+  x ^= x >> 16;
+  return x;
+}
+// Uniform in (0, 1] and [0, 1) from 24 bits.
+float Open(uint h) { return (float(h >> 8) + 1.0) * (1.0 / 16777216.0); }
+float Closed(uint h) { return float(h >> 8) * (1.0 / 16777216.0); }
+#endif
+
+void main() {
+  ivec2 pixel = ivec2(gl_FragCoord.xy);
+  vec3 c;
+#if IDENTITY
+  c = texelFetch(u_source, ivec3(pixel, 0), 0).rgb;
+#else
+  vec3 m = texelFetch(u_map, pixel, 0).xyz;
+  if (m.z < 0.0) {
+    c = vec3(0.0);
+  } else {
+    int layer = int(m.z + 0.5);
+    ivec2 last = textureSize(u_source, 0).xy - 1;
+    vec2 f = floor(m.xy);
+    vec2 w = m.xy - f;
+    ivec2 a = clamp(ivec2(f), ivec2(0), last);
+    ivec2 b = clamp(ivec2(f) + 1, ivec2(0), last);
+    vec3 c00 = texelFetch(u_source, ivec3(a.x, a.y, layer), 0).rgb;
+    vec3 c10 = texelFetch(u_source, ivec3(b.x, a.y, layer), 0).rgb;
+    vec3 c01 = texelFetch(u_source, ivec3(a.x, b.y, layer), 0).rgb;
+    vec3 c11 = texelFetch(u_source, ivec3(b.x, b.y, layer), 0).rgb;
+    c = mix(mix(c00, c10, w.x), mix(c01, c11, w.x), w.y);
+  }
+#endif
+  vec3 dn = 255.0 * c;
+#if NOISE
+  uint h = Hash(uint(pixel.x) ^ Hash(uint(pixel.y) ^ u_key));
+  float r0 = sqrt(-2.0 * log(Open(Hash(h))));
+  float a0 = 6.283185307179586 * Closed(Hash(h ^ 0x9e3779b9u));
+  float r1 = sqrt(-2.0 * log(Open(Hash(h ^ 0x7f4a7c15u))));
+  float a1 = 6.283185307179586 * Closed(Hash(h ^ 0x85ebca6bu));
+  vec3 z = vec3(r0 * cos(a0), r0 * sin(a0), r1 * cos(a1));
+  vec3 sigma = sqrt(u_read_sigma * u_read_sigma + u_gain * max(dn, vec3(0.0)));
+  dn += sigma * z;
+#endif
+  o_color = vec4(clamp(floor(dn + 0.5), 0.0, 255.0) * (1.0 / 255.0), 1.0);
+}
+)";
+
+/// Ground truth of the scene in one source view: instance id; the surface's z in the CAMERA's
+/// optical frame (u_depth_axis: the camera's +z in this view's OpenGL eye frame; a linear
+/// function of position, so interpolation is exact), and its depth along the VIEW's axis (for
+/// the remap's step test: in a cube face far off the camera's axis the camera z of a surface
+/// changes by several per cent per pixel, its depth in the view does not). Attribute 0:
+/// position.
+inline constexpr const char* kTruthVertexSource = R"(#version 330 core
+layout(location = 0) in vec3 a_position;
+uniform mat4 u_mvp;
+uniform mat4 u_mv;
+uniform vec3 u_depth_axis;
+out vec2 v_z;
+void main() {
+  gl_Position = u_mvp * vec4(a_position, 1.0);
+  vec3 p = (u_mv * vec4(a_position, 1.0)).xyz;
+  v_z = vec2(dot(u_depth_axis, p), -p.z);
+}
+)";
+
+inline constexpr const char* kTruthFragmentSource = R"(#version 330 core
+uniform uint u_id;
+in vec2 v_z;
+layout(location = 0) out uint o_id;
+layout(location = 1) out vec2 o_z;
+void main() {
+  o_id = u_id;
+  o_z = v_z;
+}
+)";
+
+/// The truth's remap: the id of the nearest source pixel; the depth interpolated bilinearly
+/// where the four source pixels around the ray see the same id (one surface), the nearest
+/// one's otherwise (no depth mixed across an edge or a step). IDENTITY as in the final pass.
+inline constexpr const char* kTruthRemapFragmentSource = R"(
+uniform usampler2DArray u_ids;
+uniform sampler2DArray u_z;
+#if !IDENTITY
+uniform sampler2D u_map;
+#endif
+layout(location = 0) out uint o_id;
+layout(location = 1) out float o_z;
+void main() {
+  ivec2 pixel = ivec2(gl_FragCoord.xy);
+#if IDENTITY
+  o_id = texelFetch(u_ids, ivec3(pixel, 0), 0).r;
+  o_z = texelFetch(u_z, ivec3(pixel, 0), 0).r;
+#else
+  // r: the camera's z, g: the depth along the view's axis (0: no surface).
+  vec3 m = texelFetch(u_map, pixel, 0).xyz;
+  if (m.z < 0.0) {
+    o_id = 0u;
+    o_z = 0.0;
+    return;
+  }
+  int layer = int(m.z + 0.5);
+  ivec2 last = textureSize(u_ids, 0).xy - 1;
+  ivec2 n = clamp(ivec2(floor(m.xy + 0.5)), ivec2(0), last);
+  o_id = texelFetch(u_ids, ivec3(n, layer), 0).r;
+  vec2 f = floor(m.xy);
+  vec2 w = m.xy - f;
+  ivec2 a = clamp(ivec2(f), ivec2(0), last);
+  ivec2 b = clamp(ivec2(f) + 1, ivec2(0), last);
+  uint i00 = texelFetch(u_ids, ivec3(a.x, a.y, layer), 0).r;
+  uint i10 = texelFetch(u_ids, ivec3(b.x, a.y, layer), 0).r;
+  uint i01 = texelFetch(u_ids, ivec3(a.x, b.y, layer), 0).r;
+  uint i11 = texelFetch(u_ids, ivec3(b.x, b.y, layer), 0).r;
+  vec2 z00 = texelFetch(u_z, ivec3(a.x, a.y, layer), 0).rg;
+  vec2 z10 = texelFetch(u_z, ivec3(b.x, a.y, layer), 0).rg;
+  vec2 z01 = texelFetch(u_z, ivec3(a.x, b.y, layer), 0).rg;
+  vec2 z11 = texelFetch(u_z, ivec3(b.x, b.y, layer), 0).rg;
+  float d_min = min(min(z00.g, z10.g), min(z01.g, z11.g));
+  float d_max = max(max(z00.g, z10.g), max(z01.g, z11.g));
+  // Same id, all surfaces, and no depth step (an object occluding part of itself): 2 % of the
+  // depth between neighbours is a surface at 85 degrees' incidence on a 600-pixel focal.
+  bool one_surface = i00 == i10 && i00 == i01 && i00 == i11 && d_min > 0.0 &&
+                     d_max - d_min <= 0.02 * d_min;
+  o_z = one_surface ? mix(mix(z00.r, z10.r, w.x), mix(z01.r, z11.r, w.x), w.y)
+                    : texelFetch(u_z, ivec3(n, layer), 0).r;
+#endif
+}
+)";
+
+}  // namespace saccade::render::gl

@@ -1,0 +1,378 @@
+#include "render/gl/internal_effects.h"
+
+#include <fmt/format.h>
+
+#include <string>
+
+#include "render/gl/internal_effect_shaders.h"
+#include "render/gl/internal_gl_util.h"
+#include "saccade/core/error.h"
+
+namespace saccade::render::gl {
+namespace {
+
+// Texture units of the effect passes (unit 0 belongs to the scene passes' material textures).
+constexpr GLint kSourceUnit = 1;
+constexpr GLint kMapUnit = 2;
+constexpr GLint kIdsUnit = 3;
+constexpr GLint kZUnit = 4;
+
+std::string Defines(bool identity, bool noise) {
+  return fmt::format("#version 330 core\n#define IDENTITY {}\n#define NOISE {}\n", identity ? 1 : 0,
+                     noise ? 1 : 0);
+}
+
+// Texel-exact sampling only (texelFetch): no filtering, no mipmaps (a texture whose minifying
+// filter wants mipmaps it lacks is incomplete and reads as zero).
+void NearestNoMipmaps(GLenum target) {
+  glTexParameteri(target, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+  glTexParameteri(target, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+  glTexParameteri(target, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+  glTexParameteri(target, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+}
+
+GLuint MakeArray(GLenum internal_format, GLenum format, GLenum type, int width, int height,
+                 int layers) {
+  GLuint texture = 0;
+  glGenTextures(1, &texture);
+  glBindTexture(GL_TEXTURE_2D_ARRAY, texture);
+  NearestNoMipmaps(GL_TEXTURE_2D_ARRAY);
+  glTexImage3D(GL_TEXTURE_2D_ARRAY, 0, static_cast<GLint>(internal_format), width, height, layers,
+               0, format, type, nullptr);
+  glBindTexture(GL_TEXTURE_2D_ARRAY, 0);
+  return texture;
+}
+
+GLuint MakeTexture2d(GLenum internal_format, GLenum format, GLenum type, int width, int height,
+                     const void* pixels) {
+  GLuint texture = 0;
+  glGenTextures(1, &texture);
+  glBindTexture(GL_TEXTURE_2D, texture);
+  NearestNoMipmaps(GL_TEXTURE_2D);
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+  glTexImage2D(GL_TEXTURE_2D, 0, static_cast<GLint>(internal_format), width, height, 0, format,
+               type, pixels);
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+  glBindTexture(GL_TEXTURE_2D, 0);
+  return texture;
+}
+
+GLuint MakeRenderbuffer(GLenum format, int width, int height, int samples) {
+  GLuint name = 0;
+  glGenRenderbuffers(1, &name);
+  glBindRenderbuffer(GL_RENDERBUFFER, name);
+  if (samples > 0) {
+    glRenderbufferStorageMultisample(GL_RENDERBUFFER, samples, format, width, height);
+  } else {
+    glRenderbufferStorage(GL_RENDERBUFFER, format, width, height);
+  }
+  glBindRenderbuffer(GL_RENDERBUFFER, 0);
+  return name;
+}
+
+void CheckComplete(const char* what, int width, int height) {
+  const GLenum status = glCheckFramebufferStatus(GL_FRAMEBUFFER);
+  if (status != GL_FRAMEBUFFER_COMPLETE) {
+    throw Error(fmt::format("Renderer: the {} x {} {} framebuffer is incomplete: status 0x{:04X}",
+                            width, height, what, status));
+  }
+}
+
+void BindTexture(GLint unit, GLenum target, GLuint texture) {
+  glActiveTexture(static_cast<GLenum>(GL_TEXTURE0 + unit));
+  glBindTexture(target, texture);
+}
+
+}  // namespace
+
+// --- EffectPrograms ---------------------------------------------------------------------
+
+EffectPrograms::EffectPrograms() {
+  glGenVertexArrays(1, &vao_);
+  accumulate_ =
+      BuildProgram("motion blur accumulation", kFullscreenVertexSource, kAccumulateFragmentSource);
+  accumulate_layer_ = Uniform(accumulate_, "u_layer");
+  accumulate_weight_ = Uniform(accumulate_, "u_weight");
+  glUseProgram(accumulate_);
+  glUniform1i(Uniform(accumulate_, "u_source"), kSourceUnit);
+  truth_.program = BuildProgram("ground truth", kTruthVertexSource, kTruthFragmentSource);
+  truth_.mvp = Uniform(truth_.program, "u_mvp");
+  truth_.mv = Uniform(truth_.program, "u_mv");
+  truth_.depth_axis = Uniform(truth_.program, "u_depth_axis");
+  truth_.id = Uniform(truth_.program, "u_id");
+  glUseProgram(0);
+  CheckGlError("MakeRenderer: building the effect programs");
+}
+
+EffectPrograms::~EffectPrograms() {
+  glDeleteVertexArrays(1, &vao_);
+  glDeleteProgram(accumulate_);
+  glDeleteProgram(truth_.program);
+  for (const auto& [variant, final] : finals_) glDeleteProgram(final.program);
+  for (const auto& [variant, program] : truth_remaps_) glDeleteProgram(program);
+}
+
+const EffectPrograms::Final& EffectPrograms::GetFinal(bool identity, bool noise) {
+  const int variant = (identity ? 1 : 0) | (noise ? 2 : 0);
+  if (const auto it = finals_.find(variant); it != finals_.end()) return it->second;
+  Final f;
+  f.program =
+      BuildProgram(fmt::format("final pass (identity {}, noise {})", identity, noise),
+                   kFullscreenVertexSource, Defines(identity, noise) + kFinalFragmentSource);
+  f.read_sigma = Uniform(f.program, "u_read_sigma");
+  f.gain = Uniform(f.program, "u_gain");
+  f.key = Uniform(f.program, "u_key");
+  glUseProgram(f.program);
+  glUniform1i(Uniform(f.program, "u_source"), kSourceUnit);
+  glUniform1i(Uniform(f.program, "u_map"), kMapUnit);
+  glUseProgram(0);
+  CheckGlError("MakeRenderer: building the final pass");
+  return finals_.emplace(variant, f).first->second;
+}
+
+GLuint EffectPrograms::GetTruthRemap(bool identity) {
+  const int variant = identity ? 1 : 0;
+  if (const auto it = truth_remaps_.find(variant); it != truth_remaps_.end()) return it->second;
+  const GLuint program =
+      BuildProgram(fmt::format("truth remap (identity {})", identity), kFullscreenVertexSource,
+                   Defines(identity, false) + kTruthRemapFragmentSource);
+  glUseProgram(program);
+  glUniform1i(Uniform(program, "u_ids"), kIdsUnit);
+  glUniform1i(Uniform(program, "u_z"), kZUnit);
+  glUniform1i(Uniform(program, "u_map"), kMapUnit);
+  glUseProgram(0);
+  CheckGlError("MakeRenderer: building the truth remap");
+  return truth_remaps_.emplace(variant, program).first->second;
+}
+
+void EffectPrograms::DrawFullscreen() const {
+  glBindVertexArray(vao_);
+  glDrawArrays(GL_TRIANGLES, 0, 3);
+  glBindVertexArray(0);
+}
+
+// --- PixelBuffers -------------------------------------------------------------------------
+
+PixelBuffers::PixelBuffers(int width, int height, int bytes_per_pixel)
+    : width_(width), height_(height), bytes_per_pixel_(bytes_per_pixel) {
+  glGenBuffers(CameraTarget::kSlots, buffers_);
+  for (GLuint buffer : buffers_) {
+    glBindBuffer(GL_PIXEL_PACK_BUFFER, buffer);
+    glBufferData(GL_PIXEL_PACK_BUFFER, static_cast<GLsizeiptr>(width_) * height_ * bytes_per_pixel_,
+                 nullptr, GL_STREAM_READ);
+  }
+  glBindBuffer(GL_PIXEL_PACK_BUFFER, 0);
+}
+
+PixelBuffers::~PixelBuffers() { glDeleteBuffers(CameraTarget::kSlots, buffers_); }
+
+void PixelBuffers::Read(int slot, GLenum format, GLenum type) const {
+  glBindBuffer(GL_PIXEL_PACK_BUFFER, buffers_[slot]);
+  glPixelStorei(GL_PACK_ALIGNMENT, 1);
+  glReadPixels(0, 0, width_, height_, format, type, nullptr);
+  glBindBuffer(GL_PIXEL_PACK_BUFFER, 0);
+}
+
+const void* PixelBuffers::Map(int slot) const {
+  glBindBuffer(GL_PIXEL_PACK_BUFFER, buffers_[slot]);
+  return glMapBufferRange(GL_PIXEL_PACK_BUFFER, 0,
+                          static_cast<GLsizeiptr>(width_) * height_ * bytes_per_pixel_,
+                          GL_MAP_READ_BIT);
+}
+
+void PixelBuffers::Unmap() const {
+  glUnmapBuffer(GL_PIXEL_PACK_BUFFER);
+  glBindBuffer(GL_PIXEL_PACK_BUFFER, 0);
+}
+
+// --- EffectTarget -------------------------------------------------------------------------
+
+EffectTarget::EffectTarget(const geometry::LensMap& lens, int samples, bool blur, bool truth)
+    : lens_(lens),
+      samples_(samples),
+      blur_(blur),
+      truth_(truth),
+      source_width_(lens.views.at(0).intrinsics.width()),
+      source_height_(lens.views.at(0).intrinsics.height()),
+      layers_(static_cast<int>(lens.views.size())),
+      color_buffers_(lens.width, lens.height, 4) {
+  GLint max_size = 0, max_layers = 0;
+  glGetIntegerv(GL_MAX_TEXTURE_SIZE, &max_size);
+  glGetIntegerv(GL_MAX_ARRAY_TEXTURE_LAYERS, &max_layers);
+  if (source_width_ > max_size || source_height_ > max_size || layers_ > max_layers) {
+    throw Error(fmt::format(
+        "Renderer: the lens needs {} source view(s) of {} x {} pixels, beyond the device's "
+        "limit of {} a side",
+        layers_, source_width_, source_height_, max_size));
+  }
+  const int w = source_width_, h = source_height_;
+  source_ = MakeArray(GL_RGBA8, GL_RGBA, GL_UNSIGNED_BYTE, w, h, layers_);
+  glGenFramebuffers(1, &draw_framebuffer_);
+  glBindFramebuffer(GL_FRAMEBUFFER, draw_framebuffer_);
+  depth_ = MakeRenderbuffer(GL_DEPTH_COMPONENT32F, w, h, samples_);
+  glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, depth_);
+  if (samples_ > 0) {
+    msaa_color_ = MakeRenderbuffer(GL_RGBA8, w, h, samples_);
+    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, msaa_color_);
+    CheckComplete("multisampled source view", w, h);
+    glGenFramebuffers(1, &resolve_framebuffer_);
+    glBindFramebuffer(GL_FRAMEBUFFER, resolve_framebuffer_);
+    glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, source_, 0, 0);
+    CheckComplete("source view", w, h);
+  } else {
+    glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, source_, 0, 0);
+    CheckComplete("source view", w, h);
+  }
+  if (blur_) {
+    accumulation_ = MakeArray(GL_RGBA32F, GL_RGBA, GL_FLOAT, w, h, layers_);
+    glGenFramebuffers(1, &accumulation_framebuffer_);
+    glBindFramebuffer(GL_FRAMEBUFFER, accumulation_framebuffer_);
+    glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, accumulation_, 0, 0);
+    CheckComplete("motion blur accumulation", w, h);
+  }
+  if (lens_.kind != geometry::LensMap::Kind::kIdentity) {
+    map_ = MakeTexture2d(GL_RGB32F, GL_RGB, GL_FLOAT, lens_.width, lens_.height, lens_.map.data());
+  }
+  output_color_ = MakeArray(GL_RGBA8, GL_RGBA, GL_UNSIGNED_BYTE, lens_.width, lens_.height, 1);
+  glGenFramebuffers(1, &output_framebuffer_);
+  glBindFramebuffer(GL_FRAMEBUFFER, output_framebuffer_);
+  glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, output_color_, 0, 0);
+  CheckComplete("camera image", lens_.width, lens_.height);
+
+  if (truth_) {
+    truth_ids_ = MakeArray(GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, w, h, layers_);
+    truth_z_ = MakeArray(GL_RG32F, GL_RG, GL_FLOAT, w, h, layers_);  // camera z, view depth
+    truth_depth_ = MakeRenderbuffer(GL_DEPTH_COMPONENT32F, w, h, 0);
+    glGenFramebuffers(1, &truth_framebuffer_);
+    glBindFramebuffer(GL_FRAMEBUFFER, truth_framebuffer_);
+    glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, truth_ids_, 0, 0);
+    glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT1, truth_z_, 0, 0);
+    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, truth_depth_);
+    const GLenum buffers[] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
+    glDrawBuffers(2, buffers);
+    CheckComplete("ground truth", w, h);
+    output_ids_ =
+        MakeArray(GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, lens_.width, lens_.height, 1);
+    output_z_ = MakeArray(GL_R32F, GL_RED, GL_FLOAT, lens_.width, lens_.height, 1);
+    glGenFramebuffers(1, &output_truth_framebuffer_);
+    glBindFramebuffer(GL_FRAMEBUFFER, output_truth_framebuffer_);
+    glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, output_ids_, 0, 0);
+    glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT1, output_z_, 0, 0);
+    glDrawBuffers(2, buffers);
+    CheckComplete("ground truth image", lens_.width, lens_.height);
+    id_buffers_ = std::make_unique<PixelBuffers>(lens_.width, lens_.height, 4);
+    depth_buffers_ = std::make_unique<PixelBuffers>(lens_.width, lens_.height, 4);
+  }
+  glBindFramebuffer(GL_FRAMEBUFFER, 0);
+  CheckGlError(
+      fmt::format("Renderer: making the effect targets ({} view(s) of {} x {})", layers_, w, h));
+}
+
+EffectTarget::~EffectTarget() {
+  const GLuint framebuffers[] = {draw_framebuffer_,         resolve_framebuffer_,
+                                 accumulation_framebuffer_, truth_framebuffer_,
+                                 output_framebuffer_,       output_truth_framebuffer_};
+  glDeleteFramebuffers(6, framebuffers);
+  const GLuint textures[] = {source_,  accumulation_, map_,        truth_ids_,
+                             truth_z_, output_color_, output_ids_, output_z_};
+  glDeleteTextures(8, textures);
+  const GLuint renderbuffers[] = {msaa_color_, depth_, truth_depth_};
+  glDeleteRenderbuffers(3, renderbuffers);
+}
+
+void EffectTarget::BindViewForDrawing(int view) const {
+  glBindFramebuffer(GL_FRAMEBUFFER, draw_framebuffer_);
+  if (samples_ == 0) {
+    glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, source_, 0, view);
+  }
+  glViewport(0, 0, source_width_, source_height_);
+}
+
+void EffectTarget::FinishView(int view) const {
+  if (samples_ == 0) return;
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, draw_framebuffer_);
+  glBindFramebuffer(GL_DRAW_FRAMEBUFFER, resolve_framebuffer_);
+  glFramebufferTextureLayer(GL_DRAW_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, source_, 0, view);
+  glBlitFramebuffer(0, 0, source_width_, source_height_, 0, 0, source_width_, source_height_,
+                    GL_COLOR_BUFFER_BIT, GL_NEAREST);
+}
+
+void EffectTarget::ClearAccumulation() const {
+  glBindFramebuffer(GL_FRAMEBUFFER, accumulation_framebuffer_);
+  const GLfloat zero[4] = {0.0f, 0.0f, 0.0f, 0.0f};
+  for (int layer = 0; layer < layers_; ++layer) {
+    glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, accumulation_, 0, layer);
+    glClearBufferfv(GL_COLOR, 0, zero);
+  }
+}
+
+void EffectTarget::Accumulate(const EffectPrograms& programs, int view, float weight) const {
+  glBindFramebuffer(GL_FRAMEBUFFER, accumulation_framebuffer_);
+  glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, accumulation_, 0, view);
+  glViewport(0, 0, source_width_, source_height_);
+  glDisable(GL_DEPTH_TEST);
+  glEnable(GL_BLEND);
+  glBlendFunc(GL_ONE, GL_ONE);
+  glUseProgram(programs.accumulate());
+  glUniform1i(programs.accumulate_layer(), view);
+  glUniform1f(programs.accumulate_weight(), weight);
+  BindTexture(kSourceUnit, GL_TEXTURE_2D_ARRAY, source_);
+  programs.DrawFullscreen();
+  glDisable(GL_BLEND);
+  glEnable(GL_DEPTH_TEST);
+  glActiveTexture(GL_TEXTURE0);
+}
+
+void EffectTarget::BindTruthForDrawing(int view) const {
+  glBindFramebuffer(GL_FRAMEBUFFER, truth_framebuffer_);
+  glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, truth_ids_, 0, view);
+  glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT1, truth_z_, 0, view);
+  glViewport(0, 0, source_width_, source_height_);
+  const GLuint zero_id[4] = {0, 0, 0, 0};
+  const GLfloat zero_z[4] = {0.0f, 0.0f, 0.0f, 0.0f};
+  const GLfloat far_depth = 1.0f;
+  glClearBufferuiv(GL_COLOR, 0, zero_id);
+  glClearBufferfv(GL_COLOR, 1, zero_z);
+  glClearBufferfv(GL_DEPTH, 0, &far_depth);
+}
+
+void EffectTarget::Finish(EffectPrograms& programs, bool accumulated, const NoiseParams* noise,
+                          int slot) const {
+  const bool identity = lens_.kind == geometry::LensMap::Kind::kIdentity;
+  glDisable(GL_DEPTH_TEST);
+  glViewport(0, 0, lens_.width, lens_.height);
+  if (!identity) BindTexture(kMapUnit, GL_TEXTURE_2D, map_);
+
+  const EffectPrograms::Final& final = programs.GetFinal(identity, noise != nullptr);
+  glBindFramebuffer(GL_FRAMEBUFFER, output_framebuffer_);
+  glUseProgram(final.program);
+  if (noise != nullptr) {
+    glUniform1f(final.read_sigma, noise->read_sigma_dn);
+    glUniform1f(final.gain, noise->gain_dn_per_e);
+    glUniform1ui(final.key, noise->key);
+  }
+  BindTexture(kSourceUnit, GL_TEXTURE_2D_ARRAY, accumulated ? accumulation_ : source_);
+  programs.DrawFullscreen();
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, output_framebuffer_);
+  glReadBuffer(GL_COLOR_ATTACHMENT0);
+  color_buffers_.Read(slot, GL_RGBA, GL_UNSIGNED_BYTE);
+
+  if (truth_) {
+    glBindFramebuffer(GL_FRAMEBUFFER, output_truth_framebuffer_);
+    glUseProgram(programs.GetTruthRemap(identity));
+    BindTexture(kIdsUnit, GL_TEXTURE_2D_ARRAY, truth_ids_);
+    BindTexture(kZUnit, GL_TEXTURE_2D_ARRAY, truth_z_);
+    programs.DrawFullscreen();
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, output_truth_framebuffer_);
+    glReadBuffer(GL_COLOR_ATTACHMENT0);
+    id_buffers_->Read(slot, GL_RED_INTEGER, GL_UNSIGNED_INT);
+    glReadBuffer(GL_COLOR_ATTACHMENT1);
+    depth_buffers_->Read(slot, GL_RED, GL_FLOAT);
+    glReadBuffer(GL_COLOR_ATTACHMENT0);
+  }
+  glUseProgram(0);
+  glActiveTexture(GL_TEXTURE0);
+  glEnable(GL_DEPTH_TEST);
+}
+
+}  // namespace saccade::render::gl

@@ -1,0 +1,149 @@
+#pragma once
+// The effect path of one camera (seed section 4.3), on the GPU:
+//
+//   scene passes, one per source view (geometry/lens_map.h: the camera itself, a wider
+//   pinhole, or cube faces), each into one layer of an RGBA8 texture array (through an MSAA
+//   framebuffer and a resolve when MSAA is on)
+//     -> with motion blur, repeated per sub-frame and summed with weights into an RGBA32F
+//        array (additive blending)
+//   -> one final pass at the camera's size: lens remap (per-pixel map, bilinear), sensor
+//      noise, quantisation to 8 bits (internal_effect_shaders.h)
+//   -> readback through pixel buffer objects, one per in-flight slot.
+//
+// Ground truth, when asked: one more scene pass per view into an R32UI id array and an RG32F
+// depth array (the camera's z and the view's depth; no MSAA: ids are not blended), remapped
+// by the same map into R32UI / R32F images at the camera's size, read back the same way.
+//
+// Everything here needs the renderer's context current.
+
+#include <epoxy/gl.h>
+
+#include <array>
+#include <cstdint>
+#include <map>
+#include <memory>
+
+#include "render/gl/internal_camera_target.h"
+#include "saccade/geometry/lens_map.h"
+
+namespace saccade::render::gl {
+
+/// Programs and the empty vertex array shared by every camera's effect passes.
+class EffectPrograms {
+ public:
+  struct Final {
+    GLuint program = 0;
+    GLint read_sigma = -1, gain = -1, key = -1;
+  };
+  struct Truth {
+    GLuint program = 0;
+    GLint mvp = -1, mv = -1, depth_axis = -1, id = -1;
+  };
+
+  /// Builds the programs. Throws saccade::Error with the compiler's log on failure.
+  EffectPrograms();
+  ~EffectPrograms();
+  EffectPrograms(const EffectPrograms&) = delete;
+  EffectPrograms& operator=(const EffectPrograms&) = delete;
+
+  /// The final pass for an identity map or not, with noise or not (built on first use).
+  const Final& GetFinal(bool identity, bool noise);
+  /// The truth remap for an identity map or not.
+  GLuint GetTruthRemap(bool identity);
+  const Truth& truth() const { return truth_; }
+  GLuint accumulate() const { return accumulate_; }
+  GLint accumulate_layer() const { return accumulate_layer_; }
+  GLint accumulate_weight() const { return accumulate_weight_; }
+  /// Draws the full-screen triangle (program and framebuffer bound by the caller).
+  void DrawFullscreen() const;
+
+ private:
+  GLuint vao_ = 0;
+  GLuint accumulate_ = 0;
+  GLint accumulate_layer_ = -1, accumulate_weight_ = -1;
+  std::map<int, Final> finals_;
+  std::map<int, GLuint> truth_remaps_;
+  Truth truth_;
+};
+
+/// Sensor noise of one frame of one camera (SensorSpec, with the key mixed on the CPU).
+struct NoiseParams {
+  float read_sigma_dn = 0.0f;
+  float gain_dn_per_e = 0.0f;
+  uint32_t key = 0;
+};
+
+/// Pixel buffer objects, one per in-flight slot, for one image of fixed size and format.
+class PixelBuffers {
+ public:
+  PixelBuffers(int width, int height, int bytes_per_pixel);
+  ~PixelBuffers();
+  PixelBuffers(const PixelBuffers&) = delete;
+  PixelBuffers& operator=(const PixelBuffers&) = delete;
+  /// Starts the copy of the bound read framebuffer's read buffer into the slot's buffer.
+  void Read(int slot, GLenum format, GLenum type) const;
+  /// Maps the slot's buffer (after its fence), nullptr on failure; Unmap after use.
+  const void* Map(int slot) const;
+  void Unmap() const;
+
+ private:
+  int width_, height_, bytes_per_pixel_;
+  GLuint buffers_[CameraTarget::kSlots] = {0, 0};
+};
+
+/// The GL objects of one camera's effect path.
+class EffectTarget {
+ public:
+  /// `samples` 0 for no MSAA; `blur`: allocate the accumulation array; `truth`: the id and
+  /// depth arrays and outputs. Throws saccade::Error naming the sizes when the device refuses.
+  EffectTarget(const geometry::LensMap& lens, int samples, bool blur, bool truth);
+  ~EffectTarget();
+  EffectTarget(const EffectTarget&) = delete;
+  EffectTarget& operator=(const EffectTarget&) = delete;
+
+  const geometry::LensMap& lens() const { return lens_; }
+  bool has_truth() const { return truth_; }
+
+  /// Binds the framebuffer that draws source view `view` and sets the viewport; the caller
+  /// clears and draws, then calls FinishView.
+  void BindViewForDrawing(int view) const;
+  /// Resolves MSAA into the view's layer (nothing to do without MSAA).
+  void FinishView(int view) const;
+  /// Motion blur: zeroes the accumulation array, then adds view layers with weights.
+  void ClearAccumulation() const;
+  void Accumulate(const EffectPrograms& programs, int view, float weight) const;
+  /// Binds the truth framebuffer of `view`, sets the viewport and clears it (id 0, z 0).
+  void BindTruthForDrawing(int view) const;
+
+  /// The final pass (from the accumulation array when `accumulated`), the truth remap when
+  /// the target has truth, and the start of every readback into `slot`. `noise` may be null.
+  void Finish(EffectPrograms& programs, bool accumulated, const NoiseParams* noise, int slot) const;
+
+  /// After the slot's fence: the camera-size RGBA8 pixels, ids (uint32) and depth (float),
+  /// row 0 at the top; nullptr on failure. Unmap each after use.
+  const PixelBuffers& color_buffers() const { return color_buffers_; }
+  const PixelBuffers& id_buffers() const { return *id_buffers_; }
+  const PixelBuffers& depth_buffers() const { return *depth_buffers_; }
+
+ private:
+  geometry::LensMap lens_;
+  int samples_;
+  bool blur_;
+  bool truth_;
+  int source_width_, source_height_, layers_;
+  GLuint source_ = 0;        // RGBA8 array
+  GLuint accumulation_ = 0;  // RGBA32F array
+  GLuint map_ = 0;           // RGB32F, camera size
+  GLuint draw_framebuffer_ = 0;
+  GLuint msaa_color_ = 0, depth_ = 0;  // renderbuffers (colour only with MSAA)
+  GLuint resolve_framebuffer_ = 0;     // MSAA: the layer to resolve into
+  GLuint accumulation_framebuffer_ = 0;
+  GLuint truth_ids_ = 0, truth_z_ = 0, truth_depth_ = 0;  // R32UI, RG32F arrays; depth rb
+  GLuint truth_framebuffer_ = 0;
+  GLuint output_color_ = 0, output_framebuffer_ = 0;  // RGBA8, camera size
+  GLuint output_ids_ = 0, output_z_ = 0, output_truth_framebuffer_ = 0;
+  PixelBuffers color_buffers_;
+  std::unique_ptr<PixelBuffers> id_buffers_, depth_buffers_;
+};
+
+}  // namespace saccade::render::gl
