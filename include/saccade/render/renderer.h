@@ -7,6 +7,15 @@
 // (geometry/gl_projection.h), at its exact size; the rows are flipped on the GPU so that the
 // frames come back with row 0 at the top; pixels come back through pixel buffer objects,
 // asynchronously and double buffered.
+//
+// Effects (seed section 4.3), all on the GPU and each switchable: a camera with lens
+// distortion is drawn as one wider pinhole view, or as cube faces for lenses beyond 120
+// degrees, and remapped per pixel (geometry/lens_map.h) so that points land where
+// cv::projectPoints / cv::fisheye::projectPoints put them; motion blur averages sub-frames
+// over the exposure; read and shot noise are added in digital numbers, seeded per camera and
+// frame; one final pass does remap, noise and quantisation. Cameras without any effect take
+// the direct path (no extra pass). Ground truth (depth, ids, boxes) goes through the same
+// remap, so it matches the distorted colour image pixel for pixel.
 
 #include <Eigen/Core>
 #include <cstdint>
