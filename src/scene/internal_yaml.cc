@@ -2,7 +2,9 @@
 
 #include <fmt/format.h>
 
+#include <charconv>
 #include <cmath>
+#include <limits>
 #include <set>
 #include <utility>
 
@@ -129,6 +131,21 @@ int64_t Entry::AsInteger(int64_t min, int64_t max) const {
     Fail(expected + ", got " + Describe());
   }
   if (value < min || value > max) Fail(expected + ", got " + Describe());
+  return value;
+}
+
+uint64_t Entry::AsUint64() const {
+  const std::string expected =
+      fmt::format("expected an integer in [0, {}]", std::numeric_limits<uint64_t>::max());
+  if (!node_.IsScalar()) Fail(expected + ", got " + Describe());
+  const std::string& text = node_.Scalar();
+  const bool hex = text.size() > 2 && text[0] == '0' && (text[1] == 'x' || text[1] == 'X');
+  const char* first = text.data() + (hex ? 2 : 0);
+  const char* last = text.data() + text.size();
+  uint64_t value = 0;
+  // from_chars takes no sign, no spaces and no prefix: anything else is left unparsed.
+  const auto [end, ec] = std::from_chars(first, last, value, hex ? 16 : 10);
+  if (ec != std::errc() || end != last || first == last) Fail(expected + ", got " + Describe());
   return value;
 }
 

@@ -51,6 +51,8 @@ class Entry {
   double AsPositive() const;     ///< finite, > 0
   double AsNonNegative() const;  ///< finite, >= 0
   int64_t AsInteger(int64_t min, int64_t max) const;
+  /// A non-negative integer up to 2^64 - 1, decimal or 0x-prefixed hexadecimal.
+  uint64_t AsUint64() const;
   bool AsBool() const;
   std::string AsString() const;  ///< a scalar
   std::string AsNonEmptyString() const;

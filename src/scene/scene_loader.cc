@@ -38,6 +38,11 @@ constexpr double kDefaultFar = 50.0;
 constexpr std::uintmax_t kMaxFileBytes = std::uintmax_t{4} << 30;
 // A look_at `up` within this sine of the viewing direction leaves the roll undefined.
 constexpr double kMinUpSine = 1e-6;
+// Sensor ranges: the same as SensorSpec::Validate's (scene.h), checked here with the line.
+constexpr double kMaxExposure = 1.0;  // seconds
+constexpr int kMaxBlurSamples = 64;
+constexpr double kMaxNoiseDn = 64.0;  // read noise, DN
+constexpr double kMaxGainDnPerE = 64.0;
 
 const Eigen::Vector4f kDefaultPrimitiveColor(0.7f, 0.7f, 0.7f, 1.0f);
 
@@ -523,6 +528,49 @@ class SceneReader {
     return clip;
   }
 
+  // A number in [0, max]; `what` says what it is ("an exposure in seconds").
+  static double ReadInRange(const Entry& e, double max, const char* what) {
+    const double value = e.AsDouble();
+    if (!(value >= 0.0 && value <= max)) {
+      e.Fail(fmt::format("expected {} in [0, {}], got {}", what, max, e.Describe()));
+    }
+    return value;
+  }
+
+  // {exposure | exposure_ms, blur_samples, read_noise_dn, gain_dn_per_e, seed}: SensorSpec.
+  static SensorSpec ReadSensor(const Entry& e) {
+    e.ExpectMap(
+        {"exposure", "exposure_ms", "blur_samples", "read_noise_dn", "gain_dn_per_e", "seed"},
+        "a sensor {exposure | exposure_ms, blur_samples, read_noise_dn, gain_dn_per_e, "
+        "seed}");
+    SensorSpec sensor;
+    const auto seconds = e.Find("exposure");
+    const auto ms = e.Find("exposure_ms");
+    if (seconds && ms) {
+      ms->Fail("give either 'exposure' (seconds) or 'exposure_ms', not both");
+    }
+    if (seconds) sensor.exposure = ReadInRange(*seconds, kMaxExposure, "an exposure in seconds");
+    if (ms) {
+      sensor.exposure = ReadInRange(*ms, kMaxExposure * 1e3, "an exposure in milliseconds") / 1e3;
+    }
+    if (const auto n = e.Find("blur_samples")) {
+      sensor.blur_samples = static_cast<int>(n->AsInteger(1, kMaxBlurSamples));
+    }
+    if (const auto x = e.Find("read_noise_dn")) {
+      sensor.read_noise_dn = ReadInRange(*x, kMaxNoiseDn, "a standard deviation in DN");
+    }
+    if (const auto x = e.Find("gain_dn_per_e")) {
+      sensor.gain_dn_per_e = ReadInRange(*x, kMaxGainDnPerE, "a gain in DN per electron");
+    }
+    if (const auto x = e.Find("seed")) sensor.seed = x->AsUint64();
+    try {
+      sensor.Validate();  // a safety net: every range was checked above, with its line
+    } catch (const InvalidArgument& error) {
+      e.Fail(error.what());
+    }
+    return sensor;
+  }
+
   // The optical frame (x right, y down, z forward) at `eye` looking at `target`.
   static geometry::Pose ReadLookAt(const Entry& e) {
     e.ExpectMap({"eye", "target", "up"}, "a look_at {eye, target, up}");
@@ -549,8 +597,8 @@ class SceneReader {
   }
 
   CameraSpec ReadWorldCamera(const Entry& e, std::map<std::string, std::string>& names) {
-    e.ExpectMap({"name", "calibration", "pose", "look_at", "clip"},
-                "a camera {name, calibration, pose | look_at, clip}");
+    e.ExpectMap({"name", "calibration", "pose", "look_at", "clip", "sensor"},
+                "a camera {name, calibration, pose | look_at, clip, sensor}");
     const Entry name_entry = e.Get("name");
     const std::string name = name_entry.AsNonEmptyString();
     CheckCameraName(name_entry, name, names);
@@ -565,6 +613,7 @@ class SceneReader {
                       geometry::ClipPlanes{kDefaultNear, kDefaultFar},
                       SensorSpec{}};
     if (const auto clip = e.Find("clip")) camera.clip = ReadClip(*clip);
+    if (const auto sensor = e.Find("sensor")) camera.sensor = ReadSensor(*sensor);
     return camera;
   }
 
@@ -594,11 +643,13 @@ class SceneReader {
       for (int i = 0; i < 2; ++i) {
         const auto camera = c->Find(i == 0 ? "left" : "right");
         if (!camera) continue;
-        camera->ExpectMap({"calibration", "clip"}, "an eye camera {calibration, clip}");
+        camera->ExpectMap({"calibration", "clip", "sensor"},
+                          "an eye camera {calibration, clip, sensor}");
         if (const auto calibration = camera->Find("calibration")) {
           (i == 0 ? left : right) = ReadCalibration(*calibration);
         }
         if (const auto clip = camera->Find("clip")) clips[i] = ReadClip(*clip);
+        if (const auto sensor = camera->Find("sensor")) sensors[i] = ReadSensor(*sensor);
       }
     }
     // The description again, with the scene's pose and calibrations in place of its own.

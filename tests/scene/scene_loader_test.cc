@@ -562,5 +562,120 @@ TEST_F(SceneLoaderTest, RobotPoseReplacesTheDescriptions) {
   EXPECT_TRUE(Load(kValid).robot()->head.X_WB().translation().isApprox(Eigen::Vector3d(0, 0, 1.2)));
 }
 
+// A sensor block on a world camera and on an eye camera (robot.cameras.left).
+std::string WithSensors(const std::string& world_sensor, const std::string& eye_sensor) {
+  std::string text = Replace(kValid, "    clip: {near: 0.1, far: 20}\n",
+                             "    clip: {near: 0.1, far: 20}\n    sensor:\n" + world_sensor);
+  return Replace(text, "  visible: false\n",
+                 "  visible: false\n  cameras:\n    left:\n      sensor:\n" + eye_sensor);
+}
+
+const std::string kWorldSensor = R"(      exposure: 0.004
+      blur_samples: 16
+      read_noise_dn: 1.5
+      gain_dn_per_e: 0.25
+      seed: 18446744073709551615
+)";
+const std::string kEyeSensor = R"(        exposure_ms: 8
+        read_noise_dn: 2
+        seed: 42
+)";
+
+TEST_F(SceneLoaderTest, SensorBlocksAreReadForWorldAndEyeCameras) {
+  const Scene scene = Load(WithSensors(kWorldSensor, kEyeSensor));
+  const SensorSpec& rig = scene.FindCamera("rig")->sensor;
+  EXPECT_EQ(rig.exposure, 0.004);
+  EXPECT_EQ(rig.blur_samples, 16);
+  EXPECT_EQ(rig.read_noise_dn, 1.5);
+  EXPECT_EQ(rig.gain_dn_per_e, 0.25);
+  EXPECT_EQ(rig.seed, UINT64_C(18446744073709551615));  // 2^64 - 1
+  EXPECT_TRUE(rig.HasBlur());
+  EXPECT_TRUE(rig.HasNoise());
+  const SensorSpec& left = scene.FindCamera("left")->sensor;
+  EXPECT_NEAR(left.exposure, 0.008, kParseTolerance);  // milliseconds to seconds
+  EXPECT_EQ(left.blur_samples, SensorSpec{}.blur_samples);
+  EXPECT_EQ(left.read_noise_dn, 2.0);
+  EXPECT_EQ(left.gain_dn_per_e, 0.0);
+  EXPECT_EQ(left.seed, 42u);
+  // Cameras without a block keep the defaults: everything off.
+  for (const char* name : {"right", "top"}) {
+    const SensorSpec& sensor = scene.FindCamera(name)->sensor;
+    EXPECT_FALSE(sensor.HasBlur()) << name;
+    EXPECT_FALSE(sensor.HasNoise()) << name;
+    EXPECT_EQ(sensor.seed, 0u) << name;
+  }
+  // The range's ends are allowed; a hexadecimal seed too.
+  const Scene ends =
+      Load(WithSensors("      exposure: 1\n      blur_samples: 64\n      read_noise_dn: 64\n"
+                       "      gain_dn_per_e: 0\n      seed: 0x10\n",
+                       "        exposure_ms: 0\n        blur_samples: 1\n        seed: 0\n"));
+  EXPECT_EQ(ends.FindCamera("rig")->sensor.exposure, 1.0);
+  EXPECT_EQ(ends.FindCamera("rig")->sensor.blur_samples, 64);
+  EXPECT_EQ(ends.FindCamera("rig")->sensor.seed, 16u);
+  EXPECT_EQ(ends.FindCamera("left")->sensor.exposure, 0.0);
+}
+
+TEST_F(SceneLoaderTest, BadSensorsNameTheFileLineAndKey) {
+  // World camera: cameras[0].sensor.
+  const auto world = [&](const std::string& from, const std::string& to) {
+    return WithSensors(Replace(kWorldSensor, from, to), kEyeSensor);
+  };
+  ExpectError(world("exposure: 0.004", "exposure: -0.004"), "exposure: -0.004",
+              "cameras[0].sensor.exposure",
+              {"expected an exposure in seconds in [0, 1]", "got '-0.004'"});
+  ExpectError(world("exposure: 0.004", "exposure: 2"), "exposure: 2", "cameras[0].sensor.exposure",
+              {"in [0, 1]", "got '2'"});
+  ExpectError(world("exposure: 0.004\n", "exposure: 0.004\n      exposure_ms: 4\n"),
+              "exposure_ms: 4", "cameras[0].sensor.exposure_ms",
+              {"either 'exposure' (seconds) or 'exposure_ms', not both"});
+  ExpectError(world("blur_samples: 16", "blur_samples: 0"), "blur_samples: 0",
+              "cameras[0].sensor.blur_samples", {"expected an integer in [1, 64]", "got '0'"});
+  ExpectError(world("blur_samples: 16", "blur_samples: 65"), "blur_samples: 65",
+              "cameras[0].sensor.blur_samples", {"expected an integer in [1, 64]", "got '65'"});
+  ExpectError(world("blur_samples: 16", "blur_samples: 2.5"), "blur_samples: 2.5",
+              "cameras[0].sensor.blur_samples", {"expected an integer in [1, 64]", "got '2.5'"});
+  ExpectError(world("read_noise_dn: 1.5", "read_noise_dn: .nan"), "read_noise_dn: .nan",
+              "cameras[0].sensor.read_noise_dn", {"expected a finite number", "'.nan'"});
+  ExpectError(world("read_noise_dn: 1.5", "read_noise_dn: 65"), "read_noise_dn: 65",
+              "cameras[0].sensor.read_noise_dn",
+              {"expected a standard deviation in DN in [0, 64]", "got '65'"});
+  ExpectError(world("gain_dn_per_e: 0.25", "gain_dn_per_e: -1"), "gain_dn_per_e: -1",
+              "cameras[0].sensor.gain_dn_per_e",
+              {"expected a gain in DN per electron in [0, 64]", "got '-1'"});
+  ExpectError(world("gain_dn_per_e: 0.25", "gain_dn_per_e: .inf"), "gain_dn_per_e: .inf",
+              "cameras[0].sensor.gain_dn_per_e", {"expected a finite number"});
+  ExpectError(
+      world("blur_samples: 16", "blur_sample: 16"), "blur_sample: 16",
+      "cameras[0].sensor.blur_sample",
+      {"unknown key 'blur_sample'", "expected one of: exposure, exposure_ms, blur_samples"});
+  ExpectError(world("seed: 18446744073709551615", "seed: -1"), "seed: -1", "cameras[0].sensor.seed",
+              {"expected an integer in [0, 18446744073709551615]", "got '-1'"});
+  ExpectError(world("seed: 18446744073709551615", "seed: 18446744073709551616"),
+              "seed: 18446744073709551616", "cameras[0].sensor.seed",
+              {"expected an integer in [0, 18446744073709551615]"});
+  ExpectError(world("seed: 18446744073709551615", "seed: abc"), "seed: abc",
+              "cameras[0].sensor.seed", {"expected an integer", "got 'abc'"});
+  ExpectError(WithSensors("      [1, 2]\n", kEyeSensor), "[1, 2]", "cameras[0].sensor",
+              {"expected a sensor {exposure | exposure_ms", "got a list of 2"});
+
+  // Eye camera: robot.cameras.left.sensor.
+  const auto eye = [&](const std::string& from, const std::string& to) {
+    return WithSensors(kWorldSensor, Replace(kEyeSensor, from, to));
+  };
+  ExpectError(eye("exposure_ms: 8", "exposure_ms: -8"), "exposure_ms: -8",
+              "robot.cameras.left.sensor.exposure_ms",
+              {"expected an exposure in milliseconds in [0, 1000]", "got '-8'"});
+  ExpectError(eye("exposure_ms: 8\n", "exposure_ms: 8\n        exposure: 0.008\n"),
+              "exposure_ms: 8", "robot.cameras.left.sensor.exposure_ms", {"not both"});
+  ExpectError(eye("read_noise_dn: 2", "read_noise_dn: .NaN"), "read_noise_dn: .NaN",
+              "robot.cameras.left.sensor.read_noise_dn", {"expected a finite number"});
+  ExpectError(eye("seed: 42", "seed: -42"), "seed: -42", "robot.cameras.left.sensor.seed",
+              {"expected an integer in [0, 18446744073709551615]", "got '-42'"});
+  ExpectError(eye("seed: 42", "seed: 42\n        noise: 1"), "noise: 1",
+              "robot.cameras.left.sensor.noise", {"unknown key 'noise'"});
+  ExpectError(eye("exposure_ms: 8", "exposure_ms: 8\n        blur_samples: 0"), "blur_samples: 0",
+              "robot.cameras.left.sensor.blur_samples", {"expected an integer in [1, 64]"});
+}
+
 }  // namespace
 }  // namespace saccade::scene

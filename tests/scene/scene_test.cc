@@ -135,7 +135,16 @@ TEST(ShippedScenes, BenchLoadsAndSharesTheMugModel) {
   for (const CameraSpec& camera : scene.cameras()) {
     EXPECT_EQ(camera.model.intrinsics().width(), 1024);
     EXPECT_EQ(camera.model.intrinsics().height(), 768);
+    // What `saccade bench` times the effects with: a lens, noise and an exposure.
+    EXPECT_EQ(camera.model.distortion().model(), geometry::DistortionModel::kRadialTangential);
+    EXPECT_FALSE(camera.model.distortion().IsIdentity());
+    EXPECT_TRUE(camera.sensor.HasNoise()) << camera.name;
+    EXPECT_TRUE(camera.sensor.HasBlur()) << camera.name;
   }
+  // The eye cameras' calibrations replace the description's, with its intrinsics.
+  const auto popeye = head::HeadDescription::FromYamlFile(testing::kPopeye);
+  EXPECT_EQ(scene.cameras()[0].model.intrinsics(), popeye.left_camera().intrinsics());
+  EXPECT_EQ(scene.cameras()[1].model.intrinsics(), popeye.right_camera().intrinsics());
   EXPECT_EQ(scene.ground().pattern, Ground::Pattern::kChecker);
   EXPECT_EQ(scene.ground().size, 10.0);
   std::shared_ptr<const Model> mug;
