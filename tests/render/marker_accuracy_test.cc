@@ -1,26 +1,38 @@
 // Rendered pixels land where OpenCV projects them (DESIGN.md: "the simulator's pixels land where
-// OpenCV says they must"): small smooth markers at known 3D points, seen by a world camera with
-// an off-centre principal point, fx != fy and skew, at an even and at an odd image size. Each
-// marker's intensity-weighted centroid in the rendered image is compared to cv::projectPoints
-// of the marker's centre.
+// OpenCV says they must"): small smooth markers at known 3D points, seen by a world camera, and
+// each marker's intensity-weighted centroid in the rendered image compared to OpenCV's. The
+// cameras: pinholes with an off-centre principal point, fx != fy and skew, at an even and at an
+// odd image size; a strong radial-tangential lens (barrel, k1 = -0.3: the image corners are
+// pulled in by about 100 px), rendered through a wider pinhole view and remapped; and a
+// Kannala-Brandt fisheye seeing 95 degrees off its axis at the image's edges (a 190 degree
+// lens), rendered through a cube and remapped. cv::fisheye::projectPoints works on x/z and y/z,
+// so it mirrors rays beyond 90 degrees: the fisheye's markers stay within 87.5 degrees of the
+// axis (a 175 degree field; geometry/lens_map_test.cc checks the rim beyond 90 degrees against
+// the Kannala-Brandt formula).
 //
-// The markers and why they measure the projection and nothing else:
-// - Each marker is a picture (scene::MakePicture) of a Gaussian blob, placed fronto-parallel:
-//   its plane is at constant depth Z in the camera frame. A plane at constant depth maps to the
-//   image by an AFFINE map (u = (fx X + s Y) / Z + cx, v = fy Y / Z + cy), and an affine map
-//   sends the centroid of an intensity pattern to the centroid of its image: no perspective
-//   bias. (A sphere would have one: its image is an ellipse whose centre lies
-//   f tan(theta) sin^2(alpha) / cos^2(theta) beyond the projection of its centre, for angular
-//   radius alpha at angle theta off the axis; at a corner of this camera (theta ~ 35 deg) a
-//   sphere 10 px across is off by ~0.03 px, most of the error budget.)
-// - The blob is smooth (sigma ~ 1.7 px on screen) and point-symmetric about the texture's centre,
-//   as are all its mipmap levels, so the rendered intensity is point-symmetric about the
-//   projected centre: no hard edges to alias, and sampling it at pixel centres moves the
-//   centroid only by the (tiny) aliasing of a smooth function.
+// OpenCV's centroid of a marker is the centroid of its image as cv::projectPoints (or
+// cv::fisheye::projectPoints) maps it: every texel of the marker projected, weighted by its
+// value times the area OpenCV's projection gives it (the intensity a sensor collects is the
+// texture's value per unit of IMAGE area). Where the map from the marker's plane to the image is
+// affine (a pinhole camera, a marker at constant depth: u = (fx X + s Y) / Z + cx,
+// v = fy Y / Z + cy) that is exactly the projection of the marker's centre, which the pinhole
+// cases check; through a lens the map curves and the centroid differs from the centre's pixel
+// by up to a few thousandths of a pixel, which the reference includes rather than ignores.
+// (A sphere would not do even for a pinhole: its image is an ellipse whose centre lies
+// f tan(theta) sin^2(alpha) / cos^2(theta) beyond the projection of its centre.)
+//
+// Why the comparison measures the projection and nothing else:
+// - Each marker is a picture (scene::MakePicture) of a Gaussian blob, smooth (sigma ~ 1.7 px on
+//   screen) and point-symmetric about the texture's centre, as are all its mipmap levels: no
+//   hard edges to alias, and sampling it at pixel centres moves the centroid only by the (tiny)
+//   aliasing of a smooth function. Pinhole cases hold it fronto-parallel; lens cases turn it to
+//   face the camera (at 95 degrees off the axis no plane of constant depth exists).
 // - 8-bit quantisation adds a random +-0.5 LSB a pixel: on a blob of peak 255 and sigma 2 px
 //   the centroid moves by ~0.003 px RMS, 0.008 px at most (simulated over sub-pixel phases).
 // - Vertex positions go through float matrices built in double (model-view computed in double
 //   on the CPU), and llvmpipe snaps vertices to 1/256 px: both far below 0.01 px.
+// - The lens remap is a box filter of each pixel's footprint (render/gl/internal_effect_
+//   shaders.h): symmetric, so it moves no centroid either.
 // Black background, no ground, ambient light only: the image is the blobs and zeros.
 
 #include <gtest/gtest.h>
@@ -31,6 +43,7 @@
 #include <filesystem>
 #include <iostream>
 #include <memory>
+#include <numbers>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core.hpp>
 #include <random>
@@ -40,6 +53,7 @@
 #include "saccade/core/image.h"
 #include "saccade/core/image_io.h"
 #include "saccade/geometry/camera_model.h"
+#include "saccade/geometry/distortion.h"
 #include "saccade/geometry/pose.h"
 #include "saccade/render/renderer.h"
 #include "saccade/scene/scene.h"
@@ -90,10 +104,13 @@ std::shared_ptr<const scene::Texture> GaussianTexture() {
   return texture;
 }
 
+constexpr double kDeg = std::numbers::pi / 180.0;
+
 struct Case {
   std::string name;
-  geometry::Intrinsics K;
+  geometry::CameraModel model;
   int msaa;
+  double max_angle_deg = 90.0;  // markers only where the ray is at most this far off the axis
 };
 
 std::ostream& operator<<(std::ostream& os, const Case& c) { return os << c.name; }
@@ -106,12 +123,14 @@ struct Marker {
   double error = 0.0;
 };
 
-// OpenCV's pixels of world points for a camera at X_WC with K (skew included):
-// cv::projectPoints reads no skew from its camera matrix, so it projects with an identity
-// matrix to normalized coordinates and K (with skew) is applied after, as in
-// tests/geometry/camera_model_test.cc.
-std::vector<Vector2d> OpenCvProject(const geometry::Intrinsics& K, const geometry::Pose& X_WC,
+// OpenCV's pixels of world points for a camera at X_WC: cv::fisheye::projectPoints for a
+// fisheye, cv::projectPoints otherwise. cv::projectPoints reads no skew from its camera matrix,
+// so without distortion it projects with an identity matrix to normalized coordinates and K
+// (with skew) is applied after, as in tests/geometry/camera_model_test.cc; the lens cases have
+// no skew.
+std::vector<Vector2d> OpenCvProject(const geometry::CameraModel& camera, const geometry::Pose& X_WC,
                                     const std::vector<Vector3d>& points_W) {
+  const geometry::Intrinsics& K = camera.intrinsics();
   const geometry::Pose X_CW = X_WC.inverse();
   cv::Matx33d R;
   for (int r = 0; r < 3; ++r) {
@@ -122,15 +141,62 @@ std::vector<Vector2d> OpenCvProject(const geometry::Intrinsics& K, const geometr
   const cv::Vec3d tvec(X_CW.translation().x(), X_CW.translation().y(), X_CW.translation().z());
   std::vector<cv::Point3d> object;
   for (const Vector3d& p : points_W) object.emplace_back(p.x(), p.y(), p.z());
-  std::vector<cv::Point2d> normalized;
-  cv::projectPoints(object, rvec, tvec, cv::Matx33d::eye(), cv::noArray(), normalized);
   const cv::Matx33d Kcv(K.fx(), K.skew(), K.cx(), 0.0, K.fy(), K.cy(), 0.0, 0.0, 1.0);
+  const geometry::DistortionModel model = camera.distortion().model();
+  const std::vector<double>& D = camera.distortion().coefficients();
+  std::vector<cv::Point2d> image;
   std::vector<Vector2d> out;
-  for (const cv::Point2d& p : normalized) {
-    const cv::Vec3d q = Kcv * cv::Vec3d(p.x, p.y, 1.0);
-    out.emplace_back(q[0] / q[2], q[1] / q[2]);
+  if (model == geometry::DistortionModel::kFisheye) {
+    cv::fisheye::projectPoints(object, image, rvec, tvec, Kcv, D, K.skew() / K.fx());
+  } else if (model == geometry::DistortionModel::kRadialTangential) {
+    EXPECT_EQ(K.skew(), 0.0) << "cv::projectPoints ignores skew";
+    cv::projectPoints(object, rvec, tvec, Kcv, D, image);
+  } else {
+    std::vector<cv::Point2d> normalized;
+    cv::projectPoints(object, rvec, tvec, cv::Matx33d::eye(), cv::noArray(), normalized);
+    for (const cv::Point2d& p : normalized) {
+      const cv::Vec3d q = Kcv * cv::Vec3d(p.x, p.y, 1.0);
+      image.emplace_back(q[0] / q[2], q[1] / q[2]);
+    }
   }
+  for (const cv::Point2d& p : image) out.emplace_back(p.x, p.y);
   return out;
+}
+
+// OpenCV's centroid of the image of a marker texture at X_WO (MakePicture's frame: the plane
+// x = 0, right +y, top +z, `side` metres square), seen by the camera at X_WC: the texel centres
+// projected, each weighted by its value times the area of its projected texel (the cross
+// product of the projected steps to its neighbours' centres, by central differences).
+Vector2d OpenCvCentroid(const geometry::CameraModel& camera, const geometry::Pose& X_WC,
+                        const Image& texture, const geometry::Pose& X_WO, double side) {
+  const int n = texture.width();
+  const double texel = side / n;
+  std::vector<Vector3d> points;  // per texel: centre, -y, +y, -z, +z half a texel away
+  std::vector<double> values;
+  for (int y = 0; y < n; ++y) {
+    for (int x = 0; x < n; ++x) {
+      const double value = texture.row(y)[3 * x];
+      if (value == 0.0) continue;
+      // Texel (x, y) from the top-left: right along +y, down along -z.
+      const Vector3d p_O(0.0, (x + 0.5) * texel - 0.5 * side, 0.5 * side - (y + 0.5) * texel);
+      for (const Vector3d& d : {Vector3d(0, 0, 0), Vector3d(0, -0.5, 0), Vector3d(0, 0.5, 0),
+                                Vector3d(0, 0, -0.5), Vector3d(0, 0, 0.5)}) {
+        points.push_back(X_WO * (p_O + texel * d));
+      }
+      values.push_back(value);
+    }
+  }
+  const std::vector<Vector2d> uv = OpenCvProject(camera, X_WC, points);
+  Vector2d sum = Vector2d::Zero();
+  double mass = 0.0;
+  for (std::size_t i = 0; i < values.size(); ++i) {
+    const Vector2d* q = &uv[5 * i];
+    const Vector2d a = q[2] - q[1], b = q[4] - q[3];
+    const double weight = values[i] * std::abs(a.x() * b.y() - a.y() * b.x());
+    sum += weight * q[0];
+    mass += weight;
+  }
+  return sum / mass;
 }
 
 // An image showing the error field: the render in grey, each marker's error x 100 as a red
@@ -167,20 +233,23 @@ class MarkerAccuracyTest : public ::testing::TestWithParam<Case> {};
 
 TEST_P(MarkerAccuracyTest, CentroidsMatchOpenCvProjection) {
   const Case& param = GetParam();
-  const geometry::Intrinsics& K = param.K;
+  const geometry::CameraModel& model = param.model;
+  const geometry::Intrinsics& K = model.intrinsics();
+  const bool lens = model.distortion().model() != geometry::DistortionModel::kNone;
   // A camera metres from the origin, in a general orientation.
   const geometry::Pose X_WC =
       geometry::MakePose(geometry::RotationFromRpy(-1.9, 0.15, 2.4), Vector3d(3.2, -1.7, 1.4));
 
   // Markers on a jittered grid that covers the whole image up to kBorderPx from its edges,
-  // corners included, at depths from 1.5 m to 8 m.
+  // corners included (where there is a ray at most max_angle_deg off the axis), at depths (along
+  // the ray) from 1.5 m to 8 m.
   std::mt19937 rng(20240611);
   std::uniform_real_distribution<double> jitter(-0.5, 0.5), depth(1.5, 8.0);
-  constexpr int kColumns = 9, kRows = 7;
-  const Eigen::Matrix3d K_inverse = K.Matrix().inverse();
+  constexpr int kColumns = 11, kRows = 9;
   auto texture = GaussianTexture();
   std::vector<scene::Object> objects;
   std::vector<Marker> markers;
+  double max_angle = 0.0;  // of the markers' centres off the axis
   for (int row = 0; row < kRows; ++row) {
     for (int column = 0; column < kColumns; ++column) {
       const double span_u = K.width() - 1 - 2 * kBorderPx, span_v = K.height() - 1 - 2 * kBorderPx;
@@ -188,31 +257,56 @@ TEST_P(MarkerAccuracyTest, CentroidsMatchOpenCvProjection) {
       double v = kBorderPx + span_v * row / (kRows - 1) + jitter(rng);
       u = std::clamp(u, kBorderPx, K.width() - 1 - kBorderPx);
       v = std::clamp(v, kBorderPx, K.height() - 1 - kBorderPx);
-      const double Z = depth(rng);
-      const Vector3d p_C = Z * (K_inverse * Vector3d(u, v, 1.0));
-      // The picture faces the camera (its +x towards -z_C), upright in the image (its top, +z,
-      // towards -y_C), its right edge along +x_C: fronto-parallel.
+      const double distance = depth(rng);
+      const std::optional<Vector3d> ray = model.Unproject(Vector2d(u, v));
+      if (!ray) continue;  // beyond where the lens's polynomial is invertible (the fisheye)
+      const Vector3d direction = ray->normalized();
+      const double angle = std::acos(std::clamp(direction.z(), -1.0, 1.0));
+      if (angle > param.max_angle_deg * kDeg) continue;
+      max_angle = std::max(max_angle, angle);
+      const Vector3d p_C =
+          lens ? Vector3d(distance * direction) : Vector3d(distance / direction.z() * direction);
+      // Pinhole: the picture faces the camera (its +x towards -z_C), upright in the image (its
+      // top, +z, towards -y_C), its right edge along +x_C: fronto-parallel. Lens: its +x
+      // towards the camera's centre, its top as close to -y_C as that allows.
       Eigen::Matrix3d R_CO;
-      R_CO.col(0) = -Vector3d::UnitZ();
-      R_CO.col(1) = Vector3d::UnitX();
-      R_CO.col(2) = -Vector3d::UnitY();
+      if (lens) {
+        R_CO.col(0) = -direction;
+        R_CO.col(2) = (-Vector3d::UnitY() + direction.y() * direction).normalized();
+        R_CO.col(1) = R_CO.col(2).cross(R_CO.col(0));
+      } else {
+        R_CO.col(0) = -Vector3d::UnitZ();
+        R_CO.col(1) = Vector3d::UnitX();
+        R_CO.col(2) = -Vector3d::UnitY();
+      }
       const geometry::Pose X_WO = X_WC * geometry::MakePose(R_CO, p_C);
+      // About kMarkerPx pixels on screen along its larger direction: the picture's pixels per
+      // metre from OpenCV's projection of its centre and points 1 mm along its axes.
+      const std::vector<Vector2d> local = OpenCvProject(
+          model, X_WC,
+          {X_WO.translation(), X_WO * Vector3d(0.0, 1e-3, 0.0), X_WO * Vector3d(0.0, 0.0, 1e-3)});
+      const double px_per_m =
+          1e3 * std::max((local[1] - local[0]).norm(), (local[2] - local[0]).norm());
+      const double side = kMarkerPx / px_per_m;
       scene::Object object;
       object.name = "marker" + std::to_string(markers.size());
       object.id = static_cast<uint32_t>(markers.size() + 1);
-      object.model = scene::MakePicture(texture, kMarkerPx * Z / K.fy());
+      object.model = scene::MakePicture(texture, side);
       object.motion = scene::Motion::Static(X_WO);
       objects.push_back(object);
-      markers.push_back(Marker{X_WO.translation(), Vector2d::Zero()});
+      Marker marker{X_WO.translation(), Vector2d::Zero()};
+      marker.expected = OpenCvCentroid(model, X_WC, texture->image, X_WO, side);
+      markers.push_back(marker);
     }
   }
-  std::vector<Vector3d> points_W;
-  for (const Marker& m : markers) points_W.push_back(m.p_W);
-  const std::vector<Vector2d> expected = OpenCvProject(K, X_WC, points_W);
-  for (std::size_t i = 0; i < markers.size(); ++i) markers[i].expected = expected[i];
+  ASSERT_GE(markers.size(), 40u) << "markers in the field of view";
 
-  scene::CameraSpec camera{"world", geometry::CameraModel(K),        scene::CameraMount::kWorld,
-                           X_WC,    geometry::ClipPlanes{0.1, 20.0}, scene::SensorSpec{}};
+  scene::CameraSpec camera{"world",
+                           model,
+                           scene::CameraMount::kWorld,
+                           X_WC,
+                           geometry::ClipPlanes{0.1, 20.0},
+                           scene::SensorSpec{}};
   scene::Light ambient;
   ambient.type = scene::Light::Type::kAmbient;
   ambient.intensity = 1.0f;
@@ -229,6 +323,7 @@ TEST_P(MarkerAccuracyTest, CentroidsMatchOpenCvProjection) {
   const Image& image = *frames[0].color;
   ASSERT_EQ(image.width(), K.width());
   ASSERT_EQ(image.height(), K.height());
+  EXPECT_EQ(image.metadata().distortion_model, geometry::ToString(model.distortion().model()));
 
   // Intensity-weighted centroids in windows about OpenCV's pixels; every lit pixel must fall in
   // some window, and every window's border must be dark (the marker lies wholly inside).
@@ -269,8 +364,9 @@ TEST_P(MarkerAccuracyTest, CentroidsMatchOpenCvProjection) {
     }
   }
   const double rms = std::sqrt(sum_squares / markers.size());
-  std::cout << param.name << ": " << markers.size() << " markers, RMS error " << rms << " px, max "
-            << max_error << " px (" << renderer->DeviceDescription() << ")\n";
+  std::cout << param.name << ": " << markers.size() << " markers up to " << max_angle / kDeg
+            << " deg off the axis, RMS error " << rms << " px, max " << max_error << " px ("
+            << renderer->DeviceDescription() << ")\n";
   RecordProperty("rms_error_px", std::to_string(rms));
   RecordProperty("max_error_px", std::to_string(max_error));
 
@@ -298,14 +394,28 @@ TEST_P(MarkerAccuracyTest, CentroidsMatchOpenCvProjection) {
   }
 }
 
-INSTANTIATE_TEST_SUITE_P(
-    Cameras, MarkerAccuracyTest,
-    ::testing::Values(
-        Case{"1024x768", geometry::Intrinsics(1024, 768, 900.0, 870.0, 530.3, 370.8, 2.5), 0},
-        Case{"641x479", geometry::Intrinsics(641, 479, 610.0, 590.0, 317.9, 242.6, -1.7), 0},
-        Case{"1024x768_msaa4", geometry::Intrinsics(1024, 768, 900.0, 870.0, 530.3, 370.8, 2.5), 4},
-        Case{"641x479_msaa4", geometry::Intrinsics(641, 479, 610.0, 590.0, 317.9, 242.6, -1.7), 4}),
-    [](const ::testing::TestParamInfo<Case>& info) { return info.param.name; });
+const geometry::Intrinsics kEven(1024, 768, 900.0, 870.0, 530.3, 370.8, 2.5);
+const geometry::Intrinsics kOdd(641, 479, 610.0, 590.0, 317.9, 242.6, -1.7);
+// Strong barrel, as in calibration_test.cc.
+const geometry::CameraModel kRadTan(geometry::Intrinsics(1024, 768, 900.0, 905.0, 515.3, 380.7),
+                                    geometry::Distortion::RadialTangential(std::vector<double>{
+                                        -0.30, 0.10, 0.0008, -0.0012, -0.015}));
+// theta_d = theta (1 + k1 theta^2 + ...) reaches 512 px from the centre at theta ~ 95 degrees.
+const geometry::CameraModel kFisheye190(
+    geometry::Intrinsics(1024, 1024, 305.0, 305.6, 512.8, 510.9),
+    geometry::Distortion::Fisheye(std::vector<double>{0.01, -0.003, 0.0005, -0.0001}));
+
+INSTANTIATE_TEST_SUITE_P(Cameras, MarkerAccuracyTest,
+                         ::testing::Values(Case{"1024x768", geometry::CameraModel(kEven), 0},
+                                           Case{"641x479", geometry::CameraModel(kOdd), 0},
+                                           Case{"1024x768_msaa4", geometry::CameraModel(kEven), 4},
+                                           Case{"641x479_msaa4", geometry::CameraModel(kOdd), 4},
+                                           Case{"radtan_strong", kRadTan, 0},
+                                           Case{"radtan_strong_msaa4", kRadTan, 4},
+                                           Case{"fisheye_190deg_msaa4", kFisheye190, 4, 87.5}),
+                         [](const ::testing::TestParamInfo<Case>& info) {
+                           return info.param.name;
+                         });
 
 }  // namespace
 }  // namespace saccade::render

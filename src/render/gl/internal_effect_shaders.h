@@ -31,9 +31,15 @@ void main() {
 
 /// The camera's image: lens remap, sensor noise, quantisation to 8 bits.
 /// IDENTITY 1: the source is the image itself (no distortion), one layer at the image's size.
-/// Otherwise u_map holds, per pixel, (x, y, view) in the source views (geometry/lens_map.h),
-/// sampled bilinearly by hand (exact float weights on every device, unlike fixed-point
-/// texture filtering); view < 0: no ray, black.
+/// Otherwise u_map holds, per pixel, (x, y, view, taps) (internal_effects.h, RemapTable):
+/// (x, y) in source view `view` (geometry/lens_map.h; view < 0: no ray, black), and the pixel
+/// is the mean of the source over its footprint, a box as a sensor's pixel integrates: taps =
+/// nu + 16 nv samples on a grid over the parallelogram spanned by u_footprint's (du, dv), the
+/// map's steps to the neighbouring pixels. Each sample is bilinear by hand (exact float
+/// weights on every device, unlike fixed-point texture filtering). Most pixels of most lenses
+/// take one sample; where a lens compresses the source (a fisheye's rim, a cube face seen
+/// obliquely: several source pixels a pixel step) one would alias, and a corner or an edge
+/// would move by tenths of a pixel from one frame to the next.
 /// NOISE 1: signal S in DN (0..255), plus Gaussian noise of variance
 ///   u_read_sigma^2 + u_gain * S   (read noise; EMVA 1288 shot noise, gain K in DN/e-),
 /// drawn by Box-Muller from a 32-bit integer hash (lowbias32, C. Wellons) of the pixel and
@@ -43,6 +49,7 @@ inline constexpr const char* kFinalFragmentSource = R"(
 uniform sampler2DArray u_source;
 #if !IDENTITY
 uniform sampler2D u_map;
+uniform sampler2D u_footprint;
 #endif
 #if NOISE
 uniform float u_read_sigma;
@@ -50,6 +57,20 @@ uniform float u_gain;
 uniform uint u_key;
 #endif
 out vec4 o_color;
+
+#if !IDENTITY
+vec3 Bilinear(vec2 x, int layer, ivec2 last) {
+  vec2 f = floor(x);
+  vec2 w = x - f;
+  ivec2 a = clamp(ivec2(f), ivec2(0), last);
+  ivec2 b = clamp(ivec2(f) + 1, ivec2(0), last);
+  vec3 c00 = texelFetch(u_source, ivec3(a.x, a.y, layer), 0).rgb;
+  vec3 c10 = texelFetch(u_source, ivec3(b.x, a.y, layer), 0).rgb;
+  vec3 c01 = texelFetch(u_source, ivec3(a.x, b.y, layer), 0).rgb;
+  vec3 c11 = texelFetch(u_source, ivec3(b.x, b.y, layer), 0).rgb;
+  return mix(mix(c00, c10, w.x), mix(c01, c11, w.x), w.y);
+}
+#endif
 
 #if NOISE
 uint Hash(uint x) {
@@ -71,21 +92,27 @@ void main() {
 #if IDENTITY
   c = texelFetch(u_source, ivec3(pixel, 0), 0).rgb;
 #else
-  vec3 m = texelFetch(u_map, pixel, 0).xyz;
+  vec4 m = texelFetch(u_map, pixel, 0);
   if (m.z < 0.0) {
     c = vec3(0.0);
   } else {
     int layer = int(m.z + 0.5);
     ivec2 last = textureSize(u_source, 0).xy - 1;
-    vec2 f = floor(m.xy);
-    vec2 w = m.xy - f;
-    ivec2 a = clamp(ivec2(f), ivec2(0), last);
-    ivec2 b = clamp(ivec2(f) + 1, ivec2(0), last);
-    vec3 c00 = texelFetch(u_source, ivec3(a.x, a.y, layer), 0).rgb;
-    vec3 c10 = texelFetch(u_source, ivec3(b.x, a.y, layer), 0).rgb;
-    vec3 c01 = texelFetch(u_source, ivec3(a.x, b.y, layer), 0).rgb;
-    vec3 c11 = texelFetch(u_source, ivec3(b.x, b.y, layer), 0).rgb;
-    c = mix(mix(c00, c10, w.x), mix(c01, c11, w.x), w.y);
+    int taps = int(m.w + 0.5);
+    if (taps == 17) {  // nu = nv = 1
+      c = Bilinear(m.xy, layer, last);
+    } else {
+      int nu = taps & 15, nv = taps >> 4;
+      vec4 footprint = texelFetch(u_footprint, pixel, 0);
+      vec3 sum = vec3(0.0);
+      for (int j = 0; j < nv; ++j) {
+        for (int i = 0; i < nu; ++i) {
+          vec2 o = (vec2(i, j) + 0.5) / vec2(nu, nv) - 0.5;
+          sum += Bilinear(m.xy + o.x * footprint.xy + o.y * footprint.zw, layer, last);
+        }
+      }
+      c = sum / float(nu * nv);
+    }
   }
 #endif
   vec3 dn = 255.0 * c;

@@ -6,8 +6,9 @@
 //   framebuffer and a resolve when MSAA is on)
 //     -> with motion blur, repeated per sub-frame and summed with weights into an RGBA32F
 //        array (additive blending)
-//   -> one final pass at the camera's size: lens remap (per-pixel map, bilinear), sensor
-//      noise, quantisation to 8 bits (internal_effect_shaders.h)
+//   -> one final pass at the camera's size: lens remap (per-pixel map; each pixel the mean of
+//      the source over its footprint, RemapTable), sensor noise, quantisation to 8 bits
+//      (internal_effect_shaders.h)
 //   -> readback through pixel buffer objects, one per in-flight slot.
 //
 // Ground truth, when asked: one more scene pass per view into an R32UI id array and an RG32F
@@ -22,11 +23,26 @@
 #include <cstdint>
 #include <map>
 #include <memory>
+#include <vector>
 
 #include "render/gl/internal_camera_target.h"
 #include "saccade/geometry/lens_map.h"
 
 namespace saccade::render::gl {
+
+/// What the final pass reads of a lens map (kFinalFragmentSource), per pixel of the camera:
+/// - map: (x, y, view, taps), the lens map's entry and the footprint's samples, taps =
+///   nu + 16 nv with nu, nv in [1, 4]: ceil(step length / 1.5 source pixels) along the
+///   pixel's u and v steps;
+/// - footprint: (du.x, du.y, dv.x, dv.y), the source-pixel steps to the neighbouring pixels
+///   (central differences within the pixel's view, one-sided at its edge; zero where no
+///   neighbour shares it, and for pixels with no ray).
+struct RemapTable {
+  std::vector<float> map;
+  std::vector<float> footprint;
+  int64_t multi_tap_pixels = 0;  ///< pixels with more than one sample
+};
+RemapTable MakeRemapTable(const geometry::LensMap& lens);
 
 /// Programs and the empty vertex array shared by every camera's effect passes.
 class EffectPrograms {
@@ -133,7 +149,8 @@ class EffectTarget {
   int source_width_, source_height_, layers_;
   GLuint source_ = 0;        // RGBA8 array
   GLuint accumulation_ = 0;  // RGBA32F array
-  GLuint map_ = 0;           // RGB32F, camera size
+  GLuint map_ = 0;           // RGBA32F, camera size: RemapTable::map
+  GLuint footprint_ = 0;     // RGBA32F, camera size: RemapTable::footprint
   GLuint draw_framebuffer_ = 0;
   GLuint msaa_color_ = 0, depth_ = 0;  // renderbuffers (colour only with MSAA)
   GLuint resolve_framebuffer_ = 0;     // MSAA: the layer to resolve into
