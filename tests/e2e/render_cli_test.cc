@@ -175,6 +175,55 @@ TEST(BenchCli, ReportsFramesPerSecondAndStages) {
   EXPECT_EQ(out["height"].get<int>(), 768);
   EXPECT_EQ(out["cameras"].size(), 2u);
   EXPECT_GT(out["ms_per_frame"]["draw"].get<double>(), 0.0);
+  EXPECT_TRUE(out["ms_per_frame"].contains("effects"));
+  // The default: every effect the scene describes is on.
+  EXPECT_TRUE(out["distortion"].get<bool>());
+  EXPECT_TRUE(out["noise"].get<bool>());
+  EXPECT_TRUE(out["motion_blur"].get<bool>());
+  // The cost of each effect: the bench scene configures all of them, so every run is timed.
+  const json& effects = out["effects"];
+  ASSERT_TRUE(effects.is_array());
+  std::vector<std::string> names;
+  for (const json& run : effects) {
+    names.push_back(run["name"].get<std::string>());
+    EXPECT_TRUE(run["configured"].get<bool>()) << run.dump();
+    EXPECT_GT(run["frames_per_second"].get<double>(), 0.0) << run.dump();
+    EXPECT_NEAR(run["ms_per_frame"].get<double>(), 1000.0 / run["frames_per_second"].get<double>(),
+                1e-6);
+    EXPECT_NEAR(run["extra_ms"].get<double>(),
+                run["ms_per_frame"].get<double>() - effects[0]["ms_per_frame"].get<double>(), 1e-9);
+  }
+  EXPECT_THAT(names,
+              ::testing::ElementsAre("off", "distortion", "noise", "motion_blur", "truth", "all"));
+  EXPECT_EQ(effects[0]["extra_ms"].get<double>(), 0.0);
+  EXPECT_EQ(effects[3]["head_pan_rad_per_s"].get<double>(), 2.0);  // blur needs motion
+}
+
+TEST(BenchCli, SaysWhichEffectsTheSceneDoesNotConfigure) {
+  // The portraits scene's cameras have no lens distortion, noise or exposure.
+  const CommandRun run = Saccade("bench --scene " + kScene + " --frames 2 --warmup 0");
+  ASSERT_EQ(run.status, 0) << run.output;
+  EXPECT_THAT(run.output, HasSubstr("cost of each effect"));
+  EXPECT_THAT(run.output, HasSubstr("blur is not configured"));
+  EXPECT_THAT(run.output, HasSubstr("no camera of the scene has read or shot noise"));
+  EXPECT_THAT(run.output, HasSubstr("truth depth+ids+boxes"));
+  const CommandRun json_run =
+      Saccade("bench --scene " + kScene + " --frames 2 --warmup 0 --no-noise --json");
+  ASSERT_EQ(json_run.status, 0) << json_run.output;
+  const json out = json::parse(json_run.output);
+  EXPECT_FALSE(out["noise"].get<bool>());
+  for (const json& run : out["effects"]) {
+    if (run["name"] == "motion_blur" || run["name"] == "noise") {
+      EXPECT_FALSE(run["configured"].get<bool>()) << run.dump();
+      EXPECT_TRUE(run["frames_per_second"].is_null()) << run.dump();
+      EXPECT_FALSE(run["note"].get<std::string>().empty());
+    }
+  }
+  // --no-effect-table: the first figure only.
+  const CommandRun quick =
+      Saccade("bench --scene " + kScene + " --frames 2 --warmup 0 --no-effect-table");
+  ASSERT_EQ(quick.status, 0) << quick.output;
+  EXPECT_THAT(quick.output, ::testing::Not(HasSubstr("cost of each effect")));
 }
 
 }  // namespace
