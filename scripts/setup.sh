@@ -24,6 +24,8 @@ packages=(
   # reference data and demo assets: OpenCV's sample calibration files, Assimp's test models
   # (broken ones included), MuJoCo's mug
   opencv-doc assimp-testmodels libmujoco-samples
+  # OpenCV's trained Haar cascades (faces, eyes, cat faces) for the perception loop
+  opencv-data
 )
 
 missing=()
