@@ -15,9 +15,9 @@
 #include <system_error>
 #include <utility>
 
+#include "core/internal_yaml.h"
 #include "internal_assets.h"
 #include "internal_robot_body.h"
-#include "internal_yaml.h"
 #include "saccade/core/error.h"
 #include "saccade/geometry/calibration_io.h"
 #include "saccade/scene/scene.h"
@@ -26,7 +26,7 @@ namespace saccade::scene {
 namespace {
 
 namespace fs = std::filesystem;
-using internal::Entry;
+using saccade::internal::Entry;
 
 constexpr double kDegToRad = std::numbers::pi / 180.0;
 // Instance ids stay exact in a float (2^24) for renderers that pass them through one.
@@ -44,6 +44,10 @@ constexpr int kMaxBlurSamples = 64;
 constexpr double kMaxNoiseDn = 64.0;  // read noise, DN
 constexpr double kMaxGainDnPerE = 64.0;
 
+// The YAML reader (core) has no Eigen: its fixed-size arrays become Eigen vectors here.
+Eigen::Vector3d ToEigen(const std::array<double, 3>& v) { return {v[0], v[1], v[2]}; }
+Eigen::Vector4f ToEigen(const std::array<float, 4>& v) { return {v[0], v[1], v[2], v[3]}; }
+
 const Eigen::Vector4f kDefaultPrimitiveColor(0.7f, 0.7f, 0.7f, 1.0f);
 
 // An angle triple given as `<key>_deg` (degrees) or `<key>` (radians): at most one of them.
@@ -53,8 +57,8 @@ std::optional<Eigen::Vector3d> FindAngles(const Entry& parent, const std::string
   const auto rad = parent.Find(key.c_str());
   const auto deg = parent.Find(deg_key.c_str());
   if (rad && deg) deg->Fail("give either '" + key + "' (radians) or '" + deg_key + "', not both");
-  if (deg) return deg->AsVector3(names) * kDegToRad;
-  if (rad) return rad->AsVector3(names);
+  if (deg) return ToEigen(deg->AsVector3(names)) * kDegToRad;
+  if (rad) return ToEigen(rad->AsVector3(names));
   return std::nullopt;
 }
 
@@ -65,7 +69,7 @@ geometry::Pose PoseFrom(const Eigen::Vector3d& position, const Eigen::Vector3d& 
 // {position, rpy | rpy_deg}; rpy defaults to 0.
 geometry::Pose ReadPose(const Entry& e) {
   e.ExpectMap({"position", "rpy", "rpy_deg"}, "a pose {position, rpy_deg}");
-  const Eigen::Vector3d position = e.Get("position").AsVector3();
+  const Eigen::Vector3d position = ToEigen(e.Get("position").AsVector3());
   const Eigen::Vector3d rpy =
       FindAngles(e, "rpy", "[roll, pitch, yaw]").value_or(Eigen::Vector3d::Zero());
   return PoseFrom(position, rpy);
@@ -109,7 +113,7 @@ class SceneReader {
     top.ExpectMap({"background", "lights", "ground", "objects", "robot", "cameras"}, "a scene");
 
     Eigen::Vector3f background(0.62f, 0.72f, 0.82f);
-    if (const auto e = top.Find("background")) background = Rgb(e->AsColor(false));
+    if (const auto e = top.Find("background")) background = Rgb(ToEigen(e->AsColor(false)));
 
     std::vector<Light> lights;
     if (const auto e = top.Find("lights")) {
@@ -218,18 +222,18 @@ class SceneReader {
       light.type = Light::Type::kDirectional;
       e.ExpectMap({"type", "color", "intensity", "direction"}, "a directional light");
       const Entry direction = e.Get("direction");
-      const Eigen::Vector3d d = direction.AsVector3();
+      const Eigen::Vector3d d = ToEigen(direction.AsVector3());
       if (!(d.norm() > 0.0)) direction.Fail("expected a non-zero direction, got [0, 0, 0]");
       light.direction_W = d.normalized();
     } else if (type == "point") {
       light.type = Light::Type::kPoint;
       e.ExpectMap({"type", "color", "intensity", "position", "attenuation"}, "a point light");
-      light.position_W = e.Get("position").AsVector3();
+      light.position_W = ToEigen(e.Get("position").AsVector3());
       if (const auto a = e.Find("attenuation")) light.attenuation = a->AsNonNegative();
     } else {
       type_entry.Fail("expected 'ambient', 'directional' or 'point', got " + type_entry.Describe());
     }
-    if (const auto c = e.Find("color")) light.color = Rgb(c->AsColor(false));
+    if (const auto c = e.Find("color")) light.color = Rgb(ToEigen(c->AsColor(false)));
     if (const auto i = e.Find("intensity"))
       light.intensity = static_cast<float>(i->AsNonNegative());
     return light;
@@ -260,8 +264,8 @@ class SceneReader {
           .Fail(fmt::format("expected line_width < cell, got line_width {} m and cell {} m",
                             g.line_width, g.cell));
     }
-    if (const auto x = e.Find("color")) g.color = Rgb(x->AsColor(false));
-    if (const auto x = e.Find("color2")) g.color2 = Rgb(x->AsColor(false));
+    if (const auto x = e.Find("color")) g.color = Rgb(ToEigen(x->AsColor(false)));
+    if (const auto x = e.Find("color2")) g.color2 = Rgb(ToEigen(x->AsColor(false)));
     return g;
   }
 
@@ -333,7 +337,7 @@ class SceneReader {
       object.model = model;
     } else {
       Eigen::Vector4f color = kDefaultPrimitiveColor;
-      if (const auto c = e.Find("color")) color = c->AsColor(true);
+      if (const auto c = e.Find("color")) color = ToEigen(c->AsColor(true));
       object.model = Primitive(kind, color);
       if (kind == "box") {
         scale = scale.cwiseProduct(ReadPositiveSizes(e.Get("size"), 3, "[x, y, z]"));
@@ -383,7 +387,7 @@ class SceneReader {
                                 waypoints.back().time, waypoint.time));
         }
         waypoint.pose = PoseFrom(
-            item.Get("position").AsVector3(),
+            ToEigen(item.Get("position").AsVector3()),
             FindAngles(item, "rpy", "[roll, pitch, yaw]").value_or(Eigen::Vector3d::Zero()));
         waypoints.push_back(waypoint);
       }
@@ -404,7 +408,7 @@ class SceneReader {
     if (type == "constant_velocity") {
       e.ExpectMap({"type", "linear", "angular", "angular_deg"}, "a constant-velocity motion");
       Eigen::Vector3d v = Eigen::Vector3d::Zero();
-      if (const auto l = e.Find("linear")) v = l->AsVector3("[vx, vy, vz] (m/s)");
+      if (const auto l = e.Find("linear")) v = ToEigen(l->AsVector3("[vx, vy, vz] (m/s)"));
       const Eigen::Vector3d w = FindAngles(e, "angular", "[wx, wy, wz] (about world axes)")
                                     .value_or(Eigen::Vector3d::Zero());
       try {
@@ -574,12 +578,12 @@ class SceneReader {
   // The optical frame (x right, y down, z forward) at `eye` looking at `target`.
   static geometry::Pose ReadLookAt(const Entry& e) {
     e.ExpectMap({"eye", "target", "up"}, "a look_at {eye, target, up}");
-    const Eigen::Vector3d eye = e.Get("eye").AsVector3();
+    const Eigen::Vector3d eye = ToEigen(e.Get("eye").AsVector3());
     const Entry target_entry = e.Get("target");
-    const Eigen::Vector3d target = target_entry.AsVector3();
+    const Eigen::Vector3d target = ToEigen(target_entry.AsVector3());
     Eigen::Vector3d up = Eigen::Vector3d::UnitZ();
     const auto up_entry = e.Find("up");
-    if (up_entry) up = up_entry->AsVector3();
+    if (up_entry) up = ToEigen(up_entry->AsVector3());
     const Eigen::Vector3d forward = target - eye;
     if (!(forward.norm() > 0.0) || !forward.allFinite()) {
       target_entry.Fail("expected a target apart from the eye");
@@ -750,7 +754,7 @@ Scene Scene::Load(const std::filesystem::path& path) {
 
 Scene Scene::FromYamlString(const std::string& text, const std::string& source,
                             const std::filesystem::path& base_dir) {
-  const YAML::Node root = internal::ParseYaml(text, source);
+  const YAML::Node root = saccade::internal::ParseYaml(text, source);
   try {
     return SceneReader(source, base_dir).Read(root);
   } catch (const FileError&) {

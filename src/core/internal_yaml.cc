@@ -1,4 +1,4 @@
-#include "internal_yaml.h"
+#include "core/internal_yaml.h"
 
 #include <fmt/format.h>
 
@@ -10,7 +10,7 @@
 
 #include "saccade/core/error.h"
 
-namespace saccade::scene::internal {
+namespace saccade::internal {
 
 Entry::Entry(YAML::Node node, std::string path, const std::string* file, int fallback_line)
     : node_(std::move(node)), path_(std::move(path)), file_(file), fallback_line_(fallback_line) {}
@@ -185,12 +185,12 @@ std::vector<double> Entry::AsDoubles(int size, const char* names) const {
   return values;
 }
 
-Eigen::Vector3d Entry::AsVector3(const char* names) const {
+std::array<double, 3> Entry::AsVector3(const char* names) const {
   const std::vector<double> v = AsDoubles(3, names);
   return {v[0], v[1], v[2]};
 }
 
-Eigen::Vector4f Entry::AsColor(bool allow_alpha) const {
+std::array<float, 4> Entry::AsColor(bool allow_alpha) const {
   const char* expected = allow_alpha ? "expected a colour [r, g, b] or [r, g, b, a], each in [0, 1]"
                                      : "expected a colour [r, g, b], each in [0, 1]";
   const bool length_ok =
@@ -199,14 +199,14 @@ Eigen::Vector4f Entry::AsColor(bool allow_alpha) const {
     Fail(fmt::format("{}, got {}", expected,
                      node_.IsSequence() ? fmt::format("{} numbers", node_.size()) : Describe()));
   }
-  Eigen::Vector4f color(0.0f, 0.0f, 0.0f, 1.0f);
+  std::array<float, 4> color{0.0f, 0.0f, 0.0f, 1.0f};
   for (std::size_t i = 0; i < node_.size(); ++i) {
     const Entry channel(node_[i], fmt::format("{}[{}]", path_, i), file_, line());
     const double value = channel.AsDouble();
     if (value < 0.0 || value > 1.0) {
       channel.Fail(fmt::format("{}, got {}", expected, value));
     }
-    color[static_cast<int>(i)] = static_cast<float>(value);
+    color[i] = static_cast<float>(value);
   }
   return color;
 }
@@ -224,4 +224,4 @@ YAML::Node ParseYaml(const std::string& text, const std::string& source) {
   }
 }
 
-}  // namespace saccade::scene::internal
+}  // namespace saccade::internal

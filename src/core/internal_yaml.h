@@ -1,18 +1,19 @@
 #pragma once
-// Private to the scene module: a YAML node with its key path and file, so that every error
-// names file, 1-based line and key path ("objects[2].pose.position"). Every accessor checks
-// the node's type and value and throws saccade::FileError; none lets a YAML exception out.
+// Private to saccade's modules (core, scene, runtime): a YAML node with its key path and file, so
+// that every error names file, 1-based line and key path ("objects[2].pose.position"). Every
+// accessor checks the node's type and value and throws saccade::FileError; none lets a YAML
+// exception out.
 
 #include <yaml-cpp/yaml.h>
 
-#include <Eigen/Core>
+#include <array>
 #include <cstdint>
 #include <initializer_list>
 #include <optional>
 #include <string>
 #include <vector>
 
-namespace saccade::scene::internal {
+namespace saccade::internal {
 
 class Entry {
  public:
@@ -58,9 +59,9 @@ class Entry {
   std::string AsNonEmptyString() const;
   /// `size` finite numbers; `names` says what they are in the message ("[x, y, z]").
   std::vector<double> AsDoubles(int size, const char* names = "") const;
-  Eigen::Vector3d AsVector3(const char* names = "[x, y, z]") const;
+  std::array<double, 3> AsVector3(const char* names = "[x, y, z]") const;
   /// A colour: [r, g, b] (alpha 1) or, when `allow_alpha`, [r, g, b, a]; each in [0, 1].
-  Eigen::Vector4f AsColor(bool allow_alpha) const;
+  std::array<float, 4> AsColor(bool allow_alpha) const;
 
  private:
   std::string Join(const std::string& key) const;
@@ -74,4 +75,4 @@ class Entry {
 /// Parses YAML text; a syntax error throws FileError with the line.
 YAML::Node ParseYaml(const std::string& text, const std::string& source);
 
-}  // namespace saccade::scene::internal
+}  // namespace saccade::internal

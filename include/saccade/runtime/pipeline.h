@@ -1,0 +1,127 @@
+#pragma once
+// Pipelines: components in execution order, their parameters and connections, from a YAML
+// file (DESIGN.md: swapping simulated for real hardware is a change of that file).
+//
+//   clock: {mode: simulated, step: 0.04, steps: 500}   # or {mode: realtime, rate_hz: 25}
+//   seed: 1                                            # default 0
+//   on_error: stop                                     # or continue; default stop
+//   components:                                        # execution order
+//     - name: cameras                                  # letters, digits, '_' or '-'
+//       type: sim.cameras                              # a ComponentRegistry type
+//       params: {...}                                  # free-form, handed to Configure
+//     - name: detector
+//       type: vision.faces
+//       inputs:
+//         image: cameras.left                          # <component>.<output>
+//         joints: {from: motors.joints, delay: 1}      # delivered at the next step
+//
+// A connection from a later (or the same) component is a cycle unless it has `delay: 1`;
+// connections from earlier components are delivered at once. Every error is a FileError
+// naming file, line and key.
+
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "saccade/runtime/component.h"
+#include "saccade/runtime/component_registry.h"
+
+namespace saccade::runtime {
+
+enum class ClockMode { kSimulated, kRealtime };
+enum class OnError { kStop, kContinue };
+
+/// How time advances.
+struct ClockSpec {
+  ClockMode mode = ClockMode::kSimulated;
+  double step = 0.04;   ///< s, > 0 (simulated)
+  double rate_hz = 25;  ///< Hz, > 0 (real time)
+  int64_t steps = 0;    ///< steps to run; 0: until RunOptions::stop is set (scheduler.h)
+};
+
+/// One input's connection: `to_input` of the component reads `from_component.from_output`.
+struct ConnectionSpec {
+  std::string from_component;
+  std::string from_output;
+  std::string to_input;
+  int delay = 0;  ///< 0 or 1 step
+  int line = 0;   ///< in the pipeline file
+};
+
+struct ComponentSpec {
+  std::string name;
+  std::string type;
+  nlohmann::json params = nlohmann::json::object();
+  std::vector<ConnectionSpec> inputs;
+  int line = 0;
+  int type_line = 0;
+  int params_line = 0;
+};
+
+/// A parsed (not yet built) pipeline file.
+struct PipelineSpec {
+  std::string file;  ///< for messages
+  ClockSpec clock;
+  uint64_t seed = 0;
+  OnError on_error = OnError::kStop;
+  std::vector<ComponentSpec> components;
+};
+
+/// Parses pipeline YAML; checks its shape (keys, types, ranges, duplicate names).
+/// Throws FileError ("file:line: key: what").
+PipelineSpec ParsePipeline(const std::string& text, const std::string& source);
+/// Reads and parses a pipeline file. Throws FileError.
+PipelineSpec LoadPipelineFile(const std::string& path);
+
+/// The seed handed to a component: a fixed mix of the pipeline seed and the component's
+/// name (the same on every platform and run).
+uint64_t ComponentSeed(uint64_t pipeline_seed, const std::string& component_name);
+
+/// Built components, configured and connected, ready to run (see scheduler.h).
+class Pipeline {
+ public:
+  /// Creates each component from `registry`, configures it with its params and connects the
+  /// ports. Throws FileError naming file, line and key for: an unknown type (listing the
+  /// known ones), bad params (Configure's message), an unknown component or port, ports of
+  /// different message types (naming both), a required input left unconnected, and a cycle
+  /// (naming its components).
+  static Pipeline Build(const PipelineSpec& spec,
+                        const ComponentRegistry& registry = ComponentRegistry::Global());
+  static Pipeline LoadFile(const std::string& path,
+                           const ComponentRegistry& registry = ComponentRegistry::Global());
+  static Pipeline LoadString(const std::string& text, const std::string& source,
+                             const ComponentRegistry& registry = ComponentRegistry::Global());
+
+  Pipeline(Pipeline&&) noexcept;
+  Pipeline& operator=(Pipeline&&) noexcept;
+  ~Pipeline();
+
+  const PipelineSpec& spec() const { return spec_; }
+  /// Components in execution order.
+  const std::vector<std::unique_ptr<Component>>& components() const { return components_; }
+  /// nullptr when there is none of that name.
+  Component* Find(const std::string& name) const;
+  /// The component `name` as a T; nullptr when absent or of another type.
+  template <typename T>
+  T* Find(const std::string& name) const {
+    return dynamic_cast<T*>(Find(name));
+  }
+
+  /// Hands over messages held back by delayed connections (the scheduler, each step).
+  void DeliverDelayed();
+  /// Seconds spent delivering messages since the last call (and resets the count).
+  double TakeDeliverySeconds();
+
+ private:
+  Pipeline() = default;
+
+  PipelineSpec spec_;
+  std::vector<std::unique_ptr<Component>> components_;
+  // Boxed so that the delivery callbacks' pointer stays valid when the pipeline moves.
+  std::unique_ptr<double> delivery_seconds_ = std::make_unique<double>(0.0);
+};
+
+}  // namespace saccade::runtime

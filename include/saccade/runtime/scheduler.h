@@ -1,0 +1,78 @@
+#pragma once
+// Runs a pipeline: Start every component, Step them in order each tick, Stop them.
+//
+// Simulated clock: time = step * clock.step, no waiting; the same pipeline and seed give
+// the same run, bit for bit. Real time: one tick every 1 / rate_hz seconds of wall clock
+// (the loop sleeps until the next tick; a tick that ends after the next one was due is an
+// overrun, counted, and the missed ticks are skipped rather than bunched).
+
+#include <atomic>
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "saccade/runtime/pipeline.h"
+
+namespace saccade::runtime {
+
+/// A component's failure during a run.
+struct StepError {
+  std::string component;
+  std::string phase;  ///< "start", "step" or "stop"
+  int64_t step = -1;  ///< the step index ("step" phase), -1 otherwise
+  std::string message;
+  /// "component 'detector' failed at step 12: <message>"
+  std::string ToString() const;
+};
+
+/// Step times of one component over a run, in milliseconds.
+struct ComponentTiming {
+  std::string name;
+  int64_t steps = 0;  ///< steps timed
+  double mean_ms = 0.0;
+  double median_ms = 0.0;
+  double p95_ms = 0.0;
+  double max_ms = 0.0;
+  int64_t errors = 0;
+};
+
+/// What a run did and where its time went.
+struct RunSummary {
+  int64_t steps = 0;                        ///< steps completed (the failing step included)
+  double sim_time = 0.0;                    ///< s: context time of the last step
+  double wall_seconds = 0.0;                ///< from Start to the end of Stop
+  bool stopped_on_error = false;            ///< on_error: stop ended the run
+  std::vector<StepError> errors;            ///< every failure, in order
+  std::vector<ComponentTiming> components;  ///< in execution order
+  /// Per step, the loop's time outside components' own work: message delivery, the
+  /// scheduler's bookkeeping (not the real-time sleep). Mean, median and p95 in ms.
+  double overhead_mean_ms = 0.0;
+  double overhead_median_ms = 0.0;
+  double overhead_p95_ms = 0.0;
+  /// overhead / (overhead + components' time), over the whole run, in [0, 1].
+  double overhead_share = 0.0;
+  int64_t overruns = 0;  ///< real time: ticks that ended after the next was due
+
+  /// One line: steps, errors, overhead share.
+  std::string BriefReport() const;
+  /// A table: one line per component plus the overhead.
+  std::string FullReport() const;
+};
+
+struct RunOptions {
+  /// Overrides the pipeline's clock.steps when >= 0 (0: until `stop`).
+  int64_t steps = -1;
+  /// Set (from another thread, a signal handler) to end the run after the current step.
+  const std::atomic<bool>* stop = nullptr;
+  /// Told of each failure as it happens (e.g. to log it); may be empty.
+  std::function<void(const StepError&)> on_error;
+  /// Called after each step with its context (progress, recording); may be empty.
+  std::function<void(const StepContext&)> after_step;
+};
+
+/// Runs `pipeline` once. Component failures are reported in the summary, not thrown;
+/// throws InvalidArgument when neither steps nor a stop flag bound the run.
+RunSummary RunPipeline(Pipeline& pipeline, const RunOptions& options = {});
+
+}  // namespace saccade::runtime

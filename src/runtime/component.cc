@@ -1,0 +1,45 @@
+#include "saccade/runtime/component.h"
+
+#include <algorithm>
+
+namespace saccade::runtime {
+namespace {
+
+bool IsIdentifier(const std::string& name) {
+  if (name.empty()) return false;
+  return std::all_of(name.begin(), name.end(), [](char c) {
+    return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_' ||
+           c == '-';
+  });
+}
+
+}  // namespace
+
+InputBase* Component::FindInput(const std::string& name) const {
+  for (const auto& port : inputs_) {
+    if (port->name() == name) return port.get();
+  }
+  return nullptr;
+}
+
+OutputBase* Component::FindOutput(const std::string& name) const {
+  for (const auto& port : outputs_) {
+    if (port->name() == name) return port.get();
+  }
+  return nullptr;
+}
+
+void Component::CheckNewPort(const std::string& name, bool input) const {
+  const char* kind = input ? "AddInput" : "AddOutput";
+  if (!IsIdentifier(name)) {
+    throw InvalidArgument(std::string("Component::") + kind + ": component '" + name_ +
+                          "': port name '" + name +
+                          "' must be non-empty letters, digits, '_' or '-'");
+  }
+  if ((input && FindInput(name) != nullptr) || (!input && FindOutput(name) != nullptr)) {
+    throw InvalidArgument(std::string("Component::") + kind + ": component '" + name_ +
+                          "' already has a port named '" + name + "'");
+  }
+}
+
+}  // namespace saccade::runtime

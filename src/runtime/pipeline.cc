@@ -1,0 +1,406 @@
+#include "saccade/runtime/pipeline.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cstdint>
+#include <fstream>
+#include <limits>
+#include <map>
+#include <optional>
+#include <set>
+#include <sstream>
+#include <utility>
+
+#include "core/internal_yaml.h"
+
+namespace saccade::runtime {
+namespace {
+
+using saccade::internal::Entry;
+
+// Names are used in "<component>.<port>" references: no dots, no spaces.
+bool IsName(const std::string& name) {
+  return !name.empty() && std::all_of(name.begin(), name.end(), [](char c) {
+    return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_' ||
+           c == '-';
+  });
+}
+
+int KeyLine(const YAML::Node& key, int fallback) {
+  return key.Mark().is_null() ? fallback : key.Mark().line + 1;
+}
+
+// Plain YAML scalars become JSON numbers, booleans or null where they read as such; quoted
+// ones stay strings.
+nlohmann::json ToJson(const Entry& e) {
+  const YAML::Node& node = e.node();
+  if (!node.IsDefined() || node.IsNull()) return nullptr;
+  if (node.IsSequence()) {
+    nlohmann::json array = nlohmann::json::array();
+    for (std::size_t i = 0; i < node.size(); ++i) {
+      array.push_back(
+          ToJson(Entry(node[i], fmt::format("{}[{}]", e.path(), i), &e.file(), e.line())));
+    }
+    return array;
+  }
+  if (node.IsMap()) {
+    nlohmann::json object = nlohmann::json::object();
+    for (auto it = node.begin(); it != node.end(); ++it) {
+      const int key_line = KeyLine(it->first, e.line());
+      if (!it->first.IsScalar()) {
+        throw FileError(e.file(), key_line, e.path(), "expected a key name, got a list or a map");
+      }
+      const std::string key = it->first.Scalar();
+      if (object.contains(key)) {
+        throw FileError(e.file(), key_line, e.path() + "." + key, "duplicate key '" + key + "'");
+      }
+      object[key] = ToJson(Entry(it->second, e.path() + "." + key, &e.file(), key_line));
+    }
+    return object;
+  }
+  const std::string& text = node.Scalar();
+  if (node.Tag() == "!") return text;  // quoted
+  long long integer = 0;
+  double number = 0.0;
+  bool boolean = false;
+  if (YAML::convert<long long>::decode(node, integer)) return integer;
+  if (YAML::convert<double>::decode(node, number)) return number;
+  if (YAML::convert<bool>::decode(node, boolean)) return boolean;
+  return text;
+}
+
+ClockSpec ParseClock(const Entry& e) {
+  e.ExpectMap({"mode", "step", "rate_hz", "steps"}, "a clock {mode, step | rate_hz, steps}");
+  ClockSpec clock;
+  const Entry mode = e.Get("mode");
+  const std::string name = mode.AsString();
+  if (name == "simulated") {
+    clock.mode = ClockMode::kSimulated;
+    if (const auto r = e.Find("rate_hz")) r->Fail("'rate_hz' is for mode realtime; use 'step'");
+    if (const auto s = e.Find("step")) clock.step = s->AsPositive();
+  } else if (name == "realtime") {
+    clock.mode = ClockMode::kRealtime;
+    if (const auto s = e.Find("step")) s->Fail("'step' is for mode simulated; use 'rate_hz'");
+    if (const auto r = e.Find("rate_hz")) clock.rate_hz = r->AsPositive();
+    clock.step = 1.0 / clock.rate_hz;
+  } else {
+    mode.Fail("expected simulated or realtime, got " + mode.Describe());
+  }
+  if (const auto s = e.Find("steps")) {
+    clock.steps = s->AsInteger(0, std::numeric_limits<int64_t>::max());
+  }
+  return clock;
+}
+
+ConnectionSpec ParseConnection(const Entry& e, const std::string& input) {
+  ConnectionSpec connection;
+  connection.to_input = input;
+  connection.line = e.line();
+  std::optional<Entry> from;
+  if (e.IsMap()) {
+    e.ExpectMap({"from", "delay"}, "a connection {from: component.output, delay: 0 | 1}");
+    from = e.Get("from");
+    if (const auto d = e.Find("delay")) connection.delay = static_cast<int>(d->AsInteger(0, 1));
+  } else if (e.IsScalar()) {
+    from = e;
+  } else {
+    e.Fail("expected a connection 'component.output' or {from: component.output, delay: 1}, got " +
+           e.Describe());
+  }
+  const std::string text = from->AsString();
+  const std::size_t dot = text.find('.');
+  if (dot == std::string::npos || !IsName(text.substr(0, dot)) || !IsName(text.substr(dot + 1))) {
+    from->Fail("expected 'component.output', got '" + text + "'");
+  }
+  connection.from_component = text.substr(0, dot);
+  connection.from_output = text.substr(dot + 1);
+  return connection;
+}
+
+ComponentSpec ParseComponent(const Entry& e) {
+  e.ExpectMap({"name", "type", "params", "inputs"}, "a component {name, type, params, inputs}");
+  ComponentSpec spec;
+  spec.line = e.line();
+  const Entry name = e.Get("name");
+  spec.name = name.AsNonEmptyString();
+  if (!IsName(spec.name)) {
+    name.Fail("expected a name of letters, digits, '_' or '-' (no dots), got '" + spec.name + "'");
+  }
+  const Entry type = e.Get("type");
+  spec.type = type.AsNonEmptyString();
+  spec.type_line = type.line();
+  spec.params_line = spec.line;
+  if (const auto params = e.Find("params")) {
+    spec.params_line = params->line();
+    if (!params->IsNull()) {
+      if (!params->IsMap()) params->Fail("expected a map of parameters, got " + params->Describe());
+      spec.params = ToJson(*params);
+    }
+  }
+  if (const auto inputs = e.Find("inputs")) {
+    if (!inputs->IsNull()) {
+      if (!inputs->IsMap()) {
+        inputs->Fail("expected a map input: component.output, got " + inputs->Describe());
+      }
+      std::set<std::string> seen;
+      for (auto it = inputs->node().begin(); it != inputs->node().end(); ++it) {
+        const int key_line = KeyLine(it->first, inputs->line());
+        if (!it->first.IsScalar()) {
+          throw FileError(inputs->file(), key_line, inputs->path(), "expected an input name");
+        }
+        const std::string input = it->first.Scalar();
+        const std::string path = inputs->path() + "." + input;
+        if (!seen.insert(input).second) {
+          throw FileError(inputs->file(), key_line, path,
+                          "input '" + input + "' is connected twice");
+        }
+        spec.inputs.push_back(
+            ParseConnection(Entry(it->second, path, &inputs->file(), key_line), input));
+      }
+    }
+  }
+  return spec;
+}
+
+std::string Join(const std::vector<std::string>& names) {
+  std::string text;
+  for (const std::string& name : names) text += (text.empty() ? "" : ", ") + name;
+  return text.empty() ? "(none)" : text;
+}
+
+template <typename Ports>
+std::string PortNames(const Ports& ports) {
+  std::vector<std::string> names;
+  for (const auto& port : ports) names.push_back(port->name() + " (" + port->message_type() + ")");
+  return Join(names);
+}
+
+std::string ComponentKey(std::size_t index) { return fmt::format("components[{}]", index); }
+
+}  // namespace
+
+PipelineSpec ParsePipeline(const std::string& text, const std::string& source) {
+  const YAML::Node root_node = saccade::internal::ParseYaml(text, source);
+  const Entry root(root_node, "", &source, 1);
+  root.ExpectMap({"clock", "seed", "on_error", "components"},
+                 "a pipeline {clock, seed, on_error, components}");
+  PipelineSpec spec;
+  spec.file = source;
+  if (const auto clock = root.Find("clock")) spec.clock = ParseClock(*clock);
+  if (const auto seed = root.Find("seed")) spec.seed = seed->AsUint64();
+  if (const auto on_error = root.Find("on_error")) {
+    const std::string value = on_error->AsString();
+    if (value == "stop") {
+      spec.on_error = OnError::kStop;
+    } else if (value == "continue") {
+      spec.on_error = OnError::kContinue;
+    } else {
+      on_error->Fail("expected stop or continue, got " + on_error->Describe());
+    }
+  }
+  const Entry components = root.Get("components");
+  const std::vector<Entry> entries = components.AsSequence("components");
+  if (entries.empty()) components.Fail("expected at least one component, got an empty list");
+  std::map<std::string, int> lines;  // name -> line of its first use
+  for (const Entry& entry : entries) {
+    ComponentSpec component = ParseComponent(entry);
+    const auto [it, inserted] = lines.emplace(component.name, component.line);
+    if (!inserted) {
+      entry.Get("name").Fail(fmt::format("duplicate component name '{}' (first at line {})",
+                                         component.name, it->second));
+    }
+    spec.components.push_back(std::move(component));
+  }
+  return spec;
+}
+
+PipelineSpec LoadPipelineFile(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw FileError(path, 0, "", "cannot open the pipeline file");
+  std::ostringstream text;
+  text << in.rdbuf();
+  return ParsePipeline(text.str(), path);
+}
+
+uint64_t ComponentSeed(uint64_t pipeline_seed, const std::string& component_name) {
+  // FNV-1a of the name, then SplitMix64's finaliser over the mix: fixed on every platform,
+  // unlike std::hash.
+  uint64_t hash = 14695981039346656037ull;
+  for (const unsigned char c : component_name) {
+    hash ^= c;
+    hash *= 1099511628211ull;
+  }
+  uint64_t z = pipeline_seed + 0x9e3779b97f4a7c15ull * (hash | 1);
+  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+  z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+  return z ^ (z >> 31);
+}
+
+Pipeline::Pipeline(Pipeline&&) noexcept = default;
+Pipeline& Pipeline::operator=(Pipeline&&) noexcept = default;
+Pipeline::~Pipeline() = default;
+
+Pipeline Pipeline::LoadFile(const std::string& path, const ComponentRegistry& registry) {
+  return Build(LoadPipelineFile(path), registry);
+}
+
+Pipeline Pipeline::LoadString(const std::string& text, const std::string& source,
+                              const ComponentRegistry& registry) {
+  return Build(ParsePipeline(text, source), registry);
+}
+
+Pipeline Pipeline::Build(const PipelineSpec& spec, const ComponentRegistry& registry) {
+  Pipeline pipeline;
+  pipeline.spec_ = spec;
+  const std::string& file = spec.file;
+  const std::size_t n = spec.components.size();
+  std::map<std::string, std::size_t> index;
+  for (std::size_t i = 0; i < n; ++i) {
+    const ComponentSpec& c = spec.components[i];
+    if (!index.emplace(c.name, i).second) {
+      throw FileError(file, c.line, ComponentKey(i) + ".name",
+                      "duplicate component name '" + c.name + "'");
+    }
+  }
+
+  // Create and configure, in order.
+  for (std::size_t i = 0; i < n; ++i) {
+    const ComponentSpec& c = spec.components[i];
+    if (!registry.Has(c.type)) {
+      throw FileError(file, c.type_line, ComponentKey(i) + ".type",
+                      "unknown component type '" + c.type + "' for component '" + c.name +
+                          "'; known types: " + Join(registry.Types()));
+    }
+    std::unique_ptr<Component> component = registry.Create(c.type);
+    component->Initialise(c.name, ComponentSeed(spec.seed, c.name));
+    try {
+      component->Configure(c.params);
+    } catch (const std::exception& error) {
+      throw FileError(file, c.params_line, ComponentKey(i) + ".params",
+                      "component '" + c.name + "' (" + c.type + "): " + error.what());
+    }
+    pipeline.components_.push_back(std::move(component));
+  }
+
+  // Immediate edges producer -> consumer, to name the components of a cycle.
+  std::vector<std::vector<std::size_t>> readers(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    for (const ConnectionSpec& connection : spec.components[i].inputs) {
+      const auto it = index.find(connection.from_component);
+      if (it != index.end() && connection.delay == 0) readers[it->second].push_back(i);
+    }
+  }
+
+  double* delivery_seconds = pipeline.delivery_seconds_.get();
+  for (std::size_t i = 0; i < n; ++i) {
+    const ComponentSpec& c = spec.components[i];
+    Component& consumer = *pipeline.components_[i];
+    for (const ConnectionSpec& connection : c.inputs) {
+      const std::string key = ComponentKey(i) + ".inputs." + connection.to_input;
+      const std::string from = connection.from_component + "." + connection.from_output;
+      const auto Fail = [&](const std::string& what) {
+        throw FileError(file, connection.line, key, what);
+      };
+      InputBase* input = consumer.FindInput(connection.to_input);
+      if (input == nullptr) {
+        Fail(fmt::format("component '{}' ({}) has no input '{}'; its inputs: {}", c.name, c.type,
+                         connection.to_input, PortNames(consumer.inputs())));
+      }
+      const auto it = index.find(connection.from_component);
+      if (it == index.end()) {
+        std::vector<std::string> names;
+        for (const ComponentSpec& other : spec.components) names.push_back(other.name);
+        Fail(fmt::format("unknown component '{}' in '{}'; components: {}",
+                         connection.from_component, from, Join(names)));
+      }
+      const std::size_t j = it->second;
+      const Component& producer = *pipeline.components_[j];
+      OutputBase* output = producer.FindOutput(connection.from_output);
+      if (output == nullptr) {
+        Fail(fmt::format("component '{}' ({}) has no output '{}'; its outputs: {}", producer.name(),
+                         spec.components[j].type, connection.from_output,
+                         PortNames(producer.outputs())));
+      }
+      if (output->message_type() != input->message_type()) {
+        Fail(fmt::format("type mismatch: output '{}' sends {}, input '{}.{}' expects {}", from,
+                         output->message_type(), c.name, connection.to_input,
+                         input->message_type()));
+      }
+      if (j >= i && connection.delay == 0) {
+        // The producer runs after (or is) the consumer: find the consumer's path to it.
+        std::vector<std::size_t> parent(n, n);
+        std::vector<std::size_t> queue{i};
+        std::vector<bool> seen(n, false);
+        seen[i] = true;
+        for (std::size_t q = 0; q < queue.size() && !seen[j]; ++q) {
+          for (std::size_t next : readers[queue[q]]) {
+            if (!seen[next]) {
+              seen[next] = true;
+              parent[next] = queue[q];
+              queue.push_back(next);
+            }
+          }
+        }
+        if (j == i || seen[j]) {
+          std::string cycle = c.name;
+          if (j != i) {
+            std::vector<std::string> path;
+            for (std::size_t k = j; k != n; k = parent[k]) path.push_back(spec.components[k].name);
+            std::reverse(path.begin(), path.end());
+            cycle.clear();
+            for (const std::string& name : path) cycle += name + " -> ";
+          } else {
+            cycle += " -> ";
+          }
+          cycle += c.name;
+          Fail(
+              fmt::format("cycle: {} without a delay; add 'delay: 1' to one of its connections, "
+                          "e.g. this one: {{from: {}, delay: 1}}",
+                          cycle, from));
+        }
+        Fail(
+            fmt::format("'{}' runs after '{}' in execution order, so this connection closes a "
+                        "cycle: list '{}' before '{}', or add 'delay: 1' to read the previous "
+                        "step's message ({{from: {}, delay: 1}})",
+                        producer.name(), c.name, producer.name(), c.name, from));
+      }
+      try {
+        input->ConnectFrom(*output, connection.delay,
+                           [delivery_seconds](double seconds) { *delivery_seconds += seconds; });
+      } catch (const Error& error) {
+        Fail(error.what());
+      }
+    }
+    for (const auto& input : consumer.inputs()) {
+      if (input->required() && !input->connected()) {
+        throw FileError(file, c.line, ComponentKey(i) + ".inputs",
+                        fmt::format("required input '{}' ({}) of component '{}' ({}) is not "
+                                    "connected",
+                                    input->name(), input->message_type(), c.name, c.type));
+      }
+    }
+  }
+  return pipeline;
+}
+
+Component* Pipeline::Find(const std::string& name) const {
+  for (const auto& component : components_) {
+    if (component->name() == name) return component.get();
+  }
+  return nullptr;
+}
+
+void Pipeline::DeliverDelayed() {
+  for (const auto& component : components_) {
+    for (const auto& input : component->inputs()) input->DeliverDelayed();
+  }
+}
+
+double Pipeline::TakeDeliverySeconds() {
+  const double seconds = *delivery_seconds_;
+  *delivery_seconds_ = 0.0;
+  return seconds;
+}
+
+}  // namespace saccade::runtime

@@ -1,0 +1,205 @@
+#include "saccade/runtime/scheduler.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <exception>
+#include <thread>
+#include <utility>
+
+namespace saccade::runtime {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double Seconds(Clock::duration d) { return std::chrono::duration<double>(d).count(); }
+
+struct Stats {
+  double mean = 0.0;
+  double median = 0.0;
+  double p95 = 0.0;
+  double max = 0.0;
+};
+
+// Milliseconds from seconds; p95 by nearest rank.
+Stats Summarise(std::vector<double> seconds) {
+  Stats stats;
+  if (seconds.empty()) return stats;
+  std::sort(seconds.begin(), seconds.end());
+  double sum = 0.0;
+  for (double s : seconds) sum += s;
+  const std::size_t n = seconds.size();
+  stats.mean = 1e3 * sum / static_cast<double>(n);
+  stats.median = 1e3 * (n % 2 == 1 ? seconds[n / 2] : 0.5 * (seconds[n / 2 - 1] + seconds[n / 2]));
+  const auto rank = static_cast<std::size_t>(std::ceil(0.95 * static_cast<double>(n)));
+  stats.p95 = 1e3 * seconds[std::max<std::size_t>(rank, 1) - 1];
+  stats.max = 1e3 * seconds.back();
+  return stats;
+}
+
+std::string What(const std::exception_ptr& error) {
+  try {
+    std::rethrow_exception(error);
+  } catch (const std::exception& e) {
+    return e.what();
+  } catch (...) {
+    return "unknown exception";
+  }
+}
+
+}  // namespace
+
+std::string StepError::ToString() const {
+  if (phase == "step") {
+    return fmt::format("component '{}' failed at step {}: {}", component, step, message);
+  }
+  return fmt::format("component '{}' failed in {}: {}", component, phase, message);
+}
+
+std::string RunSummary::BriefReport() const {
+  return fmt::format("{} steps, {} errors{}, overhead {:.4f} ms/step ({:.2f}% of the loop){}",
+                     steps, errors.size(), stopped_on_error ? " (stopped on error)" : "",
+                     overhead_mean_ms, 100.0 * overhead_share,
+                     overruns > 0 ? fmt::format(", {} overruns", overruns) : "");
+}
+
+std::string RunSummary::FullReport() const {
+  std::string text = BriefReport() + "\n";
+  text += fmt::format("{:<24} {:>8} {:>10} {:>10} {:>10} {:>10} {:>7}\n", "component", "steps",
+                      "mean ms", "median ms", "p95 ms", "max ms", "errors");
+  for (const ComponentTiming& c : components) {
+    text += fmt::format("{:<24} {:>8} {:>10.4f} {:>10.4f} {:>10.4f} {:>10.4f} {:>7}\n", c.name,
+                        c.steps, c.mean_ms, c.median_ms, c.p95_ms, c.max_ms, c.errors);
+  }
+  text += fmt::format("{:<24} {:>8} {:>10.4f} {:>10.4f} {:>10.4f}\n", "(outside components)", steps,
+                      overhead_mean_ms, overhead_median_ms, overhead_p95_ms);
+  for (const StepError& error : errors) text += error.ToString() + "\n";
+  return text;
+}
+
+RunSummary RunPipeline(Pipeline& pipeline, const RunOptions& options) {
+  const PipelineSpec& spec = pipeline.spec();
+  const int64_t steps = options.steps >= 0 ? options.steps : spec.clock.steps;
+  if (steps == 0 && options.stop == nullptr) {
+    throw InvalidArgument("RunPipeline: pipeline '" + spec.file +
+                          "' has no clock.steps and no stop flag was given: it would never end");
+  }
+  const bool realtime = spec.clock.mode == ClockMode::kRealtime;
+  const double dt = realtime ? 1.0 / spec.clock.rate_hz : spec.clock.step;
+  const auto& components = pipeline.components();
+  const std::size_t n = components.size();
+
+  RunSummary summary;
+  std::vector<std::vector<double>> step_seconds(n);
+  std::vector<double> overhead_seconds;
+  std::vector<int64_t> error_counts(n, 0);
+  const auto report = [&](StepError error) {
+    if (options.on_error) options.on_error(error);
+    summary.errors.push_back(std::move(error));
+  };
+
+  const Clock::time_point run_start = Clock::now();
+  std::size_t started = 0;
+  for (; started < n; ++started) {
+    try {
+      components[started]->Start();
+    } catch (...) {
+      report({components[started]->name(), "start", -1, What(std::current_exception())});
+      ++error_counts[started];
+      summary.stopped_on_error = true;
+      break;
+    }
+  }
+
+  if (started == n) {
+    pipeline.TakeDeliverySeconds();  // deliveries during Start are not the loop's
+    const auto period = std::chrono::round<Clock::duration>(std::chrono::duration<double>(dt));
+    const Clock::time_point loop_start = Clock::now();
+    Clock::time_point next_tick = loop_start;
+    double total_component = 0.0;
+    double total_overhead = 0.0;
+    for (int64_t k = 0; steps == 0 || k < steps; ++k) {
+      if (options.stop != nullptr && options.stop->load()) break;
+      if (realtime) std::this_thread::sleep_until(next_tick);
+      const Clock::time_point tick_start = Clock::now();
+      StepContext context;
+      context.step = k;
+      // Simulated time is a product, not a running sum: no drift, the same on every run.
+      context.time = realtime ? Seconds(tick_start - loop_start) : static_cast<double>(k) * dt;
+      context.dt = dt;
+
+      pipeline.DeliverDelayed();
+      double component_seconds = 0.0;
+      bool stop_now = false;
+      for (std::size_t i = 0; i < n; ++i) {
+        Component& component = *components[i];
+        context.seed = component.seed();
+        pipeline.TakeDeliverySeconds();
+        const Clock::time_point start = Clock::now();
+        try {
+          component.Step(context);
+        } catch (...) {
+          report({component.name(), "step", k, What(std::current_exception())});
+          ++error_counts[i];
+          stop_now = spec.on_error == OnError::kStop;
+        }
+        // Deliveries made while the component emitted are the bus's time, not the component's.
+        const double own =
+            std::max(0.0, Seconds(Clock::now() - start) - pipeline.TakeDeliverySeconds());
+        for (const auto& input : component.inputs()) input->MarkSeen();
+        step_seconds[i].push_back(own);
+        component_seconds += own;
+        if (stop_now) break;
+      }
+      const double loop = Seconds(Clock::now() - tick_start);
+      const double overhead = std::max(0.0, loop - component_seconds);
+      overhead_seconds.push_back(overhead);
+      total_component += component_seconds;
+      total_overhead += overhead;
+      summary.steps = k + 1;
+      summary.sim_time = context.time;
+      if (options.after_step) options.after_step(context);
+      if (stop_now) {
+        summary.stopped_on_error = true;
+        break;
+      }
+      if (realtime) {
+        next_tick += period;
+        const Clock::time_point now = Clock::now();
+        if (now > next_tick) {
+          ++summary.overruns;
+          while (next_tick < now) next_tick += period;  // skip missed ticks, do not bunch
+        }
+      }
+    }
+    const double total = total_component + total_overhead;
+    summary.overhead_share = total > 0.0 ? total_overhead / total : 0.0;
+  }
+
+  // Every started component is stopped, the last started first.
+  for (std::size_t i = started; i-- > 0;) {
+    try {
+      components[i]->Stop();
+    } catch (...) {
+      report({components[i]->name(), "stop", -1, What(std::current_exception())});
+      ++error_counts[i];
+    }
+  }
+  summary.wall_seconds = Seconds(Clock::now() - run_start);
+
+  for (std::size_t i = 0; i < n; ++i) {
+    const Stats stats = Summarise(step_seconds[i]);
+    summary.components.push_back({components[i]->name(),
+                                  static_cast<int64_t>(step_seconds[i].size()), stats.mean,
+                                  stats.median, stats.p95, stats.max, error_counts[i]});
+  }
+  const Stats overhead = Summarise(std::move(overhead_seconds));
+  summary.overhead_mean_ms = overhead.mean;
+  summary.overhead_median_ms = overhead.median;
+  summary.overhead_p95_ms = overhead.p95;
+  return summary;
+}
+
+}  // namespace saccade::runtime

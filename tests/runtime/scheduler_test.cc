@@ -1,0 +1,275 @@
+// Running pipelines: order and delays, determinism, failures (stop / continue), real-time
+// pacing, and the timing summary.
+
+#include "saccade/runtime/scheduler.h"
+
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <chrono>
+#include <string>
+#include <vector>
+
+#include "runtime/test_components.h"
+
+namespace saccade::runtime {
+namespace {
+
+using testing::MakeTestRegistry;
+using testing::Record;
+using testing::Recorder;
+using testing::Thrower;
+
+Pipeline Load(const std::string& text) {
+  static const ComponentRegistry registry = MakeTestRegistry();
+  return Pipeline::LoadString(text, "run.yaml", registry);
+}
+
+TEST(SchedulerTest, ImmediateConnectionDeliversWithinTheStep) {
+  Pipeline pipeline = Load(R"(clock: {mode: simulated, step: 0.25, steps: 3}
+components:
+  - {name: source, type: test.source, params: {start: 100}}
+  - {name: recorder, type: test.recorder, inputs: {in: source.out}}
+)");
+  const RunSummary summary = RunPipeline(pipeline);
+  EXPECT_EQ(summary.steps, 3);
+  EXPECT_TRUE(summary.errors.empty());
+  const auto& records = pipeline.Find<Recorder>("recorder")->records;
+  ASSERT_EQ(records.size(), 3u);
+  for (int k = 0; k < 3; ++k) {
+    EXPECT_EQ(records[k].step, k);
+    EXPECT_EQ(records[k].time, 0.25 * k);
+    EXPECT_TRUE(records[k].fresh);
+    EXPECT_EQ(records[k].value, 100.0 + k);
+  }
+}
+
+TEST(SchedulerTest, DelayedFeedbackArrivesOneStepLater) {
+  // recorder runs first and reads source's output of the previous step.
+  Pipeline pipeline = Load(R"(clock: {mode: simulated, step: 1, steps: 4}
+components:
+  - name: recorder
+    type: test.recorder
+    inputs:
+      in: {from: source.out, delay: 1}
+  - {name: source, type: test.source, params: {start: 10}}
+)");
+  RunPipeline(pipeline);
+  const auto& r = pipeline.Find<Recorder>("recorder")->records;
+  ASSERT_EQ(r.size(), 4u);
+  EXPECT_FALSE(r[0].has_value);
+  EXPECT_FALSE(r[0].fresh);
+  for (int k = 1; k < 4; ++k) {
+    EXPECT_TRUE(r[k].fresh);
+    EXPECT_EQ(r[k].value, 10.0 + (k - 1)) << "step " << k;
+  }
+}
+
+TEST(SchedulerTest, DelayedLoopThroughTwoComponents) {
+  // relay reads its own output through a delay: 1, 2, 3, ... one per step.
+  Pipeline pipeline = Load(R"(clock: {mode: simulated, step: 1, steps: 5}
+components:
+  - name: relay
+    type: test.relay
+    inputs: {in: {from: seeder.out, delay: 1}}
+  - name: seeder
+    type: test.relay
+    inputs: {in: relay.out}
+  - {name: recorder, type: test.recorder, inputs: {in: seeder.out}}
+)");
+  RunPipeline(pipeline);
+  // Nothing ever starts the loop: relay has no value, so nothing is emitted.
+  const auto& r = pipeline.Find<Recorder>("recorder")->records;
+  ASSERT_EQ(r.size(), 5u);
+  for (const Record& record : r) EXPECT_FALSE(record.has_value);
+}
+
+TEST(SchedulerTest, FreshOnlyWhenANewMessageArrived) {
+  // source emits at steps 0, 2, 4; the recorder keeps the latest in between.
+  Pipeline pipeline = Load(R"(clock: {mode: simulated, step: 1, steps: 5}
+components:
+  - {name: source, type: test.source, params: {every: 2}}
+  - {name: recorder, type: test.recorder, inputs: {in: source.out}}
+)");
+  RunPipeline(pipeline);
+  const auto& r = pipeline.Find<Recorder>("recorder")->records;
+  ASSERT_EQ(r.size(), 5u);
+  const bool fresh[] = {true, false, true, false, true};
+  const double value[] = {0, 0, 2, 2, 4};
+  for (int k = 0; k < 5; ++k) {
+    EXPECT_TRUE(r[k].has_value);
+    EXPECT_EQ(r[k].fresh, fresh[k]) << "step " << k;
+    EXPECT_EQ(r[k].value, value[k]) << "step " << k;
+  }
+}
+
+std::vector<double> RandomRun(uint64_t seed) {
+  Pipeline pipeline = Load(R"(clock: {mode: simulated, step: 0.04, steps: 50}
+seed: )" + std::to_string(seed) +
+                           R"(
+components:
+  - {name: noise, type: test.random}
+  - {name: other_noise, type: test.random}
+  - {name: recorder, type: test.recorder, inputs: {in: noise.out}}
+  - {name: other, type: test.recorder, inputs: {in: other_noise.out}}
+)");
+  RunPipeline(pipeline);
+  std::vector<double> values;
+  for (const char* name : {"recorder", "other"}) {
+    for (const Record& r : pipeline.Find<Recorder>(name)->records) {
+      values.push_back(r.value);
+      values.push_back(r.time);
+    }
+  }
+  return values;
+}
+
+TEST(SchedulerTest, SimulatedRunsAreDeterministicPerSeed) {
+  const std::vector<double> a = RandomRun(1);
+  const std::vector<double> b = RandomRun(1);
+  const std::vector<double> c = RandomRun(2);
+  ASSERT_EQ(a.size(), 200u);
+  EXPECT_EQ(a, b);  // bit for bit
+  EXPECT_NE(a, c);
+  // Two components of the same type get different streams.
+  EXPECT_NE(a[0], a[100]);
+}
+
+constexpr const char* kThrowing = R"(clock: {mode: simulated, step: 1, steps: 6}
+on_error: ON_ERROR
+components:
+  - {name: before, type: test.thrower}
+  - {name: camera, type: test.thrower, params: {at: 2}}
+  - {name: after, type: test.thrower}
+)";
+
+std::string WithOnError(const std::string& value) {
+  std::string text = kThrowing;
+  text.replace(text.find("ON_ERROR"), 8, value);
+  return text;
+}
+
+TEST(SchedulerTest, ThrowingComponentStopsTheRunCleanly) {
+  Pipeline pipeline = Load(WithOnError("stop"));
+  std::vector<std::string> reported;
+  RunOptions options;
+  options.on_error = [&](const StepError& e) { reported.push_back(e.ToString()); };
+  const RunSummary summary = RunPipeline(pipeline, options);
+  EXPECT_TRUE(summary.stopped_on_error);
+  EXPECT_EQ(summary.steps, 3);  // steps 0, 1 and the failing 2
+  ASSERT_EQ(summary.errors.size(), 1u);
+  EXPECT_EQ(summary.errors[0].component, "camera");
+  EXPECT_EQ(summary.errors[0].step, 2);
+  EXPECT_EQ(summary.errors[0].message, "sensor unplugged");
+  EXPECT_EQ(reported,
+            (std::vector<std::string>{"component 'camera' failed at step 2: sensor unplugged"}));
+  const auto* before = pipeline.Find<Thrower>("before");
+  const auto* camera = pipeline.Find<Thrower>("camera");
+  const auto* after = pipeline.Find<Thrower>("after");
+  EXPECT_EQ(before->steps, 3);
+  EXPECT_EQ(camera->steps, 3);
+  EXPECT_EQ(after->steps, 2);  // the failing step ends at the failing component
+  for (const Thrower* t : {before, camera, after}) {
+    EXPECT_EQ(t->starts, 1);
+    EXPECT_EQ(t->stops, 1);
+  }
+  EXPECT_EQ(summary.components[1].errors, 1);
+  EXPECT_NE(summary.BriefReport().find("stopped on error"), std::string::npos);
+}
+
+TEST(SchedulerTest, ThrowingComponentWithContinueCountsErrors) {
+  std::string text = WithOnError("continue");
+  text.replace(text.find("{at: 2}"), 7, "{at: 2, every: true}");
+  Pipeline pipeline = Load(text);
+  const RunSummary summary = RunPipeline(pipeline);
+  EXPECT_FALSE(summary.stopped_on_error);
+  EXPECT_EQ(summary.steps, 6);
+  ASSERT_EQ(summary.errors.size(), 4u);  // steps 2, 3, 4, 5
+  for (int i = 0; i < 4; ++i) EXPECT_EQ(summary.errors[i].step, 2 + i);
+  EXPECT_EQ(summary.components[1].errors, 4);
+  EXPECT_EQ(pipeline.Find<Thrower>("after")->steps, 6);
+  EXPECT_EQ(pipeline.Find<Thrower>("after")->stops, 1);
+}
+
+TEST(SchedulerTest, FailingStartStopsOnlyStartedComponents) {
+  class BadStart : public Component {
+   public:
+    void Start() override { throw std::runtime_error("no device"); }
+    void Step(const StepContext&) override { ADD_FAILURE() << "stepped"; }
+  };
+  ComponentRegistry registry = MakeTestRegistry();
+  registry.Register<BadStart>("test.bad_start");
+  Pipeline pipeline = Pipeline::LoadString(R"(clock: {mode: simulated, step: 1, steps: 3}
+components:
+  - {name: a, type: test.thrower}
+  - {name: device, type: test.bad_start}
+  - {name: c, type: test.thrower}
+)",
+                                           "run.yaml", registry);
+  const RunSummary summary = RunPipeline(pipeline);
+  EXPECT_TRUE(summary.stopped_on_error);
+  EXPECT_EQ(summary.steps, 0);
+  ASSERT_EQ(summary.errors.size(), 1u);
+  EXPECT_EQ(summary.errors[0].ToString(), "component 'device' failed in start: no device");
+  EXPECT_EQ(pipeline.Find<Thrower>("a")->stops, 1);
+  EXPECT_EQ(pipeline.Find<Thrower>("c")->starts, 0);
+  EXPECT_EQ(pipeline.Find<Thrower>("c")->stops, 0);
+}
+
+TEST(SchedulerTest, RealTimeIsPacedByTheWallClock) {
+  Pipeline pipeline = Load(R"(clock: {mode: realtime, rate_hz: 50, steps: 5}
+components:
+  - {name: source, type: test.source}
+  - {name: recorder, type: test.recorder, inputs: {in: source.out}}
+)");
+  const auto start = std::chrono::steady_clock::now();
+  const RunSummary summary = RunPipeline(pipeline);
+  const double elapsed =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  EXPECT_EQ(summary.steps, 5);
+  // Ticks at 0, 20, 40, 60, 80 ms: the last starts no earlier than 80 ms. No upper bound.
+  EXPECT_GE(elapsed, 0.080);
+  const auto& r = pipeline.Find<Recorder>("recorder")->records;
+  ASSERT_EQ(r.size(), 5u);
+  EXPECT_GE(r[4].time, 0.080);
+  for (std::size_t k = 1; k < r.size(); ++k) EXPECT_GT(r[k].time, r[k - 1].time);
+}
+
+TEST(SchedulerTest, StopFlagEndsAnUnboundedRun) {
+  Pipeline pipeline = Load(R"(components:
+  - {name: source, type: test.source}
+)");
+  EXPECT_THROW(RunPipeline(pipeline), InvalidArgument);  // nothing would end it
+  std::atomic<bool> stop{false};
+  RunOptions options;
+  options.stop = &stop;
+  options.after_step = [&](const StepContext& context) {
+    if (context.step == 9) stop = true;
+  };
+  EXPECT_EQ(RunPipeline(pipeline, options).steps, 10);
+}
+
+TEST(SchedulerTest, SummaryReportsComponentTimesAndOverhead) {
+  Pipeline pipeline = Load(R"(clock: {mode: simulated, step: 1, steps: 20}
+components:
+  - {name: source, type: test.source}
+  - {name: recorder, type: test.recorder, inputs: {in: source.out}}
+)");
+  const RunSummary summary = RunPipeline(pipeline);
+  ASSERT_EQ(summary.components.size(), 2u);
+  for (const ComponentTiming& c : summary.components) {
+    EXPECT_EQ(c.steps, 20);
+    EXPECT_GE(c.mean_ms, 0.0);
+    EXPECT_LE(c.median_ms, c.p95_ms);
+    EXPECT_LE(c.p95_ms, c.max_ms);
+  }
+  EXPECT_GE(summary.overhead_mean_ms, 0.0);
+  EXPECT_GE(summary.overhead_share, 0.0);
+  EXPECT_LE(summary.overhead_share, 1.0);
+  const std::string report = summary.FullReport();
+  EXPECT_NE(report.find("recorder"), std::string::npos);
+  EXPECT_NE(report.find("(outside components)"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace saccade::runtime
