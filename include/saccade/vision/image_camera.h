@@ -1,0 +1,18 @@
+#pragma once
+// The camera of an image, read back from the metadata every frame carries (core/image.h):
+// its model (K and distortion, at the image's size) and its pose X_WC.
+#include "saccade/core/image.h"
+#include "saccade/geometry/camera_model.h"
+#include "saccade/geometry/pose.h"
+
+namespace saccade::vision {
+
+/// The camera model of `image`: K and distortion from its metadata, size from the image.
+/// Throws InvalidArgument naming the camera when K is not a valid camera matrix or the
+/// distortion model or coefficients are not ones geometry::Distortion accepts.
+geometry::CameraModel CameraModelOf(const Image& image);
+
+/// X_WC of `image`'s optical frame (metres), from its metadata; the bottom row is not checked.
+geometry::Pose CameraPoseOf(const Image& image);
+
+}  // namespace saccade::vision

@@ -1,0 +1,164 @@
+#include "saccade/vision/camshift_tracker.h"
+
+#include <algorithm>
+#include <cmath>
+#include <opencv2/imgproc.hpp>
+#include <opencv2/video/tracking.hpp>
+
+#include "internal_cv.h"
+#include "saccade/core/error.h"
+
+namespace saccade::vision {
+namespace {
+
+bool InRange(int value, int lo, int hi) { return value >= lo && value <= hi; }
+
+}  // namespace
+
+bool CamShiftTracker::Options::IsValid(std::string* error) const {
+  std::string what;
+  if (!InRange(hue_bins, 2, 180)) {
+    what = "hue_bins " + std::to_string(hue_bins) + ", expected 2 .. 180";
+  } else if (!InRange(saturation_bins, 1, 256)) {
+    what = "saturation_bins " + std::to_string(saturation_bins) + ", expected 1 .. 256";
+  } else if (!InRange(min_saturation, 0, 255)) {
+    what = "min_saturation " + std::to_string(min_saturation) + ", expected 0 .. 255";
+  } else if (!InRange(min_value, 0, 255)) {
+    what = "min_value " + std::to_string(min_value) + ", expected 0 .. 255";
+  } else if (!(seed_fraction > 0.0 && seed_fraction <= 1.0)) {
+    what = "seed_fraction " + std::to_string(seed_fraction) + ", expected 0 < x <= 1";
+  } else if (!(min_mass_ratio >= 0.0 && min_mass_ratio < 1.0)) {
+    what = "min_mass_ratio " + std::to_string(min_mass_ratio) + ", expected 0 <= x < 1";
+  } else if (min_window_px < 1) {
+    what = "min_window_px " + std::to_string(min_window_px) + ", expected >= 1";
+  } else if (!(max_growth > 1.0) || !std::isfinite(max_growth)) {
+    what = "max_growth " + std::to_string(max_growth) + ", expected a finite number > 1";
+  } else if (max_iterations < 1) {
+    what = "max_iterations " + std::to_string(max_iterations) + ", expected >= 1";
+  } else if (!(epsilon_px > 0.0) || !std::isfinite(epsilon_px)) {
+    what = "epsilon_px " + std::to_string(epsilon_px) + ", expected a finite number > 0";
+  }
+  if (what.empty()) return true;
+  if (error) *error = "CamShiftTracker::Options: " + what;
+  return false;
+}
+
+CamShiftTracker::CamShiftTracker() : CamShiftTracker(Options()) {}
+
+CamShiftTracker::CamShiftTracker(const Options& options) : options_(options) {
+  std::string error;
+  if (!options.IsValid(&error)) throw InvalidArgument(error);
+}
+
+cv::Mat CamShiftTracker::BackProject(const Image& image, const char* who) const {
+  const cv::Mat rgb = internal::WrapMat(image, who);
+  if (rgb.channels() == 1) {
+    throw InvalidArgument(std::string(who) + ": image format gray8, expected rgb8 or rgba8 " +
+                          "(CamShift tracks colour)");
+  }
+  cv::Mat hsv;
+  if (rgb.channels() == 4) {
+    cv::Mat rgb3;
+    cv::cvtColor(rgb, rgb3, cv::COLOR_RGBA2RGB);
+    cv::cvtColor(rgb3, hsv, cv::COLOR_RGB2HSV);
+  } else {
+    cv::cvtColor(rgb, hsv, cv::COLOR_RGB2HSV);
+  }
+  cv::Mat mask;
+  cv::inRange(hsv, cv::Scalar(0, options_.min_saturation, options_.min_value),
+              cv::Scalar(180, 256, 256), mask);
+  if (histogram_.empty()) return hsv;  // Start: the caller builds the histogram
+  const int channels[] = {0, 1};
+  const float hue_range[] = {0.f, 180.f}, sat_range[] = {0.f, 256.f};
+  const float* ranges[] = {hue_range, sat_range};
+  cv::Mat back;
+  cv::calcBackProject(&hsv, 1, channels, histogram_, back, ranges);
+  back &= mask;
+  return back;
+}
+
+bool CamShiftTracker::Start(const Image& image, const cv::Rect& box) {
+  histogram_.release();
+  state_ = TrackState();
+  const cv::Mat hsv = BackProject(image, "CamShiftTracker::Start");
+  const cv::Rect image_rect(0, 0, hsv.cols, hsv.rows);
+  if (box.width < options_.min_window_px || box.height < options_.min_window_px ||
+      (box & image_rect) != box) {
+    state_.reason = "seed box outside the image or smaller than min_window_px";
+    return false;
+  }
+  const double f = options_.seed_fraction;
+  const int w = std::max(1, static_cast<int>(std::lround(box.width * f)));
+  const int h = std::max(1, static_cast<int>(std::lround(box.height * f)));
+  const cv::Rect seed(box.x + (box.width - w) / 2, box.y + (box.height - h) / 2, w, h);
+  cv::Mat mask;
+  cv::inRange(hsv(seed), cv::Scalar(0, options_.min_saturation, options_.min_value),
+              cv::Scalar(180, 256, 256), mask);
+  if (cv::countNonZero(mask) == 0) {
+    state_.reason = "seed box holds no saturated, bright pixel: no colour to track";
+    return false;
+  }
+  const int channels[] = {0, 1};
+  const int bins[] = {options_.hue_bins, options_.saturation_bins};
+  const float hue_range[] = {0.f, 180.f}, sat_range[] = {0.f, 256.f};
+  const float* ranges[] = {hue_range, sat_range};
+  const cv::Mat roi = hsv(seed);
+  cv::calcHist(&roi, 1, channels, mask, histogram_, 2, bins, ranges);
+  cv::normalize(histogram_, histogram_, 0, 255, cv::NORM_MINMAX);
+  const cv::Mat back = BackProject(image, "CamShiftTracker::Start");
+  seed_mass_ = cv::sum(back(box))[0];
+  seed_area_ = box.area();
+  if (seed_mass_ <= 0.0) {
+    histogram_.release();
+    state_.reason = "seed box has no back-projection mass";
+    return false;
+  }
+  state_.status = TrackState::Status::kTracking;
+  state_.window = box;
+  state_.box =
+      cv::RotatedRect(cv::Point2f(box.x + (box.width - 1) / 2.f, box.y + (box.height - 1) / 2.f),
+                      cv::Size2f(box.width, box.height), 0.f);
+  state_.mass_ratio = 1.0;
+  return true;
+}
+
+TrackState CamShiftTracker::Update(const Image& image) {
+  if (state_.status != TrackState::Status::kTracking) return state_;
+  const cv::Mat back = BackProject(image, "CamShiftTracker::Update");
+  const cv::Rect image_rect(0, 0, back.cols, back.rows);
+  cv::Rect window = state_.window & image_rect;
+  const auto lose = [&](std::string reason) {
+    state_.status = TrackState::Status::kLost;
+    state_.reason = std::move(reason);
+    return state_;
+  };
+  if (window.width < options_.min_window_px || window.height < options_.min_window_px) {
+    return lose("window left the image");
+  }
+  // cv::CamShift moves and resizes `window` in place.
+  const cv::TermCriteria criteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS,
+                                  options_.max_iterations, options_.epsilon_px);
+  const cv::RotatedRect box = cv::CamShift(back, window, criteria);
+  state_.box = box;
+  state_.window = window & image_rect;
+  state_.mass_ratio = state_.window.area() > 0 ? cv::sum(back(state_.window))[0] / seed_mass_ : 0.0;
+  if (box.size.area() <= 0.f) {
+    return lose("no back-projection mass left in the search window");
+  }
+  if (state_.window.width < options_.min_window_px ||
+      state_.window.height < options_.min_window_px) {
+    return lose("window collapsed to " + std::to_string(state_.window.width) + " x " +
+                std::to_string(state_.window.height) + " px");
+  }
+  if (state_.window.area() > options_.max_growth * seed_area_) {
+    return lose("window grew to " + std::to_string(state_.window.area() / seed_area_) +
+                " times the seed's area");
+  }
+  if (state_.mass_ratio < options_.min_mass_ratio) {
+    return lose("back-projection mass fell to " + std::to_string(state_.mass_ratio) +
+                " of the seed's");
+  }
+  return state_;
+}
+
+}  // namespace saccade::vision

@@ -1,0 +1,77 @@
+#include "saccade/vision/inhibition_of_return.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "saccade/core/error.h"
+
+namespace saccade::vision {
+
+bool InhibitionOfReturn::Options::IsValid(std::string* error) const {
+  std::string what;
+  if (!(fixation_time_s > 0.0) || !std::isfinite(fixation_time_s)) {
+    what = "fixation_time_s " + std::to_string(fixation_time_s) + ", expected a finite number > 0";
+  } else if (!(radius_m > 0.0) || !std::isfinite(radius_m)) {
+    what = "radius_m " + std::to_string(radius_m) + ", expected a finite number > 0";
+  } else if (!(suppression_time_s > 0.0) || !std::isfinite(suppression_time_s)) {
+    what = "suppression_time_s " + std::to_string(suppression_time_s) +
+           ", expected a finite number > 0";
+  }
+  if (what.empty()) return true;
+  if (error) *error = "InhibitionOfReturn::Options: " + what;
+  return false;
+}
+
+InhibitionOfReturn::InhibitionOfReturn() : InhibitionOfReturn(Options()) {}
+
+InhibitionOfReturn::InhibitionOfReturn(const Options& options) : options_(options) {
+  std::string error;
+  if (!options.IsValid(&error)) throw InvalidArgument(error);
+}
+
+bool InhibitionOfReturn::IsSuppressed(const Eigen::Vector3d& p_W, double time_s) const {
+  return std::any_of(suppressions_.begin(), suppressions_.end(), [&](const Suppression& s) {
+    return time_s < s.until_s && (p_W - s.p_W).norm() <= options_.radius_m;
+  });
+}
+
+std::optional<std::size_t> InhibitionOfReturn::Select(
+    double time_s, std::span<const Eigen::Vector3d> candidates_W, const Eigen::Vector3d& p_W_viewer,
+    const std::optional<Eigen::Vector3d>& p_W_fixation) {
+  if (started_ && time_s < last_time_) {  // time went back: a new run
+    suppressions_.clear();
+    dwelling_ = false;
+  }
+  started_ = true;
+  last_time_ = time_s;
+  std::erase_if(suppressions_, [&](const Suppression& s) { return time_s >= s.until_s; });
+
+  // Dwell: the fixation stays within radius_m of where it began. Fixating a place already
+  // suppressed does not start a new dwell (it would only extend the suppression).
+  if (!p_W_fixation || IsSuppressed(*p_W_fixation, time_s)) {
+    dwelling_ = false;
+  } else if (!dwelling_ || (*p_W_fixation - dwell_p_W_).norm() > options_.radius_m) {
+    dwelling_ = true;
+    dwell_p_W_ = *p_W_fixation;
+    dwell_start_ = time_s;
+  }
+  if (dwelling_ && time_s - dwell_start_ >= options_.fixation_time_s) {
+    suppressions_.push_back({dwell_p_W_, time_s + options_.suppression_time_s});
+    dwelling_ = false;
+  }
+
+  std::optional<std::size_t> best;
+  double best_distance = std::numeric_limits<double>::infinity();
+  for (std::size_t i = 0; i < candidates_W.size(); ++i) {
+    if (!candidates_W[i].allFinite() || IsSuppressed(candidates_W[i], time_s)) continue;
+    const double d = (candidates_W[i] - p_W_viewer).norm();
+    if (d < best_distance) {
+      best_distance = d;
+      best = i;
+    }
+  }
+  return best;
+}
+
+}  // namespace saccade::vision
