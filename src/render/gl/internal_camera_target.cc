@@ -8,18 +8,6 @@
 namespace saccade::render::gl {
 namespace {
 
-GLuint MakeRenderbuffer(GLenum format, int width, int height, int samples) {
-  GLuint name = 0;
-  glGenRenderbuffers(1, &name);
-  glBindRenderbuffer(GL_RENDERBUFFER, name);
-  if (samples > 0) {
-    glRenderbufferStorageMultisample(GL_RENDERBUFFER, samples, format, width, height);
-  } else {
-    glRenderbufferStorage(GL_RENDERBUFFER, format, width, height);
-  }
-  return name;
-}
-
 void CheckComplete(int width, int height, int samples) {
   const GLenum status = glCheckFramebufferStatus(GL_FRAMEBUFFER);
   if (status != GL_FRAMEBUFFER_COMPLETE) {

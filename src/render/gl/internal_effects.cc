@@ -123,19 +123,6 @@ GLuint MakeTexture2d(GLenum internal_format, GLenum format, GLenum type, int wid
   return texture;
 }
 
-GLuint MakeRenderbuffer(GLenum format, int width, int height, int samples) {
-  GLuint name = 0;
-  glGenRenderbuffers(1, &name);
-  glBindRenderbuffer(GL_RENDERBUFFER, name);
-  if (samples > 0) {
-    glRenderbufferStorageMultisample(GL_RENDERBUFFER, samples, format, width, height);
-  } else {
-    glRenderbufferStorage(GL_RENDERBUFFER, format, width, height);
-  }
-  glBindRenderbuffer(GL_RENDERBUFFER, 0);
-  return name;
-}
-
 void CheckComplete(const char* what, int width, int height) {
   const GLenum status = glCheckFramebufferStatus(GL_FRAMEBUFFER);
   if (status != GL_FRAMEBUFFER_COMPLETE) {

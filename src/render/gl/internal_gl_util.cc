@@ -103,4 +103,17 @@ GLuint BuildProgram(std::string_view name, const std::string& vertex_source,
 
 GLint Uniform(GLuint program, const char* name) { return glGetUniformLocation(program, name); }
 
+GLuint MakeRenderbuffer(GLenum format, int width, int height, int samples) {
+  GLuint name = 0;
+  glGenRenderbuffers(1, &name);
+  glBindRenderbuffer(GL_RENDERBUFFER, name);
+  if (samples > 0) {
+    glRenderbufferStorageMultisample(GL_RENDERBUFFER, samples, format, width, height);
+  } else {
+    glRenderbufferStorage(GL_RENDERBUFFER, format, width, height);
+  }
+  glBindRenderbuffer(GL_RENDERBUFFER, 0);
+  return name;
+}
+
 }  // namespace saccade::render::gl

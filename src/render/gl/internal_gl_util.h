@@ -24,4 +24,7 @@ GLuint BuildProgram(std::string_view name, const std::string& vertex_source,
 /// A uniform's location; -1 (the GL value for "ignored") when the linker removed it.
 GLint Uniform(GLuint program, const char* name);
 
+/// A renderbuffer of `format`, multisampled when samples > 0; left unbound.
+GLuint MakeRenderbuffer(GLenum format, int width, int height, int samples);
+
 }  // namespace saccade::render::gl
