@@ -3,7 +3,7 @@
 # saccade::opencv. Only `vision` and the tests link it (DESIGN.md layers).
 find_path(SACCADE_OPENCV_INCLUDE_DIR opencv2/core.hpp PATH_SUFFIXES opencv4 REQUIRED)
 set(_saccade_opencv_libs)
-foreach(_module core imgproc calib3d imgcodecs objdetect video features2d flann)
+foreach(_module core imgproc calib3d imgcodecs objdetect video videoio features2d flann)
   find_library(SACCADE_OPENCV_${_module} NAMES opencv_${_module} REQUIRED)
   list(APPEND _saccade_opencv_libs ${SACCADE_OPENCV_${_module}})
 endforeach()

@@ -15,7 +15,7 @@ packages=(
   # libraries (README lists what each is for)
   libeigen3-dev libyaml-cpp-dev nlohmann-json3-dev libcli11-dev libfmt-dev libspdlog-dev
   libopencv-core-dev libopencv-imgproc-dev libopencv-calib3d-dev libopencv-imgcodecs-dev
-  libopencv-objdetect-dev libopencv-video-dev libopencv-features2d-dev
+  libopencv-objdetect-dev libopencv-video-dev libopencv-videoio-dev libopencv-features2d-dev
   libassimp-dev libpng-dev libstb-dev libepoxy-dev libegl-dev libgl-dev libmeshoptimizer-dev
   # OpenGL without a display or GPU: Mesa's EGL and llvmpipe
   libegl-mesa0 libgl1-mesa-dri

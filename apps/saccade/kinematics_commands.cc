@@ -1,4 +1,4 @@
-// fk, ik, camera, demo: the kinematics and camera-model subcommands.
+// fk, ik, camera: the kinematics and camera-model subcommands.
 
 #include <fmt/format.h>
 
@@ -44,24 +44,6 @@ void PrintPose(const char* name, const Pose& X) {
   const Eigen::Vector3d z = X.linear().col(2);
   fmt::print("  {:<14} position {} m   optical axis {}\n", name, FormatVector(X.translation()),
              FormatVector(z));
-}
-
-void PrintHead(const HeadDescription& head) {
-  const auto& g = head.geometry();
-  fmt::print(
-      "head {}: baseline {:.4f} m (B = {:.4f}), D = {:.4f}, H = {:.4f}, "
-      "delta_l = {:.4f}, delta_r = {:.4f} m\n",
-      head.name(), 2 * g.B, g.B, g.D, g.H, g.delta_l, g.delta_r);
-  for (const auto joint : saccade::head::kAllJoints) {
-    const auto& l = head.limits(joint);
-    fmt::print("  joint {:<5} [{:+7.2f}, {:+7.2f}] deg, max {:.0f} deg/s, {:.0f} deg/s^2\n",
-               saccade::head::JointName(joint), l.min * kRadToDeg, l.max * kRadToDeg,
-               l.max_velocity * kRadToDeg, l.max_acceleration * kRadToDeg);
-  }
-  const auto& k = head.left_camera().intrinsics();
-  fmt::print("  cameras {}x{}, fx {:.3f} fy {:.3f} cx {:.3f} cy {:.3f} px, distortion {}\n",
-             k.width(), k.height(), k.fx(), k.fy(), k.cx(), k.cy(),
-             saccade::geometry::ToString(head.left_camera().distortion().model()));
 }
 
 void PrintFrames(const saccade::head::HeadFrames& frames) {
@@ -198,28 +180,6 @@ int RunCamera(const std::string& path, double near, double far, bool as_json) {
   return 0;
 }
 
-int RunDemo(const std::string& head_path) {
-  const HeadDescription head = HeadDescription::FromYamlFile(head_path);
-  fmt::print("saccade {} — the POPEYE stereo head, kinematics only for now\n\n", SACCADE_VERSION);
-  PrintHead(head);
-  fmt::print("\nforward kinematics at rest (all joints 0):\n");
-  PrintFrames(saccade::head::ForwardKinematics(head, JointState{}));
-
-  const Eigen::Vector3d target = head.X_WB() * Eigen::Vector3d(1.5, 0.4, -0.3);
-  fmt::print("\nfixating a face-height target 1.5 m ahead, 0.4 m left, 0.3 m below the head:\n");
-  fmt::print("  target         {} m\n", FormatVector(target));
-  const auto result = saccade::head::SolveFixation(head, target);
-  fmt::print("  joints         {}\n", FormatJointsDeg(result.joints));
-  fmt::print("  reachable      {} (axis error {:.2e} rad, {} iterations)\n",
-             result.reachable() ? "yes" : "no", result.axis_error, result.iterations);
-  const auto frames = saccade::head::ForwardKinematics(head, result.joints);
-  PrintFrames(frames);
-  if (frames.p_WFixation) {
-    fmt::print("  |fixation - target| = {:.3e} m\n", (*frames.p_WFixation - target).norm());
-  }
-  return 0;
-}
-
 }  // namespace
 
 Runner AddFkCommand(CLI::App& app) {
@@ -288,17 +248,6 @@ Runner AddCameraCommand(CLI::App& app) {
       ->capture_default_str();
   camera->add_flag("--json", o->json, "Print JSON (stable interface, see README)");
   return [o] { return RunCamera(o->calibration, o->near, o->far, o->json); };
-}
-
-Runner AddDemoCommand(CLI::App& app) {
-  auto head = std::make_shared<std::string>(ShippedFile("robots/popeye.yaml"));
-  auto* demo = app.add_subcommand("demo",
-                                  "The main job: the POPEYE head's kinematics and a "
-                                  "fixation solved for a sample target.");
-  demo->add_option("--head", *head, "Head description YAML")
-      ->check(CLI::ExistingFile)
-      ->capture_default_str();
-  return [head] { return RunDemo(*head); };
 }
 
 }  // namespace saccade::app

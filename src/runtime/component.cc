@@ -1,6 +1,7 @@
 #include "saccade/runtime/component.h"
 
 #include <algorithm>
+#include <filesystem>
 
 namespace saccade::runtime {
 namespace {
@@ -14,6 +15,12 @@ bool IsIdentifier(const std::string& name) {
 }
 
 }  // namespace
+
+std::string Component::ResolvePath(const std::string& path) const {
+  const std::filesystem::path p(path);
+  if (p.is_absolute() || base_dir_.empty() || path.empty()) return path;
+  return (std::filesystem::path(base_dir_) / p).lexically_normal().string();
+}
 
 InputBase* Component::FindInput(const std::string& name) const {
   for (const auto& port : inputs_) {

@@ -12,24 +12,6 @@ std::string Expect(const nlohmann::json& value, const char* type, const char* ke
   return fmt::format("{}: field '{}': expected {}, got {}", type, key, what, value.dump());
 }
 
-double Number(const nlohmann::json& json, const char* type, const char* key) {
-  const nlohmann::json& value = JsonField(json, type, key);
-  if (!value.is_number()) throw Error(Expect(value, type, key, "a number"));
-  return value.get<double>();
-}
-
-int64_t Integer(const nlohmann::json& json, const char* type, const char* key) {
-  const nlohmann::json& value = JsonField(json, type, key);
-  if (!value.is_number_integer()) throw Error(Expect(value, type, key, "an integer"));
-  return value.get<int64_t>();
-}
-
-std::string String(const nlohmann::json& json, const char* type, const char* key) {
-  const nlohmann::json& value = JsonField(json, type, key);
-  if (!value.is_string()) throw Error(Expect(value, type, key, "a string"));
-  return value.get<std::string>();
-}
-
 MessageRegistry MakeGlobal() {
   MessageRegistry registry;
   registry.Register<Tick>();
@@ -48,6 +30,43 @@ const nlohmann::json& JsonField(const nlohmann::json& json, const char* type, co
   const auto it = json.find(key);
   if (it == json.end()) throw Error(fmt::format("{}: missing field '{}'", type, key));
   return *it;
+}
+
+double JsonNumber(const nlohmann::json& json, const char* type, const char* key) {
+  const nlohmann::json& value = JsonField(json, type, key);
+  if (!value.is_number()) throw Error(Expect(value, type, key, "a number"));
+  return value.get<double>();
+}
+
+int64_t JsonInteger(const nlohmann::json& json, const char* type, const char* key) {
+  const nlohmann::json& value = JsonField(json, type, key);
+  if (!value.is_number_integer()) throw Error(Expect(value, type, key, "an integer"));
+  return value.get<int64_t>();
+}
+
+bool JsonBool(const nlohmann::json& json, const char* type, const char* key) {
+  const nlohmann::json& value = JsonField(json, type, key);
+  if (!value.is_boolean()) throw Error(Expect(value, type, key, "true or false"));
+  return value.get<bool>();
+}
+
+std::string JsonString(const nlohmann::json& json, const char* type, const char* key) {
+  const nlohmann::json& value = JsonField(json, type, key);
+  if (!value.is_string()) throw Error(Expect(value, type, key, "a string"));
+  return value.get<std::string>();
+}
+
+std::vector<double> JsonNumbers(const nlohmann::json& json, const char* type, const char* key,
+                                std::size_t n) {
+  const nlohmann::json& value = JsonField(json, type, key);
+  const std::string what = fmt::format("an array of {} numbers", n);
+  if (!value.is_array() || value.size() != n) throw Error(Expect(value, type, key, what.c_str()));
+  std::vector<double> out;
+  for (const nlohmann::json& item : value) {
+    if (!item.is_number()) throw Error(Expect(value, type, key, what.c_str()));
+    out.push_back(item.get<double>());
+  }
+  return out;
 }
 
 MessageRegistry& MessageRegistry::Global() {
@@ -76,18 +95,18 @@ nlohmann::json MessageTraits<Tick>::ToJson(const Tick& m) {
 }
 
 Tick MessageTraits<Tick>::FromJson(const nlohmann::json& j) {
-  return {Integer(j, kName, "step"), Number(j, kName, "time")};
+  return {JsonInteger(j, kName, "step"), JsonNumber(j, kName, "time")};
 }
 
 nlohmann::json MessageTraits<Value>::ToJson(const Value& m) { return {{"value", m.value}}; }
 
 Value MessageTraits<Value>::FromJson(const nlohmann::json& j) {
-  return {Number(j, kName, "value")};
+  return {JsonNumber(j, kName, "value")};
 }
 
 nlohmann::json MessageTraits<Text>::ToJson(const Text& m) { return {{"text", m.text}}; }
 
-Text MessageTraits<Text>::FromJson(const nlohmann::json& j) { return {String(j, kName, "text")}; }
+Text MessageTraits<Text>::FromJson(const nlohmann::json& j) { return {JsonString(j, kName, "text")}; }
 
 nlohmann::json MessageTraits<ImageMessage>::ToJson(const ImageMessage& m) {
   if (!m.image) return nullptr;
@@ -101,15 +120,15 @@ nlohmann::json MessageTraits<ImageMessage>::ToJson(const ImageMessage& m) {
 
 ImageMessage MessageTraits<ImageMessage>::FromJson(const nlohmann::json& j) {
   if (j.is_null()) return {};
-  const int64_t width = Integer(j, kName, "width");
-  const int64_t height = Integer(j, kName, "height");
+  const int64_t width = JsonInteger(j, kName, "width");
+  const int64_t height = JsonInteger(j, kName, "height");
   for (const auto& [key, side] : {std::pair{"width", width}, std::pair{"height", height}}) {
     if (side < 0 || side > kMaxJsonImageSide) {
       throw Error(fmt::format("{}: field '{}': expected an integer in [0, {}], got {}", kName, key,
                               kMaxJsonImageSide, side));
     }
   }
-  const std::string format_name = String(j, kName, "format");
+  const std::string format_name = JsonString(j, kName, "format");
   PixelFormat format = PixelFormat::kRgb8;
   bool known = false;
   std::string expected;
@@ -126,9 +145,9 @@ ImageMessage MessageTraits<ImageMessage>::FromJson(const nlohmann::json& j) {
                             format_name));
   }
   // Every field is checked before the pixels are allocated.
-  std::string camera = String(j, kName, "camera");
-  const int64_t frame_index = Integer(j, kName, "frame_index");
-  const double time = Number(j, kName, "time");
+  std::string camera = JsonString(j, kName, "camera");
+  const int64_t frame_index = JsonInteger(j, kName, "frame_index");
+  const double time = JsonNumber(j, kName, "time");
   auto image = std::make_shared<Image>(static_cast<int>(width), static_cast<int>(height), format);
   image->metadata().camera = std::move(camera);
   image->metadata().frame_index = frame_index;

@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <fstream>
 #include <limits>
+#include <filesystem>
 #include <map>
 #include <optional>
 #include <set>
@@ -264,6 +265,8 @@ Pipeline Pipeline::Build(const PipelineSpec& spec, const ComponentRegistry& regi
     }
   }
 
+  // Relative paths in params resolve against the pipeline file's folder.
+  const std::string base_dir = std::filesystem::path(file).parent_path().string();
   // Create and configure, in order.
   for (std::size_t i = 0; i < n; ++i) {
     const ComponentSpec& c = spec.components[i];
@@ -273,7 +276,7 @@ Pipeline Pipeline::Build(const PipelineSpec& spec, const ComponentRegistry& regi
                           "'; known types: " + Join(registry.Types()));
     }
     std::unique_ptr<Component> component = registry.Create(c.type);
-    component->Initialise(c.name, ComponentSeed(spec.seed, c.name));
+    component->Initialise(c.name, ComponentSeed(spec.seed, c.name), base_dir);
     try {
       component->Configure(c.params);
     } catch (const std::exception& error) {

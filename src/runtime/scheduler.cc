@@ -94,6 +94,7 @@ RunSummary RunPipeline(Pipeline& pipeline, const RunOptions& options) {
   RunSummary summary;
   std::vector<std::vector<double>> step_seconds(n);
   std::vector<double> overhead_seconds;
+  std::vector<double> step_own;  // this step's component times, for options.step_timing
   std::vector<int64_t> error_counts(n, 0);
   const auto report = [&](StepError error) {
     if (options.on_error) options.on_error(error);
@@ -132,6 +133,7 @@ RunSummary RunPipeline(Pipeline& pipeline, const RunOptions& options) {
 
       pipeline.DeliverDelayed();
       double component_seconds = 0.0;
+      step_own.clear();
       bool stop_now = false;
       for (std::size_t i = 0; i < n; ++i) {
         Component& component = *components[i];
@@ -150,6 +152,7 @@ RunSummary RunPipeline(Pipeline& pipeline, const RunOptions& options) {
             std::max(0.0, Seconds(Clock::now() - start) - pipeline.TakeDeliverySeconds());
         for (const auto& input : component.inputs()) input->MarkSeen();
         step_seconds[i].push_back(own);
+        step_own.push_back(own);
         component_seconds += own;
         if (stop_now) break;
       }
@@ -160,6 +163,7 @@ RunSummary RunPipeline(Pipeline& pipeline, const RunOptions& options) {
       total_overhead += overhead;
       summary.steps = k + 1;
       summary.sim_time = context.time;
+      if (options.step_timing) options.step_timing(context, step_own, overhead);
       if (options.after_step) options.after_step(context);
       if (stop_now) {
         summary.stopped_on_error = true;

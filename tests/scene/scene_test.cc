@@ -32,7 +32,7 @@ constexpr double kFloatTolerance = 1e-6;
 constexpr double kTolerance = 1e-12;
 
 const Scene& Portraits() {
-  static const Scene scene = Scene::Load(kSourceDir + "/scenes/portraits.yaml");
+  static const Scene scene = Scene::Load(kSourceDir + "/scenes/astronaut_and_cat.yaml");
   return scene;
 }
 const Scene& Bench() {

@@ -1,6 +1,6 @@
-// CamShift on the eye cameras' renders of scenes/portraits.yaml, seeded by the face detector:
-// the track keeps the astronaut's face while the head pans (the face slides across the image)
-// and reports the loss when the head turns away from her.
+// CamShift on the eye cameras' renders of scenes/astronaut_and_cat.yaml, seeded by the face
+// detector: the track keeps the astronaut's face while the head pans (the face slides across
+// the image) and reports the loss when the head turns away from her.
 #include "saccade/vision/camshift_tracker.h"
 
 #include <gtest/gtest.h>

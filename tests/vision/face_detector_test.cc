@@ -1,6 +1,6 @@
-// Face detection on the eye cameras' renders of scenes/portraits.yaml: the astronaut's face is
-// found in both eyes inside her picture's ground-truth box, and whatever the face cascade
-// finds on the cat is rejected (flagged with its reason, not dropped).
+// Face detection on the eye cameras' renders of scenes/astronaut_and_cat.yaml: the astronaut's
+// face is found in both eyes inside her picture's ground-truth box, and whatever the face
+// cascade finds on the cat is rejected (flagged with its reason, not dropped).
 #include "saccade/vision/face_detector.h"
 
 #include <gtest/gtest.h>

@@ -1,5 +1,5 @@
 #pragma once
-// Test support: scenes/portraits.yaml rendered by the eye cameras with the head fixating a
+// Test support: scenes/astronaut_and_cat.yaml rendered by the eye cameras with the head fixating a
 // chosen world point (head IK), and the ground truth the vision tests compare with.
 #include <gtest/gtest.h>
 
@@ -21,7 +21,7 @@ namespace saccade::vision::testing {
 /// The loaded scene (once per test program).
 inline const scene::Scene& Portraits() {
   static const scene::Scene scene =
-      scene::Scene::Load(std::string(SACCADE_SOURCE_DIR) + "/scenes/portraits.yaml");
+      scene::Scene::Load(std::string(SACCADE_SOURCE_DIR) + "/scenes/astronaut_and_cat.yaml");
   return scene;
 }
 

@@ -1,7 +1,7 @@
-// Stereo association and triangulation on the eye cameras' renders of scenes/portraits.yaml:
-// the astronaut's face detected in both eyes, associated, and triangulated near the true face
-// centre (the centre of the face box in her picture's own texture, placed in the world by the
-// picture's pose: see portraits.h).
+// Stereo association and triangulation on the eye cameras' renders of
+// scenes/astronaut_and_cat.yaml: the astronaut's face detected in both eyes, associated, and
+// triangulated near the true face centre (the centre of the face box in her picture's own
+// texture, placed in the world by the picture's pose: see portraits.h).
 #include "saccade/vision/stereo_associator.h"
 
 #include <gtest/gtest.h>

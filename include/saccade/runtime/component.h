@@ -59,11 +59,17 @@ class Component {
   const std::vector<std::unique_ptr<InputBase>>& inputs() const { return inputs_; }
   const std::vector<std::unique_ptr<OutputBase>>& outputs() const { return outputs_; }
 
-  /// Sets the name and seed; the pipeline calls this before Configure.
-  void Initialise(std::string name, uint64_t seed) {
+  /// Sets the name, the seed and the folder that relative paths in the params resolve
+  /// against (the pipeline file's); the pipeline calls this before Configure.
+  void Initialise(std::string name, uint64_t seed, std::string base_dir = {}) {
     name_ = std::move(name);
     seed_ = seed;
+    base_dir_ = std::move(base_dir);
   }
+
+  /// `path` as given when absolute or when there is no base folder; else relative to the
+  /// pipeline file's folder.
+  std::string ResolvePath(const std::string& path) const;
 
  protected:
   /// Declares an output. Throws InvalidArgument when the name is taken or not an identifier.
@@ -91,6 +97,7 @@ class Component {
 
   std::string name_;
   uint64_t seed_ = 0;
+  std::string base_dir_;
   std::vector<std::unique_ptr<InputBase>> inputs_;
   std::vector<std::unique_ptr<OutputBase>> outputs_;
 };

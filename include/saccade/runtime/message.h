@@ -15,6 +15,8 @@
 // MessageRegistry::Global().Register<my::Target>().
 
 #include <concepts>
+#include <cstddef>
+#include <cstdint>
 #include <functional>
 #include <map>
 #include <memory>
@@ -124,6 +126,14 @@ inline constexpr int kMaxJsonImageSide = 16384;
 /// Reads a required field of a JSON object, naming the message type and field on error.
 /// Throws saccade::Error ("<type>: field '<key>': expected <what>").
 const nlohmann::json& JsonField(const nlohmann::json& json, const char* type, const char* key);
+/// A required field of the given kind; throws saccade::Error as JsonField, naming what was got.
+double JsonNumber(const nlohmann::json& json, const char* type, const char* key);
+int64_t JsonInteger(const nlohmann::json& json, const char* type, const char* key);
+bool JsonBool(const nlohmann::json& json, const char* type, const char* key);
+std::string JsonString(const nlohmann::json& json, const char* type, const char* key);
+/// A required array of exactly `n` numbers.
+std::vector<double> JsonNumbers(const nlohmann::json& json, const char* type, const char* key,
+                                std::size_t n);
 
 template <>
 struct MessageTraits<Tick> {

@@ -69,6 +69,12 @@ struct RunOptions {
   std::function<void(const StepError&)> on_error;
   /// Called after each step with its context (progress, recording); may be empty.
   std::function<void(const StepContext&)> after_step;
+  /// Called after each step (before after_step) with each component's own time in that step
+  /// (seconds, in execution order; a component not stepped, after an error, is absent) and
+  /// the loop's overhead in it (seconds). For per-step latencies; may be empty.
+  std::function<void(const StepContext&, const std::vector<double>& component_seconds,
+                     double overhead_seconds)>
+      step_timing;
 };
 
 /// Runs `pipeline` once. Component failures are reported in the summary, not thrown;

@@ -1,0 +1,646 @@
+// demo: the active-vision loop (seed section 6) run headless on a scene, with a report of
+// every fixation against the scene's ground truth, the loop's latency and, optionally, a
+// recording of the annotated frames.
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <csignal>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <map>
+#include <memory>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <opencv2/videoio.hpp>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "commands.h"
+#include "saccade/components/face_truth.h"
+#include "saccade/components/fixation_component.h"
+#include "saccade/components/messages.h"
+#include "saccade/components/register.h"
+#include "saccade/components/scene_cache.h"
+#include "saccade/components/sim_components.h"
+#include "saccade/core/error.h"
+#include "saccade/runtime/pipeline.h"
+#include "saccade/runtime/scheduler.h"
+#include "saccade/vision/image_camera.h"
+
+namespace saccade::app {
+namespace {
+
+namespace fs = std::filesystem;
+using components::CandidatesMessage;
+using components::FacesMessage;
+using components::JointStateMessage;
+using components::PictureFace;
+using components::SelectionMessage;
+using components::TargetMessage;
+using components::TrackMessage;
+using nlohmann::json;
+
+std::atomic<bool> g_stop{false};
+extern "C" void OnDemoInterrupt(int) { g_stop = true; }
+
+struct Options {
+  std::string pipeline = ShippedFile("pipelines/demo.yaml");
+  std::string scene;
+  double duration = 40.0;
+  std::string record;
+  bool force = false;
+  bool json = false;
+  bool realtime = false;
+  bool keep_going = false;
+  bool list = false;
+};
+
+/// One attended target, from its selection to the end of its dwell.
+struct Fixation {
+  int64_t target_id = -1;
+  double selected_at = 0.0;
+  std::optional<double> fixated_at;
+  bool completed = false;  // inhibition of return suppressed it
+  std::string object = "unknown";
+  bool is_face = false;
+  std::string source;
+  Eigen::Vector3d p_W = Eigen::Vector3d::Zero();
+  Eigen::Vector3d truth_W = Eigen::Vector3d::Zero();
+  double distance_m = 0.0;
+  double error_3d_m = 0.0;
+  double left_error_deg = 0.0;
+  double right_error_deg = 0.0;
+  // Over the dwell (pursuit of a moving face): per-eye angular error, mean and max.
+  int dwell_samples = 0;
+  double dwell_sum_deg[2] = {0.0, 0.0};
+  double dwell_max_deg[2] = {0.0, 0.0};
+};
+
+/// Angle (degrees) between a camera's optical axis and the direction to p_W.
+double AxisErrorDeg(const Image& image, const Eigen::Vector3d& p_W) {
+  const geometry::Pose X_WC = vision::CameraPoseOf(image);
+  const Eigen::Vector3d axis = X_WC.linear().col(2);
+  const Eigen::Vector3d to = (p_W - X_WC.translation()).normalized();
+  return std::acos(std::clamp(axis.dot(to), -1.0, 1.0)) * kRadToDeg;
+}
+
+struct Stats {
+  double median = 0.0, p95 = 0.0, mean = 0.0, max = 0.0;
+};
+Stats Summarise(std::vector<double> v) {
+  Stats s;
+  if (v.empty()) return s;
+  std::sort(v.begin(), v.end());
+  const auto at = [&](double q) {
+    return v[std::min(v.size() - 1, static_cast<std::size_t>(q * (v.size() - 1) + 0.5))];
+  };
+  s.median = at(0.5);
+  s.p95 = at(0.95);
+  s.max = v.back();
+  for (double x : v) s.mean += x / static_cast<double>(v.size());
+  return s;
+}
+
+/// Everything the loop's outputs said during the current step.
+struct Latest {
+  std::map<std::string, std::shared_ptr<const Image>> images;  // by camera
+  std::map<std::string, FacesMessage> faces;
+  std::map<std::string, TrackMessage> tracks;
+  std::optional<SelectionMessage> selection;
+  std::optional<TargetMessage> target;
+  std::optional<JointStateMessage> joints;
+};
+
+/// Subscribes `slot` to every output of message type T in the pipeline.
+template <typename T, typename Slot>
+void Tap(runtime::Pipeline& pipeline, Slot slot) {
+  for (const auto& component : pipeline.components()) {
+    for (const auto& output : component->outputs()) {
+      if (auto* typed = dynamic_cast<runtime::Output<T>*>(output.get())) {
+        typed->signal().Connect(slot);
+      }
+    }
+  }
+}
+
+/// Writes the annotated frames: frames/NNNNNN.jpg, demo.avi (MJPEG), fixation PNGs.
+class Recorder {
+ public:
+  Recorder(const fs::path& dir, double fps, bool force) : dir_(dir), fps_(fps) {
+    if (fs::exists(dir) && !fs::is_directory(dir)) {
+      throw InvalidArgument("demo: --record " + dir.string() + ": exists and is not a folder");
+    }
+    const bool used = fs::exists(dir / "summary.json") || fs::exists(dir / "frames") ||
+                      fs::exists(dir / "demo.avi");
+    if (used && !force) {
+      throw InvalidArgument("demo: --record " + dir.string() +
+                            " already holds a recording; pass --force to replace it");
+    }
+    if (used) {
+      fs::remove_all(dir / "frames");
+      fs::remove(dir / "demo.avi");
+      fs::remove(dir / "summary.json");
+      for (const auto& entry : fs::directory_iterator(dir)) {
+        if (entry.path().filename().string().rfind("fixation_", 0) == 0) fs::remove(entry.path());
+      }
+    }
+    fs::create_directories(dir / "frames");
+  }
+
+  ~Recorder() { writer_.release(); }
+
+  void Write(int64_t step, const cv::Mat& bgr) {
+    cv::imwrite((dir_ / "frames" / fmt::format("{:06d}.jpg", step)).string(), bgr,
+                {cv::IMWRITE_JPEG_QUALITY, 85});
+    if (!writer_.isOpened()) {
+      writer_.open((dir_ / "demo.avi").string(), cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), fps_,
+                   bgr.size());
+      if (!writer_.isOpened()) {
+        throw Error("demo: cannot write " + (dir_ / "demo.avi").string() +
+                    " (OpenCV's MJPEG writer failed)");
+      }
+    }
+    writer_.write(bgr);
+    ++frames_;
+  }
+
+  void WriteFixation(int index, const std::string& object, const cv::Mat& bgr) {
+    cv::imwrite((dir_ / fmt::format("fixation_{}_{}.png", index, object)).string(), bgr);
+  }
+
+  /// summary.json, atomically (a reader never sees half of it).
+  void WriteSummary(const json& summary) {
+    const fs::path tmp = dir_ / ".summary.json.tmp";
+    {
+      std::ofstream out(tmp);
+      out << summary.dump(2) << "\n";
+      if (!out) throw FileError(tmp.string(), 0, "", "cannot write");
+    }
+    fs::rename(tmp, dir_ / "summary.json");
+  }
+
+  int64_t frames() const { return frames_; }
+
+ private:
+  fs::path dir_;
+  double fps_;
+  cv::VideoWriter writer_;
+  int64_t frames_ = 0;
+};
+
+/// The annotated view of one eye: detections (green accepted, red rejected), the track
+/// (yellow), the target (cyan), at half size.
+cv::Mat Annotate(const Latest& latest, const std::string& camera) {
+  const auto it = latest.images.find(camera);
+  if (it == latest.images.end() || !it->second) return cv::Mat(384, 512, CV_8UC3, cv::Scalar(0));
+  const Image& image = *it->second;
+  cv::Mat rgb(image.height(), image.width(), CV_8UC3, const_cast<uint8_t*>(image.data()));
+  cv::Mat bgr;
+  cv::cvtColor(rgb, bgr, cv::COLOR_RGB2BGR);
+  const int64_t frame = image.metadata().frame_index;
+  if (const auto f = latest.faces.find(camera);
+      f != latest.faces.end() && f->second.image &&
+      f->second.image->metadata().frame_index == frame) {
+    for (const FacesMessage::Face& face : f->second.faces) {
+      const cv::Scalar color = face.rejected ? cv::Scalar(0, 0, 255) : cv::Scalar(0, 220, 0);
+      cv::rectangle(bgr, face.box, color, 3);
+      if (face.rejected) {
+        cv::putText(bgr, face.reason, face.box.tl() + cv::Point(0, -8), cv::FONT_HERSHEY_SIMPLEX,
+                    0.9, color, 2);
+      }
+    }
+  }
+  if (const auto t = latest.tracks.find(camera); t != latest.tracks.end() && t->second.tracking) {
+    cv::rectangle(bgr, t->second.window, cv::Scalar(0, 220, 255), 2);
+  }
+  if (latest.target && latest.target->valid) {
+    const geometry::CameraModel model = vision::CameraModelOf(image);
+    const Eigen::Vector3d p_C = vision::CameraPoseOf(image).inverse() * latest.target->p_W;
+    if (p_C.z() > 0.0) {
+      if (const auto uv = model.Project(p_C)) {
+        cv::circle(bgr, cv::Point(static_cast<int>(uv->x()), static_cast<int>(uv->y())), 10,
+                   cv::Scalar(255, 255, 0), 3);
+      }
+    }
+  }
+  // The image centre: where a fixated target lands.
+  cv::drawMarker(bgr, cv::Point(image.width() / 2, image.height() / 2), cv::Scalar(255, 255, 255),
+                 cv::MARKER_CROSS, 30, 2);
+  cv::Mat half;
+  cv::resize(bgr, half, cv::Size(bgr.cols / 2, bgr.rows / 2), 0, 0, cv::INTER_AREA);
+  return half;
+}
+
+cv::Mat Compose(const Latest& latest, double time, const std::string& status) {
+  cv::Mat left = Annotate(latest, "left");
+  cv::Mat right = Annotate(latest, "right");
+  if (right.rows != left.rows) cv::resize(right, right, cv::Size(right.cols, left.rows));
+  cv::Mat both;
+  cv::hconcat(left, right, both);
+  cv::Mat out(both.rows + 36, both.cols, CV_8UC3, cv::Scalar(30, 30, 30));
+  both.copyTo(out(cv::Rect(0, 36, both.cols, both.rows)));
+  cv::putText(out, fmt::format("t = {:6.2f} s   {}", time, status), cv::Point(10, 25),
+              cv::FONT_HERSHEY_SIMPLEX, 0.7, cv::Scalar(255, 255, 255), 2);
+  return out;
+}
+
+json FixationJson(const Fixation& f) {
+  json j = {{"target_id", f.target_id},
+            {"object", f.object},
+            {"is_face", f.is_face},
+            {"selected_at_s", f.selected_at},
+            {"fixated", f.fixated_at.has_value()},
+            {"completed", f.completed}};
+  if (f.fixated_at) {
+    j["fixated_at_s"] = *f.fixated_at;
+    j["time_to_fixate_s"] = *f.fixated_at - f.selected_at;
+    j["target_W"] = VectorJson(f.p_W);
+    j["target_source"] = f.source;
+    j["distance_m"] = f.distance_m;
+    if (f.is_face) {
+      j["truth_W"] = VectorJson(f.truth_W);
+      j["error_3d_m"] = f.error_3d_m;
+      j["eye_error_deg"] = {{"left", f.left_error_deg}, {"right", f.right_error_deg}};
+      if (f.dwell_samples > 0) {
+        j["dwell_eye_error_deg"] = {
+            {"samples", f.dwell_samples},
+            {"left_mean", f.dwell_sum_deg[0] / f.dwell_samples},
+            {"right_mean", f.dwell_sum_deg[1] / f.dwell_samples},
+            {"left_max", f.dwell_max_deg[0]},
+            {"right_max", f.dwell_max_deg[1]}};
+      }
+    }
+  }
+  return j;
+}
+
+int RunDemo(const Options& o) {
+  components::RegisterComponents();
+  if (o.list) {
+    const runtime::ComponentRegistry& registry = runtime::ComponentRegistry::Global();
+    for (const std::string& type : registry.Types()) {
+      fmt::print("{:<24} {}\n", type, registry.Description(type));
+    }
+    fmt::print("Ports and parameters: include/saccade/components/*.h\n");
+    return 0;
+  }
+  if (!(o.duration > 0.0) || !std::isfinite(o.duration)) {
+    throw InvalidArgument(fmt::format("demo: --duration must be > 0 s, got {}", o.duration));
+  }
+  runtime::PipelineSpec spec = runtime::LoadPipelineFile(o.pipeline);
+  if (!o.scene.empty()) {
+    // --scene replaces every component's `scene` parameter (absolute: the pipeline file's
+    // folder is not the user's).
+    const std::string scene = fs::absolute(o.scene).lexically_normal().string();
+    if (!fs::exists(scene)) throw InvalidArgument("demo: --scene " + o.scene + ": no such file");
+    for (runtime::ComponentSpec& c : spec.components) {
+      if (c.params.is_object() && c.params.contains("scene")) c.params["scene"] = scene;
+    }
+  }
+  if (o.keep_going) spec.on_error = runtime::OnError::kContinue;
+  const double dt = spec.clock.step;
+  if (o.realtime) {
+    spec.clock.mode = runtime::ClockMode::kRealtime;
+    spec.clock.rate_hz = 1.0 / dt;
+  }
+  runtime::Pipeline pipeline = runtime::Pipeline::Build(spec);
+
+  // The scene the cameras render, and where the cameras and the fixation controller run.
+  std::optional<std::size_t> cameras_index, fixation_index;
+  const components::SimCameras* cameras = nullptr;
+  for (std::size_t i = 0; i < pipeline.components().size(); ++i) {
+    const runtime::Component* c = pipeline.components()[i].get();
+    if (!cameras_index && dynamic_cast<const components::SimCameras*>(c)) {
+      cameras_index = i;
+      cameras = static_cast<const components::SimCameras*>(c);
+    }
+    if (dynamic_cast<const components::FixationComponent*>(c)) fixation_index = i;
+  }
+  if (cameras == nullptr) {
+    throw InvalidArgument("demo: pipeline " + o.pipeline +
+                          " has no sim.cameras component: the demo measures against the "
+                          "simulated scene");
+  }
+  const scene::Scene& scene = cameras->scene();
+  const std::vector<PictureFace> pictures = components::FindPictureFaces(scene);
+  int faces_total = 0;
+  for (const PictureFace& p : pictures) faces_total += p.has_face ? 1 : 0;
+
+  Latest latest;
+  Tap<runtime::ImageMessage>(pipeline, [&](const runtime::ImageMessage& m) {
+    if (m.image) latest.images[m.image->metadata().camera] = m.image;
+  });
+  Tap<FacesMessage>(pipeline, [&](const FacesMessage& m) {
+    if (m.image) latest.faces[m.image->metadata().camera] = m;
+  });
+  Tap<TrackMessage>(pipeline, [&](const TrackMessage& m) {
+    if (m.image) latest.tracks[m.image->metadata().camera] = m;
+  });
+  Tap<SelectionMessage>(pipeline, [&](const SelectionMessage& m) { latest.selection = m; });
+  Tap<TargetMessage>(pipeline, [&](const TargetMessage& m) { latest.target = m; });
+  Tap<JointStateMessage>(pipeline, [&](const JointStateMessage& m) { latest.joints = m; });
+
+  std::unique_ptr<Recorder> recorder;
+  if (!o.record.empty()) recorder = std::make_unique<Recorder>(o.record, 1.0 / dt, o.force);
+
+  std::vector<Fixation> fixations;
+  std::map<std::string, std::map<std::string, int>> decoy_rejections;  // picture -> reason -> n
+  std::vector<double> loop_latency_ms;
+
+  runtime::RunOptions run;
+  run.steps = static_cast<int64_t>(std::ceil(o.duration / dt - 1e-9));
+  g_stop = false;
+  run.stop = &g_stop;
+  run.on_error = [&](const runtime::StepError& error) {
+    fmt::print(stderr, "saccade: error: {}\n", error.ToString());
+  };
+  run.step_timing = [&](const runtime::StepContext&, const std::vector<double>& seconds,
+                        double overhead) {
+    if (!cameras_index || !fixation_index || seconds.size() <= *fixation_index) return;
+    // From the end of the capture to the motor command: every stage in between, and the
+    // loop's own time in this step.
+    double total = overhead;
+    for (std::size_t i = *cameras_index + 1; i <= *fixation_index; ++i) total += seconds[i];
+    loop_latency_ms.push_back(1e3 * total);
+  };
+  run.after_step = [&](const runtime::StepContext& context) {
+    const double t = context.time;
+    // Rejected detections on a decoy picture (the cat), by reason.
+    for (const auto& [camera, faces] : latest.faces) {
+      if (!faces.image || faces.image->metadata().frame_index != context.step) continue;
+      for (const FacesMessage::Face& face : faces.faces) {
+        if (!face.rejected) continue;
+        for (const PictureFace& p : pictures) {
+          if (p.has_face) continue;
+          const auto box = components::ProjectedBox(scene, scene.objects()[p.object], *faces.image);
+          const double cx = face.box.x + face.box.width / 2.0;
+          const double cy = face.box.y + face.box.height / 2.0;
+          if (box && cx >= (*box)[0] && cx <= (*box)[2] && cy >= (*box)[1] && cy <= (*box)[3]) {
+            ++decoy_rejections[p.name][face.reason];
+          }
+        }
+      }
+    }
+
+    std::string status = "looking for faces";
+    const SelectionMessage* sel = latest.selection ? &*latest.selection : nullptr;
+    bool fixated_now = false;
+    if (sel != nullptr && sel->valid && !sel->exploring) {
+      if (fixations.empty() || fixations.back().target_id != sel->target_id) {
+        Fixation f;
+        f.target_id = sel->target_id;
+        f.selected_at = t;
+        fixations.push_back(f);
+      }
+      Fixation& f = fixations.back();
+      status = fmt::format("target {}: {}", f.target_id, sel->fixating ? "fixating" : "saccade");
+      const auto left = latest.images.find("left");
+      const auto right = latest.images.find("right");
+      const bool eyes = left != latest.images.end() && right != latest.images.end();
+      if (sel->fixating && eyes) {
+        if (!f.fixated_at) {
+          // Identify the object: the nearest face centre (or decoy picture) to the target.
+          f.fixated_at = t;
+          f.p_W = latest.target && latest.target->valid ? latest.target->p_W : sel->p_W;
+          f.source = latest.target ? latest.target->source : "selection";
+          f.distance_m = (f.p_W - 0.5 * (vision::CameraPoseOf(*left->second).translation() +
+                                         vision::CameraPoseOf(*right->second).translation()))
+                             .norm();
+          double best = 0.35;
+          for (const PictureFace& p : pictures) {
+            scene::SceneState state = scene.InitialState();
+            state.time = t;
+            const Eigen::Vector3d ref = p.has_face
+                                            ? components::FaceCentreAt(scene, p, t)
+                                            : scene.ObjectPose(scene.objects()[p.object], state)
+                                                  .translation();
+            const double d = (ref - f.p_W).norm();
+            if (d < best) {
+              best = d;
+              f.object = p.name;
+              f.is_face = p.has_face;
+              f.truth_W = ref;
+            }
+          }
+          if (f.is_face) {
+            f.error_3d_m = (f.p_W - f.truth_W).norm();
+            f.left_error_deg = AxisErrorDeg(*left->second, f.truth_W);
+            f.right_error_deg = AxisErrorDeg(*right->second, f.truth_W);
+          }
+          fixated_now = true;
+        }
+        if (f.is_face) {
+          // Pursuit: how well the eyes stay on the (possibly moving) true face centre.
+          const PictureFace* p = nullptr;
+          for (const PictureFace& q : pictures) {
+            if (q.name == f.object) p = &q;
+          }
+          const Eigen::Vector3d truth = components::FaceCentreAt(scene, *p, t);
+          const double e[2] = {AxisErrorDeg(*left->second, truth),
+                               AxisErrorDeg(*right->second, truth)};
+          for (int k = 0; k < 2; ++k) {
+            f.dwell_sum_deg[k] += e[k];
+            f.dwell_max_deg[k] = std::max(f.dwell_max_deg[k], e[k]);
+          }
+          ++f.dwell_samples;
+        }
+      }
+      if (f.fixated_at) {
+        for (const Eigen::Vector3d& s : sel->suppressed_W) {
+          if ((s - f.p_W).norm() < 0.2) f.completed = true;
+        }
+      }
+    } else if (sel != nullptr && sel->exploring) {
+      status = "exploring: looking straight ahead";
+    }
+    // Earlier targets the selection moved away from are complete once suppressed too.
+    if (sel != nullptr) {
+      for (Fixation& f : fixations) {
+        if (!f.fixated_at || f.completed) continue;
+        for (const Eigen::Vector3d& s : sel->suppressed_W) {
+          if ((s - f.p_W).norm() < 0.2) f.completed = true;
+        }
+      }
+    }
+
+    if (fixated_now) {
+      const Fixation& f = fixations.back();
+      if (!o.json) {
+        if (f.is_face) {
+          fmt::print(
+              "t = {:6.2f} s  fixated {:<16} at {:.2f} m  3D error {:5.1f} mm  eye axis error "
+              "L {:.3f} deg R {:.3f} deg  took {:.2f} s  ({})\n",
+              t, f.object, f.distance_m, 1e3 * f.error_3d_m, f.left_error_deg, f.right_error_deg,
+              *f.fixated_at - f.selected_at, f.source);
+        } else {
+          fmt::print("t = {:6.2f} s  fixated {} (not a face)  took {:.2f} s\n", t, f.object,
+                     *f.fixated_at - f.selected_at);
+        }
+        std::fflush(stdout);
+      }
+    }
+    if (recorder) {
+      const cv::Mat frame = Compose(latest, t, status);
+      recorder->Write(context.step, frame);
+      if (fixated_now) {
+        recorder->WriteFixation(static_cast<int>(fixations.size()), fixations.back().object,
+                                frame);
+      }
+    }
+    // Done once every face has been fixated and let go.
+    int done = 0;
+    for (const PictureFace& p : pictures) {
+      if (!p.has_face) continue;
+      for (const Fixation& f : fixations) {
+        if (f.object == p.name && f.completed) {
+          ++done;
+          break;
+        }
+      }
+    }
+    if (faces_total > 0 && done == faces_total) g_stop = true;
+  };
+
+  auto previous_int = std::signal(SIGINT, OnDemoInterrupt);
+  auto previous_term = std::signal(SIGTERM, OnDemoInterrupt);
+  const runtime::RunSummary summary = runtime::RunPipeline(pipeline, run);
+  std::signal(SIGINT, previous_int);
+  std::signal(SIGTERM, previous_term);
+
+  // ---- the report ----
+  int faces_fixated = 0;
+  std::vector<std::string> seen;
+  for (const Fixation& f : fixations) {
+    if (f.fixated_at && f.is_face && std::find(seen.begin(), seen.end(), f.object) == seen.end()) {
+      seen.push_back(f.object);
+      ++faces_fixated;
+    }
+  }
+  json decoys = json::array();
+  for (const PictureFace& p : pictures) {
+    if (p.has_face) continue;
+    bool fixated = false;
+    for (const Fixation& f : fixations) fixated = fixated || (f.fixated_at && f.object == p.name);
+    int rejected = 0;
+    for (const auto& [reason, n] : decoy_rejections[p.name]) rejected += n;
+    decoys.push_back({{"name", p.name},
+                      {"fixated", fixated},
+                      {"rejected", !fixated},
+                      {"rejected_detections", rejected},
+                      {"by_reason", decoy_rejections[p.name]}});
+  }
+  json stages = json::array();
+  for (const runtime::ComponentTiming& c : summary.components) {
+    stages.push_back({{"name", c.name},
+                      {"median_ms", c.median_ms},
+                      {"p95_ms", c.p95_ms},
+                      {"mean_ms", c.mean_ms},
+                      {"max_ms", c.max_ms}});
+  }
+  const Stats latency = Summarise(loop_latency_ms);
+  json fixations_json = json::array();
+  for (const Fixation& f : fixations) fixations_json.push_back(FixationJson(f));
+  json errors = json::array();
+  for (const runtime::StepError& e : summary.errors) errors.push_back(e.ToString());
+  json report = {
+      {"pipeline", o.pipeline},
+      {"scene", o.scene.empty() ? json(nullptr) : json(o.scene)},
+      {"steps", summary.steps},
+      {"sim_time_s", summary.sim_time + dt},
+      {"wall_s", summary.wall_seconds},
+      {"faces", faces_total},
+      {"faces_fixated", faces_fixated},
+      {"fixations", fixations_json},
+      {"decoys", decoys},
+      {"latency_ms",
+       {{"capture_to_command", {{"median", latency.median}, {"p95", latency.p95}}},
+        {"stages", stages}}},
+      {"overhead_share", summary.overhead_share},
+      {"overhead_ms", {{"median", summary.overhead_median_ms}, {"p95", summary.overhead_p95_ms}}},
+      {"errors", errors},
+      {"interrupted", g_stop.load() && faces_fixated < faces_total}};
+  if (recorder) {
+    report["record"] = {{"folder", o.record},
+                        {"frames", recorder->frames()},
+                        {"video", (fs::path(o.record) / "demo.avi").string()}};
+    recorder->WriteSummary(report);
+    recorder.reset();  // closes the video
+  }
+
+  if (o.json) {
+    fmt::print("{}\n", report.dump(2));
+  } else {
+    fmt::print("\n{} of {} faces fixated in {:.2f} s of simulated time ({} steps, {:.1f} s wall)\n",
+               faces_fixated, faces_total, summary.sim_time + dt, summary.steps,
+               summary.wall_seconds);
+    for (const json& d : decoys) {
+      fmt::print("decoy {}: {} ({} detections on it rejected{})\n", d["name"].get<std::string>(),
+                 d["fixated"].get<bool>() ? "FIXATED (not rejected)" : "rejected, never fixated",
+                 d["rejected_detections"].get<int>(),
+                 d["by_reason"].empty() ? "" : ": " + d["by_reason"].dump());
+    }
+    fmt::print("\nlatency per stage (ms, wall clock on this machine):\n");
+    fmt::print("  {:<14} {:>8} {:>8} {:>8}\n", "stage", "median", "p95", "max");
+    for (const runtime::ComponentTiming& c : summary.components) {
+      fmt::print("  {:<14} {:>8.2f} {:>8.2f} {:>8.2f}\n", c.name, c.median_ms, c.p95_ms, c.max_ms);
+    }
+    fmt::print("  capture -> motor command: median {:.2f} ms, p95 {:.2f} ms\n", latency.median,
+               latency.p95);
+    fmt::print("  outside the components (messaging, scheduling): {:.4f} ms/step median, "
+               "{:.3f} % of the loop\n",
+               summary.overhead_median_ms, 100.0 * summary.overhead_share);
+    if (recorder == nullptr && !o.record.empty()) {
+      fmt::print("\nrecorded to {}: frames/, demo.avi, summary.json, fixation_*.png\n", o.record);
+    }
+  }
+  if (!summary.errors.empty() && summary.stopped_on_error) return 1;
+  if (faces_fixated == 0) {
+    fmt::print(stderr, "saccade: demo: no face was fixated\n");
+    return 3;
+  }
+  return 0;
+}
+
+}  // namespace
+
+Runner AddDemoCommand(CLI::App& app) {
+  auto o = std::make_shared<Options>();
+  auto* demo = app.add_subcommand(
+      "demo",
+      "The main job: the active-vision loop of the seed paper, headless. The POPEYE head finds "
+      "the faces on the scene's portraits (rejecting the cat), tracks each with CamShift, "
+      "triangulates it and fixates it, closest first, moving on once inhibition of return "
+      "suppresses it. Prints each fixation's object, 3D error against the true face centre, "
+      "each eye's angular error and the time it took, then the latency of every stage. "
+      "Exit status: 0 when at least one face was fixated, 3 when none was, 1 on an error.");
+  demo->add_option("--pipeline", o->pipeline, "Pipeline YAML (components and connections)")
+      ->check(CLI::ExistingFile)
+      ->capture_default_str();
+  demo->add_option("--scene", o->scene,
+                   "Scene YAML; replaces every component's `scene` parameter (default: the "
+                   "pipeline's, scenes/portraits.yaml; scenes/portraits_moving.yaml shows "
+                   "smooth pursuit)")
+      ->check(CLI::ExistingFile);
+  demo->add_option("--duration", o->duration,
+                   "Longest run, simulated seconds; it ends sooner once every face was fixated")
+      ->capture_default_str();
+  demo->add_option("--record", o->record,
+                   "Folder for the annotated frames (frames/*.jpg), a video (demo.avi, MJPEG), "
+                   "a PNG per fixation and summary.json");
+  demo->add_flag("--force", o->force, "Replace an earlier recording in the --record folder");
+  demo->add_flag("--json", o->json, "Print the report as JSON (the same as summary.json)");
+  demo->add_flag("--realtime", o->realtime,
+                 "Run on the wall clock at the pipeline's rate instead of simulated time");
+  demo->add_flag("--keep-going", o->keep_going,
+                 "Continue after a component fails (the pipeline's on_error: continue)");
+  demo->add_flag("--list-components", o->list, "List the component types a pipeline can use");
+  return [o] { return RunDemo(*o); };
+}
+
+}  // namespace saccade::app

@@ -1,0 +1,41 @@
+#pragma once
+// control.fixation -- turns the 3D target into joint commands (seed section 3 and appendix A:
+// inverse kinematics, pan then tilt then symmetric vergence): a saccade to a new target, smooth
+// pursuit (position plus the joint velocities that follow the target's motion) of a moving one.
+//   params: scene (required: the head), pursuit true,
+//           min_pursuit_speed_m_s 0.02 (slower targets get saccades: triangulation jitter is
+//           not motion), velocity_smoothing 0.5 (0 .. 1: weight of the newest velocity)
+//   inputs: target (vision.target, required)
+//   outputs: command (head.command), for every new valid target
+//   The command is always within the joint limits (IK clamps; the motors clamp again).
+#include <memory>
+#include <optional>
+
+#include "saccade/components/messages.h"
+#include "saccade/runtime/component.h"
+#include "saccade/scene/scene.h"
+
+namespace saccade::components {
+
+class FixationComponent : public runtime::Component {
+ public:
+  FixationComponent();
+  void Configure(const nlohmann::json& params) override;
+  void Step(const runtime::StepContext& context) override;
+
+ private:
+  head::JointState Solve(const Eigen::Vector3d& p_W, const head::JointState& seed) const;
+
+  runtime::Input<TargetMessage>& target_;
+  runtime::Output<JointCommand>& command_;
+  std::shared_ptr<const scene::Scene> scene_;
+  bool pursuit_ = true;
+  double min_pursuit_speed_ = 0.02;
+  double smoothing_ = 0.5;
+  // The previous target, for its velocity.
+  std::optional<TargetMessage> previous_;
+  Eigen::Vector3d velocity_W_ = Eigen::Vector3d::Zero();
+  head::JointState last_joints_;
+};
+
+}  // namespace saccade::components

@@ -1,0 +1,67 @@
+#pragma once
+// The simulated robot as pipeline components (seed Fig. 2, left block): the cameras rendered
+// from a scene, and the head's motors. The real robot replaces them by components with the
+// same ports (issue 7).
+//
+// sim.cameras -- renders the scene's cameras (seed: cameraCapture through the FBO).
+//   params:  scene (required): scene file, relative to the pipeline file
+//            cameras: [left, right]      which cameras, one output each (named as the camera)
+//            distortion, noise, motion_blur: true   the scene's effects, each switchable
+//            msaa: 0 (0, 2, 4, 8); lod_max_error_px: 0.25
+//   inputs:  joints (head.joints, optional): the head's state at this step's time; connect
+//            it from sim.head with delay 1. Without it, the scene's initial joints.
+//   outputs: <camera> (runtime.image) per camera, shared; frame index = step.
+//
+// sim.head -- the head's four motors under their velocity and acceleration limits
+//   (head/motors.h): saccades and smooth pursuit, never outside the joint limits.
+//   params:  scene (required): the scene whose robot it is (its head and initial joints)
+//   inputs:  command (head.command, optional): the latest command, applied when it arrives
+//   outputs: joints (head.joints): the state at the end of the step (time + dt), i.e. at the
+//            next step's time, which is when the cameras see it.
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "saccade/components/messages.h"
+#include "saccade/head/motors.h"
+#include "saccade/render/renderer.h"
+#include "saccade/runtime/component.h"
+#include "saccade/scene/scene.h"
+
+namespace saccade::components {
+
+class SimCameras : public runtime::Component {
+ public:
+  SimCameras();
+  void Configure(const nlohmann::json& params) override;
+  void Start() override;
+  void Step(const runtime::StepContext& context) override;
+  void Stop() override;
+
+  const scene::Scene& scene() const { return *scene_; }
+
+ private:
+  runtime::Input<JointStateMessage>& joints_;
+  std::vector<runtime::Output<runtime::ImageMessage>*> outputs_;
+  std::shared_ptr<const scene::Scene> scene_;
+  render::RendererOptions options_;
+  std::unique_ptr<render::Renderer> renderer_;
+};
+
+class SimHead : public runtime::Component {
+ public:
+  SimHead();
+  void Configure(const nlohmann::json& params) override;
+  void Start() override;
+  void Step(const runtime::StepContext& context) override;
+
+  const head::Motors& motors() const { return *motors_; }
+
+ private:
+  runtime::Input<JointCommand>& command_;
+  runtime::Output<JointStateMessage>& joints_;
+  std::shared_ptr<const scene::Scene> scene_;
+  std::unique_ptr<head::Motors> motors_;
+};
+
+}  // namespace saccade::components

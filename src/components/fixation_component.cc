@@ -1,0 +1,66 @@
+#include "saccade/components/fixation_component.h"
+
+#include "components/internal_params.h"
+#include "saccade/components/scene_cache.h"
+#include "saccade/head/kinematics.h"
+
+namespace saccade::components {
+
+FixationComponent::FixationComponent()
+    : target_(AddInput<TargetMessage>("target", /*required=*/true)),
+      command_(AddOutput<JointCommand>("command")) {}
+
+void FixationComponent::Configure(const nlohmann::json& params) {
+  internal::Params p(params);
+  const std::string path = ResolvePath(p.RequiredString("scene"));
+  pursuit_ = p.Bool("pursuit", true);
+  min_pursuit_speed_ = p.Number("min_pursuit_speed_m_s", 0.02, 0.0, 1e6);
+  smoothing_ = p.Number("velocity_smoothing", 0.5, 0.0, 1.0);
+  p.Finish();
+  scene_ = LoadSharedScene(path);
+  last_joints_ = RobotOf(*scene_, path).initial_joints;
+}
+
+head::JointState FixationComponent::Solve(const Eigen::Vector3d& p_W,
+                                          const head::JointState& seed) const {
+  head::IkOptions options;
+  options.seed = seed;
+  // Unreachable targets give the nearest angles within the limits (kinematics.h).
+  return head::SolveFixation(scene_->robot()->head, p_W, options).joints;
+}
+
+void FixationComponent::Step(const runtime::StepContext& context) {
+  if (!target_.fresh()) return;
+  const TargetMessage& target = target_.value();
+  if (!target.valid || !target.p_W.allFinite()) {
+    previous_.reset();
+    return;
+  }
+  // The target's velocity, from successive points of the same target (seconds apart > 0).
+  if (previous_ && previous_->target_id == target.target_id && target.time > previous_->time) {
+    const Eigen::Vector3d v = (target.p_W - previous_->p_W) / (target.time - previous_->time);
+    velocity_W_ = smoothing_ * v + (1.0 - smoothing_) * velocity_W_;
+  } else {
+    velocity_W_.setZero();
+  }
+  previous_ = target;
+
+  JointCommand command;
+  command.time = context.time;
+  command.target_id = target.target_id;
+  command.positions = Solve(target.p_W, last_joints_);
+  if (pursuit_ && velocity_W_.norm() > 0.0 && velocity_W_.norm() >= min_pursuit_speed_) {
+    // Joint velocities by a finite difference of the IK along the target's motion.
+    constexpr double kH = 0.02;  // s
+    const head::JointState ahead = Solve(target.p_W + kH * velocity_W_, command.positions);
+    for (head::Joint joint : head::kAllJoints) {
+      command.velocities[joint] = (ahead[joint] - command.positions[joint]) / kH;
+    }
+  } else {
+    command.velocities = {0.0, 0.0, 0.0, 0.0};
+  }
+  last_joints_ = command.positions;
+  command_.Emit(command);
+}
+
+}  // namespace saccade::components

@@ -1,0 +1,31 @@
+#include "saccade/components/register.h"
+
+#include "saccade/components/fixation_component.h"
+#include "saccade/components/messages.h"
+#include "saccade/components/sim_components.h"
+#include "saccade/components/vision_components.h"
+
+namespace saccade::components {
+
+void RegisterComponents(runtime::ComponentRegistry& registry) {
+  RegisterMessages();
+  if (registry.Has("sim.cameras")) return;
+  registry.Register<SimCameras>("sim.cameras", "renders the scene's cameras (OpenGL/EGL)");
+  registry.Register<SimHead>("sim.head", "the head's motors under velocity/acceleration limits");
+  registry.Register<UndistortComponent>("vision.undistort", "removes lens distortion");
+  registry.Register<MedianComponent>("vision.median", "median filter");
+  registry.Register<SharpenComponent>("vision.sharpen", "unsharp-mask sharpening");
+  registry.Register<FaceDetectorComponent>("vision.face_detector",
+                                           "Haar faces, cat faces and eyeless boxes rejected");
+  registry.Register<StereoFacesComponent>("vision.stereo_faces",
+                                          "left/right association and triangulation");
+  registry.Register<AttentionComponent>("vision.attention",
+                                        "closest face, inhibition of return");
+  registry.Register<CamShiftComponent>("vision.camshift", "CamShift track of the selected face");
+  registry.Register<TriangulateComponent>("vision.triangulate",
+                                          "3D target from the tracks (or detections)");
+  registry.Register<FixationComponent>("control.fixation",
+                                       "inverse kinematics: saccades and smooth pursuit");
+}
+
+}  // namespace saccade::components

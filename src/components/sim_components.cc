@@ -1,0 +1,84 @@
+#include "saccade/components/sim_components.h"
+
+#include "components/internal_params.h"
+#include "saccade/components/scene_cache.h"
+#include "saccade/core/error.h"
+
+namespace saccade::components {
+
+SimCameras::SimCameras() : joints_(AddInput<JointStateMessage>("joints")) {}
+
+void SimCameras::Configure(const nlohmann::json& params) {
+  internal::Params p(params);
+  const std::string path = ResolvePath(p.RequiredString("scene"));
+  options_.cameras = p.Strings("cameras", {"left", "right"});
+  options_.distortion = p.Bool("distortion", true);
+  options_.noise = p.Bool("noise", true);
+  options_.motion_blur = p.Bool("motion_blur", true);
+  options_.msaa_samples = static_cast<int>(p.Integer("msaa", 0, 0, 8));
+  options_.lod_max_error_px = p.Number("lod_max_error_px", 0.25, 0.0, 1e6);
+  p.Finish();
+  std::string error;
+  if (!options_.IsValid(&error)) throw InvalidArgument(error);
+  scene_ = LoadSharedScene(path);
+  for (const std::string& camera : options_.cameras) {
+    if (scene_->FindCamera(camera) == nullptr) {
+      throw InvalidArgument("parameter 'cameras': scene '" + path + "' has no camera '" + camera +
+                            "'");
+    }
+    outputs_.push_back(&AddOutput<runtime::ImageMessage>(camera));
+  }
+}
+
+void SimCameras::Start() { renderer_ = render::MakeRenderer(*scene_, options_); }
+
+void SimCameras::Step(const runtime::StepContext& context) {
+  scene::SceneState state = scene_->InitialState();
+  state.time = context.time;
+  if (const JointStateMessage* joints = joints_.get()) {
+    state.joints = joints->positions;
+    state.joint_velocities = joints->velocities;
+  }
+  std::vector<render::Frame> frames = renderer_->Render(state, context.step);
+  for (std::size_t i = 0; i < frames.size() && i < outputs_.size(); ++i) {
+    outputs_[i]->Emit(runtime::ImageMessage{frames[i].color});
+  }
+}
+
+void SimCameras::Stop() { renderer_.reset(); }
+
+SimHead::SimHead()
+    : command_(AddInput<JointCommand>("command")),
+      joints_(AddOutput<JointStateMessage>("joints")) {}
+
+void SimHead::Configure(const nlohmann::json& params) {
+  internal::Params p(params);
+  const std::string path = ResolvePath(p.RequiredString("scene"));
+  p.Finish();
+  scene_ = LoadSharedScene(path);
+  RobotOf(*scene_, path);
+}
+
+void SimHead::Start() {
+  const scene::Robot& robot = *scene_->robot();
+  motors_ = std::make_unique<head::Motors>(robot.head, robot.initial_joints);
+}
+
+void SimHead::Step(const runtime::StepContext& context) {
+  if (command_.fresh()) {
+    const JointCommand& command = command_.value();
+    // Motors clamp targets to the joint limits and count it; non-finite values throw.
+    motors_->SetTarget(command.positions, command.velocities);
+  }
+  motors_->Step(context.dt);
+  JointStateMessage out;
+  out.time = context.time + context.dt;
+  out.positions = motors_->positions();
+  out.velocities = motors_->velocities();
+  out.targets = motors_->targets();
+  out.arrived = motors_->Arrived(1e-4);
+  out.clamped_commands = motors_->clamped_commands();
+  joints_.Emit(out);
+}
+
+}  // namespace saccade::components

@@ -1,0 +1,329 @@
+// Each component of the loop on its own: the perception components on rendered images of the
+// two-picture scene, attention, fixation and the motors on known inputs, and their errors.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "saccade/components/face_truth.h"
+#include "saccade/components/messages.h"
+#include "saccade/components/register.h"
+#include "saccade/components/scene_cache.h"
+#include "saccade/core/error.h"
+#include "saccade/head/kinematics.h"
+#include "saccade/runtime/pipeline.h"
+
+namespace saccade::components {
+namespace {
+
+using nlohmann::json;
+using runtime::Component;
+
+const std::string kScene = std::string(SACCADE_SOURCE_DIR) + "/scenes/astronaut_and_cat.yaml";
+
+// Triangulated detections of a ~100 px face at 2.2 m: the box centres differ between the eyes
+// by a pixel or two (quantisation), i.e. a few centimetres in depth at this baseline.
+constexpr double kTriangulationToleranceM = 0.03;
+// IK solutions are exact to ~1e-9 rad (kinematics.h); FK of them back to the point.
+constexpr double kIkToleranceM = 1e-6;
+
+/// The scene, held for the whole test program (LoadSharedScene keeps it only while held).
+const scene::Scene& Scene() {
+  static const std::shared_ptr<const scene::Scene> scene = LoadSharedScene(kScene);
+  return *scene;
+}
+
+std::unique_ptr<Component> Make(const std::string& type, const json& params) {
+  RegisterComponents();
+  std::unique_ptr<Component> c = runtime::ComponentRegistry::Global().Create(type);
+  c->Initialise(type, 1);
+  c->Configure(params);
+  return c;
+}
+
+template <typename T>
+runtime::Input<T>& In(Component& c, const std::string& name) {
+  auto* input = dynamic_cast<runtime::Input<T>*>(c.FindInput(name));
+  EXPECT_NE(input, nullptr) << name;
+  return *input;
+}
+
+/// The latest message an output sent.
+template <typename T>
+std::shared_ptr<std::optional<T>> Capture(Component& c, const std::string& name) {
+  auto latest = std::make_shared<std::optional<T>>();
+  auto* output = dynamic_cast<runtime::Output<T>*>(c.FindOutput(name));
+  EXPECT_NE(output, nullptr) << name;
+  output->signal().Connect([latest](const T& m) { *latest = m; });
+  return latest;
+}
+
+runtime::StepContext At(int64_t step) {
+  runtime::StepContext context;
+  context.step = step;
+  context.dt = 0.04;
+  context.time = step * context.dt;
+  return context;
+}
+
+PictureFace Astronaut() {
+  for (const PictureFace& p : FindPictureFaces(Scene())) {
+    if (p.has_face) return p;
+  }
+  ADD_FAILURE() << "no face in " << kScene;
+  return {};
+}
+
+TEST(FacePictures, OnlyTheAstronautHasAFaceTheCatIsADecoy) {
+  const auto pictures = FindPictureFaces(Scene());
+  ASSERT_EQ(pictures.size(), 2u);
+  EXPECT_EQ(pictures[0].name, "astronaut");
+  EXPECT_TRUE(pictures[0].has_face);
+  EXPECT_EQ(pictures[1].name, "chelsea");
+  EXPECT_FALSE(pictures[1].has_face);
+  // A human face on a 0.8 m portrait, as the cascade boxes it.
+  EXPECT_GT(pictures[0].width_m, 0.08);
+  EXPECT_LT(pictures[0].width_m, 0.25);
+}
+
+// The head fixates a point beside the face: the face is detected in both eyes, the cat's
+// candidates rejected, the pair triangulated onto the true face centre, selected, tracked,
+// and the fixation command turns the head onto it.
+TEST(PerceptionComponents, FromRenderedImagesToACommandThatFixatesTheFace) {
+  const scene::Scene& scene = Scene();
+  const Eigen::Vector3d face = FaceCentreAt(scene, Astronaut(), 0.0);
+  const head::IkResult look = head::SolveFixation(scene.robot()->head, face + Eigen::Vector3d(0, 0.1, -0.05));
+  ASSERT_TRUE(look.reachable());
+
+  auto cameras = Make("sim.cameras", {{"scene", kScene}});
+  auto faces_left = Make("vision.face_detector", json::object());
+  auto faces_right = Make("vision.face_detector", json::object());
+  auto stereo = Make("vision.stereo_faces", json::object());
+  auto attention = Make("vision.attention", {{"scene", kScene}});
+  auto track_left = Make("vision.camshift", {{"eye", "left"}});
+  auto track_right = Make("vision.camshift", {{"eye", "right"}});
+  auto triangulate = Make("vision.triangulate", json::object());
+  auto fixation = Make("control.fixation", {{"scene", kScene}});
+  auto left = Capture<runtime::ImageMessage>(*cameras, "left");
+  auto right = Capture<runtime::ImageMessage>(*cameras, "right");
+  auto fl = Capture<FacesMessage>(*faces_left, "faces");
+  auto fr = Capture<FacesMessage>(*faces_right, "faces");
+  auto candidates = Capture<CandidatesMessage>(*stereo, "candidates");
+  auto selection = Capture<SelectionMessage>(*attention, "selection");
+  auto tl = Capture<TrackMessage>(*track_left, "track");
+  auto tr = Capture<TrackMessage>(*track_right, "track");
+  auto target = Capture<TargetMessage>(*triangulate, "target");
+  auto command = Capture<JointCommand>(*fixation, "command");
+
+  cameras->Start();
+  for (int64_t step = 0; step < 3; ++step) {
+    JointStateMessage joints;
+    joints.time = At(step).time;
+    joints.positions = look.joints;
+    In<JointStateMessage>(*cameras, "joints").Deliver(joints);
+    cameras->Step(At(step));
+    ASSERT_TRUE(*left && *right);
+    EXPECT_EQ((*left)->image->metadata().frame_index, step);
+    EXPECT_EQ((*left)->image->metadata().joints[0], look.joints.pan);  // rendered at the joints
+    In<runtime::ImageMessage>(*faces_left, "image").Deliver(**left);
+    In<runtime::ImageMessage>(*faces_right, "image").Deliver(**right);
+    faces_left->Step(At(step));
+    faces_right->Step(At(step));
+    for (auto* in : {&faces_left, &faces_right}) (*in)->inputs()[0]->MarkSeen();
+    In<FacesMessage>(*stereo, "left").Deliver(**fl);
+    In<FacesMessage>(*stereo, "right").Deliver(**fr);
+    stereo->Step(At(step));
+    In<CandidatesMessage>(*attention, "candidates").Deliver(**candidates);
+    attention->Step(At(step));
+    for (auto* t : {&track_left, &track_right}) {
+      In<runtime::ImageMessage>(**t, "image").Deliver(t == &track_left ? **left : **right);
+      In<SelectionMessage>(**t, "selection").Deliver(**selection);
+      (*t)->Step(At(step));
+    }
+    In<TrackMessage>(*triangulate, "left").Deliver(**tl);
+    In<TrackMessage>(*triangulate, "right").Deliver(**tr);
+    In<SelectionMessage>(*triangulate, "selection").Deliver(**selection);
+    triangulate->Step(At(step));
+    In<TargetMessage>(*fixation, "target").Deliver(**target);
+    fixation->Step(At(step));
+  }
+  cameras->Stop();
+
+  // One accepted face per eye; whatever fired on the cat is flagged, never accepted.
+  for (const auto* faces : {&*fl, &*fr}) {
+    int accepted = 0;
+    for (const FacesMessage::Face& f : (*faces)->faces) accepted += f.rejected ? 0 : 1;
+    EXPECT_EQ(accepted, 1);
+  }
+  ASSERT_EQ((*candidates)->candidates.size(), 1u);
+  EXPECT_LT(((*candidates)->candidates[0].p_W - face).norm(), kTriangulationToleranceM);
+  ASSERT_TRUE((*selection)->valid);
+  EXPECT_EQ((*selection)->target_id, 0);  // the same target over the three frames
+  EXPECT_FALSE((*selection)->fixating);   // no joints: the head is not known to be on it
+  EXPECT_TRUE((*tl)->tracking);
+  EXPECT_TRUE((*tr)->tracking);
+  EXPECT_TRUE((*tl)->window.contains(cv::Point((*tl)->center)));
+  ASSERT_TRUE((*target)->valid);
+  EXPECT_LT(((*target)->p_W - face).norm(), kTriangulationToleranceM);
+  // The command fixates the target exactly: both optical axes meet on it.
+  const head::HeadFrames frames =
+      head::ForwardKinematics(scene.robot()->head, (*command)->positions);
+  ASSERT_TRUE(frames.p_WFixation);
+  EXPECT_LT((*frames.p_WFixation - (*target)->p_W).norm(), kIkToleranceM);
+  EXPECT_FALSE((*command)->pursuit());  // a still face: a saccade
+}
+
+CandidatesMessage Candidates(double time, std::vector<Eigen::Vector3d> points) {
+  CandidatesMessage m;
+  m.time = time;
+  for (const Eigen::Vector3d& p : points) m.candidates.push_back({p, {}, {}, p.norm(), 0, 0, 0.15});
+  return m;
+}
+
+// Attention: the closest face first; once fixated for fixation_time_s, the next; when nothing
+// is left, home.
+TEST(AttentionComponent, VisitsTheClosestFirstThenTheNextThenGoesHome) {
+  const scene::Scene& scene = Scene();
+  auto attention = Make("vision.attention", {{"scene", kScene},
+                                             {"fixation_time_s", 0.2},
+                                             {"explore_after_s", 0.1}});
+  auto selection = Capture<SelectionMessage>(*attention, "selection");
+  const Eigen::Vector3d near(1.5, 0.3, 1.2), far(3.0, -0.4, 1.3);
+  std::vector<int64_t> ids;
+  std::vector<Eigen::Vector3d> looked_at;
+  for (int64_t step = 0; step < 40; ++step) {
+    const double t = At(step).time;
+    // The head is on whatever was selected last (as if the motors were instant).
+    if (*selection && (*selection)->valid) {
+      JointStateMessage joints;
+      joints.positions = head::SolveFixation(scene.robot()->head, (*selection)->p_W).joints;
+      joints.arrived = true;
+      In<JointStateMessage>(*attention, "joints").Deliver(joints);
+    }
+    // Both faces are seen for the first 25 steps, then nothing.
+    In<CandidatesMessage>(*attention, "candidates")
+        .Deliver(step < 25 ? Candidates(t, {far, near}) : Candidates(t, {}));
+    attention->Step(At(step));
+    attention->inputs()[0]->MarkSeen();
+    if (ids.empty() || ids.back() != (*selection)->target_id) {
+      ids.push_back((*selection)->target_id);
+      looked_at.push_back((*selection)->p_W);
+    }
+  }
+  ASSERT_GE(ids.size(), 3u);
+  EXPECT_LT((looked_at[0] - near).norm(), 1e-12);  // closest first
+  EXPECT_LT((looked_at[1] - far).norm(), 1e-12);   // then the next
+  EXPECT_TRUE((*selection)->exploring);             // nothing left: home
+  EXPECT_EQ((*selection)->suppressed_W.size(), 2u);
+}
+
+TEST(SimHead, CommandsBeyondTheLimitsAreClampedAndCountedNeverExceeded) {
+  const scene::Scene& scene = Scene();
+  auto head_component = Make("sim.head", {{"scene", kScene}});
+  auto joints = Capture<JointStateMessage>(*head_component, "joints");
+  head_component->Start();
+  JointCommand command;
+  command.positions = {3.0, -2.0, 0.0, 0.0};  // pan 172 deg, tilt -115 deg: beyond the limits
+  In<JointCommand>(*head_component, "command").Deliver(command);
+  const auto& limits = scene.robot()->head;
+  for (int64_t step = 0; step < 100; ++step) {
+    head_component->Step(At(step));
+    head_component->inputs()[0]->MarkSeen();
+    EXPECT_LE((*joints)->positions.pan, limits.limits(head::Joint::kPan).max + 1e-12);
+    EXPECT_GE((*joints)->positions.tilt, limits.limits(head::Joint::kTilt).min - 1e-12);
+    EXPECT_LE(std::abs((*joints)->velocities.pan),
+              limits.limits(head::Joint::kPan).max_velocity + 1e-9);
+  }
+  EXPECT_TRUE((*joints)->arrived);
+  EXPECT_DOUBLE_EQ((*joints)->positions.pan, limits.limits(head::Joint::kPan).max);
+  EXPECT_EQ((*joints)->clamped_commands, 2);  // pan and tilt
+  EXPECT_NEAR((*joints)->time, 100 * 0.04, 1e-12);  // the state at the next step's time
+
+  command.positions.tilt = std::nan("");
+  In<JointCommand>(*head_component, "command").Deliver(command);
+  try {
+    head_component->Step(At(100));
+    FAIL() << "a NaN command was accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("tilt"), std::string::npos) << e.what();
+  }
+}
+
+// Pursuit: a target moving at constant velocity gets joint velocities that follow it.
+TEST(FixationComponent, AMovingTargetGetsPursuitVelocitiesThatFollowIt) {
+  const scene::Scene& scene = Scene();
+  auto fixation = Make("control.fixation", {{"scene", kScene}, {"velocity_smoothing", 1.0}});
+  auto command = Capture<JointCommand>(*fixation, "command");
+  const Eigen::Vector3d v(0.0, 0.2, 0.0);  // 0.2 m/s to the left
+  for (int64_t step = 0; step < 5; ++step) {
+    TargetMessage target;
+    target.valid = true;
+    target.target_id = 1;
+    target.time = At(step).time;
+    target.p_W = Eigen::Vector3d(2.0, 0.0, 1.2) + v * target.time;
+    In<TargetMessage>(*fixation, "target").Deliver(target);
+    fixation->Step(At(step));
+  }
+  ASSERT_TRUE(*command);
+  EXPECT_TRUE((*command)->pursuit());
+  // Pan rate of a point 2 m ahead moving sideways at 0.2 m/s: ~0.1 rad/s (to the left, > 0).
+  const double t = At(4).time;
+  const double expected = 0.2 * 2.0 / (4.0 + std::pow(0.2 * t, 2));
+  EXPECT_NEAR((*command)->velocities.pan, expected, 0.01 * expected);
+  const auto& head = scene.robot()->head;
+  const head::HeadFrames frames = head::ForwardKinematics(head, (*command)->positions);
+  ASSERT_TRUE(frames.p_WFixation);
+  EXPECT_LT((*frames.p_WFixation - (Eigen::Vector3d(2.0, 0.0, 1.2) + v * t)).norm(), kIkToleranceM);
+}
+
+TEST(ComponentParams, UnknownMissingAndOutOfRangeParametersAreNamed) {
+  const auto message = [](const std::string& type, const json& params) {
+    try {
+      Make(type, params);
+    } catch (const Error& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  EXPECT_EQ(message("vision.face_detector", {{"min_neighbours", 3}}),
+            "unknown parameter 'min_neighbours' (known: max_size_px, min_neighbors, min_size_px, "
+            "reject_cats, require_eyes, scale_factor)");
+  EXPECT_EQ(message("vision.camshift", json::object()),
+            "parameter 'eye': expected one of left, right, got ''");
+  EXPECT_EQ(message("sim.head", json::object()), "parameter 'scene' is required");
+  EXPECT_EQ(message("vision.attention", {{"scene", kScene}, {"fixation_time_s", -1}}),
+            "parameter 'fixation_time_s': expected a number in [1e-06, 1000000], got -1");
+  EXPECT_EQ(message("sim.cameras", {{"scene", kScene}, {"cameras", {"left", "middle"}}}),
+            "parameter 'cameras': scene '" + kScene + "' has no camera 'middle'");
+}
+
+// In a pipeline file: the error names the file, the line and the component.
+TEST(ComponentParams, PipelineErrorsNameTheFileLineAndComponent) {
+  RegisterComponents();
+  const std::string file = std::string(SACCADE_SOURCE_DIR) + "/pipelines/bad.yaml";
+  const auto error = [&](const std::string& yaml) {
+    try {
+      runtime::Pipeline::LoadString(yaml, file);
+    } catch (const Error& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  const std::string head = "clock: {mode: simulated, step: 0.04, steps: 1}\ncomponents:\n";
+  EXPECT_EQ(error(head + "  - {name: d, type: vision.face_detector, params: {min_neighbors: -2}}\n"),
+            file + ":3: components[0].params: component 'd' (vision.face_detector): parameter "
+                   "'min_neighbors': expected an integer in [0, 1000], got -2");
+  // Faces into an image input: the types are named.
+  const std::string wrong = error(head +
+                                  "  - {name: c, type: sim.cameras, params: {scene: ../scenes/astronaut_and_cat.yaml}}\n"
+                                  "  - {name: d, type: vision.face_detector, inputs: {image: c.left}}\n"
+                                  "  - {name: e, type: vision.face_detector, inputs: {image: d.faces}}\n");
+  EXPECT_NE(wrong.find(":5:"), std::string::npos) << wrong;
+  EXPECT_NE(wrong.find("vision.faces"), std::string::npos) << wrong;
+  EXPECT_NE(wrong.find("runtime.image"), std::string::npos) << wrong;
+}
+
+}  // namespace
+}  // namespace saccade::components

@@ -1,0 +1,117 @@
+// `saccade demo` used as a person or a script would: the loop's report, the recording in real
+// formats, and the errors for bad input.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <opencv2/videoio.hpp>
+#include <string>
+
+#include "e2e/run_saccade.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+using saccade::e2e::CommandRun;
+using saccade::e2e::Saccade;
+using ::testing::HasSubstr;
+
+const std::string kSource = SACCADE_SOURCE_DIR;
+const std::string kTwoPictures = kSource + "/scenes/astronaut_and_cat.yaml";
+
+fs::path TempDir(const std::string& name) {
+  const fs::path dir =
+      fs::temp_directory_path() / ("saccade_demo_test_" + std::to_string(::getpid())) / name;
+  fs::remove_all(dir);
+  fs::create_directories(dir.parent_path());
+  return dir;
+}
+
+// The JSON report (the same as the recording's summary.json) and the recording itself.
+TEST(DemoCli, FixatesTheFaceRejectsTheCatAndRecordsAVideoThatOpenCvReads) {
+  const fs::path out = TempDir("record");
+  const CommandRun run = Saccade("demo --scene " + kTwoPictures + " --duration 4 --json --record " +
+                                 out.string());
+  ASSERT_EQ(run.status, 0) << run.output;
+  const json report = json::parse(run.output);
+  EXPECT_EQ(report["faces"], 1);
+  EXPECT_EQ(report["faces_fixated"], 1);
+  ASSERT_FALSE(report["fixations"].empty());
+  const json& f = report["fixations"][0];
+  EXPECT_EQ(f["object"], "astronaut");
+  EXPECT_LT(f["error_3d_m"].get<double>(), 0.05);
+  EXPECT_LT(f["eye_error_deg"]["left"].get<double>(), 0.5);
+  EXPECT_LT(f["eye_error_deg"]["right"].get<double>(), 0.5);
+  EXPECT_GT(f["time_to_fixate_s"].get<double>(), 0.0);
+  ASSERT_EQ(report["decoys"].size(), 1u);
+  EXPECT_EQ(report["decoys"][0]["name"], "chelsea");
+  EXPECT_EQ(report["decoys"][0]["rejected"], true);
+  EXPECT_GT(report["latency_ms"]["capture_to_command"]["median"].get<double>(), 0.0);
+  EXPECT_LT(report["overhead_share"].get<double>(), 0.01);
+
+  // The recording: one JPEG per step, a video with as many frames, a PNG of the fixation.
+  std::ifstream summary_file(out / "summary.json");
+  const json summary = json::parse(summary_file);
+  EXPECT_EQ(summary["faces_fixated"], 1);
+  const int64_t steps = summary["steps"];
+  int64_t jpegs = 0;
+  for (const auto& e : fs::directory_iterator(out / "frames")) jpegs += e.path().extension() == ".jpg";
+  EXPECT_EQ(jpegs, steps);
+  EXPECT_TRUE(fs::exists(out / "fixation_1_astronaut.png"));
+  // OpenCV's own MJPEG reader: no FFmpeg or GStreamer needed to read what the demo wrote.
+  cv::VideoCapture video((out / "demo.avi").string(), cv::CAP_OPENCV_MJPEG);
+  ASSERT_TRUE(video.isOpened());
+  int64_t frames = 0;
+  int width = 0;
+  for (cv::Mat frame; video.read(frame); ++frames) width = frame.cols;
+  EXPECT_EQ(frames, steps);
+  EXPECT_EQ(width, 1024);  // both eyes side by side at half size
+
+  // The same folder again without --force: refused, and the recording is kept.
+  const CommandRun again = Saccade("demo --scene " + kTwoPictures + " --duration 1 --record " +
+                                   out.string());
+  EXPECT_EQ(again.status, 1);
+  EXPECT_THAT(again.output, HasSubstr("already holds a recording; pass --force"));
+  std::ifstream kept(out / "summary.json");
+  EXPECT_EQ(json::parse(kept)["steps"], steps);
+  fs::remove_all(out.parent_path());
+}
+
+TEST(DemoCli, ExitsNonZeroWhenNoFaceIsFixated) {
+  // Two steps: the head cannot have reached any face yet.
+  const CommandRun run = Saccade("demo --scene " + kTwoPictures + " --duration 0.08");
+  EXPECT_EQ(run.status, 3) << run.output;
+  EXPECT_THAT(run.output, HasSubstr("0 of 1 faces fixated"));
+  EXPECT_THAT(run.output, HasSubstr("no face was fixated"));
+}
+
+TEST(DemoCli, ABadPipelineNamesTheFileLineAndWhatIsKnown) {
+  const fs::path dir = TempDir("pipelines");
+  fs::create_directories(dir);
+  const fs::path file = dir / "bad.yaml";
+  std::ofstream(file) << "clock: {mode: simulated, step: 0.04}\n"
+                         "components:\n"
+                         "  - name: cameras\n"
+                         "    type: sim.camera\n";
+  const CommandRun run = Saccade("demo --pipeline " + file.string());
+  EXPECT_EQ(run.status, 1);
+  EXPECT_THAT(run.output, HasSubstr(file.string() + ":4: components[0].type: unknown component "
+                                    "type 'sim.camera'"));
+  EXPECT_THAT(run.output, HasSubstr("sim.cameras"));  // the known types are listed
+  fs::remove_all(dir.parent_path());
+}
+
+TEST(DemoCli, ListsItsComponents) {
+  const CommandRun run = Saccade("demo --list-components");
+  EXPECT_EQ(run.status, 0);
+  for (const char* type : {"sim.cameras", "sim.head", "vision.face_detector", "vision.camshift",
+                           "vision.triangulate", "control.fixation", "vision.undistort"}) {
+    EXPECT_THAT(run.output, HasSubstr(type));
+  }
+}
+
+}  // namespace
