@@ -204,9 +204,8 @@ cv::Mat Annotate(const Latest& latest, const std::string& camera) {
   cv::Mat bgr;
   cv::cvtColor(rgb, bgr, cv::COLOR_RGB2BGR);
   const int64_t frame = image.metadata().frame_index;
-  if (const auto f = latest.faces.find(camera);
-      f != latest.faces.end() && f->second.image &&
-      f->second.image->metadata().frame_index == frame) {
+  if (const auto f = latest.faces.find(camera); f != latest.faces.end() && f->second.image &&
+                                                f->second.image->metadata().frame_index == frame) {
     for (const FacesMessage::Face& face : f->second.faces) {
       const cv::Scalar color = face.rejected ? cv::Scalar(0, 0, 255) : cv::Scalar(0, 220, 0);
       cv::rectangle(bgr, face.box, color, 3);
@@ -268,12 +267,11 @@ json FixationJson(const Fixation& f) {
       j["error_3d_m"] = f.error_3d_m;
       j["eye_error_deg"] = {{"left", f.left_error_deg}, {"right", f.right_error_deg}};
       if (f.dwell_samples > 0) {
-        j["dwell_eye_error_deg"] = {
-            {"samples", f.dwell_samples},
-            {"left_mean", f.dwell_sum_deg[0] / f.dwell_samples},
-            {"right_mean", f.dwell_sum_deg[1] / f.dwell_samples},
-            {"left_max", f.dwell_max_deg[0]},
-            {"right_max", f.dwell_max_deg[1]}};
+        j["dwell_eye_error_deg"] = {{"samples", f.dwell_samples},
+                                    {"left_mean", f.dwell_sum_deg[0] / f.dwell_samples},
+                                    {"right_mean", f.dwell_sum_deg[1] / f.dwell_samples},
+                                    {"left_max", f.dwell_max_deg[0]},
+                                    {"right_max", f.dwell_max_deg[1]}};
       }
     }
   }
@@ -416,10 +414,9 @@ int RunDemo(const Options& o) {
           for (const PictureFace& p : pictures) {
             scene::SceneState state = scene.InitialState();
             state.time = t;
-            const Eigen::Vector3d ref = p.has_face
-                                            ? components::FaceCentreAt(scene, p, t)
-                                            : scene.ObjectPose(scene.objects()[p.object], state)
-                                                  .translation();
+            const Eigen::Vector3d ref =
+                p.has_face ? components::FaceCentreAt(scene, p, t)
+                           : scene.ObjectPose(scene.objects()[p.object], state).translation();
             const double d = (ref - f.p_W).norm();
             if (d < best) {
               best = d;
@@ -489,8 +486,7 @@ int RunDemo(const Options& o) {
       const cv::Mat frame = Compose(latest, t, status);
       recorder->Write(context.step, frame);
       if (fixated_now) {
-        recorder->WriteFixation(static_cast<int>(fixations.size()), fixations.back().object,
-                                frame);
+        recorder->WriteFixation(static_cast<int>(fixations.size()), fixations.back().object, frame);
       }
     }
     // Done once every face has been fixated and let go.
@@ -592,9 +588,10 @@ int RunDemo(const Options& o) {
     }
     fmt::print("  capture -> motor command: median {:.2f} ms, p95 {:.2f} ms\n", latency.median,
                latency.p95);
-    fmt::print("  outside the components (messaging, scheduling): {:.4f} ms/step median, "
-               "{:.3f} % of the loop\n",
-               summary.overhead_median_ms, 100.0 * summary.overhead_share);
+    fmt::print(
+        "  outside the components (messaging, scheduling): {:.4f} ms/step median, "
+        "{:.3f} % of the loop\n",
+        summary.overhead_median_ms, 100.0 * summary.overhead_share);
     if (recorder == nullptr && !o.record.empty()) {
       fmt::print("\nrecorded to {}: frames/, demo.avi, summary.json, fixation_*.png\n", o.record);
     }

@@ -26,8 +26,8 @@ const nlohmann::json* Params::Find(const std::string& key) {
 double Params::Number(const std::string& key, double fallback, double min, double max) {
   const nlohmann::json* value = Find(key);
   if (value == nullptr) return fallback;
-  if (!value->is_number() || !std::isfinite(value->get<double>()) ||
-      value->get<double>() < min || value->get<double>() > max) {
+  if (!value->is_number() || !std::isfinite(value->get<double>()) || value->get<double>() < min ||
+      value->get<double>() > max) {
     throw InvalidArgument(fmt::format("parameter '{}': expected a number in [{}, {}], got {}", key,
                                       min, max, value->dump()));
   }
@@ -94,8 +94,8 @@ std::vector<std::string> Params::Strings(const std::string& key,
     }
   }
   if (!value->is_array() || out.size() != value->size() || out.empty()) {
-    throw InvalidArgument(fmt::format("parameter '{}': expected a non-empty list of strings, got {}",
-                                      key, value->dump()));
+    throw InvalidArgument(fmt::format(
+        "parameter '{}': expected a non-empty list of strings, got {}", key, value->dump()));
   }
   return out;
 }
@@ -118,8 +118,8 @@ std::vector<double> Params::Numbers(const std::string& key, std::size_t n) {
 void Params::Finish() const {
   for (const auto& [key, value] : params_.items()) {
     if (!known_.contains(key)) {
-      throw InvalidArgument(fmt::format("unknown parameter '{}' (known: {})", key,
-                                        fmt::join(known_, ", ")));
+      throw InvalidArgument(
+          fmt::format("unknown parameter '{}' (known: {})", key, fmt::join(known_, ", ")));
     }
   }
 }

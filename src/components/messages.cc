@@ -65,9 +65,10 @@ cv::Rect RectFromJson(const json& j, const char* type, const char* key) {
   const std::vector<double> v = JsonNumbers(j, type, key, 4);
   for (double x : v) {
     if (x != static_cast<int>(x) || v[2] < 0 || v[3] < 0) {
-      throw Error(fmt::format("{}: field '{}': expected [x, y, width, height] in whole pixels, "
-                              "width and height >= 0, got {}",
-                              type, key, JsonField(j, type, key).dump()));
+      throw Error(
+          fmt::format("{}: field '{}': expected [x, y, width, height] in whole pixels, "
+                      "width and height >= 0, got {}",
+                      type, key, JsonField(j, type, key).dump()));
     }
   }
   return {static_cast<int>(v[0]), static_cast<int>(v[1]), static_cast<int>(v[2]),
@@ -167,8 +168,8 @@ CandidatesMessage MessageTraits<CandidatesMessage>::FromJson(const json& j) {
   m.frame_index = JsonInteger(j, kName, "frame_index");
   const json& candidates = JsonField(j, kName, "candidates");
   if (!candidates.is_array()) {
-    throw Error(fmt::format("{}: field 'candidates': expected an array, got {}", kName,
-                            candidates.dump()));
+    throw Error(
+        fmt::format("{}: field 'candidates': expected an array, got {}", kName, candidates.dump()));
   }
   for (const json& c : candidates) {
     FaceCandidate candidate;

@@ -19,8 +19,7 @@ void RegisterComponents(runtime::ComponentRegistry& registry) {
                                            "Haar faces, cat faces and eyeless boxes rejected");
   registry.Register<StereoFacesComponent>("vision.stereo_faces",
                                           "left/right association and triangulation");
-  registry.Register<AttentionComponent>("vision.attention",
-                                        "closest face, inhibition of return");
+  registry.Register<AttentionComponent>("vision.attention", "closest face, inhibition of return");
   registry.Register<CamShiftComponent>("vision.camshift", "CamShift track of the selected face");
   registry.Register<TriangulateComponent>("vision.triangulate",
                                           "3D target from the tracks (or detections)");

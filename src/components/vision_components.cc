@@ -180,7 +180,8 @@ void AttentionComponent::Step(const runtime::StepContext& context) {
 
   // The head fixates the target when it is at rest with its fixation point on it.
   bool fixating = false;
-  if (current_.valid && !current_.exploring && joints_.has_value() && joints_.value().arrived && frames.p_WFixation) {
+  if (current_.valid && !current_.exploring && joints_.has_value() && joints_.value().arrived &&
+      frames.p_WFixation) {
     fixating = (*frames.p_WFixation - current_.p_W).norm() <= fixation_tolerance_m_;
   }
 
@@ -346,9 +347,9 @@ void TriangulateComponent::Step(const runtime::StepContext& context) {
                              FrameOf(l->image) == FrameOf(r->image) &&
                              FrameOf(l->image) == selection->frame_index;
   if (tracks_usable && (prefer_tracks_ || !selection->boxes_fresh)) {
-    const auto match = associator_.Triangulate(
-        *l->image, vision::StereoObservation::FromBox(l->window), *r->image,
-        vision::StereoObservation::FromBox(r->window));
+    const auto match =
+        associator_.Triangulate(*l->image, vision::StereoObservation::FromBox(l->window), *r->image,
+                                vision::StereoObservation::FromBox(r->window));
     if (match && match->reprojection_px <= max_reprojection_px_ && match->depth_m > 0.0) {
       out.p_W = match->p_W;
       out.source = "tracks";

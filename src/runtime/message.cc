@@ -106,7 +106,9 @@ Value MessageTraits<Value>::FromJson(const nlohmann::json& j) {
 
 nlohmann::json MessageTraits<Text>::ToJson(const Text& m) { return {{"text", m.text}}; }
 
-Text MessageTraits<Text>::FromJson(const nlohmann::json& j) { return {JsonString(j, kName, "text")}; }
+Text MessageTraits<Text>::FromJson(const nlohmann::json& j) {
+  return {JsonString(j, kName, "text")};
+}
 
 nlohmann::json MessageTraits<ImageMessage>::ToJson(const ImageMessage& m) {
   if (!m.image) return nullptr;

@@ -4,9 +4,9 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <filesystem>
 #include <fstream>
 #include <limits>
-#include <filesystem>
 #include <map>
 #include <optional>
 #include <set>

@@ -46,12 +46,12 @@ struct Visit {
   double fixated_at = -1.0;
   double distance_m = 0.0;
   double error_3d_m = 0.0;
-  double eye_error_deg = 0.0;      // worse eye, when fixation was reached
+  double eye_error_deg = 0.0;        // worse eye, when fixation was reached
   double dwell_max_error_deg = 0.0;  // worse eye, over the whole dwell
 };
 
 struct LoopRun {
-  std::vector<Visit> visits;  // in the order attention chose them
+  std::vector<Visit> visits;             // in the order attention chose them
   std::vector<head::JointState> joints;  // per step
   runtime::RunSummary summary;
 };
@@ -74,9 +74,8 @@ LoopRun RunLoop(const std::string& scene_file, double seconds, bool stop_when_al
   for (const auto& c : pipeline.components()) {
     for (const auto& o : c->outputs()) {
       if (auto* i = dynamic_cast<runtime::Output<runtime::ImageMessage>*>(o.get())) {
-        i->signal().Connect([&](const runtime::ImageMessage& m) {
-          images[m.image->metadata().camera] = m.image;
-        });
+        i->signal().Connect(
+            [&](const runtime::ImageMessage& m) { images[m.image->metadata().camera] = m.image; });
       } else if (auto* s = dynamic_cast<runtime::Output<SelectionMessage>*>(o.get())) {
         s->signal().Connect([&](const SelectionMessage& m) { selection = m; });
       } else if (auto* t = dynamic_cast<runtime::Output<TargetMessage>*>(o.get())) {
@@ -131,8 +130,8 @@ LoopRun RunLoop(const std::string& scene_file, double seconds, bool stop_when_al
       }
     }
     if (v.object.empty()) return;
-    const double eye = std::max(AxisErrorDeg(*images.at("left"), truth),
-                                AxisErrorDeg(*images.at("right"), truth));
+    const double eye =
+        std::max(AxisErrorDeg(*images.at("left"), truth), AxisErrorDeg(*images.at("right"), truth));
     if (v.fixated_at < 0) {
       v.fixated_at = context.time;
       v.error_3d_m = (target->p_W - truth).norm();
@@ -182,9 +181,9 @@ TEST(ClosedLoop, FixatesEveryPortraitInTurnClosestFirstAndNeverTheCat) {
   for (const std::string& name : fixated) {
     for (const PictureFace& p : FindPictureFaces(*scene_ptr)) {
       if (p.name == name) {
-        distance.push_back((FaceCentreAt(*scene_ptr, p, 0.0) -
-                            scene_ptr->robot()->head.X_WB().translation())
-                               .norm());
+        distance.push_back(
+            (FaceCentreAt(*scene_ptr, p, 0.0) - scene_ptr->robot()->head.X_WB().translation())
+                .norm());
       }
     }
   }

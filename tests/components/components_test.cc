@@ -94,7 +94,8 @@ TEST(FacePictures, OnlyTheAstronautHasAFaceTheCatIsADecoy) {
 TEST(PerceptionComponents, FromRenderedImagesToACommandThatFixatesTheFace) {
   const scene::Scene& scene = Scene();
   const Eigen::Vector3d face = FaceCentreAt(scene, Astronaut(), 0.0);
-  const head::IkResult look = head::SolveFixation(scene.robot()->head, face + Eigen::Vector3d(0, 0.1, -0.05));
+  const head::IkResult look =
+      head::SolveFixation(scene.robot()->head, face + Eigen::Vector3d(0, 0.1, -0.05));
   ASSERT_TRUE(look.reachable());
 
   auto cameras = Make("sim.cameras", {{"scene", kScene}});
@@ -186,9 +187,8 @@ CandidatesMessage Candidates(double time, std::vector<Eigen::Vector3d> points) {
 // is left, home.
 TEST(AttentionComponent, VisitsTheClosestFirstThenTheNextThenGoesHome) {
   const scene::Scene& scene = Scene();
-  auto attention = Make("vision.attention", {{"scene", kScene},
-                                             {"fixation_time_s", 0.2},
-                                             {"explore_after_s", 0.1}});
+  auto attention = Make("vision.attention",
+                        {{"scene", kScene}, {"fixation_time_s", 0.2}, {"explore_after_s", 0.1}});
   auto selection = Capture<SelectionMessage>(*attention, "selection");
   const Eigen::Vector3d near(1.5, 0.3, 1.2), far(3.0, -0.4, 1.3);
   std::vector<int64_t> ids;
@@ -215,7 +215,7 @@ TEST(AttentionComponent, VisitsTheClosestFirstThenTheNextThenGoesHome) {
   ASSERT_GE(ids.size(), 3u);
   EXPECT_LT((looked_at[0] - near).norm(), 1e-12);  // closest first
   EXPECT_LT((looked_at[1] - far).norm(), 1e-12);   // then the next
-  EXPECT_TRUE((*selection)->exploring);             // nothing left: home
+  EXPECT_TRUE((*selection)->exploring);            // nothing left: home
   EXPECT_EQ((*selection)->suppressed_W.size(), 2u);
 }
 
@@ -238,7 +238,7 @@ TEST(SimHead, CommandsBeyondTheLimitsAreClampedAndCountedNeverExceeded) {
   }
   EXPECT_TRUE((*joints)->arrived);
   EXPECT_DOUBLE_EQ((*joints)->positions.pan, limits.limits(head::Joint::kPan).max);
-  EXPECT_EQ((*joints)->clamped_commands, 2);  // pan and tilt
+  EXPECT_EQ((*joints)->clamped_commands, 2);        // pan and tilt
   EXPECT_NEAR((*joints)->time, 100 * 0.04, 1e-12);  // the state at the next step's time
 
   command.positions.tilt = std::nan("");
@@ -312,14 +312,17 @@ TEST(ComponentParams, PipelineErrorsNameTheFileLineAndComponent) {
     return std::string("accepted");
   };
   const std::string head = "clock: {mode: simulated, step: 0.04, steps: 1}\ncomponents:\n";
-  EXPECT_EQ(error(head + "  - {name: d, type: vision.face_detector, params: {min_neighbors: -2}}\n"),
-            file + ":3: components[0].params: component 'd' (vision.face_detector): parameter "
-                   "'min_neighbors': expected an integer in [0, 1000], got -2");
+  EXPECT_EQ(
+      error(head + "  - {name: d, type: vision.face_detector, params: {min_neighbors: -2}}\n"),
+      file +
+          ":3: components[0].params: component 'd' (vision.face_detector): parameter "
+          "'min_neighbors': expected an integer in [0, 1000], got -2");
   // Faces into an image input: the types are named.
-  const std::string wrong = error(head +
-                                  "  - {name: c, type: sim.cameras, params: {scene: ../scenes/astronaut_and_cat.yaml}}\n"
-                                  "  - {name: d, type: vision.face_detector, inputs: {image: c.left}}\n"
-                                  "  - {name: e, type: vision.face_detector, inputs: {image: d.faces}}\n");
+  const std::string wrong =
+      error(head +
+            "  - {name: c, type: sim.cameras, params: {scene: ../scenes/astronaut_and_cat.yaml}}\n"
+            "  - {name: d, type: vision.face_detector, inputs: {image: c.left}}\n"
+            "  - {name: e, type: vision.face_detector, inputs: {image: d.faces}}\n");
   EXPECT_NE(wrong.find(":5:"), std::string::npos) << wrong;
   EXPECT_NE(wrong.find("vision.faces"), std::string::npos) << wrong;
   EXPECT_NE(wrong.find("runtime.image"), std::string::npos) << wrong;

@@ -19,7 +19,8 @@ void ExpectRoundTrip(const T& message) {
   EXPECT_EQ(MessageTraits<T>::ToJson(back), j) << j.dump();
   // Through the registry by name, as a text link would.
   RegisterMessages();
-  const runtime::MessageType* type = runtime::MessageRegistry::Global().Find(MessageTraits<T>::kName);
+  const runtime::MessageType* type =
+      runtime::MessageRegistry::Global().Find(MessageTraits<T>::kName);
   ASSERT_NE(type, nullptr) << MessageTraits<T>::kName;
   EXPECT_EQ(type->to_json(type->from_json(j).get()), j);
 }
@@ -93,8 +94,7 @@ TEST(Messages, BadJsonNamesTheTypeAndTheField) {
     runtime::MessageTraits<JointCommand>::FromJson(j);
     FAIL() << "accepted a string angle";
   } catch (const Error& e) {
-    EXPECT_STREQ(e.what(),
-                 "head.command.positions: field 'tilt': expected a number, got \"up\"");
+    EXPECT_STREQ(e.what(), "head.command.positions: field 'tilt': expected a number, got \"up\"");
   }
   nlohmann::json faces = {{"faces", {{{"box", {1, 2, -3, 4}}}}}};
   try {

@@ -34,8 +34,8 @@ fs::path TempDir(const std::string& name) {
 // The JSON report (the same as the recording's summary.json) and the recording itself.
 TEST(DemoCli, FixatesTheFaceRejectsTheCatAndRecordsAVideoThatOpenCvReads) {
   const fs::path out = TempDir("record");
-  const CommandRun run = Saccade("demo --scene " + kTwoPictures + " --duration 4 --json --record " +
-                                 out.string());
+  const CommandRun run =
+      Saccade("demo --scene " + kTwoPictures + " --duration 4 --json --record " + out.string());
   ASSERT_EQ(run.status, 0) << run.output;
   const json report = json::parse(run.output);
   EXPECT_EQ(report["faces"], 1);
@@ -59,7 +59,8 @@ TEST(DemoCli, FixatesTheFaceRejectsTheCatAndRecordsAVideoThatOpenCvReads) {
   EXPECT_EQ(summary["faces_fixated"], 1);
   const int64_t steps = summary["steps"];
   int64_t jpegs = 0;
-  for (const auto& e : fs::directory_iterator(out / "frames")) jpegs += e.path().extension() == ".jpg";
+  for (const auto& e : fs::directory_iterator(out / "frames"))
+    jpegs += e.path().extension() == ".jpg";
   EXPECT_EQ(jpegs, steps);
   EXPECT_TRUE(fs::exists(out / "fixation_1_astronaut.png"));
   // OpenCV's own MJPEG reader: no FFmpeg or GStreamer needed to read what the demo wrote.
@@ -72,8 +73,8 @@ TEST(DemoCli, FixatesTheFaceRejectsTheCatAndRecordsAVideoThatOpenCvReads) {
   EXPECT_EQ(width, 1024);  // both eyes side by side at half size
 
   // The same folder again without --force: refused, and the recording is kept.
-  const CommandRun again = Saccade("demo --scene " + kTwoPictures + " --duration 1 --record " +
-                                   out.string());
+  const CommandRun again =
+      Saccade("demo --scene " + kTwoPictures + " --duration 1 --record " + out.string());
   EXPECT_EQ(again.status, 1);
   EXPECT_THAT(again.output, HasSubstr("already holds a recording; pass --force"));
   std::ifstream kept(out / "summary.json");
@@ -100,7 +101,7 @@ TEST(DemoCli, ABadPipelineNamesTheFileLineAndWhatIsKnown) {
   const CommandRun run = Saccade("demo --pipeline " + file.string());
   EXPECT_EQ(run.status, 1);
   EXPECT_THAT(run.output, HasSubstr(file.string() + ":4: components[0].type: unknown component "
-                                    "type 'sim.camera'"));
+                                                    "type 'sim.camera'"));
   EXPECT_THAT(run.output, HasSubstr("sim.cameras"));  // the known types are listed
   fs::remove_all(dir.parent_path());
 }

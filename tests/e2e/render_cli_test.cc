@@ -200,15 +200,16 @@ TEST(BenchCli, ReportsFramesPerSecondAndStages) {
 }
 
 TEST(BenchCli, SaysWhichEffectsTheSceneDoesNotConfigure) {
-  // The portraits scene's cameras have no lens distortion, noise or exposure.
-  const CommandRun run = Saccade("bench --scene " + kScene + " --frames 2 --warmup 0");
+  // The two-picture scene's cameras have no lens distortion, noise or exposure.
+  const std::string scene = std::string(SACCADE_SOURCE_DIR) + "/scenes/astronaut_and_cat.yaml";
+  const CommandRun run = Saccade("bench --scene " + scene + " --frames 2 --warmup 0");
   ASSERT_EQ(run.status, 0) << run.output;
   EXPECT_THAT(run.output, HasSubstr("cost of each effect"));
   EXPECT_THAT(run.output, HasSubstr("blur is not configured"));
   EXPECT_THAT(run.output, HasSubstr("no camera of the scene has read or shot noise"));
   EXPECT_THAT(run.output, HasSubstr("truth depth+ids+boxes"));
   const CommandRun json_run =
-      Saccade("bench --scene " + kScene + " --frames 2 --warmup 0 --no-noise --json");
+      Saccade("bench --scene " + scene + " --frames 2 --warmup 0 --no-noise --json");
   ASSERT_EQ(json_run.status, 0) << json_run.output;
   const json out = json::parse(json_run.output);
   EXPECT_FALSE(out["noise"].get<bool>());
@@ -221,7 +222,7 @@ TEST(BenchCli, SaysWhichEffectsTheSceneDoesNotConfigure) {
   }
   // --no-effect-table: the first figure only.
   const CommandRun quick =
-      Saccade("bench --scene " + kScene + " --frames 2 --warmup 0 --no-effect-table");
+      Saccade("bench --scene " + scene + " --frames 2 --warmup 0 --no-effect-table");
   ASSERT_EQ(quick.status, 0) << quick.output;
   EXPECT_THAT(quick.output, ::testing::Not(HasSubstr("cost of each effect")));
 }

@@ -16,11 +16,11 @@
 namespace saccade::components {
 
 struct PictureFace {
-  std::string name;           ///< the object's name
-  std::size_t object = 0;     ///< index into scene.objects()
-  bool has_face = false;      ///< false: a decoy (no accepted face in its texture)
+  std::string name;        ///< the object's name
+  std::size_t object = 0;  ///< index into scene.objects()
+  bool has_face = false;   ///< false: a decoy (no accepted face in its texture)
   Eigen::Vector3d p_O = Eigen::Vector3d::Zero();  ///< face centre in the object frame, m
-  double width_m = 0.0;       ///< the face box's width on the picture, m
+  double width_m = 0.0;                           ///< the face box's width on the picture, m
 };
 
 /// Every picture of the scene, in scene order. Runs the face detector on each texture once.

@@ -35,11 +35,11 @@ struct JointStateMessage {
 /// A joint command: a saccade (velocities zero) or smooth pursuit (the target moves at
 /// `velocities` from `positions` at `time`). The receiver clamps it to its joint limits.
 struct JointCommand {
-  double time = 0.0;             ///< s, when it was issued
-  head::JointState positions;    ///< rad
-  head::JointState velocities;   ///< rad/s, zero for a saccade
-  int64_t target_id = -1;        ///< the fixation target it serves (-1: none)
-  bool pursuit() const;          ///< any velocity non-zero
+  double time = 0.0;            ///< s, when it was issued
+  head::JointState positions;   ///< rad
+  head::JointState velocities;  ///< rad/s, zero for a saccade
+  int64_t target_id = -1;       ///< the fixation target it serves (-1: none)
+  bool pursuit() const;         ///< any velocity non-zero
 };
 
 /// Faces found in one image (vision.face_detector), rejected candidates included and flagged.
@@ -88,7 +88,7 @@ struct SelectionMessage {
   /// No face to look at for a while: p_W is the home point straight ahead of the head, so
   /// that the head looks around for faces (no boxes; not a face).
   bool exploring = false;
-  double dwell_s = 0.0;   ///< how long the target has been fixated
+  double dwell_s = 0.0;                       ///< how long the target has been fixated
   std::vector<Eigen::Vector3d> suppressed_W;  ///< places inhibition of return suppresses
 };
 

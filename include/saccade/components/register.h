@@ -9,6 +9,7 @@ namespace saccade::components {
 /// vision.face_detector, vision.stereo_faces, vision.attention, vision.camshift,
 /// vision.triangulate and control.fixation, each with its one-line description, and the
 /// messages (RegisterMessages). Registering into a registry that has them already does nothing.
-void RegisterComponents(runtime::ComponentRegistry& registry = runtime::ComponentRegistry::Global());
+void RegisterComponents(
+    runtime::ComponentRegistry& registry = runtime::ComponentRegistry::Global());
 
 }  // namespace saccade::components

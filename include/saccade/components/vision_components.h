@@ -46,9 +46,9 @@
 //   outputs: target (vision.target)
 #include <array>
 #include <memory>
-#include <vector>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "saccade/components/messages.h"
 #include "saccade/runtime/component.h"

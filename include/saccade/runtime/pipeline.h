@@ -15,6 +15,8 @@
 //         image: cameras.left                          # <component>.<output>
 //         joints: {from: motors.joints, delay: 1}      # delivered at the next step
 //
+// Relative paths in params (e.g. `scene: ../scenes/portraits.yaml`) resolve against the
+// pipeline file's folder (Component::ResolvePath).
 // A connection from a later (or the same) component is a cycle unless it has `delay: 1`;
 // connections from earlier components are delivered at once. Every error is a FileError
 // naming file, line and key.
