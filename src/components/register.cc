@@ -25,6 +25,7 @@ void RegisterComponents(runtime::ComponentRegistry& registry) {
                                           "3D target from the tracks (or detections)");
   registry.Register<FixationComponent>("control.fixation",
                                        "inverse kinematics: saccades and smooth pursuit");
+  registry.Register<DebugFault>("debug.fault", "throws at a given step (fault injection)");
 }
 
 }  // namespace saccade::components

@@ -1,10 +1,25 @@
 #include "saccade/components/sim_components.h"
 
+#include <cstdint>
+
 #include "components/internal_params.h"
 #include "saccade/components/scene_cache.h"
 #include "saccade/core/error.h"
 
 namespace saccade::components {
+
+void DebugFault::Configure(const nlohmann::json& params) {
+  internal::Params p(params);
+  if (!p.Has("at_step")) throw InvalidArgument("parameter 'at_step' is required");
+  at_step_ = p.Integer("at_step", 0, 0, INT64_MAX);
+  message_ = p.String("message", "injected fault");
+  every_ = p.Bool("every", false);
+  p.Finish();
+}
+
+void DebugFault::Step(const runtime::StepContext& context) {
+  if (context.step == at_step_ || (every_ && context.step > at_step_)) throw Error(message_);
+}
 
 SimCameras::SimCameras() : joints_(AddInput<JointStateMessage>("joints")) {}
 

@@ -2,8 +2,10 @@
 // two-picture scene, attention, fixation and the motors on known inputs, and their errors.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <memory>
+#include <opencv2/imgproc.hpp>
 #include <optional>
 #include <string>
 
@@ -14,6 +16,10 @@
 #include "saccade/core/error.h"
 #include "saccade/head/kinematics.h"
 #include "saccade/runtime/pipeline.h"
+#include "saccade/vision/image_camera.h"
+#include "saccade/vision/median_filter.h"
+#include "saccade/vision/sharpener.h"
+#include "saccade/vision/undistorter.h"
 
 namespace saccade::components {
 namespace {
@@ -174,6 +180,81 @@ TEST(PerceptionComponents, FromRenderedImagesToACommandThatFixatesTheFace) {
   ASSERT_TRUE(frames.p_WFixation);
   EXPECT_LT((*frames.p_WFixation - (*target)->p_W).norm(), kIkToleranceM);
   EXPECT_FALSE((*command)->pursuit());  // a still face: a saccade
+}
+
+/// One frame of `camera` from sim.cameras on `scene_file` with the head at rest at `joints`
+/// moving at `velocities`.
+std::shared_ptr<const Image> RenderOne(const std::string& scene_file, const std::string& camera,
+                                       const head::JointState& joints,
+                                       const head::JointState& velocities) {
+  auto cameras = Make("sim.cameras", {{"scene", scene_file}, {"cameras", {camera}}});
+  auto image = Capture<runtime::ImageMessage>(*cameras, camera);
+  cameras->Start();
+  JointStateMessage state;
+  state.positions = joints;
+  state.velocities = velocities;
+  In<JointStateMessage>(*cameras, "joints").Deliver(state);
+  cameras->Step(At(0));
+  cameras->Stop();
+  return (*image)->image;
+}
+
+double Sharpness(const Image& image) {
+  cv::Mat rgb(image.height(), image.width(), CV_8UC3, const_cast<uint8_t*>(image.data()));
+  cv::Mat gray, laplacian;
+  cv::cvtColor(rgb, gray, cv::COLOR_RGB2GRAY);
+  cv::Laplacian(gray, laplacian, CV_64F);
+  cv::Scalar mean, stddev;
+  cv::meanStdDev(laplacian, mean, stddev);
+  return stddev[0] * stddev[0];
+}
+
+// The motors' velocities reach the renderer: a saccade in progress blurs the eye's image
+// (scenes/portraits.yaml's eye cameras expose for 8 ms).
+TEST(SimCameras, TheHeadsMotionBlursTheEyeImages) {
+  const std::string portraits = std::string(SACCADE_SOURCE_DIR) + "/scenes/portraits.yaml";
+  const head::JointState still{0.0, 0.0, 0.0, 0.0};
+  const auto sharp = RenderOne(portraits, "left", still, still);
+  const auto blurred = RenderOne(portraits, "left", still, {3.0, 0.0, 0.0, 0.0});  // 170 deg/s
+  EXPECT_EQ(blurred->metadata().joints[0], 0.0);
+  // 3 rad/s over 8 ms sweeps 0.024 rad, ~31 px: the edges' energy falls several-fold.
+  EXPECT_LT(Sharpness(*blurred), 0.5 * Sharpness(*sharp));
+}
+
+// The pre-processing components give exactly what the vision classes give (those are tested
+// against OpenCV in tests/vision), with the frame's metadata.
+TEST(PreprocessingComponents, GiveWhatTheVisionClassesGive) {
+  // The bench scene's eye cameras have a radtan lens (k1 = -0.2), so undistortion has work.
+  const std::string bench = std::string(SACCADE_SOURCE_DIR) + "/scenes/bench.yaml";
+  const head::JointState still{0.0, 0.0, 0.0, 0.0};
+  const auto image = RenderOne(bench, "left", still, still);
+  ASSERT_EQ(image->metadata().distortion_model, "radtan");
+  const auto run = [&](const std::string& type, const json& params) {
+    auto c = Make(type, params);
+    auto out = Capture<runtime::ImageMessage>(*c, "image");
+    In<runtime::ImageMessage>(*c, "image").Deliver(runtime::ImageMessage{image});
+    c->Step(At(0));
+    EXPECT_TRUE(*out) << type;
+    return (*out)->image;
+  };
+  const auto equal = [](const Image& a, const Image& b) {
+    return a.width() == b.width() && a.height() == b.height() &&
+           std::equal(a.data(), a.data() + a.size_bytes(), b.data());
+  };
+  vision::MedianFilter::Options median;
+  median.kernel_size = 5;
+  EXPECT_TRUE(equal(*run("vision.median", {{"kernel_size", 5}}),
+                    vision::MedianFilter(median).Apply(*image)));
+  vision::Sharpener::Options sharpen;
+  sharpen.amount = 1.5;
+  sharpen.sigma = 2.0;
+  EXPECT_TRUE(equal(*run("vision.sharpen", {{"amount", 1.5}, {"sigma", 2.0}}),
+                    vision::Sharpener(sharpen).Apply(*image)));
+  const auto undistorted = run("vision.undistort", json::object());
+  EXPECT_TRUE(
+      equal(*undistorted, vision::Undistorter(vision::CameraModelOf(*image)).Apply(*image)));
+  EXPECT_EQ(undistorted->metadata().distortion_model, "none");
+  EXPECT_EQ(undistorted->metadata().frame_index, image->metadata().frame_index);
 }
 
 CandidatesMessage Candidates(double time, std::vector<Eigen::Vector3d> points) {

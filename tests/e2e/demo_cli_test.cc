@@ -8,6 +8,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <opencv2/videoio.hpp>
+#include <sstream>
 #include <string>
 
 #include "e2e/run_saccade.h"
@@ -106,11 +107,49 @@ TEST(DemoCli, ABadPipelineNamesTheFileLineAndWhatIsKnown) {
   fs::remove_all(dir.parent_path());
 }
 
+// A component that fails mid-run: reported with its name and step, the run stops cleanly, and
+// what was recorded up to then is kept whole; --keep-going carries on past it.
+TEST(DemoCli, AFailingComponentIsNamedAndTheRecordingIsKept) {
+  const fs::path dir = TempDir("fault");
+  fs::create_directories(dir);
+  std::ifstream demo(kSource + "/pipelines/demo.yaml");
+  std::stringstream yaml;
+  yaml << demo.rdbuf()
+       << "  - {name: fault, type: debug.fault, params: {at_step: 5, message: 'the motor "
+          "driver went away'}}\n";
+  std::ofstream(dir / "faulty.yaml") << yaml.str();
+  const fs::path out = dir / "record";
+  const CommandRun run = Saccade("demo --pipeline " + (dir / "faulty.yaml").string() + " --scene " +
+                                 kTwoPictures + " --duration 4 --record " + out.string());
+  EXPECT_EQ(run.status, 1) << run.output;
+  EXPECT_THAT(run.output,
+              HasSubstr("component 'fault' failed at step 5: the motor driver went away"));
+  std::ifstream summary_file(out / "summary.json");
+  const json summary = json::parse(summary_file);
+  EXPECT_EQ(summary["steps"], 6);  // steps 0..5, the failing one included
+  ASSERT_EQ(summary["errors"].size(), 1u);
+  int64_t jpegs = 0;
+  for (const auto& e : fs::directory_iterator(out / "frames"))
+    jpegs += e.path().extension() == ".jpg";
+  EXPECT_EQ(jpegs, 6);
+  cv::VideoCapture video((out / "demo.avi").string(), cv::CAP_OPENCV_MJPEG);
+  int64_t frames = 0;
+  for (cv::Mat frame; video.read(frame);) ++frames;
+  EXPECT_EQ(frames, 6);  // the video was closed properly
+
+  const CommandRun going = Saccade("demo --pipeline " + (dir / "faulty.yaml").string() +
+                                   " --scene " + kTwoPictures + " --duration 4 --keep-going");
+  EXPECT_EQ(going.status, 0) << going.output;
+  EXPECT_THAT(going.output, HasSubstr("1 of 1 faces fixated"));
+  fs::remove_all(dir.parent_path());
+}
+
 TEST(DemoCli, ListsItsComponents) {
   const CommandRun run = Saccade("demo --list-components");
   EXPECT_EQ(run.status, 0);
-  for (const char* type : {"sim.cameras", "sim.head", "vision.face_detector", "vision.camshift",
-                           "vision.triangulate", "control.fixation", "vision.undistort"}) {
+  for (const char* type :
+       {"sim.cameras", "sim.head", "vision.face_detector", "vision.camshift", "vision.triangulate",
+        "control.fixation", "vision.undistort", "debug.fault"}) {
     EXPECT_THAT(run.output, HasSubstr(type));
   }
 }

@@ -7,8 +7,8 @@ namespace saccade::components {
 
 /// Registers sim.cameras, sim.head, vision.undistort, vision.median, vision.sharpen,
 /// vision.face_detector, vision.stereo_faces, vision.attention, vision.camshift,
-/// vision.triangulate and control.fixation, each with its one-line description, and the
-/// messages (RegisterMessages). Registering into a registry that has them already does nothing.
+/// vision.triangulate, control.fixation and debug.fault, each with its one-line description, and
+/// the messages (RegisterMessages). Registering into a registry that has them already does nothing.
 void RegisterComponents(
     runtime::ComponentRegistry& registry = runtime::ComponentRegistry::Global());
 

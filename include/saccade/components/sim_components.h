@@ -18,6 +18,7 @@
 //   inputs:  command (head.command, optional): the latest command, applied when it arrives
 //   outputs: joints (head.joints): the state at the end of the step (time + dt), i.e. at the
 //            next step's time, which is when the cameras see it.
+#include <cstdint>
 #include <memory>
 #include <string>
 #include <vector>
@@ -29,6 +30,21 @@
 #include "saccade/scene/scene.h"
 
 namespace saccade::components {
+
+/// debug.fault -- fault injection, to see how a pipeline and its tools handle a failing
+/// component: throws saccade::Error(`message`) in its Step at step `at_step` (and, with
+/// `every: true`, at every later step). No ports.
+///   params: at_step (required, >= 0), message "injected fault", every false
+class DebugFault : public runtime::Component {
+ public:
+  void Configure(const nlohmann::json& params) override;
+  void Step(const runtime::StepContext& context) override;
+
+ private:
+  int64_t at_step_ = 0;
+  bool every_ = false;
+  std::string message_;
+};
 
 class SimCameras : public runtime::Component {
  public:
