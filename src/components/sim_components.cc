@@ -63,8 +63,42 @@ void SimCameras::Step(const runtime::StepContext& context) {
 void SimCameras::Stop() { renderer_.reset(); }
 
 SimHead::SimHead()
-    : command_(AddInput<JointCommand>("command")),
-      joints_(AddOutput<JointStateMessage>("joints")) {}
+    : command_(AddInput<JointCommand>("command")), joints_(AddOutput<JointStateMessage>("joints")) {
+  AddMethod<runtime::Empty, JointStateMessage>(
+      "state", [this](const runtime::Empty&) { return State(time_); },
+      "the joints now (positions, velocities, targets)");
+  AddMethod<JointCommand, JointStateMessage>(
+      "move",
+      [this](const JointCommand& command) {
+        Motors().SetTarget(command.positions, command.velocities);  // clamps, or throws on NaN
+        return State(time_);
+      },
+      "a saccade or pursuit command, clamped to the joint limits; replies with the targets");
+  AddMethod<runtime::Empty, JointStateMessage>(
+      "stop",
+      [this](const runtime::Empty&) {
+        // Brake every joint at its acceleration limit and hold where it stops.
+        Motors().Reset(motors_->positions(), motors_->velocities());
+        return State(time_);
+      },
+      "brakes every joint and holds where it stops");
+}
+
+head::Motors& SimHead::Motors() {
+  if (!motors_) throw Error("the head is not started");
+  return *motors_;
+}
+
+JointStateMessage SimHead::State(double time) const {
+  JointStateMessage out;
+  out.time = time;
+  out.positions = motors_->positions();
+  out.velocities = motors_->velocities();
+  out.targets = motors_->targets();
+  out.arrived = motors_->Arrived(1e-4);
+  out.clamped_commands = motors_->clamped_commands();
+  return out;
+}
 
 void SimHead::Configure(const nlohmann::json& params) {
   internal::Params p(params);
@@ -77,6 +111,7 @@ void SimHead::Configure(const nlohmann::json& params) {
 void SimHead::Start() {
   const scene::Robot& robot = *scene_->robot();
   motors_ = std::make_unique<head::Motors>(robot.head, robot.initial_joints);
+  time_ = 0.0;
 }
 
 void SimHead::Step(const runtime::StepContext& context) {
@@ -86,14 +121,8 @@ void SimHead::Step(const runtime::StepContext& context) {
     motors_->SetTarget(command.positions, command.velocities);
   }
   motors_->Step(context.dt);
-  JointStateMessage out;
-  out.time = context.time + context.dt;
-  out.positions = motors_->positions();
-  out.velocities = motors_->velocities();
-  out.targets = motors_->targets();
-  out.arrived = motors_->Arrived(1e-4);
-  out.clamped_commands = motors_->clamped_commands();
-  joints_.Emit(out);
+  time_ = context.time + context.dt;
+  joints_.Emit(State(time_));
 }
 
 }  // namespace saccade::components

@@ -153,7 +153,17 @@ void StereoFacesComponent::Step(const runtime::StepContext& context) {
 AttentionComponent::AttentionComponent()
     : candidates_(AddInput<CandidatesMessage>("candidates", /*required=*/true)),
       joints_(AddInput<JointStateMessage>("joints")),
-      selection_(AddOutput<SelectionMessage>("selection")) {}
+      selection_(AddOutput<SelectionMessage>("selection")) {
+  AddMethod<runtime::Empty, runtime::Text>(
+      "reset",
+      [this](const runtime::Empty&) {
+        const std::size_t n = ior_ ? ior_->suppressions().size() : 0;
+        ior_.emplace(ior_options_);
+        current_ = SelectionMessage{};
+        return runtime::Text{"forgot the target and " + std::to_string(n) + " suppressed places"};
+      },
+      "forgets the target and what inhibition of return suppresses: every face is new again");
+}
 
 void AttentionComponent::Configure(const nlohmann::json& params) {
   internal::Params p(params);

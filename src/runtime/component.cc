@@ -36,6 +36,24 @@ OutputBase* Component::FindOutput(const std::string& name) const {
   return nullptr;
 }
 
+const MethodBase* Component::FindMethod(const std::string& name) const {
+  for (const auto& method : methods_) {
+    if (method->name() == name) return method.get();
+  }
+  return nullptr;
+}
+
+void Component::CheckNewMethod(const std::string& name) const {
+  if (!IsIdentifier(name)) {
+    throw InvalidArgument("Component::AddMethod: component '" + name_ + "': method name '" + name +
+                          "' must be non-empty letters, digits, '_' or '-'");
+  }
+  if (FindMethod(name) != nullptr) {
+    throw InvalidArgument("Component::AddMethod: component '" + name_ +
+                          "' already has a method named '" + name + "'");
+  }
+}
+
 void Component::CheckNewPort(const std::string& name, bool input) const {
   const char* kind = input ? "AddInput" : "AddOutput";
   if (!IsIdentifier(name)) {

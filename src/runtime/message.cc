@@ -17,6 +17,7 @@ MessageRegistry MakeGlobal() {
   registry.Register<Tick>();
   registry.Register<Value>();
   registry.Register<Text>();
+  registry.Register<Empty>();
   registry.Register<ImageMessage>();
   return registry;
 }
@@ -102,6 +103,15 @@ nlohmann::json MessageTraits<Value>::ToJson(const Value& m) { return {{"value", 
 
 Value MessageTraits<Value>::FromJson(const nlohmann::json& j) {
   return {JsonNumber(j, kName, "value")};
+}
+
+nlohmann::json MessageTraits<Empty>::ToJson(const Empty&) { return nlohmann::json::object(); }
+
+Empty MessageTraits<Empty>::FromJson(const nlohmann::json& j) {
+  if (!j.is_null() && !(j.is_object() && j.empty())) {
+    throw Error(fmt::format("{}: expected {{}}, got {}", kName, j.dump()));
+  }
+  return {};
 }
 
 nlohmann::json MessageTraits<Text>::ToJson(const Text& m) { return {{"text", m.text}}; }

@@ -406,4 +406,21 @@ double Pipeline::TakeDeliverySeconds() {
   return seconds;
 }
 
+nlohmann::json Pipeline::Call(const std::string& component, const std::string& method,
+                              const nlohmann::json& request) const {
+  const Component* c = Find(component);
+  if (c == nullptr) {
+    throw MethodError(component + "." + method, "no component named '" + component + "'");
+  }
+  const MethodBase* m = c->FindMethod(method);
+  if (m == nullptr) {
+    std::vector<std::string> names;
+    for (const auto& known : c->methods()) names.push_back(known->name());
+    throw MethodError(component + "." + method,
+                      "component '" + component + "' has no such method (it has: " +
+                          (names.empty() ? std::string("none") : Join(names)) + ")");
+  }
+  return m->CallJson(request);
+}
+
 }  // namespace saccade::runtime

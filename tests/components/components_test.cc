@@ -16,6 +16,7 @@
 #include "saccade/core/error.h"
 #include "saccade/head/kinematics.h"
 #include "saccade/runtime/pipeline.h"
+#include "saccade/runtime/scheduler.h"
 #include "saccade/vision/image_camera.h"
 #include "saccade/vision/median_filter.h"
 #include "saccade/vision/sharpener.h"
@@ -330,6 +331,37 @@ TEST(SimHead, CommandsBeyondTheLimitsAreClampedAndCountedNeverExceeded) {
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find("tilt"), std::string::npos) << e.what();
   }
+}
+
+// The head's methods: state, move (clamped, NaN refused) and stop, by JSON as a script would.
+TEST(SimHead, MethodsReadMoveAndStopTheHead) {
+  RegisterComponents();
+  runtime::Pipeline pipeline = runtime::Pipeline::LoadString(
+      "clock: {mode: simulated, step: 0.04, steps: 10}\ncomponents:\n"
+      "  - {name: head, type: sim.head, params: {scene: astronaut_and_cat.yaml}}\n",
+      std::string(SACCADE_SOURCE_DIR) + "/scenes/p.yaml");
+  runtime::RunPipeline(pipeline);  // started (and stopped) once: the motors exist
+  const json moved =
+      pipeline.Call("head", "move",
+                    {{"time", 0.0},
+                     {"positions", {{"pan", 0.5}, {"tilt", 9.0}, {"left", 0.0}, {"right", 0.0}}},
+                     {"velocities", {{"pan", 0.0}, {"tilt", 0.0}, {"left", 0.0}, {"right", 0.0}}},
+                     {"target_id", -1}});
+  EXPECT_DOUBLE_EQ(moved["targets"]["pan"].get<double>(), 0.5);
+  EXPECT_DOUBLE_EQ(moved["targets"]["tilt"].get<double>(),
+                   Scene().robot()->head.limits(head::Joint::kTilt).max);  // clamped
+  EXPECT_EQ(moved["clamped_commands"], 1);
+  const json stopped = pipeline.Call("head", "stop", json::object());
+  EXPECT_EQ(stopped["targets"], stopped["positions"]);  // at rest: holds where it is
+  try {
+    json bad = moved;
+    bad["positions"] = {{"pan", 0.5}, {"tilt", "down"}, {"left", 0.0}, {"right", 0.0}};
+    pipeline.Call("head", "move", bad);
+    FAIL() << "accepted a non-numeric tilt";
+  } catch (const runtime::MethodError& e) {
+    EXPECT_NE(std::string(e.what()).find("field 'tilt'"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(pipeline.Call("head", "state", json::object())["targets"], stopped["targets"]);
 }
 
 // Pursuit: a target moving at constant velocity gets joint velocities that follow it.

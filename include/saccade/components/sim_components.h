@@ -18,6 +18,10 @@
 //   inputs:  command (head.command, optional): the latest command, applied when it arrives
 //   outputs: joints (head.joints): the state at the end of the step (time + dt), i.e. at the
 //            next step's time, which is when the cameras see it.
+//   methods: state (runtime.empty -> head.joints): the joints now;
+//            move (head.command -> head.joints): a command, as on the input, clamped to the
+//              limits (the reply's targets say where it goes); NaN or infinite values fail;
+//            stop (runtime.empty -> head.joints): brakes every joint and holds where it stops.
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -74,10 +78,14 @@ class SimHead : public runtime::Component {
   const head::Motors& motors() const { return *motors_; }
 
  private:
+  head::Motors& Motors();  // throws when not started
+  JointStateMessage State(double time) const;
+
   runtime::Input<JointCommand>& command_;
   runtime::Output<JointStateMessage>& joints_;
   std::shared_ptr<const scene::Scene> scene_;
   std::unique_ptr<head::Motors> motors_;
+  double time_ = 0.0;  // s: the time of the state (after the last step)
 };
 
 }  // namespace saccade::components

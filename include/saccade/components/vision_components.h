@@ -27,6 +27,8 @@
 //           explore_after_s 0.5, home_distance_m 3
 //   inputs: candidates (vision.candidates, required), joints (head.joints, delay 1)
 //   outputs: selection (vision.selection)
+//   methods: reset (runtime.empty -> runtime.text): forgets the target and every suppressed
+//            place, so that every face is new again.
 //
 // vision.camshift -- one eye's CamShift track of the selected face (vision/camshift_tracker.h),
 //   seeded by its detection box, re-seeded when a detection of the same target lies farther

@@ -6,8 +6,10 @@
 //   -> Start() -> Step(context) once per tick, in pipeline order -> Stop().
 // Stop() is called on every component whose Start() returned, also after an error.
 //
-// Ports are declared with AddInput<T> / AddOutput<T> (port.h); component_registry.h makes
-// components by type name.
+// Ports are declared with AddInput<T> / AddOutput<T> (port.h); methods (seed section 5.4:
+// one-to-one requests with a reply or an error) with AddMethod<Request, Reply>, callable in
+// the process by type (FindMethod) or by name with JSON (Pipeline::Call, for text links).
+// component_registry.h makes components by type name.
 
 #include <cstdint>
 #include <memory>
@@ -16,6 +18,7 @@
 #include <utility>
 #include <vector>
 
+#include "saccade/runtime/bus.h"
 #include "saccade/runtime/message.h"
 #include "saccade/runtime/port.h"
 
@@ -27,6 +30,51 @@ struct StepContext {
   double time = 0.0;  ///< s: step * dt when simulated, wall time since start in real time
   double dt = 0.0;    ///< s: the nominal step (1 / rate_hz in real time)
   uint64_t seed = 0;  ///< this component's seed: f(pipeline seed, component name), constant
+};
+
+/// A component's method without its types: name, message types, and a JSON call.
+class MethodBase {
+ public:
+  MethodBase(std::string name, std::string request_type, std::string reply_type,
+             std::string description)
+      : name_(std::move(name)),
+        request_type_(std::move(request_type)),
+        reply_type_(std::move(reply_type)),
+        description_(std::move(description)) {}
+  virtual ~MethodBase() = default;
+  const std::string& name() const { return name_; }
+  const std::string& request_type() const { return request_type_; }
+  const std::string& reply_type() const { return reply_type_; }
+  const std::string& description() const { return description_; }
+  /// Converts the request from JSON, calls, and returns the reply as JSON. Throws MethodError
+  /// (naming the method) for a malformed request or a failing handler.
+  virtual nlohmann::json CallJson(const nlohmann::json& request) const = 0;
+
+ private:
+  std::string name_, request_type_, reply_type_, description_;
+};
+
+/// A typed method of a component (bus.h's Method with its JSON adapter).
+template <Message Request, Message Reply>
+class ComponentMethod final : public MethodBase {
+ public:
+  ComponentMethod(const std::string& name, std::string description)
+      : MethodBase(name, MessageName<Request>(), MessageName<Reply>(), std::move(description)),
+        method_(name) {}
+  Method<Request, Reply>& method() { return method_; }
+  const Method<Request, Reply>& method() const { return method_; }
+  nlohmann::json CallJson(const nlohmann::json& json) const override {
+    Request request;
+    try {
+      request = MessageTraits<Request>::FromJson(json);
+    } catch (const std::exception& error) {
+      throw MethodError(name(), std::string("bad request: ") + error.what());
+    }
+    return MessageTraits<Reply>::ToJson(method_.Call(request));
+  }
+
+ private:
+  Method<Request, Reply> method_;
 };
 
 /// Base of every pipeline component. Subclasses declare ports with AddInput / AddOutput in
@@ -58,6 +106,15 @@ class Component {
   OutputBase* FindOutput(const std::string& name) const;
   const std::vector<std::unique_ptr<InputBase>>& inputs() const { return inputs_; }
   const std::vector<std::unique_ptr<OutputBase>>& outputs() const { return outputs_; }
+  const std::vector<std::unique_ptr<MethodBase>>& methods() const { return methods_; }
+  /// nullptr when there is no such method.
+  const MethodBase* FindMethod(const std::string& name) const;
+  /// The typed method, for callers in the process; nullptr when absent or of other types.
+  template <Message Request, Message Reply>
+  const Method<Request, Reply>* FindMethod(const std::string& name) const {
+    const auto* typed = dynamic_cast<const ComponentMethod<Request, Reply>*>(FindMethod(name));
+    return typed ? &typed->method() : nullptr;
+  }
 
   /// Sets the name, the seed and the folder that relative paths in the params resolve
   /// against (the pipeline file's); the pipeline calls this before Configure.
@@ -82,6 +139,18 @@ class Component {
     return ref;
   }
 
+  /// Declares a method served by `handler` (one-to-one; a throwing handler becomes a
+  /// MethodError for the caller). Throws InvalidArgument when the name is taken or not an
+  /// identifier.
+  template <Message Request, Message Reply>
+  void AddMethod(const std::string& name, std::function<Reply(const Request&)> handler,
+                 std::string description) {
+    CheckNewMethod(name);
+    auto method = std::make_unique<ComponentMethod<Request, Reply>>(name, std::move(description));
+    method->method().Bind(std::move(handler));
+    methods_.push_back(std::move(method));
+  }
+
   /// Declares an input; a `required` input must be connected in the pipeline file.
   template <Message T>
   Input<T>& AddInput(const std::string& name, bool required = false) {
@@ -94,12 +163,14 @@ class Component {
 
  private:
   void CheckNewPort(const std::string& name, bool input) const;
+  void CheckNewMethod(const std::string& name) const;
 
   std::string name_;
   uint64_t seed_ = 0;
   std::string base_dir_;
   std::vector<std::unique_ptr<InputBase>> inputs_;
   std::vector<std::unique_ptr<OutputBase>> outputs_;
+  std::vector<std::unique_ptr<MethodBase>> methods_;
 };
 
 }  // namespace saccade::runtime

@@ -113,6 +113,11 @@ struct Text {
   bool operator==(const Text&) const = default;
 };
 
+/// No content: the request of a method that takes no argument. JSON: {} (or null).
+struct Empty {
+  bool operator==(const Empty&) const = default;
+};
+
 /// A frame, shared: every receiver holds the same pixels. Its JSON form carries metadata
 /// only (camera, frame index, time, width, height, format), never pixels; FromJson gives a
 /// zero-filled image of that size with that metadata (each side at most kMaxJsonImageSide).
@@ -147,6 +152,13 @@ struct MessageTraits<Value> {
   static constexpr const char* kName = "runtime.value";
   static nlohmann::json ToJson(const Value& m);
   static Value FromJson(const nlohmann::json& j);
+};
+
+template <>
+struct MessageTraits<Empty> {
+  static constexpr const char* kName = "runtime.empty";
+  static nlohmann::json ToJson(const Empty& m);
+  static Empty FromJson(const nlohmann::json& j);
 };
 
 template <>

@@ -112,6 +112,13 @@ class Pipeline {
     return dynamic_cast<T*>(Find(name));
   }
 
+  /// Calls `component`'s `method` with a JSON request and returns the JSON reply (seed 5.4:
+  /// methods are one-to-one with a reply or an error). Call between steps, from the thread
+  /// that runs the pipeline. Throws MethodError naming what is unknown (the component, or the
+  /// method and the component's methods), a malformed request or a failing handler.
+  nlohmann::json Call(const std::string& component, const std::string& method,
+                      const nlohmann::json& request) const;
+
   /// Hands over messages held back by delayed connections (the scheduler, each step).
   void DeliverDelayed();
   /// Seconds spent delivering messages since the last call (and resets the count).
