@@ -592,7 +592,7 @@ int RunDemo(const Options& o) {
         "  outside the components (messaging, scheduling): {:.4f} ms/step median, "
         "{:.3f} % of the loop\n",
         summary.overhead_median_ms, 100.0 * summary.overhead_share);
-    if (recorder == nullptr && !o.record.empty()) {
+    if (!o.record.empty()) {
       fmt::print("\nrecorded to {}: frames/, demo.avi, summary.json, fixation_*.png\n", o.record);
     }
   }
