@@ -1,5 +1,6 @@
 #include "saccade/components/sim_components.h"
 
+#include <algorithm>
 #include <cstdint>
 
 #include "components/internal_params.h"
@@ -120,8 +121,11 @@ void SimHead::Step(const runtime::StepContext& context) {
     // Motors clamp targets to the joint limits and count it; non-finite values throw.
     motors_->SetTarget(command.positions, command.velocities);
   }
-  motors_->Step(context.dt);
-  time_ = context.time + context.dt;
+  // Up to the next step's time. Simulated: dt. Real time: the wall time that has passed, so
+  // that the head moves at its real speed however long the loop's steps take.
+  const double until = context.time + context.dt;
+  motors_->Step(std::max(0.0, until - time_));
+  time_ = until;
   joints_.Emit(State(time_));
 }
 

@@ -144,6 +144,27 @@ TEST(DemoCli, AFailingComponentIsNamedAndTheRecordingIsKept) {
   fs::remove_all(dir.parent_path());
 }
 
+// Real time: ticks on the wall clock at the pipeline's 25 Hz (or slower, when a step takes
+// longer), the motors moving by the wall time that passed.
+TEST(DemoCli, RunsInRealTime) {
+  const CommandRun run =
+      Saccade("demo --scene " + kTwoPictures + " --duration 0.4 --realtime --json");
+  EXPECT_TRUE(run.status == 0 || run.status == 3) << run.output;
+  // The report, without the line on stderr when no face was fixated.
+  const std::size_t begin = run.output.find('{'), end = run.output.rfind('}');
+  ASSERT_NE(begin, std::string::npos) << run.output;
+  const json report = json::parse(run.output.substr(begin, end - begin + 1));
+  // At most 10 ticks (fewer when every face was done sooner: time is the wall's).
+  const int64_t steps = report["steps"];
+  EXPECT_GE(steps, 1);
+  EXPECT_LE(steps, 10);
+  // Tick k starts no sooner than k periods after the first, and the clock is the wall's:
+  // never ahead of the run's wall time.
+  const double time = report["sim_time_s"];
+  EXPECT_GE(time, 0.04 * steps - 1e-9);
+  EXPECT_LE(time, report["wall_s"].get<double>() + 0.04);
+}
+
 TEST(DemoCli, ListsItsComponents) {
   const CommandRun run = Saccade("demo --list-components");
   EXPECT_EQ(run.status, 0);

@@ -17,7 +17,8 @@
 //   params:  scene (required): the scene whose robot it is (its head and initial joints)
 //   inputs:  command (head.command, optional): the latest command, applied when it arrives
 //   outputs: joints (head.joints): the state at the end of the step (time + dt), i.e. at the
-//            next step's time, which is when the cameras see it.
+//            next step's time, which is when the cameras see it. The motors advance by the
+//            time since the last state: dt in simulated time, the wall time in real time.
 //   methods: state (runtime.empty -> head.joints): the joints now;
 //            move (head.command -> head.joints): a command, as on the input, clamped to the
 //              limits (the reply's targets say where it goes); NaN or infinite values fail;
