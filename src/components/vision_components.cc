@@ -240,6 +240,7 @@ void AttentionComponent::Step(const runtime::StepContext& context) {
       out.valid = true;
       out.exploring = true;
       out.target_id = next_id_++;
+      fixating = false;  // home is not a face
       out.p_W = frames.X_WB * Eigen::Vector3d(home_distance_m_, 0.0, 0.0);
     }
   }
