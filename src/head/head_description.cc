@@ -175,9 +175,34 @@ HeadGeometry ReadGeometry(const Entry& e) {
   return g;
 }
 
-JointLimits ReadJoint(const Entry& e) {
+ServoMapping ReadServo(const Entry& e) {
+  e.ExpectMap({"id", "zero_offset", "zero_offset_deg", "direction", "gear_ratio"});
+  ServoMapping servo;
+  const Entry id = e.Get("id");
+  const double id_value = id.AsDouble();
+  if (!(id_value >= 0 && id_value <= 252 && id_value == std::floor(id_value))) {
+    id.Fail(fmt::format("expected a servo id, an integer in 0..252, got {}", id.Describe()));
+  }
+  servo.id = static_cast<int>(id_value);
+  bool degrees = false;
+  if (const auto offset = FindAngleEntry(e, "zero_offset", &degrees)) {
+    servo.zero_offset = offset->AsDouble() * (degrees ? kDegToRad : 1.0);
+  }
+  if (const auto direction = e.Find("direction")) {
+    const double value = direction->AsDouble();
+    if (value != 1.0 && value != -1.0) {
+      direction->Fail("expected 1 or -1, got " + direction->Describe());
+    }
+    servo.direction = static_cast<int>(value);
+  }
+  if (const auto ratio = e.Find("gear_ratio")) servo.gear_ratio = ratio->AsPositive();
+  return servo;
+}
+
+JointLimits ReadJoint(const Entry& e, std::optional<ServoMapping>* servo) {
   e.ExpectMap({"limits", "limits_deg", "max_velocity", "max_velocity_deg", "max_acceleration",
-               "max_acceleration_deg"});
+               "max_acceleration_deg", "servo"});
+  if (const auto entry = e.Find("servo")) *servo = ReadServo(*entry);
   JointLimits limits;
   bool degrees = false;
   const Entry range = GetAngleEntry(e, "limits", &degrees);
@@ -294,8 +319,22 @@ HeadDescription ReadHead(const YAML::Node& root, const std::string& file) {
   const Entry joints = top.Get("joints");
   joints.ExpectMap({"pan", "tilt", "left", "right"});
   std::array<JointLimits, 4> limits;
+  std::array<std::optional<ServoMapping>, 4> servos;
+  std::optional<int> servo_line;
   for (const Joint joint : kAllJoints) {
-    limits[static_cast<int>(joint)] = ReadJoint(joints.Get(JointName(joint)));
+    const Entry entry = joints.Get(JointName(joint));
+    limits[static_cast<int>(joint)] = ReadJoint(entry, &servos[static_cast<int>(joint)]);
+    if (servos[static_cast<int>(joint)]) {
+      for (const Joint other : kAllJoints) {
+        if (other == joint) break;
+        if (servos[static_cast<int>(other)] &&
+            servos[static_cast<int>(other)]->id == servos[static_cast<int>(joint)]->id) {
+          entry.Get("servo").Get("id").Fail(fmt::format("servo id {} is already joint {}'s",
+                                                        servos[static_cast<int>(joint)]->id,
+                                                        JointName(other)));
+        }
+      }
+    }
   }
   const geometry::Pose X_WB = ReadPose(top.Get("pose"));
 
@@ -304,7 +343,7 @@ HeadDescription ReadHead(const YAML::Node& root, const std::string& file) {
   const geometry::CameraModel left = ReadCamera(cameras.Get("left"));
   const geometry::CameraModel right = ReadCamera(cameras.Get("right"));
   try {
-    return HeadDescription(name, geometry, limits, X_WB, left, right);
+    return HeadDescription(name, geometry, limits, X_WB, left, right, servos);
   } catch (const InvalidArgument& error) {
     // Every field was checked above; this is a safety net that still names the file.
     throw FileError(file, 0, "", error.what());
@@ -345,13 +384,15 @@ HeadDescription::HeadDescription(std::string name, const HeadGeometry& geometry,
                                  const std::array<JointLimits, 4>& limits,
                                  const geometry::Pose& X_WB,
                                  const geometry::CameraModel& left_camera,
-                                 const geometry::CameraModel& right_camera)
+                                 const geometry::CameraModel& right_camera,
+                                 const std::array<std::optional<ServoMapping>, 4>& servos)
     : name_(std::move(name)),
       geometry_(geometry),
       limits_(limits),
       X_WB_(X_WB),
       left_camera_(left_camera),
-      right_camera_(right_camera) {
+      right_camera_(right_camera),
+      servos_(servos) {
   if (!(std::isfinite(geometry.B) && geometry.B > 0.0)) {
     ThrowInvalid(
         fmt::format("geometry.B (half baseline) must be a positive finite length in "
@@ -389,6 +430,33 @@ HeadDescription::HeadDescription(std::string name, const HeadGeometry& geometry,
                       name_j, l.max_acceleration));
     }
   }
+  for (const Joint joint : kAllJoints) {
+    const auto& servo = servos_[static_cast<int>(joint)];
+    if (!servo) continue;
+    const char* name_j = JointName(joint);
+    if (servo->id < 0 || servo->id > 252) {
+      ThrowInvalid(fmt::format("joint {}: servo id must be in 0..252, got {}", name_j, servo->id));
+    }
+    if (servo->direction != 1 && servo->direction != -1) {
+      ThrowInvalid(fmt::format("joint {}: servo direction must be 1 or -1, got {}", name_j,
+                               servo->direction));
+    }
+    if (!(std::isfinite(servo->gear_ratio) && servo->gear_ratio > 0.0)) {
+      ThrowInvalid(fmt::format("joint {}: servo gear_ratio must be positive and finite, got {}",
+                               name_j, servo->gear_ratio));
+    }
+    if (!std::isfinite(servo->zero_offset)) {
+      ThrowInvalid(fmt::format("joint {}: servo zero_offset must be finite, got {}", name_j,
+                               servo->zero_offset));
+    }
+    for (const Joint other : kAllJoints) {
+      if (other == joint) break;
+      if (servos_[static_cast<int>(other)] && servos_[static_cast<int>(other)]->id == servo->id) {
+        ThrowInvalid(fmt::format("joint {}: servo id {} is already joint {}'s", name_j, servo->id,
+                                 JointName(other)));
+      }
+    }
+  }
   const Eigen::Matrix3d R = X_WB.linear();
   if (!X_WB.matrix().allFinite() ||
       !(R.transpose() * R).isApprox(Eigen::Matrix3d::Identity(), kRotationTolerance) ||
@@ -423,6 +491,13 @@ HeadDescription HeadDescription::FromYamlString(const std::string& text,
     // Should not happen (every access is checked), but never let a YAML exception escape.
     throw FileError(source, error.mark.is_null() ? 0 : error.mark.line + 1, "", error.msg);
   }
+}
+
+bool HeadDescription::HasServos() const {
+  for (const auto& servo : servos_) {
+    if (!servo) return false;
+  }
+  return true;
 }
 
 bool HeadDescription::WithinLimits(const JointState& joints) const {

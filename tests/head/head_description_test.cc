@@ -171,6 +171,59 @@ TEST(HeadDescriptionTest, OptionalGeometryOffsetsDefaultToZero) {
   EXPECT_EQ(head.geometry().delta_r, 0.0);
 }
 
+TEST(HeadDescriptionTest, PopeyeServosMapJointsOntoDynamixelTicks) {
+  const HeadDescription head = HeadDescription::FromYamlFile(kPopeyePath);
+  ASSERT_TRUE(head.HasServos());
+  const ServoMapping& tilt = *head.servo(Joint::kTilt);
+  EXPECT_EQ(tilt.id, 2);
+  EXPECT_EQ(tilt.direction, -1);
+  EXPECT_NEAR(tilt.zero_offset, std::numbers::pi, kParseTolerance);
+  // Joint 0 is the servo's centre (180 deg); the upside-down tilt servo turns the other way.
+  EXPECT_NEAR(tilt.ServoAngle(10 * kDeg), 170 * kDeg, kParseTolerance);
+  EXPECT_NEAR(tilt.JointAngle(170 * kDeg), 10 * kDeg, kParseTolerance);
+  EXPECT_NEAR(head.servo(Joint::kPan)->ServoAngle(10 * kDeg), 190 * kDeg, kParseTolerance);
+  EXPECT_EQ(head.servo(Joint::kRight)->id, 4);
+}
+
+TEST(HeadDescriptionTest, ServoMappingIsOptionalAndChecked) {
+  const HeadDescription plain = HeadDescription::FromYamlString(kValid, "valid.yaml");
+  EXPECT_FALSE(plain.HasServos());
+  EXPECT_FALSE(plain.servo(Joint::kPan).has_value());
+
+  const std::string geared = Replace(
+      kValid, "    max_acceleration_deg: 3000\n",
+      "    max_acceleration_deg: 3000\n    servo: {id: 7, zero_offset: 1.0, gear_ratio: 2.5}\n");
+  const HeadDescription head = HeadDescription::FromYamlString(geared, "geared.yaml");
+  const ServoMapping& pan = *head.servo(Joint::kPan);
+  EXPECT_EQ(pan.id, 7);
+  EXPECT_EQ(pan.direction, 1);
+  EXPECT_NEAR(pan.ServoAngle(0.2), 1.0 + 2.5 * 0.2, 1e-15);
+  EXPECT_NEAR(pan.JointAngle(pan.ServoAngle(-0.3)), -0.3, 1e-15);
+  EXPECT_FALSE(head.HasServos());  // only the pan joint has one
+
+  const auto with_servo = [](const std::string& servo) {
+    return Replace(kValid, "    max_acceleration_deg: 3000\n",
+                   "    max_acceleration_deg: 3000\n    servo: " + servo + "\n");
+  };
+  std::string text = with_servo("{id: 300}");
+  ExpectFileError(text, LineOf(text, "servo:"), "joints.pan.servo.id", "0..252");
+  text = with_servo("{id: 1, direction: 2}");
+  ExpectFileError(text, LineOf(text, "servo:"), "joints.pan.servo.direction", "1 or -1");
+  text = with_servo("{id: 1, gear_ratio: 0}");
+  ExpectFileError(text, LineOf(text, "servo:"), "joints.pan.servo.gear_ratio", "positive");
+  text = with_servo("{id: 1, zero_offset: 1, zero_offset_deg: 50}");
+  ExpectFileError(text, LineOf(text, "servo:"), "joints.pan.servo.zero_offset", "not both");
+  text = with_servo("{id: 1, speed: 3}");
+  ExpectFileError(text, LineOf(text, "servo:"), "joints.pan.servo.speed", "unknown key 'speed'");
+  text = with_servo("{zero_offset: 1}");
+  ExpectFileError(text, LineOf(text, "servo:"), "joints.pan.servo", "missing key 'id'");
+  // Two joints on one servo id.
+  text = Replace(with_servo("{id: 5}"), "    max_acceleration_deg: 6000\n",
+                 "    max_acceleration_deg: 6000\n    servo: {id: 5}\n");
+  ExpectFileError(text, LineOf(text, "6000\n    servo: {id: 5}") + 1, "joints.left.servo.id",
+                  "servo id 5 is already joint pan's");
+}
+
 TEST(HeadDescriptionTest, UnknownKeyIsNamedWithItsLine) {
   const std::string text = Replace(kValid, "  H: 0.0\n", "  H: 0.0\n  colour: red\n");
   ExpectFileError(text, LineOf(text, "colour"), "geometry.colour", "unknown key 'colour'");

@@ -49,6 +49,27 @@ struct JointLimits {
   bool Contains(double angle) const { return angle >= min && angle <= max; }
 };
 
+/// How a joint maps onto the servo that drives it (issue 7: a head built from bus servos,
+/// e.g. Dynamixel). The servo's shaft angle, measured from the servo's own zero position, is
+///   servo_angle = zero_offset + direction * gear_ratio * joint_angle      (rad)
+/// so zero_offset is where the servo stands when the joint is at 0, direction (+1 or -1)
+/// tells which way the servo turns when the joint angle grows, and gear_ratio is servo turns
+/// per joint turn. The simulator ignores it; hw's servo drivers use it.
+struct ServoMapping {
+  int id = 1;                ///< servo id on its bus, 0..252
+  double zero_offset = 0.0;  ///< rad, servo angle at joint angle 0
+  int direction = 1;         ///< +1 or -1
+  double gear_ratio = 1.0;   ///< > 0
+  /// The servo's shaft angle (rad) for a joint angle (rad), and back; velocities scale by
+  /// direction * gear_ratio.
+  double ServoAngle(double joint_angle) const {
+    return zero_offset + direction * gear_ratio * joint_angle;
+  }
+  double JointAngle(double servo_angle) const {
+    return (servo_angle - zero_offset) / (direction * gear_ratio);
+  }
+};
+
 /// Lengths of appendix A, in metres.
 struct HeadGeometry {
   double B = 0.1;        ///< half baseline: each eye's rotation axis is B from the cyclopean point
@@ -63,11 +84,14 @@ struct HeadGeometry {
 class HeadDescription {
  public:
   /// Throws InvalidArgument naming the field when B <= 0, a length is not finite, a limit range
-  /// is empty or does not contain 0, or a velocity/acceleration limit is not positive.
+  /// is empty or does not contain 0, a velocity/acceleration limit is not positive, or a servo
+  /// mapping is invalid (id outside 0..252 or used twice, direction not +-1, gear ratio not
+  /// positive, offset not finite).
   HeadDescription(std::string name, const HeadGeometry& geometry,
                   const std::array<JointLimits, 4>& limits, const geometry::Pose& X_WB,
                   const geometry::CameraModel& left_camera,
-                  const geometry::CameraModel& right_camera);
+                  const geometry::CameraModel& right_camera,
+                  const std::array<std::optional<ServoMapping>, 4>& servos = {});
 
   /// Loads a head description YAML (robots/popeye.yaml documents the format). Throws
   /// saccade::FileError with file, line and key on a missing, malformed or invalid entry,
@@ -84,6 +108,13 @@ class HeadDescription {
   const geometry::CameraModel& left_camera() const { return left_camera_; }
   const geometry::CameraModel& right_camera() const { return right_camera_; }
 
+  /// The servo that drives the joint, when the description says (`servo:` in the YAML).
+  const std::optional<ServoMapping>& servo(Joint joint) const {
+    return servos_[static_cast<int>(joint)];
+  }
+  /// Whether every joint has a servo mapping.
+  bool HasServos() const;
+
   /// Whether every joint is within its limits.
   bool WithinLimits(const JointState& joints) const;
   /// Throws InvalidArgument naming the first joint outside its limits, its value and range
@@ -97,6 +128,7 @@ class HeadDescription {
   geometry::Pose X_WB_;
   geometry::CameraModel left_camera_;
   geometry::CameraModel right_camera_;
+  std::array<std::optional<ServoMapping>, 4> servos_;
 };
 
 }  // namespace saccade::head
