@@ -1,0 +1,199 @@
+// The head driver's safety rules (head_driver.h), on the simulated head: the same base class
+// enforces them for every driver (dynamixel_head_test.cc checks them on the servo bus).
+#include "saccade/hw/head_driver.h"
+
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <numbers>
+#include <thread>
+
+namespace saccade::hw {
+namespace {
+
+constexpr double kDeg = std::numbers::pi / 180.0;
+const std::string kPopeye = SACCADE_SOURCE_DIR "/robots/popeye.yaml";
+
+void Sleep(double seconds) { std::this_thread::sleep_for(std::chrono::duration<double>(seconds)); }
+
+// Reads until `done` or `timeout` seconds; returns the last status.
+template <typename Done>
+HeadStatus ReadUntil(HeadDriver& driver, Done done, double timeout = 3.0) {
+  const auto start = std::chrono::steady_clock::now();
+  HeadStatus status = driver.Read();
+  while (!done(status) &&
+         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() <
+             timeout) {
+    Sleep(0.005);
+    status = driver.Read();
+  }
+  return status;
+}
+
+head::JointState Pan(double rad) {
+  head::JointState s;
+  s.pan = rad;
+  return s;
+}
+
+TEST(HeadDriverTest, NonFiniteValuesAreRejectedAndNothingIsSent) {
+  SimHeadDriver driver(head::HeadDescription::FromYamlFile(kPopeye), {.watchdog_s = 0});
+  head::JointState bad;
+  bad.tilt = std::numeric_limits<double>::quiet_NaN();
+  try {
+    driver.Command(bad);
+    FAIL() << "no CommandRejected";
+  } catch (const CommandRejected& error) {
+    EXPECT_NE(std::string(error.what()).find("joint tilt position is nan"), std::string::npos)
+        << error.what();
+  }
+  head::JointState fast;
+  fast.right = std::numeric_limits<double>::infinity();
+  EXPECT_THROW(driver.Command({}, fast), CommandRejected);
+  const HeadStatus status = driver.Read();
+  EXPECT_EQ(status.commands, 0);
+  EXPECT_EQ(status.rejected_commands, 2);
+  EXPECT_EQ(status.targets, head::JointState{});
+  EXPECT_EQ(status.positions, head::JointState{});
+}
+
+TEST(HeadDriverTest, TargetsOutsideTheLimitsAreClampedAndReported) {
+  const auto head = head::HeadDescription::FromYamlFile(kPopeye);
+  SimHeadDriver driver(head, {.watchdog_s = 0});
+  head::JointState target;
+  target.pan = 120 * kDeg;
+  target.left = -80 * kDeg;
+  target.tilt = 10 * kDeg;
+  const CommandReport report = driver.Command(target);
+  EXPECT_TRUE(report.position_clamped[0]);
+  EXPECT_FALSE(report.position_clamped[1]);
+  EXPECT_TRUE(report.position_clamped[2]);
+  EXPECT_DOUBLE_EQ(report.sent_positions.pan, head.limits(head::Joint::kPan).max);
+  EXPECT_DOUBLE_EQ(report.sent_positions.left, head.limits(head::Joint::kLeft).min);
+  EXPECT_DOUBLE_EQ(report.sent_positions.tilt, 10 * kDeg);
+  EXPECT_NE(report.description.find("pan target 120.00 deg clamped to 90.00 deg"),
+            std::string::npos)
+      << report.description;
+  // The head gets there and never beyond.
+  double max_pan = 0.0;
+  const HeadStatus status = ReadUntil(driver, [&](const HeadStatus& s) {
+    max_pan = std::max(max_pan, s.positions.pan);
+    return !s.moving && s.positions.pan > 89 * kDeg;
+  });
+  EXPECT_NEAR(status.positions.pan, 90 * kDeg, 1e-6);
+  EXPECT_LE(max_pan, 90 * kDeg + 1e-12);
+  EXPECT_EQ(status.limited_commands, 1);
+  EXPECT_EQ(status.commands, 1);
+}
+
+TEST(HeadDriverTest, PursuitFasterThanTheVelocityLimitIsLimited) {
+  const auto head = head::HeadDescription::FromYamlFile(kPopeye);
+  SimHeadDriver driver(head, {.watchdog_s = 0});
+  head::JointState velocity;
+  velocity.pan = -1000 * kDeg;
+  const CommandReport report = driver.Command({}, velocity);
+  EXPECT_TRUE(report.velocity_limited[0]);
+  EXPECT_DOUBLE_EQ(report.sent_velocities.pan, -head.limits(head::Joint::kPan).max_velocity);
+  EXPECT_NE(report.description.find("pan velocity -1000.0 deg/s limited to -300.0 deg/s"),
+            std::string::npos)
+      << report.description;
+  double fastest = 0.0;
+  ReadUntil(
+      driver,
+      [&](const HeadStatus& s) {
+        fastest = std::max(fastest, std::abs(s.velocities.pan));
+        return s.positions.pan < -89 * kDeg;
+      },
+      2.0);
+  EXPECT_GT(fastest, 250 * kDeg);
+  EXPECT_LE(fastest, 300 * kDeg + 1e-9);
+}
+
+TEST(HeadDriverTest, WatchdogHoldsThePositionWhenCommandsStop) {
+  SimHeadDriver driver(head::HeadDescription::FromYamlFile(kPopeye), {.watchdog_s = 0.05});
+  // A 90 deg saccade takes about 0.4 s; the watchdog stops it after 0.05 s.
+  driver.Command(Pan(90 * kDeg));
+  const HeadStatus held = ReadUntil(driver, [](const HeadStatus& s) { return s.holding; });
+  ASSERT_TRUE(held.holding);
+  EXPECT_EQ(held.watchdog_trips, 1);
+  const HeadStatus rest = ReadUntil(driver, [](const HeadStatus& s) { return !s.moving; });
+  EXPECT_GT(rest.positions.pan, 0.1 * kDeg);
+  EXPECT_LT(rest.positions.pan, 85 * kDeg) << "the watchdog did not stop the saccade";
+  EXPECT_NEAR(rest.targets.pan, rest.positions.pan, 1e-9);
+  Sleep(0.1);
+  EXPECT_NEAR(driver.Read().positions.pan, rest.positions.pan, 1e-12);
+  EXPECT_EQ(driver.Read().watchdog_trips, 1);  // holding already: it does not fire again
+  // The next command moves again.
+  driver.Command(Pan(0.0));
+  EXPECT_FALSE(driver.Read().holding);
+}
+
+TEST(HeadDriverTest, CommandsKeepTheWatchdogQuiet) {
+  SimHeadDriver driver(head::HeadDescription::FromYamlFile(kPopeye), {.watchdog_s = 0.2});
+  for (int i = 0; i < 20; ++i) {
+    driver.Command(Pan(i * kDeg));
+    Sleep(0.02);
+  }
+  EXPECT_EQ(driver.Read().watchdog_trips, 0);
+}
+
+TEST(HeadDriverTest, EmergencyStopHoldsAndRejectsUntilCleared) {
+  SimHeadDriver driver(head::HeadDescription::FromYamlFile(kPopeye), {.watchdog_s = 0});
+  driver.Command(Pan(-90 * kDeg));
+  Sleep(0.05);
+  driver.EmergencyStop();
+  const HeadStatus stopped = ReadUntil(driver, [](const HeadStatus& s) { return !s.moving; });
+  EXPECT_TRUE(stopped.emergency_stopped);
+  EXPECT_FALSE(stopped.ready());
+  EXPECT_GT(stopped.positions.pan, -85 * kDeg);
+  try {
+    driver.Command(Pan(0.0));
+    FAIL() << "no CommandRejected";
+  } catch (const CommandRejected& error) {
+    EXPECT_NE(std::string(error.what()).find("emergency stop"), std::string::npos);
+  }
+  Sleep(0.05);
+  EXPECT_NEAR(driver.Read().positions.pan, stopped.positions.pan, 1e-12);
+  driver.ClearFault();
+  EXPECT_TRUE(driver.Read().ready());
+  driver.Command(Pan(0.0));
+  EXPECT_NEAR(
+      ReadUntil(driver,
+                [](const HeadStatus& s) { return !s.moving && std::abs(s.positions.pan) < 1e-6; })
+          .positions.pan,
+      0.0, 1e-6);
+}
+
+TEST(HeadDriverTest, TorqueOffRejectsCommandsAndStopBrakes) {
+  SimHeadDriver driver(head::HeadDescription::FromYamlFile(kPopeye), {.watchdog_s = 0});
+  driver.SetTorque(false);
+  EXPECT_FALSE(driver.Read().torque);
+  try {
+    driver.Command(Pan(0.1));
+    FAIL() << "no CommandRejected";
+  } catch (const CommandRejected& error) {
+    EXPECT_NE(std::string(error.what()).find("torque is off"), std::string::npos);
+  }
+  driver.SetTorque(true);
+  driver.Command(Pan(90 * kDeg));
+  Sleep(0.05);
+  driver.Stop();
+  const HeadStatus status = ReadUntil(driver, [](const HeadStatus& s) { return !s.moving; });
+  EXPECT_LT(status.positions.pan, 85 * kDeg);
+  EXPECT_FALSE(status.emergency_stopped);  // a stop is not latched
+  EXPECT_NO_THROW(driver.Command(Pan(0.0)));
+}
+
+TEST(HeadDriverTest, BadOptionsAreNamed) {
+  try {
+    SimHeadDriver driver(head::HeadDescription::FromYamlFile(kPopeye), {.watchdog_s = -1});
+    FAIL() << "no InvalidArgument";
+  } catch (const InvalidArgument& error) {
+    EXPECT_NE(std::string(error.what()).find("watchdog_s"), std::string::npos);
+  }
+}
+
+}  // namespace
+}  // namespace saccade::hw
