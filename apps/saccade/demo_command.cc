@@ -52,6 +52,7 @@ extern "C" void OnDemoInterrupt(int) { g_stop = true; }
 struct Options {
   std::string pipeline = ShippedFile("pipelines/demo.yaml");
   std::string scene;
+  std::string hardware;
   double duration = 40.0;
   std::string record;
   bool force = false;
@@ -291,7 +292,7 @@ int RunDemo(const Options& o) {
   if (!(o.duration > 0.0) || !std::isfinite(o.duration)) {
     throw InvalidArgument(fmt::format("demo: --duration must be > 0 s, got {}", o.duration));
   }
-  runtime::PipelineSpec spec = runtime::LoadPipelineFile(o.pipeline);
+  runtime::PipelineSpec spec = runtime::LoadPipelineFile(o.pipeline, o.hardware);
   if (!o.scene.empty()) {
     // --scene replaces every component's `scene` parameter (absolute: the pipeline file's
     // folder is not the user's).
@@ -623,6 +624,11 @@ Runner AddDemoCommand(CLI::App& app) {
                    "Scene YAML; replaces every component's `scene` parameter (default: the "
                    "pipeline's, scenes/portraits.yaml; scenes/portraits_moving.yaml shows "
                    "smooth pursuit)")
+      ->check(CLI::ExistingFile);
+  demo->add_option("--hardware", o->hardware,
+                   "Hardware file: which robot runs the loop, replacing the pipeline's "
+                   "`hardware:` line (pipelines/hardware/: simulator.yaml, "
+                   "recorded_cameras.yaml, emulated_servos.yaml, mirror.yaml, robot.yaml)")
       ->check(CLI::ExistingFile);
   demo->add_option("--duration", o->duration,
                    "Longest run, simulated seconds; it ends sooner once every face was fixated")

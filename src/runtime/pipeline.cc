@@ -119,6 +119,59 @@ ConnectionSpec ParseConnection(const Entry& e, const std::string& input) {
   return connection;
 }
 
+// The type and params of a component entry (pipeline or hardware file).
+void ParseTypeAndParams(const Entry& e, ComponentSpec* spec) {
+  const Entry type = e.Get("type");
+  spec->type = type.AsNonEmptyString();
+  spec->type_line = type.line();
+  spec->params_line = e.line();
+  if (const auto params = e.Find("params")) {
+    spec->params_line = params->line();
+    if (!params->IsNull()) {
+      if (!params->IsMap()) params->Fail("expected a map of parameters, got " + params->Describe());
+      spec->params = ToJson(*params);
+    }
+  }
+}
+
+// A hardware file: component name -> its type and params.
+std::map<std::string, ComponentSpec> LoadHardware(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw FileError(path, 0, "", "cannot open the hardware file");
+  std::ostringstream text;
+  text << in.rdbuf();
+  const YAML::Node root_node = saccade::internal::ParseYaml(text.str(), path);
+  const Entry root(root_node, "", &path, 1);
+  root.ExpectMap({"components"}, "a hardware file {components: {name: {type, params}}}");
+  const Entry components = root.Get("components");
+  if (!components.IsMap() || components.node().size() == 0) {
+    components.Fail("expected a map of components {name: {type, params}}, got " +
+                    components.Describe());
+  }
+  std::map<std::string, ComponentSpec> hardware;
+  for (auto it = components.node().begin(); it != components.node().end(); ++it) {
+    const int key_line = KeyLine(it->first, components.line());
+    const std::string name = it->first.IsScalar() ? it->first.Scalar() : "";
+    const std::string key = "components." + name;
+    if (!IsName(name)) {
+      throw FileError(
+          path, key_line, "components",
+          "expected a component name of letters, digits, '_' or '-', got '" + name + "'");
+    }
+    const Entry entry(it->second, key, &path, key_line);
+    entry.ExpectMap({"type", "params"}, "a hardware component {type, params}");
+    ComponentSpec spec;
+    spec.name = name;
+    spec.line = key_line;
+    spec.params_file = path;
+    ParseTypeAndParams(entry, &spec);
+    if (!hardware.emplace(name, std::move(spec)).second) {
+      throw FileError(path, key_line, key, "duplicate component '" + name + "'");
+    }
+  }
+  return hardware;
+}
+
 ComponentSpec ParseComponent(const Entry& e) {
   e.ExpectMap({"name", "type", "params", "inputs"}, "a component {name, type, params, inputs}");
   ComponentSpec spec;
@@ -128,16 +181,12 @@ ComponentSpec ParseComponent(const Entry& e) {
   if (!IsName(spec.name)) {
     name.Fail("expected a name of letters, digits, '_' or '-' (no dots), got '" + spec.name + "'");
   }
-  const Entry type = e.Get("type");
-  spec.type = type.AsNonEmptyString();
-  spec.type_line = type.line();
-  spec.params_line = spec.line;
-  if (const auto params = e.Find("params")) {
-    spec.params_line = params->line();
-    if (!params->IsNull()) {
-      if (!params->IsMap()) params->Fail("expected a map of parameters, got " + params->Describe());
-      spec.params = ToJson(*params);
-    }
+  if (e.Has("type")) {
+    ParseTypeAndParams(e, &spec);
+  } else if (e.Has("params")) {
+    e.Get("params").Fail("component '" + spec.name +
+                         "' has params but no type (a hardware component takes both from the "
+                         "hardware file)");
   }
   if (const auto inputs = e.Find("inputs")) {
     if (!inputs->IsNull()) {
@@ -181,11 +230,12 @@ std::string ComponentKey(std::size_t index) { return fmt::format("components[{}]
 
 }  // namespace
 
-PipelineSpec ParsePipeline(const std::string& text, const std::string& source) {
+PipelineSpec ParsePipeline(const std::string& text, const std::string& source,
+                           const std::string& hardware) {
   const YAML::Node root_node = saccade::internal::ParseYaml(text, source);
   const Entry root(root_node, "", &source, 1);
-  root.ExpectMap({"clock", "seed", "on_error", "components"},
-                 "a pipeline {clock, seed, on_error, components}");
+  root.ExpectMap({"clock", "seed", "on_error", "hardware", "components"},
+                 "a pipeline {clock, seed, on_error, hardware, components}");
   PipelineSpec spec;
   spec.file = source;
   if (const auto clock = root.Find("clock")) spec.clock = ParseClock(*clock);
@@ -213,15 +263,73 @@ PipelineSpec ParsePipeline(const std::string& text, const std::string& source) {
     }
     spec.components.push_back(std::move(component));
   }
+
+  // The hardware file fills in the components without a type.
+  std::optional<Entry> hardware_entry = root.Find("hardware");
+  if (!hardware.empty()) {
+    spec.hardware_file = hardware;
+  } else if (hardware_entry) {
+    const std::filesystem::path relative = hardware_entry->AsNonEmptyString();
+    spec.hardware_file = relative.is_absolute()
+                             ? relative.string()
+                             : (std::filesystem::path(source).parent_path() / relative).string();
+  }
+  std::map<std::string, ComponentSpec> parts;
+  if (!spec.hardware_file.empty()) {
+    try {
+      parts = LoadHardware(spec.hardware_file);
+    } catch (const FileError& error) {
+      if (hardware.empty() && hardware_entry && error.line() == 0) {
+        hardware_entry->Fail(error.what());  // a missing file: name the pipeline's line too
+      }
+      throw;
+    }
+  }
+  for (std::size_t i = 0; i < spec.components.size(); ++i) {
+    ComponentSpec& component = spec.components[i];
+    const auto part = parts.find(component.name);
+    if (!component.type.empty()) {
+      if (part != parts.end()) {
+        throw FileError(source, component.type_line, ComponentKey(i) + ".type",
+                        fmt::format("component '{}' is in the hardware file {} (line {}): leave "
+                                    "its type and params to that file",
+                                    component.name, spec.hardware_file, part->second.line));
+      }
+      continue;
+    }
+    if (part == parts.end()) {
+      throw FileError(source, component.line, ComponentKey(i),
+                      spec.hardware_file.empty()
+                          ? fmt::format("component '{}' has no type (and the pipeline names no "
+                                        "hardware file that would give it one)",
+                                        component.name)
+                          : fmt::format("component '{}' has no type, and the hardware file {} "
+                                        "does not define it",
+                                        component.name, spec.hardware_file));
+    }
+    component.type = part->second.type;
+    component.params = part->second.params;
+    component.type_line = part->second.type_line;
+    component.params_line = part->second.params_line;
+    component.params_file = part->second.params_file;
+    parts.erase(part);
+  }
+  if (!parts.empty()) {
+    const ComponentSpec& extra = parts.begin()->second;
+    throw FileError(extra.params_file, extra.line, "components." + extra.name,
+                    fmt::format("the hardware file defines '{}' but the pipeline {} has no "
+                                "component of that name",
+                                extra.name, source));
+  }
   return spec;
 }
 
-PipelineSpec LoadPipelineFile(const std::string& path) {
+PipelineSpec LoadPipelineFile(const std::string& path, const std::string& hardware) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw FileError(path, 0, "", "cannot open the pipeline file");
   std::ostringstream text;
   text << in.rdbuf();
-  return ParsePipeline(text.str(), path);
+  return ParsePipeline(text.str(), path, hardware);
 }
 
 uint64_t ComponentSeed(uint64_t pipeline_seed, const std::string& component_name) {
@@ -270,17 +378,26 @@ Pipeline Pipeline::Build(const PipelineSpec& spec, const ComponentRegistry& regi
   // Create and configure, in order.
   for (std::size_t i = 0; i < n; ++i) {
     const ComponentSpec& c = spec.components[i];
+    // A hardware component's type and params come from its hardware file.
+    const std::string& params_file = c.params_file.empty() ? file : c.params_file;
+    const std::string type_key =
+        c.params_file.empty() ? ComponentKey(i) + ".type" : "components." + c.name + ".type";
+    const std::string params_key =
+        c.params_file.empty() ? ComponentKey(i) + ".params" : "components." + c.name + ".params";
     if (!registry.Has(c.type)) {
-      throw FileError(file, c.type_line, ComponentKey(i) + ".type",
+      throw FileError(params_file, c.type_line, type_key,
                       "unknown component type '" + c.type + "' for component '" + c.name +
                           "'; known types: " + Join(registry.Types()));
     }
     std::unique_ptr<Component> component = registry.Create(c.type);
-    component->Initialise(c.name, ComponentSeed(spec.seed, c.name), base_dir);
+    component->Initialise(c.name, ComponentSeed(spec.seed, c.name),
+                          c.params_file.empty()
+                              ? base_dir
+                              : std::filesystem::path(c.params_file).parent_path().string());
     try {
       component->Configure(c.params);
     } catch (const std::exception& error) {
-      throw FileError(file, c.params_line, ComponentKey(i) + ".params",
+      throw FileError(params_file, c.params_line, params_key,
                       "component '" + c.name + "' (" + c.type + "): " + error.what());
     }
     pipeline.components_.push_back(std::move(component));

@@ -353,3 +353,121 @@ TEST(ComponentSeedTest, DependsOnSeedAndNameAndIsFixed) {
 
 }  // namespace
 }  // namespace saccade::runtime
+
+namespace saccade::runtime {
+namespace {
+
+// A folder with a pipeline and hardware files, removed at the end.
+class HardwareFileTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = std::filesystem::temp_directory_path() /
+           ("saccade_hardware_test_" +
+            std::to_string(::testing::UnitTest::GetInstance()->random_seed()) + "_" +
+            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    std::filesystem::create_directories(dir_ / "pipelines");
+    std::filesystem::create_directories(dir_ / "hardware");
+  }
+  void TearDown() override { std::filesystem::remove_all(dir_); }
+  std::string Write(const std::string& name, const std::string& text) {
+    const std::filesystem::path path = dir_ / name;
+    std::ofstream(path) << text;
+    return path.string();
+  }
+  std::filesystem::path dir_;
+};
+
+const std::string kPipelineWithHardware = R"(clock: {mode: simulated, step: 0.5, steps: 3}
+hardware: ../hardware/one.yaml
+components:
+  - name: source
+  - name: recorder
+    type: test.recorder
+    inputs: {in: source.out}
+)";
+
+TEST_F(HardwareFileTest, ComponentsWithoutTypeComeFromTheHardwareFile) {
+  Write("hardware/one.yaml", "components:\n  source: {type: test.source, params: {start: 100}}\n");
+  Write("hardware/two.yaml",
+        "components:\n  source:\n    type: test.source\n    params: {start: 7}\n");
+  const std::string pipeline = Write("pipelines/p.yaml", kPipelineWithHardware);
+  const ComponentRegistry registry = MakeTestRegistry();
+
+  const PipelineSpec spec = LoadPipelineFile(pipeline);
+  EXPECT_EQ(spec.hardware_file, (dir_ / "pipelines/../hardware/one.yaml").string());
+  EXPECT_EQ(spec.components[0].type, "test.source");
+  EXPECT_EQ(spec.components[0].params, (nlohmann::json{{"start", 100}}));
+  EXPECT_EQ(spec.components[0].params_file, spec.hardware_file);
+  EXPECT_EQ(spec.components[1].params_file, "");
+
+  // The one line to switch: another hardware file, from the command line.
+  const std::string two = (dir_ / "hardware/two.yaml").string();
+  const PipelineSpec other = LoadPipelineFile(pipeline, two);
+  EXPECT_EQ(other.hardware_file, two);
+  EXPECT_EQ(other.components[0].params, (nlohmann::json{{"start", 7}}));
+  EXPECT_EQ(other.components[0].params_line, 4);
+  Pipeline built = Pipeline::Build(other, registry);
+  EXPECT_NE(built.Find<testing::Source>("source"), nullptr);
+  // Relative paths in a hardware component's params resolve against the hardware file.
+  EXPECT_EQ(built.Find("source")->ResolvePath("x.yaml"), (dir_ / "hardware/x.yaml").string());
+  EXPECT_EQ(built.Find("recorder")->ResolvePath("x.yaml"), (dir_ / "pipelines/x.yaml").string());
+}
+
+TEST_F(HardwareFileTest, MismatchesAndBadFilesAreNamed) {
+  const ComponentRegistry registry = MakeTestRegistry();
+  const auto error = [&](const std::string& pipeline, const std::string& hardware = "") {
+    try {
+      Pipeline::Build(LoadPipelineFile(pipeline, hardware), registry);
+    } catch (const FileError& e) {
+      return std::string(e.what());
+    }
+    ADD_FAILURE() << "no FileError";
+    return std::string();
+  };
+  const auto expect = [](const std::string& message, const std::string& part) {
+    EXPECT_NE(message.find(part), std::string::npos) << "'" << part << "' not in: " << message;
+  };
+  const std::string pipeline = Write("pipelines/p.yaml", kPipelineWithHardware);
+
+  // Missing hardware file: the pipeline's line names it.
+  expect(error(pipeline), "p.yaml:2: hardware: ");
+  expect(error(pipeline), "cannot open the hardware file");
+  // A component the hardware file lacks, and one the pipeline lacks.
+  Write("hardware/one.yaml", "components:\n  camera: {type: test.source}\n");
+  expect(error(pipeline),
+         "p.yaml:4: components[0]: component 'source' has no type, and the "
+         "hardware file");
+  Write("hardware/one.yaml",
+        "components:\n  source: {type: test.source}\n  head: {type: test.relay}\n");
+  expect(error(pipeline),
+         "one.yaml:3: components.head: the hardware file defines 'head' but the "
+         "pipeline");
+  // A bad type or bad params name the hardware file's line.
+  Write("hardware/one.yaml", "components:\n  source: {type: test.nope}\n");
+  expect(error(pipeline), "one.yaml:2: components.source.type: unknown component type 'test.nope'");
+  Write("hardware/one.yaml",
+        "components:\n  source:\n    type: test.source\n    params: {start: x}\n");
+  expect(error(pipeline),
+         "one.yaml:4: components.source.params: component 'source' (test.source): "
+         "'start' must be a number");
+  Write("hardware/one.yaml", "components:\n  source: {type: test.source, inputs: {}}\n");
+  expect(error(pipeline), "one.yaml:2: components.source.inputs: unknown key 'inputs'");
+  Write("hardware/one.yaml", "parts: {}\n");
+  expect(error(pipeline), "one.yaml:1: parts: unknown key 'parts'");
+  // Both the pipeline and the hardware file typing a component.
+  Write("hardware/one.yaml",
+        "components:\n  recorder: {type: test.recorder}\n  source: {type: test.source}\n");
+  expect(error(pipeline),
+         "p.yaml:6: components[1].type: component 'recorder' is in the hardware "
+         "file");
+  // No hardware file at all.
+  const std::string plain = Write("pipelines/plain.yaml", "components:\n  - name: source\n");
+  expect(error(plain),
+         "plain.yaml:2: components[0]: component 'source' has no type (and the "
+         "pipeline names no hardware file");
+  expect(error(plain, (dir_ / "hardware/none.yaml").string()),
+         "none.yaml: cannot open the hardware file");
+}
+
+}  // namespace
+}  // namespace saccade::runtime

@@ -17,6 +17,23 @@
 //
 // Relative paths in params (e.g. `scene: ../scenes/portraits.yaml`) resolve against the
 // pipeline file's folder (Component::ResolvePath).
+//
+// Hardware files: the one line that swaps the simulated robot for the real one (issue 7).
+//
+//   hardware: ../hardware/simulator.yaml     # relative to the pipeline file
+//   components:
+//     - name: cameras                        # no type: type and params from the hardware file
+//       inputs: {joints: {from: head.joints, delay: 1}}
+//
+// A hardware file names the components that stand for the robot, with their type and params
+// (relative paths in those params resolve against the hardware file's folder):
+//
+//   components:
+//     cameras: {type: sim.cameras, params: {scene: ../scenes/portraits.yaml}}
+//     head: {type: sim.head, params: {scene: ../scenes/portraits.yaml}}
+//
+// The pipeline keeps the order and the connections; every component without a type must be
+// in the hardware file, and every component of the hardware file must be in the pipeline.
 // A connection from a later (or the same) component is a cycle unless it has `delay: 1`;
 // connections from earlier components are delivered at once. Every error is a FileError
 // naming file, line and key.
@@ -61,6 +78,9 @@ struct ComponentSpec {
   int line = 0;
   int type_line = 0;
   int params_line = 0;
+  /// The hardware file that gave the type and params ("" when the pipeline file did): the
+  /// lines above are that file's, and relative paths in the params resolve against its folder.
+  std::string params_file;
 };
 
 /// A parsed (not yet built) pipeline file.
@@ -70,13 +90,16 @@ struct PipelineSpec {
   uint64_t seed = 0;
   OnError on_error = OnError::kStop;
   std::vector<ComponentSpec> components;
+  std::string hardware_file;  ///< the hardware file used ("" when none)
 };
 
-/// Parses pipeline YAML; checks its shape (keys, types, ranges, duplicate names).
-/// Throws FileError ("file:line: key: what").
-PipelineSpec ParsePipeline(const std::string& text, const std::string& source);
-/// Reads and parses a pipeline file. Throws FileError.
-PipelineSpec LoadPipelineFile(const std::string& path);
+/// Parses pipeline YAML; checks its shape (keys, types, ranges, duplicate names), and reads
+/// its hardware file, if any: `hardware` (a path, relative to the current folder) replaces the
+/// file's own `hardware:` line when not empty. Throws FileError ("file:line: key: what").
+PipelineSpec ParsePipeline(const std::string& text, const std::string& source,
+                           const std::string& hardware = "");
+/// Reads and parses a pipeline file (and its hardware file). Throws FileError.
+PipelineSpec LoadPipelineFile(const std::string& path, const std::string& hardware = "");
 
 /// The seed handed to a component: a fixed mix of the pipeline seed and the component's
 /// name (the same on every platform and run).
