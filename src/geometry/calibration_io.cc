@@ -577,6 +577,25 @@ StereoCalibration ReadStereoCalibration(const std::filesystem::path& path,
   return stereo;
 }
 
+CameraCalibration ReadStereoCameraCalibration(const std::filesystem::path& path, int index,
+                                              std::optional<ImageSize> size) {
+  if (index != 1 && index != 2) {
+    throw InvalidArgument(
+        "ReadStereoCameraCalibration: index must be 1 (M1 D1) or 2 (M2 D2), got " +
+        std::to_string(index));
+  }
+  const Document doc = Load(path);
+  const std::string k_key = index == 1 ? "M1" : "M2";
+  const std::string d_key = index == 1 ? "D1" : "D2";
+  if (doc.Find(k_key) == nullptr && doc.Find("camera_matrix") != nullptr) {
+    doc.Fail(0, k_key,
+             "missing key; the file has camera_matrix (one camera): read it with "
+             "ReadCameraCalibration");
+  }
+  const ImageSize image_size = ResolveImageSize(doc, nullptr, size, "ReadStereoCameraCalibration");
+  return {ReadOpenCvCamera(doc, k_key, d_key, image_size, ReadFisheyeFlag(doc)), std::string()};
+}
+
 void WriteStereoCalibration(const StereoCalibration& calibration, const std::filesystem::path& path,
                             CalibrationFormat format) {
   if (!IsOpenCvFormat(format)) {

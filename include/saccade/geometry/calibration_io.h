@@ -60,6 +60,14 @@ StereoCalibration ReadStereoCalibration(
     const std::optional<std::filesystem::path>& extrinsics_path = std::nullopt,
     std::optional<ImageSize> size = std::nullopt);
 
+/// Reads one camera of a stereo file (M1 D1 M2 D2, OpenCV YAML or XML) without needing R and
+/// T: `index` 1 reads M1 D1 (the first, left camera), 2 reads M2 D2. This is how stereo_calib's
+/// intrinsics.yml is read, which stores no R, T or image size. `size` is used when the file has
+/// no image_width/image_height. Throws InvalidArgument for another index, FileError (file, line,
+/// key) as ReadCameraCalibration. The name is empty (stereo files store none).
+CameraCalibration ReadStereoCameraCalibration(const std::filesystem::path& path, int index,
+                                              std::optional<ImageSize> size = std::nullopt);
+
 /// Writes M1 D1 M2 D2 R T, image_width and image_height in one OpenCV YAML or XML file.
 void WriteStereoCalibration(const StereoCalibration& calibration, const std::filesystem::path& path,
                             CalibrationFormat format);
