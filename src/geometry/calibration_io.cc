@@ -529,6 +529,10 @@ CalibrationFormat DetectCalibrationFormat(const std::filesystem::path& path) {
   return Load(path).format;
 }
 
+std::optional<ImageSize> ReadCalibrationImageSize(const std::filesystem::path& path) {
+  return FileImageSize(Load(path));
+}
+
 CameraCalibration ReadCameraCalibration(const std::filesystem::path& path,
                                         std::optional<ImageSize> size) {
   const Document doc = Load(path);

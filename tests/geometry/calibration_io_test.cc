@@ -1030,6 +1030,25 @@ TEST_F(CalibrationIoTest, ReadsEachCameraOfStereoSampleIntrinsicsWithoutExtrinsi
   EXPECT_TRUE(left.name.empty());
 }
 
+TEST_F(CalibrationIoTest, ReadsTheImageSizeAloneWhereTheFileHasOne) {
+  const std::optional<ImageSize> left =
+      ReadCalibrationImageSize(kOpenCvExamples / "data/left_intrinsics.yml");
+  ASSERT_TRUE(left.has_value());
+  EXPECT_EQ(left->width, 640);
+  EXPECT_EQ(left->height, 480);
+  EXPECT_FALSE(ReadCalibrationImageSize(kOpenCvExamples / "data/intrinsics.yml").has_value());
+  const std::optional<ImageSize> xml = ReadCalibrationImageSize(WriteText("good.xml", kGoodXml));
+  ASSERT_TRUE(xml.has_value());
+  EXPECT_EQ(xml->width, 640);
+  try {
+    ReadCalibrationImageSize(WriteText("half.yml", Replace(kGoodYaml, "image_height: 480\n", "")));
+    ADD_FAILURE() << "no FileError";
+  } catch (const FileError& e) {
+    EXPECT_EQ(e.key(), "image_height");
+  }
+  EXPECT_THROW(ReadCalibrationImageSize(Path("missing.yml")), FileError);
+}
+
 TEST_F(CalibrationIoTest, StereoCameraMatchesTheFullStereoReader) {
   // With R and T present, camera 1 and 2 are exactly ReadStereoCalibration's left and right.
   const fs::path path = WriteText("stereo.yml", kGoodStereo);

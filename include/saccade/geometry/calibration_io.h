@@ -45,6 +45,11 @@ struct ImageSize {
 /// The format of a file by extension (.xml) and content (ROS files have distortion_model).
 CalibrationFormat DetectCalibrationFormat(const std::filesystem::path& path);
 
+/// The image size a calibration file stores (image_width and image_height), std::nullopt when
+/// it stores neither; for choosing a camera's mode before its first frame. Throws FileError as
+/// the readers (a file with one of the two, or a size that is not positive).
+std::optional<ImageSize> ReadCalibrationImageSize(const std::filesystem::path& path);
+
 /// Reads one camera. `size` is used when the file has no image_width/image_height; a file
 /// with neither throws FileError naming the missing key.
 CameraCalibration ReadCameraCalibration(const std::filesystem::path& path,
