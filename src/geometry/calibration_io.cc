@@ -529,6 +529,10 @@ CalibrationFormat DetectCalibrationFormat(const std::filesystem::path& path) {
   return Load(path).format;
 }
 
+std::optional<ImageSize> ReadCalibrationImageSize(const std::filesystem::path& path) {
+  return FileImageSize(Load(path));
+}
+
 CameraCalibration ReadCameraCalibration(const std::filesystem::path& path,
                                         std::optional<ImageSize> size) {
   const Document doc = Load(path);
@@ -575,6 +579,25 @@ StereoCalibration ReadStereoCalibration(const std::filesystem::path& path,
   }
   stereo.T = Eigen::Vector3d(T.values[0], T.values[1], T.values[2]);
   return stereo;
+}
+
+CameraCalibration ReadStereoCameraCalibration(const std::filesystem::path& path, int index,
+                                              std::optional<ImageSize> size) {
+  if (index != 1 && index != 2) {
+    throw InvalidArgument(
+        "ReadStereoCameraCalibration: index must be 1 (M1 D1) or 2 (M2 D2), got " +
+        std::to_string(index));
+  }
+  const Document doc = Load(path);
+  const std::string k_key = index == 1 ? "M1" : "M2";
+  const std::string d_key = index == 1 ? "D1" : "D2";
+  if (doc.Find(k_key) == nullptr && doc.Find("camera_matrix") != nullptr) {
+    doc.Fail(0, k_key,
+             "missing key; the file has camera_matrix (one camera): read it with "
+             "ReadCameraCalibration");
+  }
+  const ImageSize image_size = ResolveImageSize(doc, nullptr, size, "ReadStereoCameraCalibration");
+  return {ReadOpenCvCamera(doc, k_key, d_key, image_size, ReadFisheyeFlag(doc)), std::string()};
 }
 
 void WriteStereoCalibration(const StereoCalibration& calibration, const std::filesystem::path& path,

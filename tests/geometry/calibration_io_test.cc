@@ -1015,6 +1015,104 @@ TEST_F(CalibrationIoTest, StereoImageSizeMissingEverywhereNamesImageWidth) {
 }
 
 // ---------------------------------------------------------------------------------------
+// One camera of a stereo file (ReadStereoCameraCalibration).
+
+TEST_F(CalibrationIoTest, ReadsEachCameraOfStereoSampleIntrinsicsWithoutExtrinsics) {
+  const fs::path intrinsics = kOpenCvExamples / "data/intrinsics.yml";
+  ASSERT_TRUE(fs::exists(intrinsics)) << intrinsics << " is installed by opencv-doc";
+  const CameraCalibration left = ReadStereoCameraCalibration(intrinsics, 1, ImageSize{640, 480});
+  const CameraCalibration right = ReadStereoCameraCalibration(intrinsics, 2, ImageSize{640, 480});
+  ExpectMatchesOpenCv(left.model, intrinsics, "M1", "D1");
+  ExpectMatchesOpenCv(right.model, intrinsics, "M2", "D2");
+  EXPECT_EQ(left.model.intrinsics().width(), 640);
+  EXPECT_EQ(right.model.intrinsics().height(), 480);
+  EXPECT_EQ(left.model.distortion().model(), DistortionModel::kRadialTangential);
+  EXPECT_TRUE(left.name.empty());
+}
+
+TEST_F(CalibrationIoTest, ReadsTheImageSizeAloneWhereTheFileHasOne) {
+  const std::optional<ImageSize> left =
+      ReadCalibrationImageSize(kOpenCvExamples / "data/left_intrinsics.yml");
+  ASSERT_TRUE(left.has_value());
+  EXPECT_EQ(left->width, 640);
+  EXPECT_EQ(left->height, 480);
+  EXPECT_FALSE(ReadCalibrationImageSize(kOpenCvExamples / "data/intrinsics.yml").has_value());
+  const std::optional<ImageSize> xml = ReadCalibrationImageSize(WriteText("good.xml", kGoodXml));
+  ASSERT_TRUE(xml.has_value());
+  EXPECT_EQ(xml->width, 640);
+  try {
+    ReadCalibrationImageSize(WriteText("half.yml", Replace(kGoodYaml, "image_height: 480\n", "")));
+    ADD_FAILURE() << "no FileError";
+  } catch (const FileError& e) {
+    EXPECT_EQ(e.key(), "image_height");
+  }
+  EXPECT_THROW(ReadCalibrationImageSize(Path("missing.yml")), FileError);
+}
+
+TEST_F(CalibrationIoTest, StereoCameraMatchesTheFullStereoReader) {
+  // With R and T present, camera 1 and 2 are exactly ReadStereoCalibration's left and right.
+  const fs::path path = WriteText("stereo.yml", kGoodStereo);
+  const StereoCalibration stereo = ReadStereoCalibration(path, std::nullopt, ImageSize{320, 200});
+  ExpectSameCamera(ReadStereoCameraCalibration(path, 1, ImageSize{320, 200}).model, stereo.left);
+  ExpectSameCamera(ReadStereoCameraCalibration(path, 2, ImageSize{320, 200}).model, stereo.right);
+}
+
+TEST_F(CalibrationIoTest, StereoCameraErrorsNameFileLineAndKey) {
+  // Line 13 of kGoodStereo is M2; its data is on line 17.
+  const fs::path bad_data =
+      WriteText("bad.yml", Replace(kGoodStereo, "501., 0., 321.", "501., x, 321."));
+  try {
+    ReadStereoCameraCalibration(bad_data, 2, ImageSize{640, 480});
+    ADD_FAILURE() << "no FileError";
+  } catch (const FileError& e) {
+    EXPECT_EQ(e.key(), "M2.data[1]");
+    EXPECT_EQ(e.line(), 17);
+    EXPECT_NE(std::string(e.what()).find(bad_data.string() + ":17:"), std::string::npos)
+        << e.what();
+  }
+  // Camera 1 of the same file is fine: only the keys read are checked.
+  EXPECT_NO_THROW(ReadStereoCameraCalibration(bad_data, 1, ImageSize{640, 480}));
+
+  const fs::path no_d2 = WriteText("no_d2.yml", Replace(kGoodStereo, "D2:", "D3:"));
+  try {
+    ReadStereoCameraCalibration(no_d2, 2, ImageSize{640, 480});
+    ADD_FAILURE() << "no FileError";
+  } catch (const FileError& e) {
+    EXPECT_EQ(e.key(), "D2");
+    EXPECT_NE(std::string(e.what()).find("missing key"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find(no_d2.string()), std::string::npos) << e.what();
+  }
+
+  // A single-camera file: the message says so.
+  const fs::path mono = WriteText("mono.yml", kGoodYaml);
+  try {
+    ReadStereoCameraCalibration(mono, 1);
+    ADD_FAILURE() << "no FileError";
+  } catch (const FileError& e) {
+    EXPECT_EQ(e.key(), "M1");
+    EXPECT_NE(std::string(e.what()).find("camera_matrix"), std::string::npos) << e.what();
+  }
+
+  // No image size anywhere.
+  try {
+    ReadStereoCameraCalibration(WriteText("nosize.yml", kGoodStereo), 1);
+    ADD_FAILURE() << "no FileError";
+  } catch (const FileError& e) {
+    EXPECT_EQ(e.key(), "image_width");
+  }
+
+  for (int index : {0, 3, -1}) {
+    try {
+      ReadStereoCameraCalibration(mono, index);
+      ADD_FAILURE() << "no InvalidArgument for index " << index;
+    } catch (const InvalidArgument& e) {
+      EXPECT_NE(std::string(e.what()).find("got " + std::to_string(index)), std::string::npos)
+          << e.what();
+    }
+  }
+}
+
+// ---------------------------------------------------------------------------------------
 // Writing.
 
 TEST_F(CalibrationIoTest, WritingIntoAMissingDirectoryThrowsAndLeavesNothing) {

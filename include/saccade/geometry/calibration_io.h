@@ -45,6 +45,11 @@ struct ImageSize {
 /// The format of a file by extension (.xml) and content (ROS files have distortion_model).
 CalibrationFormat DetectCalibrationFormat(const std::filesystem::path& path);
 
+/// The image size a calibration file stores (image_width and image_height), std::nullopt when
+/// it stores neither; for choosing a camera's mode before its first frame. Throws FileError as
+/// the readers (a file with one of the two, or a size that is not positive).
+std::optional<ImageSize> ReadCalibrationImageSize(const std::filesystem::path& path);
+
 /// Reads one camera. `size` is used when the file has no image_width/image_height; a file
 /// with neither throws FileError naming the missing key.
 CameraCalibration ReadCameraCalibration(const std::filesystem::path& path,
@@ -59,6 +64,14 @@ StereoCalibration ReadStereoCalibration(
     const std::filesystem::path& path,
     const std::optional<std::filesystem::path>& extrinsics_path = std::nullopt,
     std::optional<ImageSize> size = std::nullopt);
+
+/// Reads one camera of a stereo file (M1 D1 M2 D2, OpenCV YAML or XML) without needing R and
+/// T: `index` 1 reads M1 D1 (the first, left camera), 2 reads M2 D2. This is how stereo_calib's
+/// intrinsics.yml is read, which stores no R, T or image size. `size` is used when the file has
+/// no image_width/image_height. Throws InvalidArgument for another index, FileError (file, line,
+/// key) as ReadCameraCalibration. The name is empty (stereo files store none).
+CameraCalibration ReadStereoCameraCalibration(const std::filesystem::path& path, int index,
+                                              std::optional<ImageSize> size = std::nullopt);
 
 /// Writes M1 D1 M2 D2 R T, image_width and image_height in one OpenCV YAML or XML file.
 void WriteStereoCalibration(const StereoCalibration& calibration, const std::filesystem::path& path,
