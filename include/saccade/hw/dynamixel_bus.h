@@ -18,6 +18,9 @@
 //
 // The servos must answer every instruction (Status Return Level 2, the default).
 //
+// A port that fails (adapter unplugged, emulator stopped) throws HardwareError from
+// SerialPort, not BusError: retrying cannot help.
+//
 // Not thread-safe: one thread owns the bus (a driver's control loop). Calls block for at
 // most (retries + 1) * (timeout + transfer time).
 
