@@ -48,6 +48,13 @@ std::string Errno(int error) {
   return strerror_r(error, buffer, sizeof(buffer));
 }
 
+// A hint for the errors of a device that went away.
+std::string Unplugged(int error) {
+  return error == EIO || error == ENXIO || error == ENODEV
+             ? " (adapter unplugged, or the emulator stopped?)"
+             : "";
+}
+
 // Raw 8N1 without flow control; reads return at once (VMIN = VTIME = 0, poll waits).
 void MakeRaw(termios* tio) {
   cfmakeraw(tio);
@@ -176,7 +183,7 @@ void SerialPort::Write(const uint8_t* data, size_t size) {
     }
     if (n < 0 && errno == EINTR) continue;
     if (n < 0 && errno != EAGAIN) {
-      throw HardwareError(path_, "write failed: " + Errno(errno));
+      throw HardwareError(path_, "write failed: " + Errno(errno) + Unplugged(errno));
     }
     // The output buffer is full: wait until it drains.
     const auto left = deadline - std::chrono::steady_clock::now();
@@ -199,8 +206,7 @@ size_t SerialPort::Read(uint8_t* buffer, size_t max, std::chrono::microseconds t
     const ssize_t n = ::read(fd_, buffer, max);
     if (n > 0) return static_cast<size_t>(n);
     if (n < 0 && errno != EAGAIN && errno != EINTR) {
-      throw HardwareError(
-          path_, "read failed: " + Errno(errno) + " (adapter unplugged, or the emulator stopped?)");
+      throw HardwareError(path_, "read failed: " + Errno(errno) + Unplugged(errno));
     }
     const auto left = deadline - std::chrono::steady_clock::now();
     if (left <= std::chrono::nanoseconds(0)) return 0;

@@ -428,6 +428,21 @@ TEST(DynamixelBusTest, OpeningErrorsNameThePort) {
   }
 }
 
+TEST(DynamixelBusTest, StoppedEmulatorIsAPortFailureNotATimeout) {
+  Rig rig;
+  EXPECT_EQ(rig.bus.Ping(1), 1020);
+  rig.emulator.Stop();  // the terminal closes: like an unplugged adapter
+  try {
+    rig.bus.Ping(1);
+    FAIL() << "expected HardwareError";
+  } catch (const BusError& e) {
+    FAIL() << "a port failure is not a bus error: " << e.what();
+  } catch (const HardwareError& e) {
+    EXPECT_TRUE(Contains(e.what(), rig.path + ": ")) << e.what();
+    EXPECT_TRUE(Contains(e.what(), "unplugged")) << e.what();
+  }
+}
+
 TEST(DynamixelBusTest, RejectsBadRequestsBeforeSendingThem) {
   PseudoTerminal pty;
   DynamixelBus bus(pty.slave_path(), kBaud);

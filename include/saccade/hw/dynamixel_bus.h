@@ -8,9 +8,9 @@
 // 3). A failed try is retried (the input is drained, the instruction sent again) up to
 // BusOptions::retries times; after the last try the call throws BusError (kTimeout, kCrc or
 // kProtocol). A status packet from another servo or for another request (a late reply to an
-// earlier try) is skipped and counted. A status whose error number (ERR & 0x7F) is not 0
-// throws BusError kServoError naming the error at once: the servo has answered, and the same
-// instruction would fail again.
+// earlier try) is skipped and counted. A status whose error number (ERR & 0x7F) is neither 0
+// nor 3 throws BusError kServoError naming the error at once: the servo has answered, and the
+// same instruction would fail again.
 //
 // The alert bit (ERR bit 7) never throws: the servo has a hardware error (overload,
 // overheating, ...) and has probably turned its torque off. It is returned in StatusReply,
@@ -18,8 +18,11 @@
 //
 // The servos must answer every instruction (Status Return Level 2, the default).
 //
-// Not thread-safe: one thread owns the bus (a driver's control loop). Calls block for at
-// most (retries + 1) * (timeout + transfer time).
+// A port that fails (adapter unplugged, emulator stopped) throws HardwareError from
+// SerialPort, not BusError: retrying cannot help.
+//
+// Not thread-safe: one thread owns the bus (a driver's control loop). A call blocks for at
+// most (retries + 1) * (timeout + transfer time), per servo for a Sync Read.
 
 #include <chrono>
 #include <cstdint>

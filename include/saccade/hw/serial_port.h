@@ -4,8 +4,8 @@
 // SerialPort talks to a USB serial adapter (ROBOTIS U2D2, FTDI: /dev/ttyUSB0) or to the
 // slave side of a PseudoTerminal: raw mode, 8 data bits, no parity, 1 stop bit, no flow
 // control. It asks FTDI-style adapters for low latency (ASYNC_LOW_LATENCY) where the driver
-// allows it, and takes the port exclusively (TIOCEXCL), so a second program opening the
-// same port fails with "busy" instead of garbling the bus.
+// allows it, and takes a real port exclusively (TIOCEXCL; not a pseudo-terminal's slave), so
+// a second program opening the same port fails with "busy" instead of garbling the bus.
 //
 // Not thread-safe: one owner reads and writes a port.
 
