@@ -17,6 +17,8 @@ packages=(
   libopencv-core-dev libopencv-imgproc-dev libopencv-calib3d-dev libopencv-imgcodecs-dev
   libopencv-objdetect-dev libopencv-video-dev libopencv-videoio-dev libopencv-features2d-dev
   libassimp-dev libpng-dev libstb-dev libepoxy-dev libegl-dev libgl-dev libmeshoptimizer-dev
+  # IIDC (IEEE 1394) cameras for the real head (optional: hw builds without it)
+  libdc1394-dev
   # OpenGL without a display or GPU: Mesa's EGL and llvmpipe
   libegl-mesa0 libgl1-mesa-dri
   # tests, benchmarks, the scene fuzzer (clang's libFuzzer)
