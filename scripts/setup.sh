@@ -17,6 +17,9 @@ packages=(
   libopencv-core-dev libopencv-imgproc-dev libopencv-calib3d-dev libopencv-imgcodecs-dev
   libopencv-objdetect-dev libopencv-video-dev libopencv-videoio-dev libopencv-features2d-dev
   libassimp-dev libpng-dev libstb-dev libepoxy-dev libegl-dev libgl-dev libmeshoptimizer-dev
+  # IIDC (IEEE 1394) cameras for the real head (optional: hw builds without it); GStreamer's
+  # base elements (appsink, videoconvert, videotestsrc) for gstreamer: camera sources and tests
+  libdc1394-dev gstreamer1.0-plugins-base
   # OpenGL without a display or GPU: Mesa's EGL and llvmpipe
   libegl-mesa0 libgl1-mesa-dri
   # tests, benchmarks, the scene fuzzer (clang's libFuzzer)

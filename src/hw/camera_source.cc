@@ -130,7 +130,7 @@ geometry::CameraModel NominalModel(int width, int height) {
       geometry::Intrinsics(width, height, f, f, (width - 1) / 2.0, (height - 1) / 2.0));
 }
 
-std::string Rethrown(const Error& e) { return std::string("calibration: ") + e.what(); }
+std::string CalibrationMessage(const Error& e) { return std::string("calibration: ") + e.what(); }
 
 class OpenedSource final : public CameraSource {
  public:
@@ -175,7 +175,7 @@ class OpenedSource final : public CameraSource {
               ? geometry::ReadCameraCalibration(calibration, size).model
               : geometry::ReadStereoCameraCalibration(calibration, calibration_index, size).model;
     } catch (const Error& e) {
-      throw HardwareError(device_, Rethrown(e));
+      throw HardwareError(device_, CalibrationMessage(e));
     }
     const geometry::Intrinsics& intrinsics = model.intrinsics();
     if (intrinsics.width() != width || intrinsics.height() != height) {
@@ -424,7 +424,7 @@ std::unique_ptr<CameraSource> OpenCameraSource(const CameraSourceSpec& spec) {
         request.height = size->height;
       }
     } catch (const Error& e) {
-      throw HardwareError(device, Rethrown(e));
+      throw HardwareError(device, CalibrationMessage(e));
     }
   }
   std::unique_ptr<internal::FrameReader> reader;

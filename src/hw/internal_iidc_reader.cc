@@ -110,6 +110,18 @@ class IidcReader final : public FrameReader {
     if (error != DC1394_SUCCESS || frame == nullptr) {
       throw HardwareError(device_, what_ + ": capture failed: " + Dc1394Error(error));
     }
+    // The ring buffer hands out its oldest frame: take the newest one there, so that a slow
+    // reader sees what the camera sees now rather than what it saw buffers ago.
+    for (;;) {
+      dc1394video_frame_t* newer = nullptr;
+      if (dc1394_capture_dequeue(camera_->camera_, DC1394_CAPTURE_POLICY_POLL, &newer) !=
+              DC1394_SUCCESS ||
+          newer == nullptr) {
+        break;
+      }
+      dc1394_capture_enqueue(camera_->camera_, frame);
+      frame = newer;
+    }
     frame_ = frame;
     if (dc1394_capture_is_frame_corrupt(camera_->camera_, frame_) == DC1394_TRUE) {
       Release();
@@ -248,8 +260,9 @@ std::unique_ptr<FrameReader> OpenIidc(const std::string& device, const std::stri
   dc1394camera_list_t* list = nullptr;
   const dc1394error_t error = dc1394_camera_enumerate(camera->context_, &list);
   if (error != DC1394_SUCCESS || list == nullptr) {
-    throw HardwareError(
-        device, "IIDC camera " + looking_for + ": cannot list IIDC cameras: " + Dc1394Error(error));
+    throw HardwareError(device, "IIDC camera " + looking_for +
+                                    ": no IIDC camera found (libdc1394 cannot list cameras: " +
+                                    Dc1394Error(error) + ")");
   }
   std::vector<uint64_t> guids;
   for (uint32_t i = 0; i < list->num; ++i) guids.push_back(list->ids[i].guid);

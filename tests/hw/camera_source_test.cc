@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <memory>
@@ -512,6 +513,50 @@ TEST_F(CameraSourceTest, UnknownSchemeNamesTheSchemeAndTheForms) {
   EXPECT_TRUE(Contains(message, "v4l2:")) << message;
   const std::string empty = HardwareMessage([&] { Open("left", "v4l2:"); });
   EXPECT_TRUE(Contains(empty, "nothing after 'v4l2:'")) << empty;
+}
+
+// A live source without a camera: GStreamer's test pattern at 30 fps (Debian's
+// gstreamer1.0-plugins-base, installed by scripts/setup.sh).
+constexpr char kTestPattern[] =
+    "gstreamer:videotestsrc pattern=colors num-buffers=4 ! "
+    "video/x-raw,format=BGR,width=64,height=48,"
+    "framerate=30/1 ! appsink";
+
+TEST_F(CameraSourceTest, GStreamerPipelineIsALiveSourceStampedByTheSteadyClock) {
+  std::unique_ptr<CameraSource> source;
+  try {
+    source = Open("live", kTestPattern);
+  } catch (const HardwareError& e) {
+    GTEST_SKIP() << "GStreamer's videotestsrc is missing (gstreamer1.0-plugins-base): " << e.what();
+  }
+  // The reference: the same pipeline through OpenCV alone.
+  cv::VideoCapture capture(std::string(kTestPattern).substr(10), cv::CAP_GSTREAMER);
+  cv::Mat bgr, expected;
+  ASSERT_TRUE(capture.read(bgr));
+  cv::cvtColor(bgr, expected, cv::COLOR_BGR2RGB);
+
+  EXPECT_TRUE(source->live());
+  EXPECT_EQ(source->model().intrinsics().width(), 64);
+  const auto opened = std::chrono::steady_clock::now();
+  double previous = -1.0;
+  // Four buffers: the first was read when opening (the size) and dropped, as live frames go
+  // stale; three remain, then the stream ends.
+  for (int i = 0; i < 3; ++i) {
+    const auto image = source->Grab();
+    ASSERT_NE(image, nullptr) << i;
+    const double since_epoch =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - source->epoch()).count();
+    EXPECT_EQ(image->metadata().frame_index, i);
+    EXPECT_GT(image->metadata().time, previous);
+    EXPECT_LE(image->metadata().time, since_epoch);
+    EXPECT_GE(image->metadata().time,
+              std::chrono::duration<double>(opened - source->epoch()).count());
+    previous = image->metadata().time;
+    // videotestsrc's colour spectrum is the same in every frame (SMPTE bars have noise).
+    EXPECT_EQ(DifferentPixels(MatOf(*image), expected), 0) << i;
+    ExpectIdentityPose(image->metadata());
+  }
+  EXPECT_EQ(source->Grab(), nullptr) << "the pipeline's end of stream ends the source";
 }
 
 TEST_F(CameraSourceTest, DevicesThatAreNotThereSaySo) {

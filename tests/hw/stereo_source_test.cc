@@ -259,6 +259,29 @@ TEST_F(StereoSourceTest, SequencesAtDifferentRatesDropAndCountTheFramesBeyondThe
   EXPECT_THROW(OpenStereoSource(left, right, 0.01), HardwareError);
 }
 
+TEST_F(StereoSourceTest, TwoLivePipelinesShareAnEpochAndPair) {
+  // GStreamer's test pattern as two live cameras (gstreamer1.0-plugins-base). Both are latched
+  // before either is decoded, so their stamps are close; 1 s is far more than needed and
+  // asserts nothing about speed.
+  CameraSourceSpec left;
+  left.name = "left";
+  left.uri =
+      "gstreamer:videotestsrc pattern=colors num-buffers=4 ! "
+      "video/x-raw,format=BGR,width=32,height=24,framerate=30/1 ! appsink";
+  CameraSourceSpec right = left;
+  right.name = "right";
+  std::unique_ptr<StereoSource> stereo;
+  try {
+    stereo = OpenStereoSource(left, right, 1.0);
+  } catch (const HardwareError& e) {
+    GTEST_SKIP() << "GStreamer's videotestsrc is missing (gstreamer1.0-plugins-base): " << e.what();
+  }
+  EXPECT_EQ(stereo->left().epoch(), stereo->right().epoch());
+  // Four buffers each, the first dropped when opening: three pairs.
+  EXPECT_EQ(Pairs(stereo.get()), (IndexPairs{{0, 0}, {1, 1}, {2, 2}}));
+  EXPECT_EQ(stereo->dropped_left() + stereo->dropped_right(), 0);
+}
+
 // ---------------------------------------------------------------------------------------
 // The chessboard: the delivered pixels and the delivered calibration belong together.
 

@@ -7,7 +7,8 @@
 //   gstreamer:<pipeline>          a GStreamer pipeline ending in appsink, as OpenCV's
 //                                 CAP_GSTREAMER takes it ("v4l2src ! videoconvert ! appsink")
 //   iidc:<guid>, iidc:<index>     an IIDC camera (IEEE 1394 FireWire, or USB IIDC) through
-//                                 libdc1394, in the mode it is set to: a 64-bit GUID in hex
+//                                 libdc1394, in the mode it is set to, each grab taking the
+//                                 newest frame of its DMA ring: a 64-bit GUID in hex
 //                                 (with or without 0x, more than 4 digits, as dc1394 prints
 //                                 it) or the index of the camera on the bus (0, 1, ...). Only
 //                                 in builds with libdc1394 (IidcSupported()).
@@ -35,7 +36,10 @@
 //
 // Time stamps, in seconds:
 // - devices (v4l2, gstreamer, iidc): the std::chrono::steady_clock time at which the frame was
-//   taken from the driver, counted from the source's epoch() (its opening, unless set);
+//   taken from the driver, counted from the source's epoch() (its opening, unless set). V4L2
+//   hands out the oldest of the frames OpenCV has it buffer: grab at the camera's rate or
+//   faster, or frames arrive (and are stamped) late. A GStreamer pipeline buffers as its
+//   appsink says ("appsink drop=true max-buffers=1" keeps only the newest);
 // - files, sequences, lists: frame_index / fps when CameraSourceSpec::fps > 0; else a video's
 //   own time stamp (CAP_PROP_POS_MSEC), and for still images (sequences, lists) 1 s per frame
 //   (still images carry no time; OpenCV's CAP_IMAGES reports 1 fps too). Looping continues
