@@ -24,6 +24,7 @@
 #include "commands.h"
 #include "saccade/components/face_truth.h"
 #include "saccade/components/fixation_component.h"
+#include "saccade/components/hw_components.h"
 #include "saccade/components/messages.h"
 #include "saccade/components/register.h"
 #include "saccade/components/scene_cache.h"
@@ -39,6 +40,7 @@ namespace {
 namespace fs = std::filesystem;
 using components::CandidatesMessage;
 using components::FacesMessage;
+using components::HeadStatusMessage;
 using components::JointStateMessage;
 using components::PictureFace;
 using components::SelectionMessage;
@@ -70,6 +72,7 @@ struct Fixation {
   bool completed = false;  // inhibition of return suppressed it
   std::string object = "unknown";
   bool is_face = false;
+  bool has_truth = false;  // the simulated scene gave the true face centre
   std::string source;
   Eigen::Vector3d p_W = Eigen::Vector3d::Zero();
   Eigen::Vector3d truth_W = Eigen::Vector3d::Zero();
@@ -263,7 +266,7 @@ json FixationJson(const Fixation& f) {
     j["target_W"] = VectorJson(f.p_W);
     j["target_source"] = f.source;
     j["distance_m"] = f.distance_m;
-    if (f.is_face) {
+    if (f.has_truth) {
       j["truth_W"] = VectorJson(f.truth_W);
       j["error_3d_m"] = f.error_3d_m;
       j["eye_error_deg"] = {{"left", f.left_error_deg}, {"right", f.right_error_deg}};
@@ -310,26 +313,36 @@ int RunDemo(const Options& o) {
   }
   runtime::Pipeline pipeline = runtime::Pipeline::Build(spec);
 
-  // The scene the cameras render, and where the cameras and the fixation controller run.
+  // Where the cameras and the fixation controller run, and the scene the cameras render:
+  // simulated cameras give ground truth; real ones (hw.cameras) give none.
   std::optional<std::size_t> cameras_index, fixation_index;
-  const components::SimCameras* cameras = nullptr;
+  const components::SimCameras* sim_cameras = nullptr;
+  const components::HwCameras* hw_cameras = nullptr;
   for (std::size_t i = 0; i < pipeline.components().size(); ++i) {
     const runtime::Component* c = pipeline.components()[i].get();
-    if (!cameras_index && dynamic_cast<const components::SimCameras*>(c)) {
+    if (!cameras_index && (dynamic_cast<const components::SimCameras*>(c) ||
+                           dynamic_cast<const components::HwCameras*>(c))) {
       cameras_index = i;
-      cameras = static_cast<const components::SimCameras*>(c);
+      sim_cameras = dynamic_cast<const components::SimCameras*>(c);
+      hw_cameras = dynamic_cast<const components::HwCameras*>(c);
     }
     if (dynamic_cast<const components::FixationComponent*>(c)) fixation_index = i;
   }
-  if (cameras == nullptr) {
+  if (!cameras_index) {
     throw InvalidArgument("demo: pipeline " + o.pipeline +
-                          " has no sim.cameras component: the demo measures against the "
-                          "simulated scene");
+                          " has no cameras (a sim.cameras or hw.cameras component)");
   }
-  const scene::Scene& scene = cameras->scene();
-  const std::vector<PictureFace> pictures = components::FindPictureFaces(scene);
+  const bool truth = sim_cameras != nullptr;
+  // Real cameras: the scene only carries the robot; its pictures are not what they see.
+  const scene::Scene& scene = truth ? sim_cameras->scene() : hw_cameras->scene();
+  const std::vector<PictureFace> pictures =
+      truth ? components::FindPictureFaces(scene) : std::vector<PictureFace>{};
   int faces_total = 0;
   for (const PictureFace& p : pictures) faces_total += p.has_face ? 1 : 0;
+  if (!truth && !o.json) {
+    fmt::print("real cameras ({}): no ground truth; fixations are reported as triangulated\n",
+               spec.components[*cameras_index].type);
+  }
 
   Latest latest;
   Tap<runtime::ImageMessage>(pipeline, [&](const runtime::ImageMessage& m) {
@@ -344,6 +357,13 @@ int RunDemo(const Options& o) {
   Tap<SelectionMessage>(pipeline, [&](const SelectionMessage& m) { latest.selection = m; });
   Tap<TargetMessage>(pipeline, [&](const TargetMessage& m) { latest.target = m; });
   Tap<JointStateMessage>(pipeline, [&](const JointStateMessage& m) { latest.joints = m; });
+  std::optional<HeadStatusMessage> head_status;
+  Tap<HeadStatusMessage>(pipeline, [&](const HeadStatusMessage& m) {
+    if (!o.json && m.fault != (head_status ? head_status->fault : "") && !m.fault.empty()) {
+      fmt::print("t = {:6.2f} s  head FAULT: {}\n", m.time, m.fault);
+    }
+    head_status = m;
+  });
 
   std::unique_ptr<Recorder> recorder;
   if (!o.record.empty()) recorder = std::make_unique<Recorder>(o.record, 1.0 / dt, o.force);
@@ -426,14 +446,20 @@ int RunDemo(const Options& o) {
               f.truth_W = ref;
             }
           }
-          if (f.is_face) {
+          if (!truth) {
+            // Real cameras: every target attention picks is a face the detectors found.
+            f.object = fmt::format("face {}", f.target_id);
+            f.is_face = true;
+          }
+          f.has_truth = truth && f.is_face;
+          if (f.has_truth) {
             f.error_3d_m = (f.p_W - f.truth_W).norm();
             f.left_error_deg = AxisErrorDeg(*left->second, f.truth_W);
             f.right_error_deg = AxisErrorDeg(*right->second, f.truth_W);
           }
           fixated_now = true;
         }
-        if (f.is_face) {
+        if (f.has_truth) {
           // Pursuit: how well the eyes stay on the (possibly moving) true face centre.
           const PictureFace* p = nullptr;
           for (const PictureFace& q : pictures) {
@@ -470,7 +496,12 @@ int RunDemo(const Options& o) {
     if (fixated_now) {
       const Fixation& f = fixations.back();
       if (!o.json) {
-        if (f.is_face) {
+        if (f.is_face && !f.has_truth) {
+          fmt::print(
+              "t = {:6.2f} s  fixated {:<16} at {:.2f} m  (triangulated; no ground truth)  "
+              "took {:.2f} s  ({})\n",
+              t, f.object, f.distance_m, *f.fixated_at - f.selected_at, f.source);
+        } else if (f.is_face) {
           fmt::print(
               "t = {:6.2f} s  fixated {:<16} at {:.2f} m  3D error {:5.1f} mm  eye axis error "
               "L {:.3f} deg R {:.3f} deg  took {:.2f} s  ({})\n",
@@ -561,6 +592,10 @@ int RunDemo(const Options& o) {
       {"overhead_share", summary.overhead_share},
       {"overhead_ms", {{"median", summary.overhead_median_ms}, {"p95", summary.overhead_p95_ms}}},
       {"errors", errors},
+      {"hardware", spec.hardware_file.empty() ? json(nullptr) : json(spec.hardware_file)},
+      {"ground_truth", truth},
+      {"head", head_status ? runtime::MessageTraits<HeadStatusMessage>::ToJson(*head_status)
+                           : json(nullptr)},
       {"interrupted", g_stop.load() && faces_fixated < faces_total}};
   if (recorder) {
     report["record"] = {{"folder", o.record},
@@ -573,9 +608,23 @@ int RunDemo(const Options& o) {
   if (o.json) {
     fmt::print("{}\n", report.dump(2));
   } else {
-    fmt::print("\n{} of {} faces fixated in {:.2f} s of simulated time ({} steps, {:.1f} s wall)\n",
-               faces_fixated, faces_total, summary.sim_time + dt, summary.steps,
-               summary.wall_seconds);
+    if (truth) {
+      fmt::print(
+          "\n{} of {} faces fixated in {:.2f} s of simulated time ({} steps, {:.1f} s wall)\n",
+          faces_fixated, faces_total, summary.sim_time + dt, summary.steps, summary.wall_seconds);
+    } else {
+      fmt::print("\n{} faces fixated in {:.2f} s ({} steps, {:.1f} s wall)\n", faces_fixated,
+                 summary.sim_time + dt, summary.steps, summary.wall_seconds);
+    }
+    if (head_status) {
+      const HeadStatusMessage& h = *head_status;
+      fmt::print(
+          "head: {}{}: {} commands, {} rejected, {} clamped or limited, {} watchdog stops{}{}\n",
+          h.driver, h.mirror ? " (mirroring the virtual head)" : "", h.commands,
+          h.rejected_commands, h.limited_commands, h.watchdog_trips,
+          h.emergency_stopped ? ", EMERGENCY STOP" : "",
+          h.fault.empty() ? "" : ", FAULT: " + h.fault);
+    }
     for (const json& d : decoys) {
       fmt::print("decoy {}: {} ({} detections on it rejected{})\n", d["name"].get<std::string>(),
                  d["fixated"].get<bool>() ? "FIXATED (not rejected)" : "rejected, never fixated",

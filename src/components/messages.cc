@@ -15,6 +15,7 @@ void RegisterMessages() {
   runtime::MessageRegistry& registry = runtime::MessageRegistry::Global();
   registry.Register<JointStateMessage>();
   registry.Register<JointCommand>();
+  registry.Register<HeadStatusMessage>();
   registry.Register<FacesMessage>();
   registry.Register<CandidatesMessage>();
   registry.Register<SelectionMessage>();
@@ -30,6 +31,7 @@ namespace {
 using components::CandidatesMessage;
 using components::FaceCandidate;
 using components::FacesMessage;
+using components::HeadStatusMessage;
 using components::JointCommand;
 using components::JointStateMessage;
 using components::SelectionMessage;
@@ -117,6 +119,44 @@ JointCommand MessageTraits<JointCommand>::FromJson(const json& j) {
   m.positions = JointsFromJson(j, kName, "positions");
   m.velocities = JointsFromJson(j, kName, "velocities");
   m.target_id = JsonInteger(j, kName, "target_id");
+  return m;
+}
+
+json MessageTraits<HeadStatusMessage>::ToJson(const HeadStatusMessage& m) {
+  return {{"time", m.time},
+          {"driver", m.driver},
+          {"positions", JointsToJson(m.positions)},
+          {"velocities", JointsToJson(m.velocities)},
+          {"targets", JointsToJson(m.targets)},
+          {"torque", m.torque},
+          {"holding", m.holding},
+          {"emergency_stopped", m.emergency_stopped},
+          {"fault", m.fault},
+          {"commands", m.commands},
+          {"rejected_commands", m.rejected_commands},
+          {"limited_commands", m.limited_commands},
+          {"watchdog_trips", m.watchdog_trips},
+          {"last_limit", m.last_limit},
+          {"mirror", m.mirror}};
+}
+
+HeadStatusMessage MessageTraits<HeadStatusMessage>::FromJson(const json& j) {
+  HeadStatusMessage m;
+  m.time = JsonNumber(j, kName, "time");
+  m.driver = JsonString(j, kName, "driver");
+  m.positions = JointsFromJson(j, kName, "positions");
+  m.velocities = JointsFromJson(j, kName, "velocities");
+  m.targets = JointsFromJson(j, kName, "targets");
+  m.torque = JsonBool(j, kName, "torque");
+  m.holding = JsonBool(j, kName, "holding");
+  m.emergency_stopped = JsonBool(j, kName, "emergency_stopped");
+  m.fault = JsonString(j, kName, "fault");
+  m.commands = JsonInteger(j, kName, "commands");
+  m.rejected_commands = JsonInteger(j, kName, "rejected_commands");
+  m.limited_commands = JsonInteger(j, kName, "limited_commands");
+  m.watchdog_trips = JsonInteger(j, kName, "watchdog_trips");
+  m.last_limit = JsonString(j, kName, "last_limit");
+  m.mirror = JsonBool(j, kName, "mirror");
   return m;
 }
 

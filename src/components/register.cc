@@ -1,6 +1,7 @@
 #include "saccade/components/register.h"
 
 #include "saccade/components/fixation_component.h"
+#include "saccade/components/hw_components.h"
 #include "saccade/components/messages.h"
 #include "saccade/components/sim_components.h"
 #include "saccade/components/vision_components.h"
@@ -25,6 +26,10 @@ void RegisterComponents(runtime::ComponentRegistry& registry) {
                                           "3D target from the tracks (or detections)");
   registry.Register<FixationComponent>("control.fixation",
                                        "inverse kinematics: saccades and smooth pursuit");
+  registry.Register<HwHead>("hw.head",
+                            "a real head's driver (Dynamixel bus), with its safety rules");
+  registry.Register<HwCameras>("hw.cameras",
+                               "real cameras (V4L2, GStreamer, IIDC, video files, image lists)");
   registry.Register<DebugFault>("debug.fault", "throws at a given step (fault injection)");
 }
 

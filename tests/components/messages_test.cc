@@ -43,6 +43,19 @@ TEST(Messages, EveryTypeRoundTripsThroughJson) {
   EXPECT_TRUE(command.pursuit());
   ExpectRoundTrip(command);
 
+  HeadStatusMessage status;
+  status.time = 3.5;
+  status.driver = "dynamixel on /tmp/saccade-servos";
+  status.positions = {0.1, 0.0, -0.02, 0.02};
+  status.torque = true;
+  status.holding = true;
+  status.fault = "servo 2 (tilt): overload";
+  status.commands = 40;
+  status.rejected_commands = 3;
+  status.watchdog_trips = 1;
+  status.last_limit = "pan target 120.00 deg clamped to 90.00 deg";
+  ExpectRoundTrip(status);
+
   auto image = std::make_shared<Image>(8, 6, PixelFormat::kRgb8);
   image->metadata().camera = "left";
   image->metadata().frame_index = 12;

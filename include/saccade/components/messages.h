@@ -42,6 +42,26 @@ struct JointCommand {
   bool pursuit() const;         ///< any velocity non-zero
 };
 
+/// A head driver's state beyond its joints (hw.head, hw/head_driver.h): the safety state,
+/// faults and counters, for operators and the GUI.
+struct HeadStatusMessage {
+  double time = 0.0;            ///< s, the step's time
+  std::string driver;           ///< "simulated", "dynamixel on /dev/ttyUSB0", ...
+  head::JointState positions;   ///< rad, measured on the device
+  head::JointState velocities;  ///< rad/s
+  head::JointState targets;     ///< rad, last sent (the hold position when held)
+  bool torque = false;
+  bool holding = false;  ///< the watchdog stopped the head
+  bool emergency_stopped = false;
+  std::string fault;  ///< "" when none
+  int64_t commands = 0;
+  int64_t rejected_commands = 0;
+  int64_t limited_commands = 0;
+  int64_t watchdog_trips = 0;
+  std::string last_limit;  ///< the last clamping or limiting, "" when none
+  bool mirror = false;     ///< the device follows a virtual head (mirror mode)
+};
+
 /// Faces found in one image (vision.face_detector), rejected candidates included and flagged.
 struct FacesMessage {
   std::shared_ptr<const Image> image;  ///< the image they were found in
@@ -134,6 +154,13 @@ struct MessageTraits<components::JointCommand> {
   static constexpr const char* kName = "head.command";
   static nlohmann::json ToJson(const components::JointCommand& m);
   static components::JointCommand FromJson(const nlohmann::json& j);
+};
+
+template <>
+struct MessageTraits<components::HeadStatusMessage> {
+  static constexpr const char* kName = "head.status";
+  static nlohmann::json ToJson(const components::HeadStatusMessage& m);
+  static components::HeadStatusMessage FromJson(const nlohmann::json& j);
 };
 
 template <>

@@ -1,0 +1,124 @@
+#pragma once
+// The real robot as pipeline components (issue 7; seed Fig. 2: popeyeRobot and the camera
+// acquisition): the same component names and ports as sim.head and sim.cameras, so that a
+// hardware file (runtime/pipeline.h) swaps one for the other.
+//
+// hw.head -- a head driver (hw/head_driver.h) as the pipeline's head, with the driver's
+//   safety rules: non-finite commands rejected, targets clamped to the joint limits and
+//   velocities limited (reported), the watchdog, the emergency stop, faults.
+//   params:  scene (required): the scene whose robot it is (its head description, with the
+//              servo mapping for dynamixel)
+//            driver (required): dynamixel | simulated (SimHeadDriver: the simulated motors on
+//              the wall clock, to try a pipeline without a device)
+//            port: the serial port (dynamixel, required), e.g. /dev/ttyUSB0; baud: 1000000
+//            timeout_ms: 20, retries: 2 (each bus transaction)
+//            watchdog_s: 0.5 (0: off)
+//            mirror: false -- mirror mode (seed: popeyeRobot): commands move a virtual
+//              (simulated) head, which is what the cameras see and what `joints` reports;
+//              the device follows the virtual head's positions every step, within its limits.
+//   inputs:  command (head.command, optional): sent to the device (or the virtual head).
+//   outputs: joints (head.joints): the device's measured joints (mirror: the virtual
+//              head's) at the step's time; status (head.status): the driver's safety state.
+//   methods: state (runtime.empty -> head.joints), move (head.command -> head.joints),
+//            stop (runtime.empty -> head.status): brake and hold,
+//            estop (runtime.empty -> head.status): emergency stop, latched until `clear`,
+//            clear (runtime.empty -> head.status): clears an emergency stop or a fault,
+//            torque_on / torque_off (runtime.empty -> head.status).
+//   A fault (a servo's overload, a servo that stops answering, ...) does not stop the
+//   pipeline: the head holds, commands are rejected and counted, `status` names the fault,
+//   and it is printed once on stderr.
+//
+// hw.cameras -- the eye cameras as real camera sources (hw/camera_source.h: V4L2 devices,
+//   GStreamer pipelines, IIDC cameras, video files, image sequences and lists), paired by
+//   time stamp (hw/stereo_source.h), delivering the same images with the same metadata as
+//   sim.cameras: K and distortion from each camera's calibration file, X_WC and the joints
+//   from the head's forward kinematics at the joints of this step.
+//   params:  scene (required): the scene whose robot carries the cameras
+//            cameras (required): {left: SOURCE, right: SOURCE}, each SOURCE
+//              {uri (required), calibration, calibration_index 0, fps 0, loop false,
+//               first 0, every 1} as hw::CameraSourceSpec documents; relative paths resolve
+//               against the pipeline (or hardware) file
+//            max_skew_s: 0.02 -- the most the two time stamps of a pair may differ
+//   inputs:  joints (head.joints, optional; connect with delay 1 as for sim.cameras)
+//   outputs: left, right (runtime.image): one pair per step; time = the step's time (the
+//            capture time stays in the source: frame_index counts the pairs delivered)
+//   When a file or list ends (without loop), nothing more is emitted and a line on stderr
+//   says so; a device error stops the pipeline with the camera and its uri named.
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "saccade/components/messages.h"
+#include "saccade/head/motors.h"
+#include "saccade/hw/head_driver.h"
+#include "saccade/hw/stereo_source.h"
+#include "saccade/runtime/component.h"
+#include "saccade/scene/scene.h"
+
+namespace saccade::components {
+
+class HwHead : public runtime::Component {
+ public:
+  HwHead();
+  void Configure(const nlohmann::json& params) override;
+  void Start() override;
+  void Step(const runtime::StepContext& context) override;
+  void Stop() override;
+
+  /// The driver, once started (tests, tools).
+  hw::HeadDriver* driver() { return driver_.get(); }
+
+ private:
+  hw::HeadDriver& Driver();  // throws when not started
+  void Send(const head::JointState& positions, const head::JointState& velocities);
+  JointStateMessage Joints(const hw::HeadStatus& status, double time) const;
+  HeadStatusMessage Status(const hw::HeadStatus& status, double time) const;
+  void Report(const hw::HeadStatus& status);
+
+  runtime::Input<JointCommand>& command_;
+  runtime::Output<JointStateMessage>& joints_;
+  runtime::Output<HeadStatusMessage>& status_;
+  std::shared_ptr<const scene::Scene> scene_;
+  std::string driver_kind_;
+  std::string port_;
+  int baud_ = 1000000;
+  double timeout_ms_ = 20.0;
+  int retries_ = 2;
+  hw::SafetyOptions safety_;
+  bool mirror_ = false;
+
+  std::unique_ptr<hw::HeadDriver> driver_;
+  std::unique_ptr<head::Motors> virtual_;  // mirror mode
+  double time_ = 0.0;
+  std::string reported_fault_;
+  std::string last_limit_;
+  std::string last_rejection_;
+};
+
+class HwCameras : public runtime::Component {
+ public:
+  HwCameras();
+  void Configure(const nlohmann::json& params) override;
+  void Start() override;
+  void Step(const runtime::StepContext& context) override;
+  void Stop() override;
+
+  /// The pair source, once started (tests, tools).
+  const hw::StereoSource* source() const { return source_.get(); }
+  /// The scene whose robot carries the cameras (not what they see).
+  const scene::Scene& scene() const { return *scene_; }
+
+ private:
+  runtime::Input<JointStateMessage>& joints_;
+  runtime::Output<runtime::ImageMessage>& left_;
+  runtime::Output<runtime::ImageMessage>& right_;
+  std::shared_ptr<const scene::Scene> scene_;
+  hw::CameraSourceSpec left_spec_;
+  hw::CameraSourceSpec right_spec_;
+  double max_skew_s_ = 0.02;
+  std::unique_ptr<hw::StereoSource> source_;
+  bool ended_ = false;
+  int64_t pairs_ = 0;
+};
+
+}  // namespace saccade::components
