@@ -541,6 +541,10 @@ int RunDemo(const Options& o) {
   std::signal(SIGINT, previous_int);
   std::signal(SIGTERM, previous_term);
 
+  // Nothing ran (a device that would not open, a component that failed to start): the
+  // error, printed above, is the whole story for people (the JSON and summary.json keep it).
+  const bool nothing_ran = summary.steps == 0 && !summary.errors.empty();
+
   // ---- the report ----
   int faces_fixated = 0;
   std::vector<std::string> seen;
@@ -594,6 +598,10 @@ int RunDemo(const Options& o) {
       {"errors", errors},
       {"hardware", spec.hardware_file.empty() ? json(nullptr) : json(spec.hardware_file)},
       {"ground_truth", truth},
+      {"cameras", hw_cameras ? json({{"pairs", hw_cameras->pairs()},
+                                     {"dropped_left", hw_cameras->dropped_left()},
+                                     {"dropped_right", hw_cameras->dropped_right()}})
+                             : json(nullptr)},
       {"head", head_status ? runtime::MessageTraits<HeadStatusMessage>::ToJson(*head_status)
                            : json(nullptr)},
       {"interrupted", g_stop.load() && faces_fixated < faces_total}};
@@ -607,7 +615,7 @@ int RunDemo(const Options& o) {
 
   if (o.json) {
     fmt::print("{}\n", report.dump(2));
-  } else {
+  } else if (!nothing_ran) {
     if (truth) {
       fmt::print(
           "\n{} of {} faces fixated in {:.2f} s of simulated time ({} steps, {:.1f} s wall)\n",
@@ -616,6 +624,7 @@ int RunDemo(const Options& o) {
       fmt::print("\n{} faces fixated in {:.2f} s ({} steps, {:.1f} s wall)\n", faces_fixated,
                  summary.sim_time + dt, summary.steps, summary.wall_seconds);
     }
+    if (hw_cameras) fmt::print("cameras: {}\n", hw_cameras->Describe());
     if (head_status) {
       const HeadStatusMessage& h = *head_status;
       fmt::print(

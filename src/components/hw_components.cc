@@ -331,11 +331,20 @@ void HwCameras::Start() {
   source_ = hw::OpenStereoSource(left_spec_, right_spec_, max_skew_s_);
   ended_ = false;
   pairs_ = 0;
+  dropped_left_ = dropped_right_ = 0;
+}
+
+std::string HwCameras::Describe() const {
+  return fmt::format("{} stereo pairs from {} and {}, {} + {} frames dropped (skew over {} s)",
+                     pairs_, left_spec_.uri, right_spec_.uri, dropped_left_, dropped_right_,
+                     max_skew_s_);
 }
 
 void HwCameras::Step(const runtime::StepContext& context) {
   if (ended_) return;
   std::optional<hw::StereoFrame> pair = source_->Grab();
+  dropped_left_ = source_->dropped_left();
+  dropped_right_ = source_->dropped_right();
   if (!pair) {
     ended_ = true;
     fmt::print(stderr, "hw.cameras '{}': the camera sources ended after {} pairs ({}, {})\n",

@@ -656,7 +656,8 @@ class SceneReader {
         if (const auto sensor = camera->Find("sensor")) sensors[i] = ReadSensor(*sensor);
       }
     }
-    // The description again, with the scene's pose and calibrations in place of its own.
+    // The description again, with the scene's pose and calibrations in place of its own (the
+    // servo mapping kept).
     std::optional<head::HeadDescription> placed;
     try {
       placed.emplace(description->name(), description->geometry(),
@@ -664,7 +665,12 @@ class SceneReader {
                                                       description->limits(head::Joint::kTilt),
                                                       description->limits(head::Joint::kLeft),
                                                       description->limits(head::Joint::kRight)},
-                     X_WB, left, right);
+                     X_WB, left, right,
+                     std::array<std::optional<head::ServoMapping>, 4>{
+                         description->servo(head::Joint::kPan),
+                         description->servo(head::Joint::kTilt),
+                         description->servo(head::Joint::kLeft),
+                         description->servo(head::Joint::kRight)});
     } catch (const InvalidArgument& error) {
       e.Fail(error.what());
     }

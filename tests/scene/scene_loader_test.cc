@@ -209,6 +209,9 @@ TEST_F(SceneLoaderTest, ValidSceneLoadsEverySection) {
   EXPECT_EQ(scene.InitialState().joints, scene.robot()->initial_joints);
   EXPECT_EQ(scene.InitialState().time, 0.0);
   EXPECT_FALSE(scene.robot()->parts.empty());
+  // The description's servo mapping survives the scene's pose and calibrations (hw.head).
+  ASSERT_TRUE(scene.robot()->head.HasServos());
+  EXPECT_EQ(scene.robot()->head.servo(head::Joint::kTilt)->direction, -1);
 
   // Cameras: the eyes first, then the file's, in order.
   ASSERT_EQ(scene.cameras().size(), 4u);

@@ -107,6 +107,12 @@ class HwCameras : public runtime::Component {
   const hw::StereoSource* source() const { return source_.get(); }
   /// The scene whose robot carries the cameras (not what they see).
   const scene::Scene& scene() const { return *scene_; }
+  /// Pairs delivered, and frames dropped for want of a partner within max_skew_s, so far.
+  int64_t pairs() const { return pairs_; }
+  int64_t dropped_left() const { return dropped_left_; }
+  int64_t dropped_right() const { return dropped_right_; }
+  /// A line for people: "25 pairs from <left uri> and <right uri>, 0 + 0 frames dropped".
+  std::string Describe() const;
 
  private:
   runtime::Input<JointStateMessage>& joints_;
@@ -119,6 +125,8 @@ class HwCameras : public runtime::Component {
   std::unique_ptr<hw::StereoSource> source_;
   bool ended_ = false;
   int64_t pairs_ = 0;
+  int64_t dropped_left_ = 0;
+  int64_t dropped_right_ = 0;
 };
 
 }  // namespace saccade::components

@@ -1,0 +1,210 @@
+// The demo's pipeline, unchanged, on other hardware (issue 7): the head on the emulated
+// Dynamixel bus (saccade-servo-emulator, a separate process on a pseudo-terminal), in mirror
+// mode, with emulated servo faults, and the eye cameras replaced by OpenCV's recorded stereo
+// pair -- each through a hardware file, as a user would switch them.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "e2e/run_saccade.h"
+
+extern char** environ;
+
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+using saccade::e2e::CommandRun;
+using saccade::e2e::Saccade;
+using ::testing::HasSubstr;
+
+const std::string kSource = SACCADE_SOURCE_DIR;
+const std::string kTwoPictures = kSource + "/scenes/astronaut_and_cat.yaml";
+
+fs::path TempDir(const std::string& name) {
+  const fs::path dir =
+      fs::temp_directory_path() / ("saccade_hardware_test_" + std::to_string(::getpid())) / name;
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir;
+}
+
+// saccade-servo-emulator in the background, for the length of a test.
+class Emulator {
+ public:
+  // `args` besides --link; returns once it has printed its first line.
+  Emulator(const fs::path& link, const std::vector<std::string>& args) {
+    int out[2];
+    EXPECT_EQ(pipe(out), 0);
+    posix_spawn_file_actions_t actions;
+    posix_spawn_file_actions_init(&actions);
+    posix_spawn_file_actions_adddup2(&actions, out[1], STDOUT_FILENO);
+    posix_spawn_file_actions_addclose(&actions, out[0]);
+    std::vector<std::string> all = {SACCADE_SERVO_EMULATOR, "--link", link.string()};
+    all.insert(all.end(), args.begin(), args.end());
+    std::vector<char*> argv;
+    for (std::string& a : all) argv.push_back(a.data());
+    argv.push_back(nullptr);
+    EXPECT_EQ(posix_spawn(&pid_, argv[0], &actions, nullptr, argv.data(), environ), 0);
+    posix_spawn_file_actions_destroy(&actions);
+    close(out[1]);
+    out_ = fdopen(out[0], "r");
+    char line[512] = {};
+    if (out_ == nullptr || fgets(line, sizeof line, out_) == nullptr) {
+      ADD_FAILURE() << "saccade-servo-emulator printed nothing";
+    }
+    first_line_ = line;
+  }
+  ~Emulator() {
+    if (pid_ > 0) {
+      kill(pid_, SIGTERM);
+      int status = 0;
+      waitpid(pid_, &status, 0);
+    }
+    if (out_ != nullptr) fclose(out_);
+  }
+  const std::string& first_line() const { return first_line_; }
+
+ private:
+  pid_t pid_ = -1;
+  FILE* out_ = nullptr;
+  std::string first_line_;
+};
+
+// A hardware file: simulated cameras on the two-picture scene, the head on the bus at `port`.
+fs::path ServoHardware(const fs::path& dir, const fs::path& port, bool mirror) {
+  const fs::path file = dir / "servos.yaml";
+  std::ofstream(file) << "components:\n"
+                         "  cameras:\n"
+                         "    type: sim.cameras\n"
+                         "    params: {scene: "
+                      << kTwoPictures
+                      << "}\n"
+                         "  head:\n"
+                         "    type: hw.head\n"
+                         "    params: {scene: "
+                      << kTwoPictures << ", driver: dynamixel, port: " << port.string()
+                      << ", watchdog_s: 1.0, mirror: " << (mirror ? "true" : "false") << "}\n";
+  return file;
+}
+
+json Summary(const fs::path& record) {
+  std::ifstream in(record / "summary.json");
+  return json::parse(in);
+}
+
+TEST(HardwareCli, TheDemoFixatesTheFaceWithTheHeadOnTheEmulatedServoBus) {
+  const fs::path dir = TempDir("servos");
+  Emulator emulator(dir / "bus", {});
+  ASSERT_THAT(emulator.first_line(), HasSubstr("serving servos 1,2,3,4"));
+  const CommandRun run =
+      Saccade("demo --hardware " + ServoHardware(dir, dir / "bus", false).string() +
+              " --duration 3 --record " + (dir / "rec").string());
+  ASSERT_EQ(run.status, 0) << run.output;
+  const json s = Summary(dir / "rec");
+  EXPECT_EQ(s["faces_fixated"], 1);
+  const json& f = s["fixations"][0];
+  EXPECT_EQ(f["object"], "astronaut");
+  EXPECT_LT(f["error_3d_m"].get<double>(), 0.05);
+  EXPECT_LT(f["eye_error_deg"]["left"].get<double>(), 0.5);
+  EXPECT_LT(f["eye_error_deg"]["right"].get<double>(), 0.5);
+  const json& head = s["head"];
+  EXPECT_THAT(head["driver"].get<std::string>(),
+              HasSubstr("dynamixel on " + (dir / "bus").string()));
+  EXPECT_GT(head["commands"].get<int>(), 10);
+  EXPECT_EQ(head["rejected_commands"], 0);
+  EXPECT_EQ(head["fault"], "");
+  // The servos moved the head off its home: the picture is not straight ahead.
+  EXPECT_GT(std::abs(head["positions"]["pan"].get<double>()) +
+                std::abs(head["positions"]["tilt"].get<double>()),
+            0.01);
+  EXPECT_THAT(run.output, HasSubstr("head: dynamixel on"));
+}
+
+TEST(HardwareCli, InMirrorModeTheServosFollowTheVirtualHead) {
+  const fs::path dir = TempDir("mirror");
+  Emulator emulator(dir / "bus", {});
+  const CommandRun run =
+      Saccade("demo --hardware " + ServoHardware(dir, dir / "bus", true).string() +
+              " --duration 3 --record " + (dir / "rec").string());
+  ASSERT_EQ(run.status, 0) << run.output;
+  const json s = Summary(dir / "rec");
+  EXPECT_EQ(s["faces_fixated"], 1);
+  const json& head = s["head"];
+  EXPECT_EQ(head["mirror"], true);
+  EXPECT_EQ(head["fault"], "");
+  // Sent: the virtual head's joints; measured: where the servos are. At the end of a
+  // fixation they agree to a servo tick or two (0.088 deg each).
+  for (const char* joint : {"pan", "tilt", "left", "right"}) {
+    EXPECT_NEAR(head["positions"][joint].get<double>(), head["targets"][joint].get<double>(), 0.004)
+        << joint;
+  }
+  EXPECT_GT(std::abs(head["targets"]["pan"].get<double>()), 0.01);
+}
+
+TEST(HardwareCli, AServoOverloadIsReportedAndTheLoopGoesOnWithTheHeadHeld) {
+  const fs::path dir = TempDir("overload");
+  Emulator emulator(dir / "bus", {"--overload", "2@1.5"});
+  const CommandRun run =
+      Saccade("demo --hardware " + ServoHardware(dir, dir / "bus", false).string() +
+              " --duration 4 --record " + (dir / "rec").string());
+  EXPECT_NE(run.status, 1) << "the fault stopped the loop:\n" << run.output;
+  EXPECT_THAT(run.output, HasSubstr("FAULT: servo 2 (tilt): overload"));
+  const json s = Summary(dir / "rec");
+  const json& head = s["head"];
+  EXPECT_THAT(head["fault"].get<std::string>(), HasSubstr("servo 2 (tilt): overload"));
+  EXPECT_GT(head["rejected_commands"].get<int>(), 0) << "commands after the fault were sent";
+  EXPECT_TRUE(s["errors"].empty()) << s["errors"].dump();
+}
+
+TEST(HardwareCli, AServoThatStopsAnsweringIsReported) {
+  const fs::path dir = TempDir("silent");
+  Emulator emulator(dir / "bus", {"--silent", "3@1.5"});
+  const CommandRun run =
+      Saccade("demo --hardware " + ServoHardware(dir, dir / "bus", false).string() +
+              " --duration 4 --record " + (dir / "rec").string());
+  EXPECT_NE(run.status, 1) << run.output;
+  const json s = Summary(dir / "rec");
+  const std::string fault = s["head"]["fault"].get<std::string>();
+  EXPECT_THAT(fault, HasSubstr("servo 3"));
+  EXPECT_THAT(fault, HasSubstr("no status packet"));
+  EXPECT_GT(s["head"]["rejected_commands"].get<int>(), 0);
+}
+
+TEST(HardwareCli, WithoutTheBusTheErrorNamesThePort) {
+  const fs::path dir = TempDir("nobus");
+  const CommandRun run = Saccade(
+      "demo --hardware " + ServoHardware(dir, dir / "no-bus", false).string() + " --duration 1");
+  EXPECT_EQ(run.status, 1) << run.output;
+  EXPECT_THAT(run.output, HasSubstr((dir / "no-bus").string()));
+  EXPECT_THAT(run.output, HasSubstr("head"));
+}
+
+TEST(HardwareCli, TheDemoRunsOnOpenCvsRecordedStereoPair) {
+  const fs::path dir = TempDir("recorded");
+  const CommandRun run =
+      Saccade("demo --hardware " + kSource + "/pipelines/hardware/recorded_cameras.yaml" +
+              " --duration 1 --record " + (dir / "rec").string());
+  // Chessboards: the loop runs, finds no face, and says so.
+  EXPECT_EQ(run.status, 3) << run.output;
+  EXPECT_THAT(run.output, HasSubstr("real cameras (hw.cameras): no ground truth"));
+  const json s = Summary(dir / "rec");
+  EXPECT_EQ(s["ground_truth"], false);
+  EXPECT_EQ(s["cameras"]["pairs"], 25);
+  EXPECT_EQ(s["cameras"]["dropped_left"], 0);
+  EXPECT_EQ(s["steps"], 25);
+  EXPECT_TRUE(s["errors"].empty()) << s["errors"].dump();
+  EXPECT_EQ(s["record"]["frames"], 25);
+}
+
+}  // namespace
