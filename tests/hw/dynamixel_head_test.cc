@@ -11,6 +11,7 @@
 #include <numbers>
 #include <thread>
 
+#include "hw/driver_test_util.h"
 #include "saccade/hw/dynamixel_protocol.h"
 #include "saccade/hw/hw_error.h"
 #include "saccade/hw/servo_emulator.h"
@@ -18,24 +19,11 @@
 namespace saccade::hw {
 namespace {
 
-constexpr double kDeg = std::numbers::pi / 180.0;
+using testing::kDeg;
+using testing::kPopeye;
+using testing::ReadUntil;
+using testing::Sleep;
 constexpr double kTick = 360.0 / 4096.0;  // deg
-const std::string kPopeye = SACCADE_SOURCE_DIR "/robots/popeye.yaml";
-
-void Sleep(double seconds) { std::this_thread::sleep_for(std::chrono::duration<double>(seconds)); }
-
-template <typename Done>
-HeadStatus ReadUntil(HeadDriver& driver, Done done, double timeout = 3.0) {
-  const auto start = std::chrono::steady_clock::now();
-  HeadStatus status = driver.Read();
-  while (!done(status) &&
-         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() <
-             timeout) {
-    Sleep(0.01);
-    status = driver.Read();
-  }
-  return status;
-}
 
 head::JointState Joints(double pan_deg, double tilt_deg, double left_deg, double right_deg) {
   return {pan_deg * kDeg, tilt_deg * kDeg, left_deg * kDeg, right_deg * kDeg};
@@ -228,6 +216,18 @@ TEST_F(DynamixelHeadTest, LostAndCorruptedPacketsAreRetriedWithoutAFault) {
   const EmulatorCounters counters = emulator_->counters();
   EXPECT_GT(counters.dropped, 0);
   EXPECT_GT(counters.corrupted, 0);
+  EXPECT_TRUE(driver_->Read().ready());
+}
+
+TEST_F(DynamixelHeadTest, EveryStatusCorruptedIsAChecksumFault) {
+  Open();
+  emulator_->SetCorruptRate(1.0);
+  const HeadStatus status = driver_->Read();
+  EXPECT_NE(status.fault.find("CRC"), std::string::npos) << status.fault;
+  EXPECT_FALSE(status.ready());
+  EXPECT_THROW(driver_->Command(Joints(5, 0, 0, 0)), CommandRejected);
+  emulator_->SetCorruptRate(0.0);
+  driver_->ClearFault();
   EXPECT_TRUE(driver_->Read().ready());
 }
 

@@ -10,28 +10,15 @@
 #include <numbers>
 #include <thread>
 
+#include "hw/driver_test_util.h"
+
 namespace saccade::hw {
 namespace {
 
-constexpr double kDeg = std::numbers::pi / 180.0;
-const std::string kPopeye = SACCADE_SOURCE_DIR "/robots/popeye.yaml";
-
-void Sleep(double seconds) { std::this_thread::sleep_for(std::chrono::duration<double>(seconds)); }
-
-// Reads until `done` or `timeout` seconds; returns the last status.
-template <typename Done>
-HeadStatus ReadUntil(HeadDriver& driver, Done done, double timeout = 3.0) {
-  const auto start = std::chrono::steady_clock::now();
-  HeadStatus status = driver.Read();
-  while (!done(status) &&
-         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() <
-             timeout) {
-    Sleep(0.005);
-    status = driver.Read();
-  }
-  return status;
-}
-
+using testing::kDeg;
+using testing::kPopeye;
+using testing::ReadUntil;
+using testing::Sleep;
 head::JointState Pan(double rad) {
   head::JointState s;
   s.pan = rad;
