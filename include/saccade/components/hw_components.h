@@ -24,6 +24,10 @@
 //            estop (runtime.empty -> head.status): emergency stop, latched until `clear`,
 //            clear (runtime.empty -> head.status): clears an emergency stop or a fault,
 //            torque_on / torque_off (runtime.empty -> head.status).
+//   A device moves on the wall clock whatever the pipeline's clock: under a simulated clock
+//   whose steps take longer than `step` (rendering on llvmpipe), the head arrives sooner in
+//   simulated time than sim.head would; run in real time (`saccade demo --realtime`) for
+//   timings.
 //   A fault (a servo's overload, a servo that stops answering, ...) does not stop the
 //   pipeline: the head holds, commands are rejected and counted, `status` names the fault,
 //   and it is printed once on stderr.
