@@ -4,12 +4,11 @@
 
 #include <chrono>
 #include <cmath>
-#include <map>
-#include <numbers>
 #include <thread>
 #include <utility>
 #include <vector>
 
+#include "saccade/core/error.h"
 #include "saccade/hw/dynamixel_bus.h"
 #include "saccade/hw/dynamixel_protocol.h"
 #include "saccade/hw/hw_error.h"
@@ -17,49 +16,13 @@
 namespace saccade::hw {
 namespace {
 
-constexpr double kTwoPi = 2.0 * std::numbers::pi;
-constexpr double kTicksPerTurn = 4096.0;
-// X-series units: velocity 0.229 rev/min, acceleration 214.577 rev/min^2.
-constexpr double kVelocityUnit = 0.229 * kTwoPi / 60.0;          // rad/s
-constexpr double kAccelerationUnit = 214.577 * kTwoPi / 3600.0;  // rad/s^2
+namespace table = dxl::table;
 
-// The X-series control table entries the driver uses (ROBOTIS e-manual, XM430-W350).
-constexpr uint16_t kOperatingMode = 11;         // 1 byte, EEPROM: 3 = position control
-constexpr uint16_t kMaxPositionLimit = 48;      // 4 bytes, EEPROM
-constexpr uint16_t kMinPositionLimit = 52;      // 4 bytes, EEPROM
-constexpr uint16_t kTorqueEnable = 64;          // 1 byte
-constexpr uint16_t kHardwareErrorStatus = 70;   // 1 byte
-constexpr uint16_t kProfileAcceleration = 108;  // 4 bytes
-constexpr uint16_t kProfileVelocity = 112;      // 4 bytes
-constexpr uint16_t kGoalPosition = 116;         // 4 bytes
-constexpr uint16_t kPresentVelocity = 128;      // 4 bytes, followed by
-                                                // PresentPosition at 132 (4 bytes)
-
-std::vector<uint8_t> Le32(int32_t value) {
-  const auto u = static_cast<uint32_t>(value);
-  return {static_cast<uint8_t>(u), static_cast<uint8_t>(u >> 8), static_cast<uint8_t>(u >> 16),
-          static_cast<uint8_t>(u >> 24)};
-}
-
+// Bytes of a signed 32-bit item, and back (the control table is little-endian).
+std::vector<uint8_t> Le32(int32_t value) { return dxl::LEBytes(static_cast<uint32_t>(value), 4); }
 int32_t FromLe32(const std::vector<uint8_t>& data, std::size_t at) {
-  const uint32_t u =
-      static_cast<uint32_t>(data.at(at)) | static_cast<uint32_t>(data.at(at + 1)) << 8 |
-      static_cast<uint32_t>(data.at(at + 2)) << 16 | static_cast<uint32_t>(data.at(at + 3)) << 24;
-  return static_cast<int32_t>(u);
-}
-
-// Names the set bits of a Hardware Error Status.
-std::string HardwareErrors(uint8_t bits) {
-  static const std::pair<uint8_t, const char*> kBits[] = {{0x01, "input voltage error"},
-                                                          {0x04, "overheating"},
-                                                          {0x08, "motor encoder error"},
-                                                          {0x10, "electrical shock"},
-                                                          {0x20, "overload"}};
-  std::string text;
-  for (const auto& [bit, name] : kBits) {
-    if (bits & bit) text += (text.empty() ? "" : ", ") + std::string(name);
-  }
-  return text.empty() ? fmt::format("hardware error 0x{:02x}", bits) : text;
+  SACCADE_ASSERT(data.size() >= at + 4, "a status packet shorter than the item it answers");
+  return dxl::SignExtend(dxl::GetLE(data.data() + at, 4), 4);
 }
 
 class DynamixelHead final : public HeadDriver {
@@ -88,9 +51,11 @@ class DynamixelHead final : public HeadDriver {
         throw HardwareError(
             port_, fmt::format("{} does not answer a ping: {}", Servo(joint), error.what()));
       }
-      const uint8_t errors = bus_.Read(Id(joint), kHardwareErrorStatus, 1).data.at(0);
+      const uint8_t errors =
+          bus_.Read(Id(joint), table::kHardwareErrorStatus.address, 1).data.at(0);
       if (errors != 0) {
-        faults += (faults.empty() ? "" : "; ") + Servo(joint) + ": " + HardwareErrors(errors);
+        faults +=
+            (faults.empty() ? "" : "; ") + Servo(joint) + ": " + dxl::HardwareErrorNames(errors);
       }
     }
     Setup();
@@ -110,7 +75,8 @@ class DynamixelHead final : public HeadDriver {
   }
 
   Measurement DoRead() override {
-    const auto replies = bus_.SyncRead(kPresentVelocity, 8, ids_);
+    // Present Velocity and Present Position, 8 bytes from 128, of every servo in one packet.
+    const auto replies = bus_.SyncRead(table::kPresentVelocity.address, 8, ids_);
     Measurement m;
     m.torque = torque_;
     std::string faults;
@@ -119,13 +85,16 @@ class DynamixelHead final : public HeadDriver {
       if (it == replies.end()) {
         throw HardwareError(port_, Servo(joint) + ": no status in the sync read");
       }
-      const ServoMappingRef servo = servos_[static_cast<int>(joint)];
-      const double servo_velocity = FromLe32(it->second.data, 0) * kVelocityUnit;
+      const head::ServoMapping& servo = servos_[static_cast<int>(joint)];
+      const double servo_velocity =
+          dxl::VelocityUnitsToRadiansPerSecond(FromLe32(it->second.data, 0));
       m.velocities[joint] = servo_velocity / (servo.direction * servo.gear_ratio);
       m.positions[joint] = TicksToJoint(servo, FromLe32(it->second.data, 4));
       if (it->second.alert()) {
-        const uint8_t errors = bus_.Read(Id(joint), kHardwareErrorStatus, 1).data.at(0);
-        faults += (faults.empty() ? "" : "; ") + Servo(joint) + ": " + HardwareErrors(errors);
+        const uint8_t errors =
+            bus_.Read(Id(joint), table::kHardwareErrorStatus.address, 1).data.at(0);
+        faults +=
+            (faults.empty() ? "" : "; ") + Servo(joint) + ": " + dxl::HardwareErrorNames(errors);
       }
     }
     if (!faults.empty()) m.fault = faults + " (the servo turned its torque off)";
@@ -134,7 +103,7 @@ class DynamixelHead final : public HeadDriver {
 
   void DoTorque(bool on) override {
     // One write per servo: each is answered (a lost Sync Write would go unnoticed).
-    for (const uint8_t id : ids_) bus_.Write(id, kTorqueEnable, {static_cast<uint8_t>(on ? 1 : 0)});
+    for (const uint8_t id : ids_) bus_.WriteItem(id, table::kTorqueEnable, on ? 1 : 0);
     torque_ = on;
   }
 
@@ -144,9 +113,10 @@ class DynamixelHead final : public HeadDriver {
     head::JointState hold;
     for (const head::Joint joint : head::kAllJoints) {
       try {
-        const int32_t ticks = FromLe32(bus_.Read(Id(joint), kPresentVelocity + 4, 4).data, 0);
+        const int32_t ticks =
+            static_cast<int32_t>(bus_.ReadItem(Id(joint), table::kPresentPosition, true));
         hold[joint] = TicksToJoint(servos_[static_cast<int>(joint)], ticks);
-        if (torque_) bus_.Write(Id(joint), kGoalPosition, Le32(ticks));
+        if (torque_) bus_.WriteItem(Id(joint), table::kGoalPosition, ticks);
       } catch (const Error&) {
         // A servo that does not answer cannot be held; the fault names it.
       }
@@ -156,7 +126,8 @@ class DynamixelHead final : public HeadDriver {
 
   void DoClearFault() override {
     for (const head::Joint joint : head::kAllJoints) {
-      const uint8_t errors = bus_.Read(Id(joint), kHardwareErrorStatus, 1).data.at(0);
+      const uint8_t errors =
+          bus_.Read(Id(joint), table::kHardwareErrorStatus.address, 1).data.at(0);
       if (errors == 0) continue;
       bus_.Reboot(Id(joint));
       // A rebooted servo answers again after its boot (about 0.5 s on real X-series).
@@ -170,10 +141,10 @@ class DynamixelHead final : public HeadDriver {
           std::this_thread::sleep_for(std::chrono::milliseconds(20));
         }
       }
-      const uint8_t after = bus_.Read(Id(joint), kHardwareErrorStatus, 1).data.at(0);
+      const uint8_t after = bus_.Read(Id(joint), table::kHardwareErrorStatus.address, 1).data.at(0);
       if (after != 0) {
-        throw HardwareError(
-            port_, Servo(joint) + " still reports " + HardwareErrors(after) + " after a reboot");
+        throw HardwareError(port_, Servo(joint) + " still reports " +
+                                       dxl::HardwareErrorNames(after) + " after a reboot");
       }
     }
     Setup();  // a reboot restores the RAM area: profile velocity and acceleration
@@ -181,8 +152,6 @@ class DynamixelHead final : public HeadDriver {
   }
 
  private:
-  using ServoMappingRef = const head::ServoMapping&;
-
   uint8_t Id(head::Joint joint) const {
     return static_cast<uint8_t>(servos_[static_cast<int>(joint)].id);
   }
@@ -205,17 +174,19 @@ class DynamixelHead final : public HeadDriver {
                                                "zero_offset and gear_ratio",
                                                Servo(joint), a, b));
       }
-      bus_.Write(Id(joint), kOperatingMode, {3});
-      bus_.Write(Id(joint), kMinPositionLimit, Le32(a));
-      bus_.Write(Id(joint), kMaxPositionLimit, Le32(b));
+      bus_.WriteItem(Id(joint), table::kOperatingMode, 3);  // position control
+      bus_.WriteItem(Id(joint), table::kMinPositionLimit, a);
+      bus_.WriteItem(Id(joint), table::kMaxPositionLimit, b);
       const double servo_velocity = limits.max_velocity * servo.gear_ratio;
       const double servo_acceleration = limits.max_acceleration * servo.gear_ratio;
-      // Round down: never faster than the description.
-      bus_.Write(Id(joint), kProfileVelocity,
-                 Le32(std::max<int32_t>(1, static_cast<int32_t>(servo_velocity / kVelocityUnit))));
-      bus_.Write(
-          Id(joint), kProfileAcceleration,
-          Le32(std::max<int32_t>(1, static_cast<int32_t>(servo_acceleration / kAccelerationUnit))));
+      // Round down (and at least 1: 0 means no limit): never faster than the description.
+      const double velocity_unit = dxl::VelocityUnitsToRadiansPerSecond(1.0);
+      const double acceleration_unit = dxl::AccelerationUnitsToRadiansPerSecond2(1.0);
+      bus_.WriteItem(Id(joint), table::kProfileVelocity,
+                     std::max<int64_t>(1, static_cast<int64_t>(servo_velocity / velocity_unit)));
+      bus_.WriteItem(
+          Id(joint), table::kProfileAcceleration,
+          std::max<int64_t>(1, static_cast<int64_t>(servo_acceleration / acceleration_unit)));
     }
   }
 
@@ -225,7 +196,7 @@ class DynamixelHead final : public HeadDriver {
       data.push_back(
           {Id(joint), Le32(JointToTicks(servos_[static_cast<int>(joint)], positions[joint]))});
     }
-    bus_.SyncWrite(kGoalPosition, 4, data);
+    bus_.SyncWrite(table::kGoalPosition.address, 4, data);
   }
 
   std::string port_;
@@ -238,11 +209,11 @@ class DynamixelHead final : public HeadDriver {
 }  // namespace
 
 int32_t JointToTicks(const head::ServoMapping& servo, double joint_angle) {
-  return static_cast<int32_t>(std::lround(servo.ServoAngle(joint_angle) / kTwoPi * kTicksPerTurn));
+  return dxl::RadiansToTicks(servo.ServoAngle(joint_angle));
 }
 
 double TicksToJoint(const head::ServoMapping& servo, int32_t ticks) {
-  return servo.JointAngle(ticks * kTwoPi / kTicksPerTurn);
+  return servo.JointAngle(dxl::TicksToRadians(ticks));
 }
 
 std::unique_ptr<HeadDriver> OpenDynamixelHead(const head::HeadDescription& description,
