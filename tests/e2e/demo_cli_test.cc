@@ -117,10 +117,19 @@ TEST(DemoCli, AFailingComponentIsNamedAndTheRecordingIsKept) {
   yaml << demo.rdbuf()
        << "  - {name: fault, type: debug.fault, params: {at_step: 5, message: 'the motor "
           "driver went away'}}\n";
-  std::ofstream(dir / "faulty.yaml") << yaml.str();
+  // The copy lives in another folder: its hardware file, by its absolute path.
+  std::string text = yaml.str();
+  const std::string line = "hardware: hardware/simulator.yaml";
+  ASSERT_NE(text.find(line), std::string::npos);
+  text.replace(text.find(line), line.size(),
+               "hardware: " + kSource + "/pipelines/hardware/simulator.yaml");
+  std::ofstream(dir / "faulty.yaml") << text;
   const fs::path out = dir / "record";
-  const CommandRun run = Saccade("demo --pipeline " + (dir / "faulty.yaml").string() + " --scene " +
-                                 kTwoPictures + " --duration 4 --record " + out.string());
+  // The copy is in another folder: its `hardware:` line is given on the command line.
+  const CommandRun run =
+      Saccade("demo --pipeline " + (dir / "faulty.yaml").string() + " --hardware " + kSource +
+              "/pipelines/hardware/simulator.yaml" + " --scene " + kTwoPictures +
+              " --duration 4 --record " + out.string());
   EXPECT_EQ(run.status, 1) << run.output;
   EXPECT_THAT(run.output,
               HasSubstr("component 'fault' failed at step 5: the motor driver went away"));

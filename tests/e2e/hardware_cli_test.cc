@@ -30,6 +30,10 @@ using ::testing::HasSubstr;
 
 const std::string kSource = SACCADE_SOURCE_DIR;
 const std::string kTwoPictures = kSource + "/scenes/astronaut_and_cat.yaml";
+// Three faces to fixate in turn: the loop runs its whole --duration (about 10 s of wall time
+// per simulated second on llvmpipe), long enough for a fault timed in wall seconds from the
+// emulator's start to strike mid-run whatever the machine's load at start-up.
+const std::string kPortraits = kSource + "/scenes/portraits.yaml";
 
 fs::path TempDir(const std::string& name) {
   const fs::path dir =
@@ -81,19 +85,20 @@ class Emulator {
   std::string first_line_;
 };
 
-// A hardware file: simulated cameras on the two-picture scene, the head on the bus at `port`.
-fs::path ServoHardware(const fs::path& dir, const fs::path& port, bool mirror) {
+// A hardware file: simulated cameras on `scene`, the head on the bus at `port`.
+fs::path ServoHardware(const fs::path& dir, const fs::path& port, bool mirror,
+                       const std::string& scene = kTwoPictures) {
   const fs::path file = dir / "servos.yaml";
   std::ofstream(file) << "components:\n"
                          "  cameras:\n"
                          "    type: sim.cameras\n"
                          "    params: {scene: "
-                      << kTwoPictures
+                      << scene
                       << "}\n"
                          "  head:\n"
                          "    type: hw.head\n"
                          "    params: {scene: "
-                      << kTwoPictures << ", driver: dynamixel, port: " << port.string()
+                      << scene << ", driver: dynamixel, port: " << port.string()
                       << ", watchdog_s: 1.0, mirror: " << (mirror ? "true" : "false") << "}\n";
   return file;
 }
@@ -154,9 +159,9 @@ TEST(HardwareCli, InMirrorModeTheServosFollowTheVirtualHead) {
 
 TEST(HardwareCli, AServoOverloadIsReportedAndTheLoopGoesOnWithTheHeadHeld) {
   const fs::path dir = TempDir("overload");
-  Emulator emulator(dir / "bus", {"--overload", "2@1.5"});
+  Emulator emulator(dir / "bus", {"--overload", "2@12"});
   const CommandRun run =
-      Saccade("demo --hardware " + ServoHardware(dir, dir / "bus", false).string() +
+      Saccade("demo --hardware " + ServoHardware(dir, dir / "bus", false, kPortraits).string() +
               " --duration 4 --record " + (dir / "rec").string());
   EXPECT_NE(run.status, 1) << "the fault stopped the loop:\n" << run.output;
   EXPECT_THAT(run.output, HasSubstr("FAULT: servo 2 (tilt): overload"));
@@ -169,9 +174,9 @@ TEST(HardwareCli, AServoOverloadIsReportedAndTheLoopGoesOnWithTheHeadHeld) {
 
 TEST(HardwareCli, AServoThatStopsAnsweringIsReported) {
   const fs::path dir = TempDir("silent");
-  Emulator emulator(dir / "bus", {"--silent", "3@1.5"});
+  Emulator emulator(dir / "bus", {"--silent", "3@12"});
   const CommandRun run =
-      Saccade("demo --hardware " + ServoHardware(dir, dir / "bus", false).string() +
+      Saccade("demo --hardware " + ServoHardware(dir, dir / "bus", false, kPortraits).string() +
               " --duration 4 --record " + (dir / "rec").string());
   EXPECT_NE(run.status, 1) << run.output;
   const json s = Summary(dir / "rec");
