@@ -2,6 +2,8 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <thread>
@@ -108,13 +110,21 @@ class DynamixelHead final : public HeadDriver {
   }
 
   head::JointState DoHold() override {
-    // Goal := present position, for every servo that still answers (one answered write each:
-    // a lost Sync Write would go unnoticed).
+    // Goal := where the servo stops when it brakes now at its profile acceleration (its
+    // present position when at rest; a goal at the present position of a moving servo would
+    // make it overshoot and come back). One answered write per servo that still answers: a
+    // lost Sync Write would go unnoticed.
     head::JointState hold;
     for (const head::Joint joint : head::kAllJoints) {
       try {
-        const int32_t ticks =
-            static_cast<int32_t>(bus_.ReadItem(Id(joint), table::kPresentPosition, true));
+        const std::vector<uint8_t> state =
+            bus_.Read(Id(joint), table::kPresentVelocity.address, 8).data;  // velocity, position
+        const double v = dxl::VelocityUnitsToRadiansPerSecond(FromLe32(state, 0));  // servo rad/s
+        const double a = profile_acceleration_[static_cast<int>(joint)];            // rad/s^2
+        const double braking_rad = v * std::abs(v) / (2.0 * a);
+        int32_t ticks = FromLe32(state, 4) + dxl::RadiansToTicks(braking_rad);
+        ticks = std::clamp(ticks, tick_limits_[static_cast<int>(joint)].first,
+                           tick_limits_[static_cast<int>(joint)].second);
         hold[joint] = TicksToJoint(servos_[static_cast<int>(joint)], ticks);
         if (torque_) bus_.WriteItem(Id(joint), table::kGoalPosition, ticks);
       } catch (const Error&) {
@@ -177,6 +187,7 @@ class DynamixelHead final : public HeadDriver {
       bus_.WriteItem(Id(joint), table::kOperatingMode, 3);  // position control
       bus_.WriteItem(Id(joint), table::kMinPositionLimit, a);
       bus_.WriteItem(Id(joint), table::kMaxPositionLimit, b);
+      tick_limits_[static_cast<int>(joint)] = {a, b};
       const double servo_velocity = limits.max_velocity * servo.gear_ratio;
       const double servo_acceleration = limits.max_acceleration * servo.gear_ratio;
       // Round down (and at least 1: 0 means no limit): never faster than the description.
@@ -184,9 +195,11 @@ class DynamixelHead final : public HeadDriver {
       const double acceleration_unit = dxl::AccelerationUnitsToRadiansPerSecond2(1.0);
       bus_.WriteItem(Id(joint), table::kProfileVelocity,
                      std::max<int64_t>(1, static_cast<int64_t>(servo_velocity / velocity_unit)));
-      bus_.WriteItem(
-          Id(joint), table::kProfileAcceleration,
-          std::max<int64_t>(1, static_cast<int64_t>(servo_acceleration / acceleration_unit)));
+      const int64_t acceleration_units =
+          std::max<int64_t>(1, static_cast<int64_t>(servo_acceleration / acceleration_unit));
+      bus_.WriteItem(Id(joint), table::kProfileAcceleration, acceleration_units);
+      profile_acceleration_[static_cast<int>(joint)] =
+          dxl::AccelerationUnitsToRadiansPerSecond2(static_cast<double>(acceleration_units));
     }
   }
 
@@ -204,6 +217,8 @@ class DynamixelHead final : public HeadDriver {
   std::array<head::ServoMapping, 4> servos_;
   std::vector<uint8_t> ids_;
   bool torque_ = false;
+  std::array<std::pair<int32_t, int32_t>, 4> tick_limits_{};  // the servos' position limits
+  std::array<double, 4> profile_acceleration_{};              // servo rad/s^2, as programmed
 };
 
 }  // namespace

@@ -137,12 +137,15 @@ TEST_F(DynamixelHeadTest, NonFiniteCommandsSendNothing) {
 TEST_F(DynamixelHeadTest, WatchdogHoldsTheServosWhenCommandsStop) {
   Open({.watchdog_s = 0.05});
   driver_->Command(Joints(90, 0, 0, 0));  // 0.4 s of motion
-  const HeadStatus held =
-      ReadUntil(driver_.operator*(), [](const HeadStatus& s) { return s.holding && !s.moving; });
+  // Held: the goal is where the servo stops braking, short of 90 deg, and it settles there.
+  const HeadStatus held = ReadUntil(driver_.operator*(), [](const HeadStatus& s) {
+    return s.holding && !s.moving && std::abs(s.positions.pan - s.targets.pan) < 2 * kTick * kDeg;
+  });
   ASSERT_TRUE(held.holding);
   EXPECT_EQ(held.watchdog_trips, 1);
+  EXPECT_NEAR(held.positions.pan, held.targets.pan, 2 * kTick * kDeg);
   const ServoSnapshot pan = emulator_->Snapshot(1);
-  EXPECT_LT(pan.goal, 2048 + 1024 - 50) << "the goal was pulled back to where the servo was";
+  EXPECT_LT(pan.goal, 2048 + 1024 - 50) << "the goal was pulled back from 90 deg";
   EXPECT_NEAR(pan.position, pan.goal, 2);
   EXPECT_LT(held.positions.pan, 85 * kDeg);
 }
