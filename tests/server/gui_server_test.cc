@@ -1,0 +1,844 @@
+// The GUI server (issue 6, docs/gui-protocol.md): static files and documents over HTTP, the
+// token, the WebSocket hello, command validation and replies, and the per-client bounds that
+// keep a slow client from slowing the publisher or growing without limit. Real sockets on
+// ephemeral ports, real files in temporary folders; clients are Beast's, driven with timeouts.
+
+#include "saccade/server/gui_server.h"
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <boost/asio.hpp>
+#include <boost/beast/core.hpp>
+#include <boost/beast/http.hpp>
+#include <boost/beast/websocket.hpp>
+#include <chrono>
+#include <cstdint>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+#include <thread>
+#include <vector>
+
+namespace saccade::server {
+namespace {
+
+namespace asio = boost::asio;
+namespace beast = boost::beast;
+namespace http = beast::http;
+namespace websocket = beast::websocket;
+namespace fs = std::filesystem;
+using tcp = asio::ip::tcp;
+using nlohmann::json;
+
+// Waits only for events to happen, never to bound how long they take.
+constexpr auto kWait = std::chrono::seconds(10);
+
+std::string Str(beast::string_view v) { return std::string(v.data(), v.size()); }
+
+// Runs `ioc` until `done` or kWait; false on timeout.
+bool RunUntil(asio::io_context& ioc, const bool& done) {
+  ioc.restart();
+  const auto deadline = std::chrono::steady_clock::now() + kWait;
+  while (!done && std::chrono::steady_clock::now() < deadline) {
+    ioc.run_one_for(std::chrono::milliseconds(100));
+    if (ioc.stopped()) ioc.restart();
+  }
+  return done;
+}
+
+// A folder tree with real files, removed at the end.
+class TempTree {
+ public:
+  TempTree() {
+    static std::atomic<int> counter{0};
+    root_ = fs::temp_directory_path() /
+            ("saccade_gui_test_" + std::to_string(::getpid()) + "_" + std::to_string(counter++));
+    fs::create_directories(root_);
+  }
+  ~TempTree() {
+    std::error_code ec;
+    fs::remove_all(root_, ec);
+  }
+  fs::path Write(const std::string& relative, const std::string& bytes) const {
+    const fs::path path = root_ / relative;
+    fs::create_directories(path.parent_path());
+    std::ofstream(path, std::ios::binary) << bytes;
+    return path;
+  }
+  fs::path path(const std::string& relative = "") const { return root_ / relative; }
+
+ private:
+  fs::path root_;
+};
+
+struct HttpResult {
+  int status = 0;
+  std::string body;
+  std::string content_type;
+  std::string cache_control;
+  std::string content_length;
+};
+
+// One keep-alive HTTP connection.
+class HttpClient {
+ public:
+  explicit HttpClient(uint16_t port) : stream_(ioc_) {
+    stream_.connect(tcp::endpoint(asio::ip::make_address("127.0.0.1"), port));
+  }
+
+  std::optional<HttpResult> Request(http::verb method, const std::string& target,
+                                    const std::map<http::field, std::string>& headers = {}) {
+    http::request<http::string_body> req{method, target, 11};
+    req.set(http::field::host, "127.0.0.1");
+    for (const auto& [field, value] : headers) req.set(field, value);
+    req.prepare_payload();
+    http::write(stream_, req);
+    http::response_parser<http::string_body> parser;
+    parser.body_limit(64 * 1024 * 1024);
+    if (method == http::verb::head) parser.skip(true);
+    bool done = false;
+    beast::error_code ec;
+    http::async_read(stream_, buffer_, parser, [&](beast::error_code e, std::size_t) {
+      ec = e;
+      done = true;
+    });
+    if (!RunUntil(ioc_, done) || ec) return std::nullopt;
+    const auto& res = parser.get();
+    HttpResult out;
+    out.status = res.result_int();
+    out.body = res.body();
+    if (res.count(http::field::content_type))
+      out.content_type = Str(res[http::field::content_type]);
+    if (res.count(http::field::cache_control)) {
+      out.cache_control = Str(res[http::field::cache_control]);
+    }
+    if (res.count(http::field::content_length)) {
+      out.content_length = Str(res[http::field::content_length]);
+    }
+    return out;
+  }
+
+  HttpResult Get(const std::string& target,
+                 const std::map<http::field, std::string>& headers = {}) {
+    auto result = Request(http::verb::get, target, headers);
+    EXPECT_TRUE(result.has_value()) << "no answer to GET " << target;
+    return result.value_or(HttpResult{});
+  }
+
+ private:
+  asio::io_context ioc_;
+  beast::tcp_stream stream_;
+  beast::flat_buffer buffer_;
+};
+
+HttpResult Get(uint16_t port, const std::string& target,
+               const std::map<http::field, std::string>& headers = {}) {
+  HttpClient client(port);
+  return client.Get(target, headers);
+}
+
+struct Message {
+  bool text = true;
+  std::string data;
+};
+
+// A WebSocket client.
+class WsClient {
+ public:
+  WsClient() : ws_(ioc_) {}
+
+  // The handshake's HTTP status: 101 when it succeeded.
+  int Connect(uint16_t port, const std::string& target = "/ws", const std::string& bearer = "") {
+    beast::get_lowest_layer(ws_).connect(tcp::endpoint(asio::ip::make_address("127.0.0.1"), port));
+    if (!bearer.empty()) {
+      ws_.set_option(websocket::stream_base::decorator([bearer](websocket::request_type& req) {
+        req.set(http::field::authorization, "Bearer " + bearer);
+      }));
+    }
+    ws_.read_message_max(64 * 1024 * 1024);
+    websocket::response_type res;
+    bool done = false;
+    ws_.async_handshake(res, "127.0.0.1", target, [&](beast::error_code, ...) { done = true; });
+    if (!RunUntil(ioc_, done)) return -1;
+    return res.result_int();
+  }
+
+  std::optional<Message> Read() {
+    beast::flat_buffer buffer;
+    bool done = false;
+    beast::error_code ec;
+    ws_.async_read(buffer, [&](beast::error_code e, std::size_t) {
+      ec = e;
+      done = true;
+    });
+    if (!RunUntil(ioc_, done)) {
+      beast::get_lowest_layer(ws_).close();
+      ioc_.restart();
+      ioc_.run();
+      return std::nullopt;
+    }
+    if (ec) {
+      last_error_ = ec;
+      return std::nullopt;
+    }
+    return Message{ws_.got_text(), beast::buffers_to_string(buffer.data())};
+  }
+
+  // The next text message of `type` (others skipped); null on timeout or close.
+  json ReadType(const std::string& type) {
+    for (;;) {
+      const auto message = Read();
+      if (!message) return nullptr;
+      if (!message->text) continue;
+      json parsed = json::parse(message->data);
+      if (parsed.value("type", "") == type) return parsed;
+    }
+  }
+
+  // The next reply or error.
+  json ReadAnswer() {
+    for (;;) {
+      const auto message = Read();
+      if (!message) return nullptr;
+      if (!message->text) continue;
+      json parsed = json::parse(message->data);
+      const std::string type = parsed.value("type", "");
+      if (type == "reply" || type == "error") return parsed;
+    }
+  }
+
+  void Send(const std::string& text, bool binary = false) {
+    ws_.binary(binary);
+    ws_.write(asio::buffer(text));
+  }
+  void SendJson(const json& command) { Send(command.dump()); }
+
+  beast::error_code last_error() const { return last_error_; }
+  websocket::close_reason close_reason() const { return ws_.reason(); }
+
+ private:
+  asio::io_context ioc_;
+  websocket::stream<beast::tcp_stream> ws_;
+  beast::error_code last_error_;
+};
+
+ServerOptions LocalOptions() {
+  ServerOptions options;
+  options.port = 0;
+  return options;
+}
+
+// A server with a command handler that echoes and a few commands that fail.
+class ServerTest : public ::testing::Test {
+ protected:
+  void SetUp() override { Make(LocalOptions()); }
+
+  void Make(ServerOptions options) {
+    server_.reset();
+    server_ = std::make_unique<GuiServer>(std::move(options));
+    server_->SetCommandHandler([this](const json& command, int64_t client) -> json {
+      ++handled_;
+      const std::string type = command.at("type");
+      if (type == "refuse") throw CommandError("joints: pan 2.50 rad is outside its limits");
+      if (type == "crash") throw std::runtime_error("out of cheese");
+      return json{{"echo", type}, {"client", client}};
+    });
+    server_->Start();
+  }
+
+  std::unique_ptr<WsClient> Connect() {
+    auto client = std::make_unique<WsClient>();
+    EXPECT_EQ(client->Connect(server_->port()), 101);
+    EXPECT_EQ(client->ReadType("hello").value("type", ""), "hello");
+    return client;
+  }
+
+  std::unique_ptr<GuiServer> server_;
+  std::atomic<int> handled_{0};
+};
+
+// ------------------------------------------------------------------------------------------
+// HTTP
+// ------------------------------------------------------------------------------------------
+
+class StaticFilesTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    tree_.Write("web/index.html", "<!doctype html><title>saccade</title>");
+    tree_.Write("web/app/main.js", "console.log('hi');");
+    tree_.Write("web/app/style.css", "body{}");
+    png_ = std::string("\x89PNG\r\n\x1a\n\0\0\0\rIHDR", 16);
+    tree_.Write("web/img/eye.png", png_);
+    tree_.Write("web/data.xyz", "raw");
+    tree_.Write("web/vendor/three/three.module.js", "wrong folder");
+    tree_.Write("three/three.module.js", "export const REVISION = '160';");
+    tree_.Write("outside/secret.txt", "secret");
+    fs::create_symlink(tree_.path("outside/secret.txt"), tree_.path("web/link.txt"));
+    fs::create_symlink("app/main.js", tree_.path("web/inside_link.js"));
+    ServerOptions options = LocalOptions();
+    options.mounts = {{"/", tree_.path("web").string()},
+                      {"/vendor/three/", tree_.path("three").string()}};
+    server_ = std::make_unique<GuiServer>(options);
+    server_->Start();
+  }
+
+  TempTree tree_;
+  std::string png_;
+  std::unique_ptr<GuiServer> server_;
+};
+
+TEST_F(StaticFilesTest, ServesFileBytesWithContentType) {
+  const HttpResult js = Get(server_->port(), "/app/main.js");
+  EXPECT_EQ(js.status, 200);
+  EXPECT_EQ(js.body, "console.log('hi');");
+  EXPECT_EQ(js.content_type.rfind("text/javascript", 0), 0u) << js.content_type;
+
+  const HttpResult png = Get(server_->port(), "/img/eye.png");
+  EXPECT_EQ(png.status, 200);
+  EXPECT_EQ(png.body, png_);
+  EXPECT_EQ(png.content_type, "image/png");
+
+  EXPECT_EQ(Get(server_->port(), "/app/style.css").content_type.rfind("text/css", 0), 0u);
+  EXPECT_EQ(Get(server_->port(), "/data.xyz").content_type, "application/octet-stream");
+}
+
+TEST_F(StaticFilesTest, RootServesIndexHtml) {
+  const HttpResult root = Get(server_->port(), "/");
+  EXPECT_EQ(root.status, 200);
+  EXPECT_EQ(root.body, "<!doctype html><title>saccade</title>");
+  EXPECT_EQ(root.content_type.rfind("text/html", 0), 0u);
+  EXPECT_EQ(Get(server_->port(), "/?token=ignored").body, root.body);
+}
+
+TEST_F(StaticFilesTest, LongestPrefixMountServes) {
+  const HttpResult three = Get(server_->port(), "/vendor/three/three.module.js");
+  EXPECT_EQ(three.status, 200);
+  EXPECT_EQ(three.body, "export const REVISION = '160';");
+}
+
+TEST_F(StaticFilesTest, PercentEncodedPathIsDecoded) {
+  EXPECT_EQ(Get(server_->port(), "/app/%6Dain.js?v=3").body, "console.log('hi');");
+}
+
+TEST_F(StaticFilesTest, MissingFileIs404) {
+  EXPECT_EQ(Get(server_->port(), "/nope.js").status, 404);
+  EXPECT_EQ(Get(server_->port(), "/app/").status, 404);  // no index.html there
+}
+
+TEST_F(StaticFilesTest, PathsLeavingTheMountAre404) {
+  // The targets exist outside the mount: 404 means refused, not missing.
+  EXPECT_EQ(Get(server_->port(), "/../outside/secret.txt").status, 404);
+  EXPECT_EQ(Get(server_->port(), "/%2e%2e/outside/secret.txt").status, 404);
+  EXPECT_EQ(Get(server_->port(), "/app/..%2F..%2Foutside/secret.txt").status, 404);
+  EXPECT_EQ(Get(server_->port(), "/vendor/three/../../outside/secret.txt").status, 404);
+  const HttpResult link = Get(server_->port(), "/link.txt");
+  EXPECT_EQ(link.status, 404);
+  EXPECT_EQ(link.body.find("secret"), std::string::npos);
+  // A symlink that stays inside is fine.
+  EXPECT_EQ(Get(server_->port(), "/inside_link.js").body, "console.log('hi');");
+}
+
+TEST_F(StaticFilesTest, OnlyGetAndHeadAreServed) {
+  HttpClient client(server_->port());
+  const auto post = client.Request(http::verb::post, "/index.html");
+  ASSERT_TRUE(post.has_value());
+  EXPECT_EQ(post->status, 405);
+  const auto head = client.Request(http::verb::head, "/index.html");
+  ASSERT_TRUE(head.has_value());
+  EXPECT_EQ(head->status, 200);
+  EXPECT_EQ(head->content_length, "37");
+  EXPECT_TRUE(head->body.empty());
+}
+
+TEST_F(StaticFilesTest, KeepAliveServesSeveralRequestsOnOneConnection) {
+  HttpClient client(server_->port());
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_EQ(client.Get("/app/main.js").body, "console.log('hi');");
+  }
+}
+
+TEST(GuiServerHttpTest, DocumentsAreServedExactlyWithTheirType) {
+  GuiServer server(LocalOptions());
+  const std::string binary("\x01\x00\x02\xff", 4);
+  server.SetDocument("/api/scene", "application/json", R"({"name":"portraits.yaml"})");
+  server.SetDocument("/api/models/0.bin", "application/octet-stream", binary);
+  server.Start();
+  const HttpResult scene = Get(server.port(), "/api/scene");
+  EXPECT_EQ(scene.status, 200);
+  EXPECT_EQ(scene.body, R"({"name":"portraits.yaml"})");
+  EXPECT_EQ(scene.content_type, "application/json");
+  EXPECT_EQ(scene.cache_control, "no-store");
+  EXPECT_EQ(Get(server.port(), "/api/models/0.bin").body, binary);
+  EXPECT_EQ(Get(server.port(), "/api/models/1.bin").status, 404);
+  server.SetDocument("/api/scene", "application/json", "{}");
+  EXPECT_EQ(Get(server.port(), "/api/scene").body, "{}");
+}
+
+TEST(GuiServerHttpTest, StatusListsClients) {
+  GuiServer server(LocalOptions());
+  server.Start();
+  WsClient client;
+  ASSERT_EQ(client.Connect(server.port()), 101);
+  ASSERT_FALSE(client.ReadType("hello").is_null());
+  const HttpResult status = Get(server.port(), "/api/status");
+  ASSERT_EQ(status.status, 200);
+  EXPECT_EQ(status.cache_control, "no-store");
+  const json body = json::parse(status.body);
+  EXPECT_EQ(body.at("protocol"), kProtocolName);
+  EXPECT_EQ(body.at("version"), kProtocolVersion);
+  ASSERT_EQ(body.at("clients").size(), 1u);
+  EXPECT_EQ(body["clients"][0]["peer"].get<std::string>().rfind("127.0.0.1:", 0), 0u);
+  EXPECT_TRUE(body["clients"][0].contains("frames_skipped"));
+}
+
+TEST(GuiServerHttpTest, WebSocketOnlyAtWs) {
+  GuiServer server(LocalOptions());
+  server.Start();
+  WsClient elsewhere;
+  EXPECT_EQ(elsewhere.Connect(server.port(), "/socket"), 404);
+  EXPECT_EQ(Get(server.port(), "/ws").status, 400);  // not an upgrade
+}
+
+// ------------------------------------------------------------------------------------------
+// Options and the token
+// ------------------------------------------------------------------------------------------
+
+TEST(GuiServerOptionsTest, NonLoopbackAddressWithoutTokenThrowsNamingTheToken) {
+  ServerOptions options = LocalOptions();
+  options.address = "0.0.0.0";
+  try {
+    GuiServer server(options);
+    FAIL() << "no exception";
+  } catch (const InvalidArgument& e) {
+    EXPECT_NE(std::string(e.what()).find("--token"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("0.0.0.0"), std::string::npos) << e.what();
+  }
+  options.token = "t";
+  EXPECT_NO_THROW(GuiServer server(options));
+}
+
+TEST(GuiServerOptionsTest, BadMountsThrowNamingTheMount) {
+  TempTree tree;
+  fs::create_directories(tree.path("web"));
+  ServerOptions options = LocalOptions();
+  options.mounts = {{"/app", tree.path("web").string()}};
+  try {
+    GuiServer server(options);
+    FAIL() << "no exception";
+  } catch (const InvalidArgument& e) {
+    EXPECT_NE(std::string(e.what()).find("'/app'"), std::string::npos) << e.what();
+  }
+  options.mounts = {{"/app/", tree.path("missing").string()}};
+  try {
+    GuiServer server(options);
+    FAIL() << "no exception";
+  } catch (const InvalidArgument& e) {
+    EXPECT_NE(std::string(e.what()).find("missing"), std::string::npos) << e.what();
+  }
+}
+
+TEST(GuiServerOptionsTest, LoopbackAddresses) {
+  EXPECT_TRUE(IsLoopbackAddress("127.0.0.1"));
+  EXPECT_TRUE(IsLoopbackAddress("127.3.2.1"));
+  EXPECT_TRUE(IsLoopbackAddress("::1"));
+  EXPECT_TRUE(IsLoopbackAddress("localhost"));
+  EXPECT_FALSE(IsLoopbackAddress("0.0.0.0"));
+  EXPECT_FALSE(IsLoopbackAddress("192.168.1.2"));
+  EXPECT_FALSE(IsLoopbackAddress("::"));
+  EXPECT_FALSE(IsLoopbackAddress("example.org"));
+}
+
+TEST(GuiServerOptionsTest, UrlNamesPortAndToken) {
+  ServerOptions options = LocalOptions();
+  GuiServer plain(options);
+  plain.Start();
+  EXPECT_EQ(plain.url(), "http://127.0.0.1:" + std::to_string(plain.port()) + "/");
+  EXPECT_NE(plain.port(), 0);
+  options.token = "s3cret";
+  GuiServer with_token(options);
+  with_token.Start();
+  EXPECT_EQ(with_token.url(),
+            "http://127.0.0.1:" + std::to_string(with_token.port()) + "/?token=s3cret");
+}
+
+TEST(GuiServerOptionsTest, StartOnAPortInUseThrowsNamingThePort) {
+  GuiServer first(LocalOptions());
+  first.Start();
+  ServerOptions options = LocalOptions();
+  options.port = first.port();
+  GuiServer second(options);
+  try {
+    second.Start();
+    FAIL() << "no exception";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find(std::to_string(first.port())), std::string::npos)
+        << e.what();
+    EXPECT_NE(std::string(e.what()).find("127.0.0.1"), std::string::npos) << e.what();
+  }
+}
+
+class TokenTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    tree_.Write("web/index.html", "page");
+    ServerOptions options = LocalOptions();
+    options.token = "s3cret";
+    options.mounts = {{"/", tree_.path("web").string()}};
+    server_ = std::make_unique<GuiServer>(options);
+    server_->SetDocument("/api/scene", "application/json", "{}");
+    server_->Start();
+  }
+  TempTree tree_;
+  std::unique_ptr<GuiServer> server_;
+};
+
+TEST_F(TokenTest, WebSocketWithoutTokenIs401) {
+  WsClient client;
+  EXPECT_EQ(client.Connect(server_->port(), "/ws"), 401);
+  WsClient wrong;
+  EXPECT_EQ(wrong.Connect(server_->port(), "/ws?token=guess"), 401);
+  EXPECT_EQ(server_->client_count(), 0);
+}
+
+TEST_F(TokenTest, WebSocketWithQueryTokenConnects) {
+  WsClient client;
+  ASSERT_EQ(client.Connect(server_->port(), "/ws?token=s3cret"), 101);
+  EXPECT_EQ(client.ReadType("hello").value("type", ""), "hello");
+}
+
+TEST_F(TokenTest, WebSocketWithBearerHeaderConnects) {
+  WsClient client;
+  ASSERT_EQ(client.Connect(server_->port(), "/ws", "s3cret"), 101);
+  EXPECT_EQ(client.ReadType("hello").value("type", ""), "hello");
+}
+
+TEST_F(TokenTest, ApiNeedsTheTokenStaticFilesDoNot) {
+  const HttpResult refused = Get(server_->port(), "/api/status");
+  EXPECT_EQ(refused.status, 401);
+  EXPECT_NE(refused.body.find("token"), std::string::npos) << refused.body;
+  EXPECT_EQ(Get(server_->port(), "/api/scene").status, 401);
+  EXPECT_EQ(Get(server_->port(), "/api/status?token=s3cret").status, 200);
+  EXPECT_EQ(
+      Get(server_->port(), "/api/scene", {{http::field::authorization, "Bearer s3cret"}}).body,
+      "{}");
+  EXPECT_EQ(
+      Get(server_->port(), "/api/scene", {{http::field::authorization, "Bearer nope"}}).status,
+      401);
+  const HttpResult page = Get(server_->port(), "/");
+  EXPECT_EQ(page.status, 200);
+  EXPECT_EQ(page.body, "page");
+}
+
+// ------------------------------------------------------------------------------------------
+// WebSocket: hello, commands, errors
+// ------------------------------------------------------------------------------------------
+
+TEST(GuiServerWsTest, HelloCarriesProtocolClientAndExtraFieldsThenWelcome) {
+  ServerOptions options = LocalOptions();
+  options.hello = {{"mode", "demo"}};
+  GuiServer server(options);
+  server.SetWelcome([] { return std::vector<std::string>{R"({"type":"state","step":7})"}; });
+  server.Start();
+  WsClient client;
+  ASSERT_EQ(client.Connect(server.port()), 101);
+  const auto first = client.Read();
+  ASSERT_TRUE(first.has_value());
+  ASSERT_TRUE(first->text);
+  const json hello = json::parse(first->data);
+  EXPECT_EQ(hello.at("type"), "hello");
+  EXPECT_EQ(hello.at("protocol"), "saccade-gui");
+  EXPECT_EQ(hello.at("version"), kProtocolVersion);
+  EXPECT_EQ(hello.at("mode"), "demo");
+  const int64_t id = hello.at("client");
+  EXPECT_GT(id, 0);
+  const auto second = client.Read();
+  ASSERT_TRUE(second.has_value());
+  EXPECT_EQ(json::parse(second->data).at("step"), 7);
+  const auto stats = server.clients();
+  ASSERT_EQ(stats.size(), 1u);
+  EXPECT_EQ(stats[0].id, id);
+}
+
+TEST_F(ServerTest, CommandReachesHandlerAndReplyCarriesIdAndFields) {
+  auto client = Connect();
+  client->SendJson(json{{"type", "ping"}, {"id", 1}});
+  const json reply = client->ReadAnswer();
+  EXPECT_EQ(reply.at("type"), "reply");
+  EXPECT_EQ(reply.at("id"), 1);
+  EXPECT_EQ(reply.at("ok"), true);
+  EXPECT_EQ(reply.at("echo"), "ping");
+  EXPECT_EQ(reply.at("client"), server_->clients().at(0).id);
+  EXPECT_EQ(handled_, 1);
+}
+
+TEST_F(ServerTest, HandlerErrorsBecomeErrorReplies) {
+  auto client = Connect();
+  client->SendJson(json{{"type", "refuse"}, {"id", 1}});
+  const json refused = client->ReadAnswer();
+  EXPECT_EQ(refused.at("type"), "error");
+  EXPECT_EQ(refused.at("id"), 1);
+  EXPECT_EQ(refused.at("error"), "joints: pan 2.50 rad is outside its limits");
+  client->SendJson(json{{"type", "crash"}, {"id", 2}});
+  const json crashed = client->ReadAnswer();
+  EXPECT_EQ(crashed.at("error"), "out of cheese");
+  client->SendJson(json{{"type", "ping"}, {"id", 3}});
+  EXPECT_EQ(client->ReadAnswer().at("type"), "reply");
+}
+
+TEST(GuiServerWsTest, WithoutHandlerEveryCommandIsAnError) {
+  GuiServer server(LocalOptions());
+  server.Start();
+  WsClient client;
+  ASSERT_EQ(client.Connect(server.port()), 101);
+  client.SendJson(json{{"type", "ping"}, {"id", 1}});
+  const json answer = client.ReadAnswer();
+  EXPECT_EQ(answer.at("type"), "error");
+  EXPECT_EQ(answer.at("id"), 1);
+  EXPECT_NE(answer.at("error").get<std::string>().find("handler"), std::string::npos);
+}
+
+struct BadMessage {
+  std::string name;
+  std::function<void(WsClient&)> send;
+  std::string expected;  // part of the error text
+};
+
+TEST_F(ServerTest, BadMessagesGetErrorRepliesAndEveryoneGoesOn) {
+  auto client = Connect();
+  auto other = Connect();
+  int64_t id = 0;
+  // Sets the connection's last id to 5 for the out-of-order case.
+  client->SendJson(json{{"type", "ping"}, {"id", 5}});
+  ASSERT_EQ(client->ReadAnswer().at("id"), 5);
+  id = 5;
+  const std::vector<BadMessage> cases = {
+      {"malformed", [](WsClient& c) { c.Send("{\"type\": \"ping\", "); }, "malformed JSON: "},
+      {"not an object", [](WsClient& c) { c.Send("[1, 2]"); }, "JSON object"},
+      {"deeply nested",
+       [](WsClient& c) { c.Send(std::string(30000, '[') + std::string(30000, ']')); },
+       "nested 30000 levels deep"},
+      {"missing type",
+       [](WsClient& c) {
+         c.SendJson(json{{"id", 100}});
+       },
+       "'type'"},
+      {"type not a string",
+       [](WsClient& c) {
+         c.SendJson(json{{"type", 3}, {"id", 100}});
+       },
+       "'type'"},
+      {"missing id",
+       [](WsClient& c) {
+         c.SendJson(json{{"type", "ping"}});
+       },
+       "'id'"},
+      {"id not an integer",
+       [](WsClient& c) {
+         c.SendJson(json{{"type", "ping"}, {"id", "7"}});
+       },
+       "'id'"},
+      {"out of order",
+       [](WsClient& c) {
+         c.SendJson(json{{"type", "ping"}, {"id", 3}});
+       },
+       "out of order: id 3 after "},
+      {"repeated id",
+       [](WsClient& c) {
+         c.SendJson(json{{"type", "ping"}, {"id", 5}});
+       },
+       "out of order: id 5 after "},
+      {"binary", [](WsClient& c) { c.Send("{}", true); }, "binary messages are not commands"},
+      {"too large", [](WsClient& c) { c.Send(std::string(100 * 1024, ' ')); },
+       "message of 102400 bytes is larger than the limit of 65536 bytes"},
+  };
+  int step = 0;
+  for (const BadMessage& bad : cases) {
+    SCOPED_TRACE(bad.name);
+    bad.send(*client);
+    const json error = client->ReadAnswer();
+    ASSERT_FALSE(error.is_null());
+    EXPECT_EQ(error.at("type"), "error");
+    EXPECT_NE(error.at("error").get<std::string>().find(bad.expected), std::string::npos)
+        << error.dump();
+    // The same connection still answers, and the other client still gets states.
+    client->SendJson(json{{"type", "ping"}, {"id", ++id}});
+    const json reply = client->ReadAnswer();
+    EXPECT_EQ(reply.value("type", ""), "reply");
+    EXPECT_EQ(reply.value("id", 0), id);
+    server_->PublishState({{"type", "state"}, {"step", ++step}});
+    EXPECT_EQ(other->ReadType("state").value("step", 0), step);
+  }
+  const auto stats = server_->clients();
+  int64_t errors = 0;
+  for (const auto& s : stats) errors += s.errors;
+  EXPECT_EQ(errors, static_cast<int64_t>(cases.size()));
+}
+
+TEST_F(ServerTest, OutOfOrderErrorCarriesTheId) {
+  auto client = Connect();
+  client->SendJson(json{{"type", "ping"}, {"id", 5}});
+  client->ReadAnswer();
+  client->SendJson(json{{"type", "ping"}, {"id", 3}});
+  const json error = client->ReadAnswer();
+  EXPECT_EQ(error.at("id"), 3);
+  EXPECT_EQ(error.at("error"), "out of order: id 3 after 5");
+}
+
+TEST_F(ServerTest, MessageBeyondTheHardBoundClosesWithTooBig) {
+  auto client = Connect();
+  auto other = Connect();
+  client->Send(std::string(64 * 1024 * 16 + 1, ' '));
+  EXPECT_FALSE(client->ReadAnswer().is_object());  // closed
+  EXPECT_EQ(client->close_reason().code, websocket::close_code::too_big);
+  server_->PublishState({{"type", "state"}, {"step", 1}});
+  EXPECT_EQ(other->ReadType("state").value("step", 0), 1);
+}
+
+// ------------------------------------------------------------------------------------------
+// Fan-out and bounds
+// ------------------------------------------------------------------------------------------
+
+TEST_F(ServerTest, ManyClientsAllReceiveTheNewestState) {
+  std::vector<std::unique_ptr<WsClient>> clients;
+  for (int i = 0; i < 20; ++i) clients.push_back(Connect());
+  EXPECT_EQ(server_->client_count(), 20);
+  for (int step = 1; step <= 50; ++step) server_->PublishState({{"type", "state"}, {"step", step}});
+  server_->Broadcast({{"type", "event"}, {"level", "info"}, {"message", "done"}});
+  // Texts go before the state, so the event may come first.
+  for (auto& client : clients) {
+    bool newest = false;
+    bool event = false;
+    while (!newest || !event) {
+      const auto message = client->Read();
+      ASSERT_TRUE(message.has_value());
+      const json parsed = json::parse(message->data);
+      if (parsed.at("type") == "state" && parsed.at("step") == 50) newest = true;
+      if (parsed.at("type") == "event" && parsed.at("message") == "done") event = true;
+    }
+  }
+}
+
+// Parses a frame message: [uint32 LE n][n bytes JSON header][payload].
+bool ParseFrame(const std::string& data, json* header, std::string* payload) {
+  if (data.size() < 4) return false;
+  const uint32_t n = static_cast<uint8_t>(data[0]) | static_cast<uint8_t>(data[1]) << 8 |
+                     static_cast<uint8_t>(data[2]) << 16 |
+                     static_cast<uint32_t>(static_cast<uint8_t>(data[3])) << 24;
+  if (data.size() < 4 + n) return false;
+  *header = json::parse(data.substr(4, n));
+  *payload = data.substr(4 + n);
+  return true;
+}
+
+TEST_F(ServerTest, SlowClientStaysBoundedWhileFastClientGetsFrames) {
+  constexpr int kCount = 300;
+  constexpr std::size_t kFrameBytes = 256 * 1024;
+  // At most a frame in flight, two pending frames, a state and a few texts.
+  constexpr std::size_t kBound = 3 * 1024 * 1024;
+
+  WsClient slow;  // connects, never reads
+  ASSERT_EQ(slow.Connect(server_->port()), 101);
+  auto fast = Connect();
+
+  std::atomic<bool> fast_ok{false};
+  std::map<std::string, int> last_frame;
+  std::string last_left_payload;
+  int frames_received = 0;
+  std::thread reader([&] {
+    while (last_frame["left"] != kCount - 1 || last_frame["right"] != kCount - 1) {
+      const auto message = fast->Read();
+      if (!message) return;
+      if (message->text) continue;
+      json header;
+      std::string payload;
+      if (!ParseFrame(message->data, &header, &payload)) return;
+      ++frames_received;
+      last_frame[header.at("camera")] = header.at("frame");
+      if (header.at("camera") == "left") last_left_payload = std::move(payload);
+    }
+    fast_ok = true;
+  });
+
+  const auto left = std::make_shared<const std::string>(kFrameBytes, 'L');
+  const auto right = std::make_shared<const std::string>(kFrameBytes, 'R');
+  std::size_t slow_max_queued = 0;
+  for (int i = 0; i < kCount; ++i) {
+    server_->PublishFrame("left", {{"type", "frame"}, {"camera", "left"}, {"frame", i}}, left);
+    server_->PublishFrame("right", {{"type", "frame"}, {"camera", "right"}, {"frame", i}}, right);
+    server_->PublishState({{"type", "state"}, {"step", i}});
+    if (i % 10 == 0) server_->Broadcast({{"type", "event"}, {"message", std::to_string(i)}});
+    for (const ClientStats& s : server_->clients()) {
+      if (s.id == 1) slow_max_queued = std::max(slow_max_queued, s.queued_bytes);
+    }
+  }
+  reader.join();
+  EXPECT_TRUE(fast_ok) << "the fast client did not get the last frame of each camera";
+  EXPECT_GT(frames_received, 0);
+  EXPECT_EQ(last_left_payload, *left);
+
+  const auto stats = server_->clients();
+  ASSERT_EQ(stats.size(), 2u);
+  const ClientStats& slow_stats = stats[0].id == 1 ? stats[0] : stats[1];
+  ASSERT_EQ(slow_stats.id, 1);
+  EXPECT_LT(slow_max_queued, kBound);
+  EXPECT_LT(slow_stats.queued_bytes, kBound);
+  EXPECT_GT(slow_stats.frames_skipped, 0);
+  EXPECT_GT(slow_stats.states_skipped, 0);
+}
+
+TEST_F(ServerTest, TextQueueDropsOldestWhenFull) {
+  ServerOptions options = LocalOptions();
+  options.max_queued_messages = 4;
+  Make(options);
+  WsClient slow;  // never reads
+  ASSERT_EQ(slow.Connect(server_->port()), 101);
+  const std::string filler(64 * 1024, 'x');
+  for (int i = 0; i < 400; ++i) {
+    server_->Broadcast({{"type", "event"}, {"message", filler}});
+  }
+  // 400 x 64 KiB is far more than the socket buffers hold.
+  const auto stats = server_->clients();
+  ASSERT_EQ(stats.size(), 1u);
+  EXPECT_GT(stats[0].messages_dropped, 0);
+  EXPECT_LT(stats[0].queued_bytes, 6u * (filler.size() + 100));
+}
+
+TEST_F(ServerTest, ClientsBeyondMaxClientsGet503) {
+  ServerOptions options = LocalOptions();
+  options.max_clients = 2;
+  Make(options);
+  auto a = Connect();
+  auto b = Connect();
+  WsClient c;
+  EXPECT_EQ(c.Connect(server_->port()), 503);
+  EXPECT_EQ(server_->client_count(), 2);
+}
+
+TEST_F(ServerTest, StopWithConnectedClientsReturnsAndIsIdempotent) {
+  auto a = Connect();
+  WsClient slow;
+  ASSERT_EQ(slow.Connect(server_->port()), 101);
+  const auto payload = std::make_shared<const std::string>(1024 * 1024, 'x');
+  for (int i = 0; i < 20; ++i) server_->PublishFrame("left", {{"frame", i}}, payload);
+  server_->Stop();
+  server_->Stop();
+  EXPECT_EQ(server_->client_count(), 0);
+  // The connection is gone: reads end.
+  std::optional<Message> message;
+  do {
+    message = a->Read();
+  } while (message.has_value());
+  EXPECT_TRUE(a->last_error());
+  // Publishing after Stop does nothing and does not block.
+  server_->PublishState({{"type", "state"}});
+  server_->Broadcast({{"type", "event"}});
+}
+
+}  // namespace
+}  // namespace saccade::server
