@@ -137,6 +137,11 @@ RunSummary RunPipeline(Pipeline& pipeline, const RunOptions& options) {
       bool stop_now = false;
       for (std::size_t i = 0; i < n; ++i) {
         Component& component = *components[i];
+        if (!component.enabled()) {
+          for (const auto& input : component.inputs()) input->MarkSeen();
+          step_own.push_back(0.0);
+          continue;
+        }
         context.seed = component.seed();
         pipeline.TakeDeliverySeconds();
         const Clock::time_point start = Clock::now();

@@ -44,6 +44,35 @@ components:
   }
 }
 
+TEST(SchedulerTest, DisabledComponentIsSkippedAndEmitsNothing) {
+  // The GUI switches perception off this way: source stops for steps 2 and 3, recorder
+  // still runs and sees no fresh value then; re-enabled, source goes on where it was.
+  Pipeline pipeline = Load(R"(clock: {mode: simulated, step: 1, steps: 6}
+components:
+  - {name: source, type: test.source, params: {start: 0}}
+  - {name: recorder, type: test.recorder, inputs: {in: source.out}}
+)");
+  Component* source = pipeline.Find<Component>("source");
+  ASSERT_NE(source, nullptr);
+  RunOptions options;
+  std::vector<double> source_seconds;
+  options.step_timing = [&](const StepContext&, const std::vector<double>& seconds, double) {
+    ASSERT_EQ(seconds.size(), 2u);
+    source_seconds.push_back(seconds[0]);
+  };
+  options.after_step = [&](const StepContext& context) {
+    source->SetEnabled(context.step < 1 || context.step >= 3);
+  };
+  RunPipeline(pipeline, options);
+  const auto& r = pipeline.Find<Recorder>("recorder")->records;
+  ASSERT_EQ(r.size(), 6u);
+  const bool fresh[] = {true, true, false, false, true, true};
+  for (int k = 0; k < 6; ++k) EXPECT_EQ(r[k].fresh, fresh[k]) << "step " << k;
+  EXPECT_EQ(r[3].value, 1.0);  // the last value it emitted before it was disabled
+  EXPECT_EQ(source_seconds[2], 0.0);
+  EXPECT_EQ(source_seconds[3], 0.0);
+}
+
 TEST(SchedulerTest, DelayedFeedbackArrivesOneStepLater) {
   // recorder runs first and reads source's output of the previous step.
   Pipeline pipeline = Load(R"(clock: {mode: simulated, step: 1, steps: 4}

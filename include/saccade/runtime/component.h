@@ -101,6 +101,12 @@ class Component {
   /// Releases resources; called once after the last Step (also after an error).
   virtual void Stop() {}
 
+  /// A disabled component is not stepped (the scheduler skips it and marks its inputs seen),
+  /// so it emits nothing: the GUI switches the perception part of a loop off this way. Set
+  /// it between steps, from the thread that runs the pipeline. Enabled by default.
+  void SetEnabled(bool enabled) { enabled_ = enabled; }
+  bool enabled() const { return enabled_; }
+
   /// nullptr when there is no such port.
   InputBase* FindInput(const std::string& name) const;
   OutputBase* FindOutput(const std::string& name) const;
@@ -168,6 +174,7 @@ class Component {
   std::string name_;
   uint64_t seed_ = 0;
   std::string base_dir_;
+  bool enabled_ = true;
   std::vector<std::unique_ptr<InputBase>> inputs_;
   std::vector<std::unique_ptr<OutputBase>> outputs_;
   std::vector<std::unique_ptr<MethodBase>> methods_;

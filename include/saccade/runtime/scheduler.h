@@ -70,7 +70,8 @@ struct RunOptions {
   /// Called after each step with its context (progress, recording); may be empty.
   std::function<void(const StepContext&)> after_step;
   /// Called after each step (before after_step) with each component's own time in that step
-  /// (seconds, in execution order; a component not stepped, after an error, is absent) and
+  /// (seconds, in execution order; a component not stepped, after an error, is absent; a
+  /// disabled one counts 0) and
   /// the loop's overhead in it (seconds). For per-step latencies; may be empty.
   std::function<void(const StepContext&, const std::vector<double>& component_seconds,
                      double overhead_seconds)>
