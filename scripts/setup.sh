@@ -17,6 +17,8 @@ packages=(
   libopencv-core-dev libopencv-imgproc-dev libopencv-calib3d-dev libopencv-imgcodecs-dev
   libopencv-objdetect-dev libopencv-video-dev libopencv-videoio-dev libopencv-features2d-dev
   libassimp-dev libpng-dev libstb-dev libepoxy-dev libegl-dev libgl-dev libmeshoptimizer-dev
+  # the browser GUI's HTTP and WebSocket server (Boost.Beast and Boost.Asio, header-only)
+  libboost-dev
   # IIDC (IEEE 1394) cameras for the real head (optional: hw builds without it); GStreamer's
   # base elements (appsink, videoconvert, videotestsrc) for gstreamer: camera sources and tests
   libdc1394-dev gstreamer1.0-plugins-base
@@ -24,12 +26,20 @@ packages=(
   libegl-mesa0 libgl1-mesa-dri
   # tests, benchmarks, the scene fuzzer (clang's libFuzzer)
   libgtest-dev libgmock-dev libbenchmark-dev clang libclang-rt-14-dev
+  # the browser tests of the GUI: Debian's Chromium, driven by playwright-core (npm)
+  chromium
   # reference data and demo assets: OpenCV's sample calibration files, Assimp's test models
   # (broken ones included), MuJoCo's mug
   opencv-doc assimp-testmodels libmujoco-samples
   # OpenCV's trained Haar cascades (faces, eyes, cat faces) for the perception loop
   opencv-data
 )
+
+# Node.js and npm install the GUI's three.js and the browser tests' playwright-core (web/):
+# Debian's packages, unless a Node.js with npm is already there.
+if ! command -v npm >/dev/null || ! command -v node >/dev/null; then
+  packages+=(nodejs npm)
+fi
 
 missing=()
 for p in "${packages[@]}"; do
@@ -70,6 +80,14 @@ if [ ! -s assets/astronaut.png ] || [ ! -s assets/chelsea.png ]; then
   rm -rf "$tmp"
 fi
 ln -sfn /usr/share/mujoco/model/mug assets/mug
+
+# The GUI's npm packages (three.js for the page, playwright-core for its browser tests), exactly
+# as web/package-lock.json pins them; again only when the lock file changed.
+if ! cmp -s web/package-lock.json web/node_modules/.saccade-installed-lock 2>/dev/null; then
+  echo "setup: installing the GUI's npm packages (web/package-lock.json)"
+  (cd web && npm ci --no-audit --no-fund --loglevel=error)
+  cp web/package-lock.json web/node_modules/.saccade-installed-lock
+fi
 
 build_dir="${1:-build}"
 shift || true

@@ -22,6 +22,7 @@ Runner AddCameraCommand(CLI::App& app);
 Runner AddDemoCommand(CLI::App& app);
 Runner AddRenderCommand(CLI::App& app);
 Runner AddBenchCommand(CLI::App& app);
+Runner AddGuiCommand(CLI::App& app);
 
 // Shared helpers.
 inline constexpr double kRadToDeg = 180.0 / M_PI;

@@ -9,6 +9,7 @@
 #include <chrono>
 #include <cmath>
 #include <csignal>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -22,6 +23,8 @@
 #include <vector>
 
 #include "commands.h"
+#include "gui_session.h"
+#include "overlay.h"
 #include "saccade/components/face_truth.h"
 #include "saccade/components/fixation_component.h"
 #include "saccade/components/hw_components.h"
@@ -62,6 +65,8 @@ struct Options {
   bool realtime = false;
   bool keep_going = false;
   bool list = false;
+  bool gui = false;
+  GuiOptions gui_options;
 };
 
 /// One attended target, from its selection to the end of its dwell.
@@ -109,28 +114,6 @@ Stats Summarise(std::vector<double> v) {
   s.max = v.back();
   for (double x : v) s.mean += x / static_cast<double>(v.size());
   return s;
-}
-
-/// Everything the loop's outputs said during the current step.
-struct Latest {
-  std::map<std::string, std::shared_ptr<const Image>> images;  // by camera
-  std::map<std::string, FacesMessage> faces;
-  std::map<std::string, TrackMessage> tracks;
-  std::optional<SelectionMessage> selection;
-  std::optional<TargetMessage> target;
-  std::optional<JointStateMessage> joints;
-};
-
-/// Subscribes `slot` to every output of message type T in the pipeline.
-template <typename T, typename Slot>
-void Tap(runtime::Pipeline& pipeline, Slot slot) {
-  for (const auto& component : pipeline.components()) {
-    for (const auto& output : component->outputs()) {
-      if (auto* typed = dynamic_cast<runtime::Output<T>*>(output.get())) {
-        typed->signal().Connect(slot);
-      }
-    }
-  }
 }
 
 /// Writes the annotated frames: frames/NNNNNN.jpg, demo.avi (MJPEG), fixation PNGs.
@@ -198,51 +181,9 @@ class Recorder {
   int64_t frames_ = 0;
 };
 
-/// The annotated view of one eye: detections (green accepted, red rejected), the track
-/// (yellow), the target (cyan), at half size.
-cv::Mat Annotate(const Latest& latest, const std::string& camera) {
-  const auto it = latest.images.find(camera);
-  if (it == latest.images.end() || !it->second) return cv::Mat(384, 512, CV_8UC3, cv::Scalar(0));
-  const Image& image = *it->second;
-  cv::Mat rgb(image.height(), image.width(), CV_8UC3, const_cast<uint8_t*>(image.data()));
-  cv::Mat bgr;
-  cv::cvtColor(rgb, bgr, cv::COLOR_RGB2BGR);
-  const int64_t frame = image.metadata().frame_index;
-  if (const auto f = latest.faces.find(camera); f != latest.faces.end() && f->second.image &&
-                                                f->second.image->metadata().frame_index == frame) {
-    for (const FacesMessage::Face& face : f->second.faces) {
-      const cv::Scalar color = face.rejected ? cv::Scalar(0, 0, 255) : cv::Scalar(0, 220, 0);
-      cv::rectangle(bgr, face.box, color, 3);
-      if (face.rejected) {
-        cv::putText(bgr, face.reason, face.box.tl() + cv::Point(0, -8), cv::FONT_HERSHEY_SIMPLEX,
-                    0.9, color, 2);
-      }
-    }
-  }
-  if (const auto t = latest.tracks.find(camera); t != latest.tracks.end() && t->second.tracking) {
-    cv::rectangle(bgr, t->second.window, cv::Scalar(0, 220, 255), 2);
-  }
-  if (latest.target && latest.target->valid) {
-    const geometry::CameraModel model = vision::CameraModelOf(image);
-    const Eigen::Vector3d p_C = vision::CameraPoseOf(image).inverse() * latest.target->p_W;
-    if (p_C.z() > 0.0) {
-      if (const auto uv = model.Project(p_C)) {
-        cv::circle(bgr, cv::Point(static_cast<int>(uv->x()), static_cast<int>(uv->y())), 10,
-                   cv::Scalar(255, 255, 0), 3);
-      }
-    }
-  }
-  // The image centre: where a fixated target lands.
-  cv::drawMarker(bgr, cv::Point(image.width() / 2, image.height() / 2), cv::Scalar(255, 255, 255),
-                 cv::MARKER_CROSS, 30, 2);
-  cv::Mat half;
-  cv::resize(bgr, half, cv::Size(bgr.cols / 2, bgr.rows / 2), 0, 0, cv::INTER_AREA);
-  return half;
-}
-
 cv::Mat Compose(const Latest& latest, double time, const std::string& status) {
-  cv::Mat left = Annotate(latest, "left");
-  cv::Mat right = Annotate(latest, "right");
+  cv::Mat left = Annotate(latest, "left", 0.5);
+  cv::Mat right = Annotate(latest, "right", 0.5);
   if (right.rows != left.rows) cv::resize(right, right, cv::Size(right.cols, left.rows));
   cv::Mat both;
   cv::hconcat(left, right, both);
@@ -282,7 +223,7 @@ json FixationJson(const Fixation& f) {
   return j;
 }
 
-int RunDemo(const Options& o) {
+int RunDemo(Options o) {
   components::RegisterComponents();
   if (o.list) {
     const runtime::ComponentRegistry& registry = runtime::ComponentRegistry::Global();
@@ -312,6 +253,9 @@ int RunDemo(const Options& o) {
     spec.clock.rate_hz = 1.0 / dt;
   }
   runtime::Pipeline pipeline = runtime::Pipeline::Build(spec);
+  if (o.gui && o.gui_options.token.empty()) {
+    if (const char* token = std::getenv("SACCADE_GUI_TOKEN")) o.gui_options.token = token;
+  }
 
   // Where the cameras and the fixation controller run, and the scene the cameras render:
   // simulated cameras give ground truth; real ones (hw.cameras) give none.
@@ -365,6 +309,15 @@ int RunDemo(const Options& o) {
     head_status = m;
   });
 
+  std::unique_ptr<GuiSession> gui;
+  if (o.gui) {
+    gui = std::make_unique<GuiSession>(
+        pipeline, scene, o.scene.empty() ? fs::path(o.pipeline).filename().string() : o.scene,
+        o.gui_options);
+    fmt::print("gui: serving {}  (open it in a browser; Ctrl-C to stop)\n", gui->url());
+    std::fflush(stdout);
+  }
+
   std::unique_ptr<Recorder> recorder;
   if (!o.record.empty()) recorder = std::make_unique<Recorder>(o.record, 1.0 / dt, o.force);
 
@@ -373,7 +326,8 @@ int RunDemo(const Options& o) {
   std::vector<double> loop_latency_ms;
 
   runtime::RunOptions run;
-  run.steps = static_cast<int64_t>(std::ceil(o.duration / dt - 1e-9));
+  // With the GUI the loop runs until Ctrl-C (or SIGTERM).
+  run.steps = o.gui ? 0 : static_cast<int64_t>(std::ceil(o.duration / dt - 1e-9));
   g_stop = false;
   run.stop = &g_stop;
   run.on_error = [&](const runtime::StepError& error) {
@@ -532,7 +486,11 @@ int RunDemo(const Options& o) {
         }
       }
     }
-    if (faces_total > 0 && done == faces_total) g_stop = true;
+    if (gui) {
+      gui->AfterStep(context, latest, g_stop);
+    } else if (faces_total > 0 && done == faces_total) {
+      g_stop = true;
+    }
   };
 
   auto previous_int = std::signal(SIGINT, OnDemoInterrupt);
@@ -655,15 +613,61 @@ int RunDemo(const Options& o) {
       fmt::print("\nrecorded to {}: frames/, demo.avi, summary.json, fixation_*.png\n", o.record);
     }
   }
+  if (gui) fmt::print("{}\n", gui->Describe());
   if (!summary.errors.empty() && summary.stopped_on_error) return 1;
-  if (faces_fixated == 0) {
+  if (faces_fixated == 0 && !o.gui) {
     fmt::print(stderr, "saccade: demo: no face was fixated\n");
     return 3;
   }
   return 0;
 }
 
+/// The options that serve the browser GUI, shared by `demo --gui` and `gui`.
+void AddGuiOptions(CLI::App* command, Options& o) {
+  command
+      ->add_option("--listen", o.gui_options.listen,
+                   "Address the GUI listens on; anything but a loopback address (127.0.0.1, "
+                   "::1) needs --token")
+      ->capture_default_str();
+  command->add_option("--port", o.gui_options.port, "TCP port of the GUI (0: any free port)")
+      ->capture_default_str();
+  command->add_option("--token", o.gui_options.token,
+                      "Access token the page must present (in the printed address); default: "
+                      "$SACCADE_GUI_TOKEN. Required with a non-loopback --listen");
+  command
+      ->add_option("--speed", o.gui_options.speed,
+                   "Simulated seconds per wall second, at most (0.05 .. 10; the page changes it)")
+      ->capture_default_str();
+  command->add_flag("--paused", o.gui_options.paused,
+                    "Start paused (the page's Resume and Step buttons run it)");
+}
+
 }  // namespace
+
+Runner AddGuiCommand(CLI::App& app) {
+  auto o = std::make_shared<Options>();
+  o->gui = true;
+  o->gui_options.mode = "gui";
+  o->gui_options.perception = false;
+  auto* gui = app.add_subcommand(
+      "gui",
+      "The browser GUI on a scene: serves a page (three.js) showing the 3D world, the head, "
+      "both camera frustums with their live images, and lets you drag a joint (direct "
+      "kinematics), click a point to fixate (inverse kinematics), switch effects and the "
+      "perception loop, pause, step and change the speed. Prints the page's address and runs "
+      "until Ctrl-C. The protocol (also for scripts): docs/gui-protocol.md. Perception starts "
+      "off; `saccade demo --gui` starts with it on.");
+  gui->add_option("--scene", o->scene, "Scene YAML (default: the demo's, scenes/portraits.yaml)")
+      ->check(CLI::ExistingFile);
+  gui->add_option("--pipeline", o->pipeline, "Pipeline YAML (default: the demo's)")
+      ->check(CLI::ExistingFile)
+      ->capture_default_str();
+  gui->add_option("--hardware", o->hardware,
+                  "Hardware file (pipelines/hardware/): the GUI drives the real head too")
+      ->check(CLI::ExistingFile);
+  AddGuiOptions(gui, *o);
+  return [o] { return RunDemo(*o); };
+}
 
 Runner AddDemoCommand(CLI::App& app) {
   auto o = std::make_shared<Options>();
@@ -701,6 +705,10 @@ Runner AddDemoCommand(CLI::App& app) {
   demo->add_flag("--keep-going", o->keep_going,
                  "Continue after a component fails (the pipeline's on_error: continue)");
   demo->add_flag("--list-components", o->list, "List the component types a pipeline can use");
+  demo->add_flag("--gui", o->gui,
+                 "Serve the browser GUI (prints its address) and run until Ctrl-C; see "
+                 "`saccade gui --help`");
+  AddGuiOptions(demo, *o);
   return [o] { return RunDemo(*o); };
 }
 

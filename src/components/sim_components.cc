@@ -48,7 +48,23 @@ void SimCameras::Configure(const nlohmann::json& params) {
 
 void SimCameras::Start() { renderer_ = render::MakeRenderer(*scene_, options_); }
 
+void SimCameras::SetEffects(bool distortion, bool noise, bool motion_blur) {
+  if (options_.distortion == distortion && options_.noise == noise &&
+      options_.motion_blur == motion_blur) {
+    return;
+  }
+  options_.distortion = distortion;
+  options_.noise = noise;
+  options_.motion_blur = motion_blur;
+  options_changed_ = true;
+}
+
 void SimCameras::Step(const runtime::StepContext& context) {
+  if (options_changed_ && renderer_) {
+    renderer_.reset();  // one GL context at a time
+    renderer_ = render::MakeRenderer(*scene_, options_);
+    options_changed_ = false;
+  }
   scene::SceneState state = scene_->InitialState();
   state.time = context.time;
   if (const JointStateMessage* joints = joints_.get()) {

@@ -60,6 +60,10 @@ class SimCameras : public runtime::Component {
   void Stop() override;
 
   const scene::Scene& scene() const { return *scene_; }
+  /// Switches the scene's effects (the GUI's toggles); the next Step renders with them (it
+  /// makes a new renderer). Call from the thread that runs the pipeline.
+  void SetEffects(bool distortion, bool noise, bool motion_blur);
+  const render::RendererOptions& options() const { return options_; }
 
  private:
   runtime::Input<JointStateMessage>& joints_;
@@ -67,6 +71,7 @@ class SimCameras : public runtime::Component {
   std::shared_ptr<const scene::Scene> scene_;
   render::RendererOptions options_;
   std::unique_ptr<render::Renderer> renderer_;
+  bool options_changed_ = false;
 };
 
 class SimHead : public runtime::Component {

@@ -1,0 +1,738 @@
+#include "gui_session.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <map>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "commands.h"
+#include "saccade/components/hw_components.h"
+#include "saccade/components/sim_components.h"
+#include "saccade/core/error.h"
+#include "saccade/head/kinematics.h"
+#include "saccade/vision/image_camera.h"
+
+namespace saccade::app {
+namespace {
+
+namespace fs = std::filesystem;
+using components::HeadStatusMessage;
+using components::JointCommand;
+using nlohmann::json;
+using server::CommandError;
+
+double WallNow() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+/// A pose as 16 numbers, row-major (docs/gui-protocol.md).
+json MatrixJson(const geometry::Pose& X) {
+  json m = json::array();
+  for (int r = 0; r < 4; ++r) {
+    for (int c = 0; c < 4; ++c) m.push_back(X.matrix()(r, c));
+  }
+  return m;
+}
+
+json Vec(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()}; }
+json Vec(const Eigen::Vector3f& v) { return {v.x(), v.y(), v.z()}; }
+json Vec(const Eigen::Vector4f& v) { return {v.x(), v.y(), v.z(), v.w()}; }
+
+json JointsObject(const head::JointState& q) {
+  return {{"pan", q.pan}, {"tilt", q.tilt}, {"left", q.left}, {"right", q.right}};
+}
+
+const char* LinkName(scene::RobotPart::Link link) {
+  switch (link) {
+    case scene::RobotPart::Link::kBase:
+      return "base";
+    case scene::RobotPart::Link::kNeck:
+      return "neck";
+    case scene::RobotPart::Link::kCyclopean:
+      return "cyclopean";
+    case scene::RobotPart::Link::kLeftEye:
+      return "left_eye";
+    case scene::RobotPart::Link::kRightEye:
+      return "right_eye";
+  }
+  return "base";
+}
+
+/// A texture as PNG bytes.
+std::string EncodePng(const Image& image) {
+  cv::Mat bgr;
+  uint8_t* data = const_cast<uint8_t*>(image.data());
+  if (image.format() == PixelFormat::kRgb8) {
+    cv::cvtColor(cv::Mat(image.height(), image.width(), CV_8UC3, data), bgr, cv::COLOR_RGB2BGR);
+  } else if (image.format() == PixelFormat::kRgba8) {
+    cv::cvtColor(cv::Mat(image.height(), image.width(), CV_8UC4, data), bgr, cv::COLOR_RGBA2BGRA);
+  } else if (image.format() == PixelFormat::kGray8) {
+    bgr = cv::Mat(image.height(), image.width(), CV_8UC1, data).clone();
+  } else {
+    throw Error(std::string("gui: cannot send a texture of format ") + ToString(image.format()));
+  }
+  std::vector<uint8_t> png;
+  cv::imencode(".png", bgr, png);
+  return std::string(png.begin(), png.end());
+}
+
+template <typename T>
+void Append(std::string& out, const T* data, std::size_t count) {
+  out.append(reinterpret_cast<const char*>(data), count * sizeof(T));
+}
+
+/// The meshes of a model, as /api/models/N.bin (docs/gui-protocol.md).
+std::string ModelBinary(const scene::Model& model) {
+  std::string out;
+  for (const scene::Mesh& mesh : model.meshes) {
+    for (const Eigen::Vector3f& p : mesh.positions) Append(out, p.data(), 3);
+    for (const Eigen::Vector3f& n : mesh.normals) Append(out, n.data(), 3);
+    for (const Eigen::Vector2f& uv : mesh.uvs) Append(out, uv.data(), 2);
+    Append(out, mesh.indices.data(), mesh.indices.size());
+  }
+  return out;
+}
+
+/// The value of a number field, finite; CommandError naming the command and the field.
+double FiniteNumber(const json& value, const std::string& where) {
+  if (!value.is_number()) throw CommandError(where + ": expected a number, got " + value.dump());
+  const double x = value.get<double>();
+  if (!std::isfinite(x)) throw CommandError(where + ": expected a finite number");
+  return x;
+}
+
+bool Flag(const json& command, const std::string& field, bool current) {
+  if (!command.contains(field)) return current;
+  if (!command[field].is_boolean()) {
+    throw CommandError(command["type"].get<std::string>() + ": " + field +
+                       " must be true or false, got " + command[field].dump());
+  }
+  return command[field].get<bool>();
+}
+
+double AxisErrorDeg(const geometry::Pose& X_WC, const Eigen::Vector3d& p_W) {
+  const Eigen::Vector3d to = (p_W - X_WC.translation()).normalized();
+  return std::acos(std::clamp(X_WC.linear().col(2).dot(to), -1.0, 1.0)) * kRadToDeg;
+}
+
+}  // namespace
+
+GuiSession::GuiSession(runtime::Pipeline& pipeline, const scene::Scene& scene,
+                       const std::string& scene_name, const GuiOptions& options)
+    : pipeline_(pipeline), scene_(scene), options_(options) {
+  paused_ = options.paused;
+  speed_ = options.speed;
+  perception_ = options.perception;
+  if (!(options.speed >= 0.05 && options.speed <= 10.0)) {
+    throw InvalidArgument(fmt::format("--speed must be in [0.05, 10], got {}", options.speed));
+  }
+  if (options.port < 0 || options.port > 65535) {
+    throw InvalidArgument(fmt::format("--port must be in [0, 65535], got {}", options.port));
+  }
+  for (const auto& component : pipeline.components()) {
+    runtime::Component* c = component.get();
+    const runtime::MethodBase* move = c->FindMethod("move");
+    if (!head_ && move && move->request_type() == runtime::MessageName<JointCommand>()) {
+      head_ = c;
+      hw_head_ = c->FindMethod("estop") != nullptr;
+    }
+    if (auto* cameras = dynamic_cast<components::SimCameras*>(c); cameras && !sim_cameras_) {
+      sim_cameras_ = cameras;
+    }
+  }
+  // Perception: every component that is not the robot (the cameras and the head).
+  for (const auto& component : pipeline.components()) {
+    runtime::Component* c = component.get();
+    if (c != head_ && !dynamic_cast<components::SimCameras*>(c) &&
+        !dynamic_cast<components::HwCameras*>(c)) {
+      perception_components_.push_back(c);
+      c->SetEnabled(options.perception);
+    }
+  }
+  if (sim_cameras_) effects_ = sim_cameras_->options();
+  Tap<HeadStatusMessage>(pipeline, [this](const HeadStatusMessage& m) {
+    head_status_ = runtime::MessageTraits<HeadStatusMessage>::ToJson(m);
+  });
+  if (scene_.robot()) targets_ = scene_.robot()->initial_joints;
+
+  server::ServerOptions server_options;
+  server_options.address = options.listen;
+  server_options.port = static_cast<uint16_t>(options.port);
+  server_options.token = options.token;
+  const fs::path web = ShippedFile("web");
+  if (!fs::exists(web / "public" / "index.html")) {
+    throw Error("gui: the page is missing: " + (web / "public" / "index.html").string());
+  }
+  if (!fs::exists(web / "node_modules" / "three" / "build" / "three.module.js")) {
+    throw Error("gui: three.js is missing from " + (web / "node_modules").string() +
+                ": run `bash scripts/setup.sh` (it installs web/package-lock.json with npm)");
+  }
+  server_options.mounts = {{"/", (web / "public").string()},
+                           {"/vendor/three/", (web / "node_modules" / "three").string()}};
+  server_options.hello = {{"mode", options.mode}};
+  server_ = std::make_unique<server::GuiServer>(server_options);
+
+  // The scene: models and textures once, as the renderer has them.
+  std::map<const scene::Model*, int> model_index;
+  std::map<const scene::Texture*, int> texture_index;
+  json models = json::array();
+  const auto add_model = [&](const std::shared_ptr<const scene::Model>& model) {
+    if (!model) return -1;
+    if (const auto it = model_index.find(model.get()); it != model_index.end()) return it->second;
+    const int index = static_cast<int>(models.size());
+    model_index[model.get()] = index;
+    json materials = json::array();
+    for (const scene::Material& m : model->materials) {
+      json texture = nullptr;
+      if (m.texture) {
+        auto [it, added] =
+            texture_index.emplace(m.texture.get(), static_cast<int>(texture_index.size()));
+        if (added) {
+          server_->SetDocument(fmt::format("/api/textures/{}.png", it->second), "image/png",
+                               EncodePng(m.texture->image));
+        }
+        texture = fmt::format("/api/textures/{}.png", it->second);
+      }
+      materials.push_back({{"base_color", Vec(m.base_color)},
+                           {"texture", texture},
+                           {"specular", m.specular},
+                           {"shininess", m.shininess}});
+    }
+    json meshes = json::array();
+    for (const scene::Mesh& mesh : model->meshes) {
+      meshes.push_back({{"vertices", mesh.positions.size()},
+                        {"indices", mesh.indices.size()},
+                        {"uvs", !mesh.uvs.empty()},
+                        {"material", mesh.material}});
+    }
+    const std::string url = fmt::format("/api/models/{}.bin", index);
+    server_->SetDocument(url, "application/octet-stream", ModelBinary(*model));
+    models.push_back(
+        {{"source", model->source},
+         {"url", url},
+         {"bounds",
+          {Vec(Eigen::Vector3f(model->bounds.min())), Vec(Eigen::Vector3f(model->bounds.max()))}},
+         {"materials", materials},
+         {"meshes", meshes}});
+    return index;
+  };
+  json objects = json::array();
+  for (const scene::Object& o : scene_.objects()) {
+    objects.push_back({{"name", o.name},
+                       {"id", o.id},
+                       {"model", add_model(o.model)},
+                       {"scale", Vec(o.scale)},
+                       {"X_WO", MatrixJson(o.motion.PoseAt(0.0))},
+                       {"moving", !o.motion.IsStatic()}});
+  }
+  json robot = nullptr;
+  json joints = json::array();
+  if (scene_.robot()) {
+    json parts = json::array();
+    for (const scene::RobotPart& p : scene_.robot()->parts) {
+      parts.push_back({{"link", LinkName(p.link)},
+                       {"model", add_model(p.model)},
+                       {"X_LinkPart", MatrixJson(p.X_LinkPart)},
+                       {"scale", Vec(p.scale)}});
+    }
+    robot = {{"visible", scene_.robot()->visible}, {"parts", parts}};
+    for (head::Joint j : head::kAllJoints) {
+      const head::JointLimits& l = scene_.robot()->head.limits(j);
+      joints.push_back({{"name", head::JointName(j)},
+                        {"min", l.min},
+                        {"max", l.max},
+                        {"max_velocity", l.max_velocity}});
+    }
+  }
+  json lights = json::array();
+  for (const scene::Light& l : scene_.lights()) {
+    const char* type = l.type == scene::Light::Type::kAmbient       ? "ambient"
+                       : l.type == scene::Light::Type::kDirectional ? "directional"
+                                                                    : "point";
+    lights.push_back({{"type", type},
+                      {"color", Vec(l.color)},
+                      {"intensity", l.intensity},
+                      {"direction", Vec(l.direction_W)},
+                      {"position", Vec(l.position_W)},
+                      {"attenuation", l.attenuation}});
+  }
+  const scene::Ground& g = scene_.ground();
+  const char* pattern = g.pattern == scene::Ground::Pattern::kPlain  ? "plain"
+                        : g.pattern == scene::Ground::Pattern::kGrid ? "grid"
+                                                                     : "checker";
+  json cameras = json::array();
+  for (const scene::CameraSpec& c : scene_.cameras()) {
+    const geometry::Intrinsics& k = c.model.intrinsics();
+    const char* eye = c.mount == scene::CameraMount::kLeftEye    ? "left"
+                      : c.mount == scene::CameraMount::kRightEye ? "right"
+                                                                 : "world";
+    cameras.push_back(
+        {{"name", c.name},
+         {"eye", eye},
+         {"width", k.width()},
+         {"height", k.height()},
+         {"K", {k.fx(), k.skew(), k.cx(), 0.0, k.fy(), k.cy(), 0.0, 0.0, 1.0}},
+         {"model", c.model.distortion().model() == geometry::DistortionModel::kFisheye ? "fisheye"
+                                                                                       : "radtan"},
+         {"X_WC", MatrixJson(c.X_WC)},
+         {"near", c.clip.near},
+         {"far", c.clip.far}});
+  }
+  const json scene_json = {{"protocol", server::kProtocolName},
+                           {"version", server::kProtocolVersion},
+                           {"mode", options.mode},
+                           {"name", scene_name},
+                           {"time", 0.0},
+                           {"background", Vec(scene_.background())},
+                           {"ground",
+                            {{"enabled", g.enabled},
+                             {"size", g.size},
+                             {"pattern", pattern},
+                             {"cell", g.cell},
+                             {"line_width", g.line_width},
+                             {"color", Vec(g.color)},
+                             {"color2", Vec(g.color2)}}},
+                           {"lights", lights},
+                           {"models", models},
+                           {"objects", objects},
+                           {"robot", robot},
+                           {"head", {{"joints", joints}}},
+                           {"cameras", cameras},
+                           {"commands",
+                            {{"effects", sim_cameras_ != nullptr},
+                             {"perception", !perception_components_.empty()},
+                             {"estop", hw_head_}}}};
+  server_->SetDocument("/api/scene", "application/json", scene_json.dump());
+  server_->SetCommandHandler(
+      [this](const json& command, int64_t client) { return Handle(command, client); });
+  server_->SetWelcome([this] {
+    std::lock_guard lock(state_mutex_);
+    return state_text_.empty() ? std::vector<std::string>{} : std::vector{state_text_};
+  });
+  server_->Start();
+  encoder_ = std::thread([this] { EncodeLoop(); });
+}
+
+GuiSession::~GuiSession() {
+  {
+    std::lock_guard lock(encode_mutex_);
+    encoder_stop_ = true;
+  }
+  encode_cv_.notify_all();
+  if (encoder_.joinable()) encoder_.join();
+  server_->Stop();
+}
+
+std::string GuiSession::Describe() const {
+  const std::vector<server::ClientStats> clients = server_->clients();
+  int64_t sent = 0, skipped = 0;
+  for (const server::ClientStats& c : clients) {
+    sent += c.frames_sent;
+    skipped += c.frames_skipped;
+  }
+  return fmt::format(
+      "gui: {} client(s) now; {} images encoded; to the clients now: {} frames sent, "
+      "{} skipped for slow clients",
+      clients.size(), frames_encoded_.load(), sent, skipped);
+}
+
+head::JointState GuiSession::CurrentTargets() const {
+  std::lock_guard lock(joints_mutex_);
+  return targets_;
+}
+
+void GuiSession::Enqueue(std::function<void()> action) {
+  std::lock_guard lock(queue_mutex_);
+  queue_.push_back(std::move(action));
+}
+
+void GuiSession::ApplyQueued() {
+  std::vector<std::function<void()>> actions;
+  {
+    std::lock_guard lock(queue_mutex_);
+    actions.swap(queue_);
+  }
+  for (auto& action : actions) {
+    try {
+      action();
+    } catch (const std::exception& error) {
+      server_->Broadcast({{"type", "event"}, {"level", "error"}, {"message", error.what()}});
+    }
+  }
+}
+
+void GuiSession::SetPerception(bool enabled) {
+  for (runtime::Component* c : perception_components_) c->SetEnabled(enabled);
+  perception_ = enabled;
+}
+
+void GuiSession::CallHead(const std::string& method, const json& request) {
+  const runtime::MethodBase* m = head_ ? head_->FindMethod(method) : nullptr;
+  if (!m) throw Error("gui: the head has no method '" + method + "'");
+  m->CallJson(request);
+}
+
+json GuiSession::Handle(const json& command, int64_t client) {
+  (void)client;
+  const std::string type = command["type"].get<std::string>();
+  if (type == "ping") return {{"time", sim_time_.load()}};
+  if (type == "joints" || type == "fixate") {
+    if (!head_ || !scene_.robot()) throw CommandError(type + ": this pipeline has no head to move");
+    const head::HeadDescription& head = scene_.robot()->head;
+    head::JointState target = CurrentTargets();
+    json reply;
+    if (type == "joints") {
+      if (!command.contains("positions") || !command["positions"].is_object() ||
+          command["positions"].empty()) {
+        throw CommandError("joints: expected positions: {pan, tilt, left, right or vergence: rad}");
+      }
+      for (const auto& [name, value] : command["positions"].items()) {
+        const double x = FiniteNumber(value, "joints: " + name);
+        if (name == "vergence") {
+          // Symmetric vergence (seed appendix A): > 0 converges, the left eye turning right.
+          target.left = -x;
+          target.right = x;
+          continue;
+        }
+        bool known = false;
+        for (head::Joint j : head::kAllJoints) {
+          if (name == head::JointName(j)) {
+            target[j] = x;
+            known = true;
+          }
+        }
+        if (!known) {
+          throw CommandError("joints: unknown joint '" + name +
+                             "' (pan, tilt, left, right or vergence)");
+        }
+      }
+      // The server's check (docs/gui-protocol.md): a value outside the limits rejects the
+      // whole command; the page's clamping is a convenience, never the safety.
+      for (head::Joint j : head::kAllJoints) {
+        const head::JointLimits& l = head.limits(j);
+        if (!l.Contains(target[j])) {
+          throw CommandError(fmt::format(
+              "joints: {} {:.4f} rad ({:.2f} deg) is outside its limits [{:.4f}, {:.4f}] rad",
+              head::JointName(j), target[j], target[j] * kRadToDeg, l.min, l.max));
+        }
+      }
+      reply = {{"targets", JointsObject(target)}};
+    } else {
+      const json& p = command.contains("p_W") ? command["p_W"] : json();
+      if (!p.is_array() || p.size() != 3) {
+        throw CommandError("fixate: expected p_W: [x, y, z] (metres, world frame), got " +
+                           p.dump());
+      }
+      const Eigen::Vector3d p_W(FiniteNumber(p[0], "fixate: p_W[0]"),
+                                FiniteNumber(p[1], "fixate: p_W[1]"),
+                                FiniteNumber(p[2], "fixate: p_W[2]"));
+      head::IkOptions ik;
+      ik.seed = target;
+      const head::IkResult solution = head::SolveFixation(head, p_W, ik);
+      if (!solution.reachable()) {
+        throw CommandError(fmt::format("fixate: [{:.3f}, {:.3f}, {:.3f}] cannot be fixated: {}",
+                                       p_W.x(), p_W.y(), p_W.z(), solution.message));
+      }
+      target = solution.joints;
+      reply = {{"targets", JointsObject(target)},
+               {"axis_error_deg", solution.axis_error * kRadToDeg}};
+    }
+    {
+      std::lock_guard lock(joints_mutex_);
+      targets_ = target;
+    }
+    Enqueue([this, target] {
+      SetPerception(false);  // the hand overrides the loop
+      JointCommand c;
+      c.time = sim_time_;
+      c.positions = target;
+      c.velocities = {0.0, 0.0, 0.0, 0.0};
+      CallHead("move", runtime::MessageTraits<JointCommand>::ToJson(c));
+    });
+    reply["perception"] = false;
+    return reply;
+  }
+  if (type == "perception") {
+    if (perception_components_.empty()) {
+      throw CommandError("perception: this pipeline has no components besides the robot");
+    }
+    const bool enabled = Flag(command, "enabled", perception_);
+    Enqueue([this, enabled] { SetPerception(enabled); });
+    return {{"perception", enabled}};
+  }
+  if (type == "effects") {
+    if (!sim_cameras_) {
+      throw CommandError("effects: the cameras are not simulated: they have no effects to switch");
+    }
+    for (const auto& [name, value] : command.items()) {
+      if (name != "type" && name != "id" && name != "distortion" && name != "noise" &&
+          name != "motion_blur") {
+        throw CommandError("effects: unknown field '" + name +
+                           "' (distortion, noise, motion_blur)");
+      }
+    }
+    std::lock_guard lock(effects_mutex_);
+    const bool d = Flag(command, "distortion", effects_.distortion);
+    const bool n = Flag(command, "noise", effects_.noise);
+    const bool b = Flag(command, "motion_blur", effects_.motion_blur);
+    effects_.distortion = d;
+    effects_.noise = n;
+    effects_.motion_blur = b;
+    Enqueue([this, d, n, b] { sim_cameras_->SetEffects(d, n, b); });
+    return {{"effects", {{"distortion", d}, {"noise", n}, {"motion_blur", b}}}};
+  }
+  if (type == "pause") {
+    paused_ = true;
+    return {{"paused", true}};
+  }
+  if (type == "resume") {
+    steps_to_run_ = 0;
+    paused_ = false;
+    return {{"paused", false}};
+  }
+  if (type == "step") {
+    int count = 1;
+    if (command.contains("count")) {
+      if (!command["count"].is_number_integer() || command["count"].get<int64_t>() < 1 ||
+          command["count"].get<int64_t>() > 1000) {
+        throw CommandError("step: count must be an integer in [1, 1000], got " +
+                           command["count"].dump());
+      }
+      count = command["count"].get<int>();
+    }
+    if (!paused_) throw CommandError("step: pause first (steps are for a paused simulation)");
+    steps_to_run_ += count;
+    return {{"steps", count}};
+  }
+  if (type == "speed") {
+    const double factor = command.contains("factor")
+                              ? FiniteNumber(command["factor"], "speed: factor")
+                              : std::nan("");
+    if (!(factor >= 0.05 && factor <= 10.0)) {
+      throw CommandError("speed: factor must be in [0.05, 10] (simulated s per wall s), got " +
+                         (command.contains("factor") ? command["factor"].dump() : "nothing"));
+    }
+    speed_ = factor;
+    return {{"speed", factor}};
+  }
+  if (type == "stop" || type == "estop" || type == "clear") {
+    if (!head_) throw CommandError(type + ": this pipeline has no head");
+    if ((type == "estop" || type == "clear") && !hw_head_) {
+      throw CommandError(type +
+                         ": only a hardware head (hw.head) has an emergency stop; use stop to "
+                         "brake the simulated one");
+    }
+    Enqueue([this, type] {
+      SetPerception(false);
+      CallHead(type, json::object());
+    });
+    return {{"perception", false}};
+  }
+  throw CommandError("unknown command type '" + type +
+                     "' (joints, fixate, perception, effects, pause, resume, step, speed, stop, "
+                     "estop, clear, ping: docs/gui-protocol.md)");
+}
+
+json GuiSession::StateJson(const runtime::StepContext& context, const Latest& latest) {
+  const double t = context.time + context.dt;  // the state after this step
+  json state = {{"type", "state"},
+                {"step", context.step},
+                {"time", t},
+                {"paused", paused_.load()},
+                {"speed", speed_.load()},
+                {"perception", perception_.load()},
+                {"manual", !perception_.load()}};
+  if (sim_cameras_) {
+    const render::RendererOptions& o = sim_cameras_->options();
+    state["effects"] = {
+        {"distortion", o.distortion}, {"noise", o.noise}, {"motion_blur", o.motion_blur}};
+  } else {
+    state["effects"] = nullptr;
+  }
+  std::optional<head::HeadFrames> frames;
+  if (latest.joints && scene_.robot()) {
+    const JointStateMessage& j = *latest.joints;
+    state["joints"] = {{"positions", JointsObject(j.positions)},
+                       {"targets", JointsObject(j.targets)},
+                       {"velocities", JointsObject(j.velocities)},
+                       {"arrived", j.arrived}};
+    frames = head::ForwardKinematics(scene_.robot()->head, j.positions);
+    state["frames"] = {
+        {"X_WB", MatrixJson(frames->X_WB)},        {"X_WN", MatrixJson(frames->X_WN)},
+        {"X_WC", MatrixJson(frames->X_WC)},        {"left_eye", MatrixJson(frames->X_WL)},
+        {"right_eye", MatrixJson(frames->X_WR)},   {"left", MatrixJson(frames->X_WCamLeft)},
+        {"right", MatrixJson(frames->X_WCamRight)}};
+    state["fixation_W"] = frames->p_WFixation ? Vec(*frames->p_WFixation) : json(nullptr);
+    std::lock_guard lock(joints_mutex_);
+    if (perception_) targets_ = j.targets;  // partial hand commands start from here
+  } else {
+    state["joints"] = nullptr;
+    state["frames"] = nullptr;
+    state["fixation_W"] = nullptr;
+  }
+  if (perception_ && latest.target && latest.target->valid) {
+    state["target"] = {
+        {"valid", true}, {"p_W", Vec(latest.target->p_W)}, {"id", latest.target->target_id}};
+    if (frames) {
+      state["fixation_error_deg"] = {
+          {"left", AxisErrorDeg(frames->X_WCamLeft, latest.target->p_W)},
+          {"right", AxisErrorDeg(frames->X_WCamRight, latest.target->p_W)}};
+    } else {
+      state["fixation_error_deg"] = nullptr;
+    }
+  } else {
+    state["target"] = nullptr;
+    state["fixation_error_deg"] = nullptr;
+  }
+  json objects = json::array();
+  for (const scene::Object& o : scene_.objects()) {
+    if (!o.motion.IsStatic()) {
+      objects.push_back({{"name", o.name}, {"X_WO", MatrixJson(o.motion.PoseAt(t))}});
+    }
+  }
+  state["objects"] = objects;
+  const double now = WallNow();
+  double steps_per_s = 0.0, frames_per_s = 0.0;
+  if (step_walls_.size() >= 2) {
+    steps_per_s =
+        (step_walls_.size() - 1) / std::max(1e-9, step_walls_.back() - step_walls_.front());
+  }
+  {
+    std::lock_guard lock(encode_mutex_);
+    if (encode_walls_.size() >= 2 && now - encode_walls_.back() < 2.0) {
+      frames_per_s =
+          (encode_walls_.size() - 1) / std::max(1e-9, encode_walls_.back() - encode_walls_.front());
+    }
+  }
+  state["timing"] = {{"step_ms", last_step_ms_},
+                     {"steps_per_s", steps_per_s},
+                     {"realtime_factor", steps_per_s * context.dt},
+                     {"frames_per_s", frames_per_s}};
+  state["head_status"] = head_status_;
+  return state;
+}
+
+void GuiSession::PublishState(const json& state) {
+  {
+    std::lock_guard lock(state_mutex_);
+    state_text_ = state.dump();
+  }
+  server_->PublishState(state);
+}
+
+void GuiSession::AfterStep(const runtime::StepContext& context, const Latest& latest,
+                           const std::atomic<bool>& stop) {
+  const double arrived = WallNow();
+  if (last_return_wall_ >= 0.0) last_step_ms_ = 1e3 * (arrived - last_return_wall_);
+  step_walls_.push_back(arrived);
+  if (step_walls_.size() > 26) step_walls_.erase(step_walls_.begin());
+  sim_time_ = context.time + context.dt;
+
+  ApplyQueued();
+  json state = StateJson(context, latest);
+  PublishState(state);
+
+  // The newest images to the encoder (it drops what it has not started on).
+  const auto left = latest.images.find("left");
+  const int64_t frame =
+      left != latest.images.end() && left->second ? left->second->metadata().frame_index : -1;
+  if (server_->client_count() > 0 && frame != last_frame_sent_) {
+    last_frame_sent_ = frame;
+    std::lock_guard lock(encode_mutex_);
+    to_encode_ = latest;
+    if (!perception_) {  // no stale detections over live images
+      to_encode_->faces.clear();
+      to_encode_->tracks.clear();
+      to_encode_->target.reset();
+      to_encode_->selection.reset();
+    }
+    to_encode_header_ = {{"frame", frame}, {"time", context.time}};
+    encode_cv_.notify_one();
+  }
+
+  // Pause and single steps: wait here, applying commands, until resumed or a step is asked.
+  int64_t waited = 0;
+  while (paused_ && !stop) {
+    if (steps_to_run_ > 0) {
+      --steps_to_run_;
+      break;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    bool pending = false;
+    {
+      std::lock_guard lock(queue_mutex_);
+      pending = !queue_.empty();
+    }
+    if (pending || ++waited % 10 == 0) {
+      // Commands while paused take effect (targets) and the page sees them.
+      ApplyQueued();
+      PublishState(StateJson(context, latest));
+    }
+    anchor_wall_ = -1.0;  // the clock restarts from here
+  }
+  // The pace: at most `speed` simulated seconds per wall second.
+  const double now = WallNow();
+  const double speed = speed_;
+  if (anchor_wall_ < 0.0 || std::abs(speed - anchor_speed_) > 1e-12) {
+    anchor_wall_ = now;
+    anchor_sim_ = context.time;
+    anchor_speed_ = speed;
+  }
+  double due = anchor_wall_ + (context.time + context.dt - anchor_sim_) / speed;
+  if (due < now - 0.5) {  // far behind (llvmpipe): do not try to catch up later
+    anchor_wall_ = now;
+    anchor_sim_ = context.time + context.dt;
+    due = now;
+  }
+  while (!stop && WallNow() < due && !paused_) {
+    std::this_thread::sleep_for(std::chrono::duration<double>(std::min(0.02, due - WallNow())));
+    ApplyQueued();
+  }
+  last_return_wall_ = WallNow();
+}
+
+void GuiSession::EncodeLoop() {
+  while (true) {
+    Latest latest;
+    json header;
+    {
+      std::unique_lock lock(encode_mutex_);
+      encode_cv_.wait(lock, [this] { return encoder_stop_ || to_encode_.has_value(); });
+      if (encoder_stop_) return;
+      latest = std::move(*to_encode_);
+      header = to_encode_header_;
+      to_encode_.reset();
+    }
+    try {
+      for (const auto& [camera, image] : latest.images) {
+        if (!image) continue;
+        const cv::Mat bgr = Annotate(latest, camera, 1.0);
+        std::vector<uint8_t> jpeg;
+        cv::imencode(".jpg", bgr, jpeg, {cv::IMWRITE_JPEG_QUALITY, options_.jpeg_quality});
+        json h = header;
+        h["type"] = "frame";
+        h["camera"] = camera;
+        h["frame"] = image->metadata().frame_index;
+        h["width"] = bgr.cols;
+        h["height"] = bgr.rows;
+        h["overlay"] = true;
+        server_->PublishFrame(camera, h,
+                              std::make_shared<const std::string>(jpeg.begin(), jpeg.end()));
+      }
+      ++frames_encoded_;
+      std::lock_guard lock(encode_mutex_);
+      encode_walls_.push_back(WallNow());
+      if (encode_walls_.size() > 26) encode_walls_.erase(encode_walls_.begin());
+    } catch (const std::exception& error) {
+      server_->Broadcast({{"type", "event"}, {"level", "error"}, {"message", error.what()}});
+    }
+  }
+}
+
+}  // namespace saccade::app

@@ -1,0 +1,127 @@
+#pragma once
+// The browser GUI of a running pipeline (issue 6): serves the page (web/public), the scene's
+// meshes and textures, and speaks docs/gui-protocol.md over the server module: the state after
+// every step, both eyes' annotated images as JPEG, and the commands (joints, fixate, effects,
+// perception, pause, step, speed, stop, estop, clear).
+//
+// Threads: commands arrive on the server's I/O thread; they are checked there (joint limits,
+// reachability, well-formed values: a bad one gets an error reply and changes nothing) and
+// queued; AfterStep applies them on the simulation thread, between steps, where the
+// components live. JPEG encoding runs on a thread of its own that always takes the newest
+// images, so that a slow encoder or client costs frames, never simulation steps.
+
+#include <atomic>
+#include <condition_variable>
+#include <functional>
+#include <memory>
+#include <mutex>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "overlay.h"
+#include "saccade/render/renderer.h"
+#include "saccade/runtime/pipeline.h"
+#include "saccade/scene/scene.h"
+#include "saccade/server/gui_server.h"
+
+namespace saccade::components {
+class SimCameras;
+}  // namespace saccade::components
+
+namespace saccade::app {
+
+struct GuiOptions {
+  std::string listen = "127.0.0.1";
+  int port = 8080;
+  std::string token;
+  std::string mode = "demo";  ///< "demo" or "gui", told to the page
+  bool perception = true;     ///< the loop commands the head at start
+  bool paused = false;
+  double speed = 1.0;  ///< simulated seconds per wall second at most
+  int jpeg_quality = 80;
+};
+
+class GuiSession {
+ public:
+  /// Starts the server (throws Error when it cannot listen). `scene` must outlive the session.
+  GuiSession(runtime::Pipeline& pipeline, const scene::Scene& scene, const std::string& scene_name,
+             const GuiOptions& options);
+  ~GuiSession();
+
+  std::string url() const { return server_->url(); }
+
+  /// On the simulation thread after each step: applies the queued commands, publishes the
+  /// state and the images, keeps the pace (speed) and waits while paused. Returns when the
+  /// next step may run or `stop` is set.
+  void AfterStep(const runtime::StepContext& context, const Latest& latest,
+                 const std::atomic<bool>& stop);
+
+  /// One line for the terminal: clients, frames sent and skipped.
+  std::string Describe() const;
+
+ private:
+  nlohmann::json Handle(const nlohmann::json& command, int64_t client);
+  void Enqueue(std::function<void()> action);
+  void ApplyQueued();
+  nlohmann::json StateJson(const runtime::StepContext& context, const Latest& latest);
+  void PublishState(const nlohmann::json& state);
+  void EncodeLoop();
+  head::JointState CurrentTargets() const;
+  void CallHead(const std::string& method, const nlohmann::json& request);
+  void SetPerception(bool enabled);  // simulation thread
+
+  runtime::Pipeline& pipeline_;
+  const scene::Scene& scene_;
+  GuiOptions options_;
+  std::unique_ptr<server::GuiServer> server_;
+
+  // The components the GUI drives (nullptr when the pipeline has none).
+  runtime::Component* head_ = nullptr;
+  components::SimCameras* sim_cameras_ = nullptr;
+  std::vector<runtime::Component*> perception_components_;  // all but cameras and head
+  bool hw_head_ = false;
+
+  // Commands, from the I/O thread to the simulation thread.
+  std::mutex queue_mutex_;
+  std::vector<std::function<void()>> queue_;
+
+  // Simulation-thread state, mirrored in atomics for the handler's checks and replies.
+  std::atomic<bool> paused_{false};
+  std::atomic<int> steps_to_run_{0};
+  std::atomic<double> speed_{1.0};
+  std::atomic<double> sim_time_{0.0};
+  std::atomic<bool> perception_{true};
+  std::mutex effects_mutex_;
+  render::RendererOptions effects_;  // as last asked (effects_mutex_)
+  nlohmann::json head_status_;       // hw.head's newest status, null without one
+  mutable std::mutex joints_mutex_;
+  head::JointState targets_;  // the latest targets, for partial joint commands (joints_mutex_)
+
+  // Pacing and timing (simulation thread).
+  double anchor_wall_ = -1.0;  // s, steady clock, at anchor_sim_
+  double anchor_sim_ = 0.0;
+  double anchor_speed_ = 0.0;
+  double last_return_wall_ = -1.0;
+  double last_step_ms_ = 0.0;
+  std::vector<double> step_walls_;  // recent AfterStep times, for steps per second
+  int64_t last_frame_sent_ = -1;
+
+  // The newest state's text, for clients that connect later.
+  mutable std::mutex state_mutex_;
+  std::string state_text_;
+
+  // The encoder thread and its one-slot mailbox.
+  std::thread encoder_;
+  std::mutex encode_mutex_;
+  std::condition_variable encode_cv_;
+  std::optional<Latest> to_encode_;
+  nlohmann::json to_encode_header_;
+  bool encoder_stop_ = false;
+  std::atomic<int64_t> frames_encoded_{0};
+  std::vector<double> encode_walls_;  // encoder thread (encode_mutex_)
+};
+
+}  // namespace saccade::app

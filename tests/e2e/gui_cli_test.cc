@@ -1,0 +1,346 @@
+// `saccade gui` as a script would use it (docs/gui-protocol.md): the real program on a real
+// scene, over HTTP and WebSocket (Boost.Beast's client). The server-side checks of the
+// commands that move the head: joint limits, reachability, malformed values; the scene
+// document and meshes; pause, step, effects; camera frames. The browser tests
+// (web/tests/gui.test.mjs) drive the page itself.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <Eigen/Geometry>
+#include <boost/asio/connect.hpp>
+#include <boost/asio/ip/tcp.hpp>
+#include <boost/beast/core.hpp>
+#include <boost/beast/http.hpp>
+#include <boost/beast/websocket.hpp>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <functional>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "e2e/run_saccade.h"
+
+extern char** environ;
+
+namespace {
+
+namespace asio = boost::asio;
+namespace beast = boost::beast;
+namespace http = beast::http;
+namespace websocket = beast::websocket;
+using nlohmann::json;
+using ::testing::HasSubstr;
+using tcp = asio::ip::tcp;
+
+const std::string kSource = SACCADE_SOURCE_DIR;
+const std::string kScene = kSource + "/scenes/astronaut_and_cat.yaml";
+
+// `saccade gui ...` in the background; the constructor waits for its address.
+class GuiProcess {
+ public:
+  explicit GuiProcess(const std::vector<std::string>& args) {
+    int out[2];
+    EXPECT_EQ(pipe(out), 0);
+    posix_spawn_file_actions_t actions;
+    posix_spawn_file_actions_init(&actions);
+    posix_spawn_file_actions_adddup2(&actions, out[1], STDOUT_FILENO);
+    posix_spawn_file_actions_addclose(&actions, out[0]);
+    std::vector<std::string> all = {SACCADE_BINARY, "gui"};
+    all.insert(all.end(), args.begin(), args.end());
+    std::vector<char*> argv;
+    for (std::string& a : all) argv.push_back(a.data());
+    argv.push_back(nullptr);
+    EXPECT_EQ(posix_spawn(&pid_, SACCADE_BINARY, &actions, nullptr, argv.data(), environ), 0);
+    posix_spawn_file_actions_destroy(&actions);
+    close(out[1]);
+    out_ = fdopen(out[0], "r");
+    // The scene loads and the renderer starts first: up to a minute on a busy machine.
+    char line[4096];
+    while (std::fgets(line, sizeof line, out_) != nullptr) {
+      const std::string s(line);
+      output_ += s;
+      const auto at = s.find("http://127.0.0.1:");
+      if (s.rfind("gui: serving", 0) == 0 && at != std::string::npos) {
+        port_ = std::stoi(s.substr(at + std::strlen("http://127.0.0.1:")));
+        break;
+      }
+    }
+  }
+  ~GuiProcess() {
+    if (pid_ > 0) {
+      kill(pid_, SIGTERM);
+      int status = 0;
+      waitpid(pid_, &status, 0);
+    }
+    if (out_) fclose(out_);
+  }
+  int port() const { return port_; }
+  const std::string& output() const { return output_; }
+
+ private:
+  pid_t pid_ = -1;
+  FILE* out_ = nullptr;
+  int port_ = -1;
+  std::string output_;
+};
+
+http::response<http::string_body> Get(int port, const std::string& target) {
+  asio::io_context io;
+  tcp::socket socket(io);
+  socket.connect(tcp::endpoint(asio::ip::make_address("127.0.0.1"), static_cast<uint16_t>(port)));
+  http::request<http::string_body> request(http::verb::get, target, 11);
+  request.set(http::field::host, "127.0.0.1");
+  http::write(socket, request);
+  beast::flat_buffer buffer;
+  http::response<http::string_body> response;
+  http::read(socket, buffer, response);
+  return response;
+}
+
+// A WebSocket client that reads until a message it wants arrives.
+class Client {
+ public:
+  explicit Client(int port) : ws_(io_) {
+    tcp::socket& socket = ws_.next_layer();
+    socket.connect(tcp::endpoint(asio::ip::make_address("127.0.0.1"), static_cast<uint16_t>(port)));
+    ws_.handshake("127.0.0.1", "/ws");
+  }
+  // The next text message satisfying `want` (binary frames go to frames_), within 120 s.
+  json WaitFor(const std::function<bool(const json&)>& want) {
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
+    while (std::chrono::steady_clock::now() < deadline) {
+      beast::flat_buffer buffer;
+      ws_.read(buffer);
+      const std::string data = beast::buffers_to_string(buffer.data());
+      if (!ws_.got_text()) {
+        binary_.push_back(data);
+        continue;
+      }
+      json message = json::parse(data);
+      if (want(message)) return message;
+    }
+    ADD_FAILURE() << "no such message within 120 s";
+    return json();
+  }
+  json Command(json command) {
+    command["id"] = ++id_;
+    ws_.text(true);
+    ws_.write(asio::buffer(command.dump()));
+    const int64_t id = id_;
+    return WaitFor([id](const json& m) {
+      return (m["type"] == "reply" || m["type"] == "error") && m.contains("id") && m["id"] == id;
+    });
+  }
+  json State(const std::function<bool(const json&)>& want = [](const json&) { return true; }) {
+    return WaitFor([&](const json& m) { return m["type"] == "state" && want(m); });
+  }
+  const std::vector<std::string>& binary() const { return binary_; }
+
+ private:
+  asio::io_context io_;
+  websocket::stream<tcp::socket> ws_;
+  int64_t id_ = 0;
+  std::vector<std::string> binary_;
+};
+
+Eigen::Matrix4d Matrix(const json& m) {
+  Eigen::Matrix4d X;
+  for (int i = 0; i < 16; ++i) X(i / 4, i % 4) = m[i].get<double>();
+  return X;
+}
+
+// Angle (deg) between a camera's optical axis (state.frames[camera]) and the way to p_W.
+double AxisErrorDeg(const json& state, const std::string& camera, const Eigen::Vector3d& p_W) {
+  const Eigen::Matrix4d X = Matrix(state["frames"][camera]);
+  const Eigen::Vector3d axis = X.block<3, 1>(0, 2);
+  const Eigen::Vector3d to = (p_W - X.block<3, 1>(0, 3)).normalized();
+  return std::acos(std::clamp(axis.dot(to), -1.0, 1.0)) * 180.0 / M_PI;
+}
+
+class GuiCliTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    gui_ = new GuiProcess({"--scene", kScene, "--port", "0", "--paused"});
+  }
+  static void TearDownTestSuite() {
+    delete gui_;
+    gui_ = nullptr;
+  }
+  static GuiProcess* gui_;
+};
+GuiProcess* GuiCliTest::gui_ = nullptr;
+
+TEST_F(GuiCliTest, ServesTheSceneAndItsMeshesAsTheRendererLoadedThem) {
+  ASSERT_GT(gui_->port(), 0) << gui_->output();
+  const auto scene_response = Get(gui_->port(), "/api/scene");
+  ASSERT_EQ(scene_response.result_int(), 200);
+  const json scene = json::parse(scene_response.body());
+  EXPECT_EQ(scene["protocol"], "saccade-gui");
+  EXPECT_EQ(scene["version"], 1);
+  EXPECT_EQ(scene["mode"], "gui");
+  std::vector<std::string> names;
+  for (const json& o : scene["objects"]) names.push_back(o["name"]);
+  EXPECT_THAT(names, ::testing::Contains("chelsea"));
+  ASSERT_EQ(scene["head"]["joints"].size(), 4u);
+  EXPECT_EQ(scene["head"]["joints"][0]["name"], "pan");
+  ASSERT_FALSE(scene["robot"].is_null());
+  EXPECT_FALSE(scene["robot"]["parts"].empty());
+  // Every model's binary has exactly the bytes its mesh list announces.
+  for (const json& model : scene["models"]) {
+    std::size_t expected = 0;
+    for (const json& mesh : model["meshes"]) {
+      const std::size_t v = mesh["vertices"], i = mesh["indices"];
+      expected += v * 6 * 4 + (mesh["uvs"].get<bool>() ? v * 2 * 4 : 0) + i * 4;
+    }
+    const auto bin = Get(gui_->port(), model["url"].get<std::string>());
+    EXPECT_EQ(bin.result_int(), 200) << model["url"];
+    EXPECT_EQ(bin.body().size(), expected) << model["url"];
+    for (const json& material : model["materials"]) {
+      if (material["texture"].is_null()) continue;
+      const auto png = Get(gui_->port(), material["texture"].get<std::string>());
+      ASSERT_EQ(png.result_int(), 200);
+      EXPECT_EQ(png.body().substr(1, 3), "PNG");
+    }
+  }
+  // The page and three.js come from the repository, not the internet.
+  const auto page = Get(gui_->port(), "/");
+  EXPECT_EQ(page.result_int(), 200);
+  EXPECT_THAT(page.body(), HasSubstr("/vendor/three/"));
+  EXPECT_EQ(Get(gui_->port(), "/vendor/three/build/three.module.js").result_int(), 200);
+}
+
+TEST_F(GuiCliTest, RejectsJointsOutsideTheLimitsAndMovesNothing) {
+  ASSERT_GT(gui_->port(), 0) << gui_->output();
+  Client client(gui_->port());
+  const json hello = client.WaitFor([](const json& m) { return m["type"] == "hello"; });
+  EXPECT_EQ(hello["protocol"], "saccade-gui");
+  const json scene = json::parse(Get(gui_->port(), "/api/scene").body());
+  const double pan_max = scene["head"]["joints"][0]["max"];
+  const json before = client.State();
+  EXPECT_TRUE(before["paused"].get<bool>());
+
+  json error = client.Command({{"type", "joints"}, {"positions", {{"pan", pan_max + 0.1}}}});
+  EXPECT_EQ(error["type"], "error");
+  EXPECT_THAT(error["error"].get<std::string>(), HasSubstr("pan"));
+  EXPECT_THAT(error["error"].get<std::string>(), HasSubstr("outside its limits"));
+  error = client.Command({{"type", "joints"}, {"positions", {{"pan", "left"}}}});
+  EXPECT_THAT(error["error"].get<std::string>(), HasSubstr("joints: pan: expected a number"));
+  error = client.Command({{"type", "joints"}, {"positions", {{"neck", 0.1}}}});
+  EXPECT_THAT(error["error"].get<std::string>(), HasSubstr("unknown joint 'neck'"));
+  error = client.Command({{"type", "fly"}});
+  EXPECT_THAT(error["error"].get<std::string>(), HasSubstr("unknown command type 'fly'"));
+  error = client.Command({{"type", "speed"}, {"factor", 100}});
+  EXPECT_THAT(error["error"].get<std::string>(), HasSubstr("speed: factor must be in"));
+  error = client.Command({{"type", "estop"}});
+  EXPECT_THAT(error["error"].get<std::string>(), HasSubstr("only a hardware head"));
+  // Behind the head: no fixation, with the reason.
+  error = client.Command({{"type", "fixate"}, {"p_W", {-3.0, 0.0, 1.2}}});
+  EXPECT_EQ(error["type"], "error");
+  EXPECT_THAT(error["error"].get<std::string>(), HasSubstr("cannot be fixated"));
+
+  // One step later the targets are where they were.
+  EXPECT_EQ(client.Command({{"type", "step"}})["type"], "reply");
+  const int64_t step = before["step"];
+  const json after = client.State([&](const json& s) { return s["step"] > step; });
+  EXPECT_EQ(after["joints"]["targets"], before["joints"]["targets"]);
+}
+
+TEST_F(GuiCliTest, DirectAndInverseKinematicsMoveTheHead) {
+  ASSERT_GT(gui_->port(), 0) << gui_->output();
+  Client client(gui_->port());
+  json reply = client.Command({{"type", "joints"}, {"positions", {{"pan", 0.2}, {"tilt", 0.05}}}});
+  ASSERT_EQ(reply["type"], "reply") << reply;
+  EXPECT_DOUBLE_EQ(reply["targets"]["pan"].get<double>(), 0.2);
+  EXPECT_EQ(client.Command({{"type", "step"}, {"count", 40}})["type"], "reply");
+  json state = client.State([](const json& s) {
+    return !s["joints"].is_null() && s["joints"]["arrived"].get<bool>() &&
+           std::abs(s["joints"]["positions"]["pan"].get<double>() - 0.2) < 1e-6;
+  });
+  EXPECT_NEAR(state["joints"]["positions"]["tilt"].get<double>(), 0.05, 1e-6);
+  EXPECT_FALSE(state["perception"].get<bool>());
+
+  // Fixate the cat's picture: both optical axes end on the point.
+  const json scene = json::parse(Get(gui_->port(), "/api/scene").body());
+  Eigen::Vector3d p_W = Eigen::Vector3d::Zero();
+  for (const json& o : scene["objects"]) {
+    if (o["name"] == "chelsea") p_W = Matrix(o["X_WO"]).block<3, 1>(0, 3);
+  }
+  reply = client.Command({{"type", "fixate"}, {"p_W", {p_W.x(), p_W.y(), p_W.z()}}});
+  ASSERT_EQ(reply["type"], "reply") << reply;
+  EXPECT_LT(reply["axis_error_deg"].get<double>(), 1e-3);
+  EXPECT_EQ(client.Command({{"type", "step"}, {"count", 60}})["type"], "reply");
+  state = client.State([](const json& s) {
+    return s["joints"]["arrived"].get<bool>() && s["joints"]["positions"]["pan"] != 0.2;
+  });
+  EXPECT_LT(AxisErrorDeg(state, "left", p_W), 0.05);
+  EXPECT_LT(AxisErrorDeg(state, "right", p_W), 0.05);
+  EXPECT_TRUE(state["fixation_W"].is_array());
+}
+
+TEST_F(GuiCliTest, SwitchesEffectsAndStreamsJpegFrames) {
+  ASSERT_GT(gui_->port(), 0) << gui_->output();
+  Client client(gui_->port());
+  json error = client.Command({{"type", "effects"}, {"noise", "off"}});
+  EXPECT_THAT(error["error"].get<std::string>(), HasSubstr("noise must be true or false"));
+  json reply = client.Command({{"type", "effects"}, {"noise", false}});
+  ASSERT_EQ(reply["type"], "reply");
+  EXPECT_EQ(client.Command({{"type", "step"}, {"count", 2}})["type"], "reply");
+  const json state = client.State([](const json& s) { return !s["effects"]["noise"].get<bool>(); });
+  EXPECT_TRUE(state["effects"]["distortion"].get<bool>());
+  // Frames: [4-byte length][JSON header][JPEG].
+  while (client.binary().empty()) client.Command({{"type", "step"}});
+  const std::string& frame = client.binary().front();
+  ASSERT_GT(frame.size(), 4u);
+  uint32_t n = 0;
+  std::memcpy(&n, frame.data(), 4);
+  const json header = json::parse(frame.substr(4, n));
+  EXPECT_EQ(header["type"], "frame");
+  EXPECT_TRUE(header["camera"] == "left" || header["camera"] == "right");
+  EXPECT_EQ(header["width"], 1024);
+  EXPECT_EQ(static_cast<unsigned char>(frame[4 + n]), 0xFF);  // JPEG's SOI marker
+  EXPECT_EQ(static_cast<unsigned char>(frame[5 + n]), 0xD8);
+}
+
+TEST_F(GuiCliTest, PerceptionSwitchedOnFindsTheFaceAndFixatesIt) {
+  ASSERT_GT(gui_->port(), 0) << gui_->output();
+  Client client(gui_->port());
+  json reply = client.Command({{"type", "perception"}, {"enabled", "yes"}});
+  EXPECT_THAT(reply["error"].get<std::string>(), HasSubstr("enabled must be true or false"));
+  reply = client.Command({{"type", "perception"}, {"enabled", true}});
+  ASSERT_EQ(reply["type"], "reply") << reply;
+  EXPECT_EQ(client.Command({{"type", "step"}, {"count", 100}})["type"], "reply");
+  // The loop finds the astronaut's face, triangulates it and turns both eyes to it.
+  const json state = client.State([](const json& s) {
+    return s["perception"].get<bool>() && !s["target"].is_null() &&
+           !s["fixation_error_deg"].is_null() &&
+           s["fixation_error_deg"]["left"].get<double>() < 0.5 &&
+           s["fixation_error_deg"]["right"].get<double>() < 0.5;
+  });
+  const Eigen::Vector3d p_W(state["target"]["p_W"][0].get<double>(),
+                            state["target"]["p_W"][1].get<double>(),
+                            state["target"]["p_W"][2].get<double>());
+  EXPECT_LT(AxisErrorDeg(state, "left", p_W), 0.5);
+  // A hand command takes the head back from the loop.
+  reply = client.Command({{"type", "joints"}, {"positions", {{"pan", 0.0}}}});
+  EXPECT_FALSE(reply["perception"].get<bool>());
+  EXPECT_EQ(client.Command({{"type", "step"}})["type"], "reply");
+  // (WaitFor fails the test when no such state comes.)
+  const json manual = client.State([](const json& s) { return !s["perception"].get<bool>(); });
+  EXPECT_TRUE(manual["target"].is_null());  // no stale target drawn while the loop is off
+}
+
+TEST(GuiCli, RefusesToListenBeyondLoopbackWithoutAToken) {
+  const saccade::e2e::CommandRun run =
+      saccade::e2e::Saccade("gui --scene " + kScene + " --listen 0.0.0.0 --port 0");
+  EXPECT_EQ(run.status, 1) << run.output;
+  EXPECT_THAT(run.output, HasSubstr("token"));
+}
+
+}  // namespace

@@ -1,0 +1,284 @@
+// saccade's browser GUI: loads the scene from the server, builds the 3D world and the head,
+// connects the WebSocket, and wires the views, controls, plots and mouse. Exposes
+// window.saccadeGui for the browser tests (web/tests/gui.test.mjs).
+import * as THREE from 'three';
+import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
+import { AccessError, Connection, fetchApi, token } from './connection.js';
+import { buildWorld, loadModels, updateObjects } from './scene.js';
+import { Head, kLinkFrames } from './head.js';
+import { installInteraction, kDragGainDegPerPx } from './interact.js';
+import { CameraView, Controls, log } from './views.js';
+import { Plot } from './plots.js';
+
+const $ = (id) => document.getElementById(id);
+const kDeg = 180 / Math.PI;
+
+// The test hooks (see the file comment).
+const gui = window.saccadeGui = {
+  ready: false,
+  accessDenied: false,
+  state: null,
+  hello: null,
+  framesReceived: { left: 0, right: 0 },
+  framesShown: { left: 0, right: 0 },
+  pageFps: { left: 0, right: 0 },
+  lastClick: null,
+  errors: [],
+  dragGainDegPerPx: kDragGainDegPerPx,
+  tokenPresent: !!token,
+};
+
+function showAccessDenied() {
+  gui.accessDenied = true;
+  $('access').hidden = false;
+  $('layout').hidden = true;
+  $('connection').textContent = 'access denied';
+  $('connection').className = 'badge bad';
+}
+
+async function start() {
+  let doc;
+  try {
+    doc = await (await fetchApi('/api/scene')).json();
+  } catch (e) {
+    if (e instanceof AccessError) { showAccessDenied(); return; }
+    throw e;
+  }
+  gui.scene = doc;
+  $('scene-name').textContent = `${doc.name} (${doc.mode})`;
+  document.title = `saccade · ${doc.name}`;
+  const limits = Object.fromEntries((doc.head?.joints ?? []).map((j) => [j.name, j]));
+
+  // The 3D view: z up, first seen from behind and above the head, the pictures beyond it.
+  const canvas = $('world-canvas');
+  const renderer = new THREE.WebGLRenderer({ canvas, antialias: true, preserveDrawingBuffer: true });
+  renderer.outputColorSpace = THREE.LinearSRGBColorSpace;  // the simulator's colours are linear
+  renderer.setPixelRatio(window.devicePixelRatio || 1);
+  const scene = new THREE.Scene();
+  const camera = new THREE.PerspectiveCamera(50, 1, 0.02, 100);
+  camera.up.set(0, 0, 1);
+  camera.position.set(-1.5, -0.7, 2.1);
+
+  const models = await loadModels(doc.models ?? []);
+  const world = buildWorld(scene, doc, models);
+  const images = { left: $('image-left'), right: $('image-right') };
+  const head = new Head(scene, doc, models, images);
+
+  let dirty = true;
+  const redraw = () => { dirty = true; };
+  let latest = null;
+
+  // The connection: commands, replies and errors.
+  const logElement = $('log');
+  const send = async (type, fields = {}) => {
+    const reply = await connection.send(type, fields);
+    return reply;
+  };
+  const app = {
+    camera, head, limits, pickables: world.pickables,
+    latestState: () => latest,
+    send,
+    onClick: (p) => {
+      gui.lastClick = p.toArray();
+      head.showClick(p);
+      redraw();
+      log(logElement, `fixate [${gui.lastClick.map((v) => v.toFixed(3)).join(', ')}]`);
+      send('fixate', { p_W: gui.lastClick });
+    },
+  };
+  installInteraction(canvas, app);  // before OrbitControls: a drag on the head disables them
+  const controls = new OrbitControls(camera, canvas);
+  controls.target.set(1.0, 0.0, 1.0);
+  controls.update();
+  controls.addEventListener('change', redraw);
+  app.controls = controls;
+
+  const controlsPanel = new Controls(document.body, send, (d) => { head.setImageDistance(d); redraw(); });
+  const views = {};
+  for (const name of ['left', 'right']) {
+    views[name] = new CameraView(images[name], $(`label-${name}`), name, (n) => {
+      gui.framesShown[n]++;
+      head.imageUpdated(n);
+      redraw();
+      maybeReady();
+    });
+  }
+
+  // Plots: joints, fixation error, rates, step time.
+  const plots = {
+    joints: new Plot($('plot-joints'), 'joints', [
+      { key: 'pan', label: 'pan', color: '#d03030' }, { key: 'tilt', label: 'tilt', color: '#2a8a2a' },
+      { key: 'left', label: 'L', color: '#2050e0' }, { key: 'right', label: 'R', color: '#c07000' }], '°'),
+    error: new Plot($('plot-error'), 'fixation error', [
+      { key: 'left', label: 'L', color: '#2050e0' }, { key: 'right', label: 'R', color: '#c07000' }], '°'),
+    rate: new Plot($('plot-rate'), 'rates', [
+      { key: 'steps', label: 'steps', color: '#d03030' }, { key: 'fps', label: 'frames', color: '#2050e0' },
+      { key: 'page', label: 'page', color: '#2a8a2a' }], '/s'),
+    step: new Plot($('plot-step'), 'step', [{ key: 'ms', label: '', color: '#803090' },
+      { key: 'rt', label: 'rt×', color: '#2a8a2a' }], 'ms'),
+  };
+
+  function maybeReady() {
+    if (!gui.ready && latest && gui.framesShown.left > 0 && gui.framesShown.right > 0) {
+      gui.ready = true;
+      log(logElement, 'ready');
+    }
+  }
+
+  const connection = new Connection({
+    onHello: (m) => {
+      gui.hello = m;
+      $('connection').textContent = `connected · client ${m.client}`;
+      $('connection').className = 'badge ok';
+    },
+    onState: (state) => {
+      latest = state;
+      gui.state = state;
+      head.update(state);
+      updateObjects(world.objects, state.objects);
+      controlsPanel.reflect(state);
+      const t = performance.now() / 1000;
+      const p = state.joints?.positions ?? {};
+      plots.joints.add(t, Object.fromEntries(Object.entries(p).map(([k, v]) => [k, v * kDeg])));
+      const e = state.fixation_error_deg;
+      plots.error.add(t, { left: e?.left, right: e?.right });
+      const timing = state.timing ?? {};
+      plots.rate.add(t, { steps: timing.steps_per_s, fps: timing.frames_per_s, page: gui.pageFps.left });
+      plots.step.add(t, { ms: timing.step_ms, rt: timing.realtime_factor });
+      $('sim-time').textContent = `step ${state.step} · t ${Number(state.time).toFixed(2)} s` +
+        (state.paused ? ' · paused' : '') + (state.manual ? ' · manual' : '');
+      redraw();
+      maybeReady();
+    },
+    onFrame: (header, blob) => {
+      if (!(header.camera in views)) return;  // world cameras: not shown
+      gui.framesReceived[header.camera]++;
+      views[header.camera].frame(header, blob);
+    },
+    onError: (m) => {
+      gui.errors.push(m);
+      log(logElement, `error${m.id != null ? ` (#${m.id})` : ''}: ${m.error}`, 'error');
+    },
+    onEvent: (m) => log(logElement, m.message, m.level),
+    onClose: () => {
+      $('connection').textContent = 'disconnected';
+      $('connection').className = 'badge bad';
+      log(logElement, 'connection closed', 'error');
+    },
+  });
+  gui.connection = connection;
+
+  // Page frame rates, once a second.
+  let counted = { ...gui.framesShown }, countedAt = performance.now();
+  setInterval(() => {
+    const now = performance.now();
+    for (const n of ['left', 'right']) {
+      gui.pageFps[n] = (gui.framesShown[n] - counted[n]) / ((now - countedAt) / 1000);
+    }
+    counted = { ...gui.framesShown };
+    countedAt = now;
+  }, 1000);
+
+  // Rendering: only when something changed; plots at ~4 Hz.
+  const resize = () => {
+    const w = canvas.clientWidth, h = canvas.clientHeight;
+    if (canvas.width !== Math.round(w * renderer.getPixelRatio()) ||
+        canvas.height !== Math.round(h * renderer.getPixelRatio())) {
+      renderer.setSize(w, h, false);
+      camera.aspect = w / Math.max(1, h);
+      camera.updateProjectionMatrix();
+      dirty = true;
+    }
+  };
+  const render = () => {
+    resize();
+    renderer.render(scene, camera);
+    dirty = false;
+  };
+  const loop = () => {
+    resize();
+    if (dirty) render();
+    requestAnimationFrame(loop);
+  };
+  requestAnimationFrame(loop);
+  setInterval(() => {
+    const t = performance.now() / 1000;
+    for (const plot of Object.values(plots)) plot.draw(t);
+  }, 250);
+
+  // The test hooks that need the world.
+  const raycaster = new THREE.Raycaster();
+  const pageOf = (p) => {
+    const r = canvas.getBoundingClientRect();
+    const ndc = p.clone().project(camera);
+    return { x: r.left + (ndc.x + 1) / 2 * r.width, y: r.top + (1 - ndc.y) / 2 * r.height, ndc };
+  };
+  const belongsTo = (object, root) => {
+    for (let o = object; o; o = o.parent) if (o === root) return true;
+    return false;
+  };
+  // Page coordinates of an object's (or a robot link's) centre: its bounding box's centre
+  // projected; when a raycast finds that point hidden by something else, the visible point of
+  // the object nearest to it (a grid of rays over its projected box). {x, y, visible}.
+  gui.screenPointOf = (name) => {
+    render();
+    const root = world.objects.get(name) ?? (name in kLinkFrames ? head.links.get(name) : null);
+    if (!root) throw new Error(`screenPointOf: no object or link named '${name}'`);
+    root.updateMatrixWorld(true);
+    const box = new THREE.Box3().setFromObject(root);
+    const centre = box.isEmpty() ? new THREE.Vector3().setFromMatrixPosition(root.matrixWorld)
+      : box.getCenter(new THREE.Vector3());
+    const c = pageOf(centre);
+    const targets = [...world.pickables, ...head.draggables,
+      ...head.links.get('base').children.flatMap((part) => part.children)];
+    const sees = (ndcX, ndcY) => {
+      if (Math.abs(ndcX) > 1 || Math.abs(ndcY) > 1) return false;
+      raycaster.setFromCamera(new THREE.Vector2(ndcX, ndcY), camera);
+      const hit = raycaster.intersectObjects(targets, false)[0];
+      return !!hit && belongsTo(hit.object, root);
+    };
+    if (c.ndc.z < 1 && sees(c.ndc.x, c.ndc.y)) return { x: c.x, y: c.y, visible: true };
+    if (box.isEmpty()) return { x: c.x, y: c.y, visible: false };
+    // The projected box, sampled on a grid; the visible sample nearest the centre.
+    const lo = new THREE.Vector2(Infinity, Infinity), hi = new THREE.Vector2(-Infinity, -Infinity);
+    for (let i = 0; i < 8; i++) {
+      const corner = new THREE.Vector3(i & 1 ? box.max.x : box.min.x, i & 2 ? box.max.y : box.min.y,
+        i & 4 ? box.max.z : box.min.z).project(camera);
+      lo.min(new THREE.Vector2(corner.x, corner.y));
+      hi.max(new THREE.Vector2(corner.x, corner.y));
+    }
+    const n = 16;
+    let best = null;
+    for (let i = 0; i <= n; i++) {
+      for (let j = 0; j <= n; j++) {
+        const x = lo.x + ((hi.x - lo.x) * i) / n, y = lo.y + ((hi.y - lo.y) * j) / n;
+        const d = Math.hypot(x - c.ndc.x, y - c.ndc.y);
+        if ((!best || d < best.d) && sees(x, y)) best = { x, y, d };
+      }
+    }
+    if (!best) return { x: c.x, y: c.y, visible: false };
+    const r = canvas.getBoundingClientRect();
+    return { x: r.left + ((best.x + 1) / 2) * r.width, y: r.top + ((1 - best.y) / 2) * r.height, visible: true };
+  };
+  // Sets the 3D view (position and target, world metres) and renders.
+  gui.setView = (position, target) => {
+    camera.position.set(...position);
+    controls.target.set(...target);
+    controls.update();
+    render();
+  };
+  gui.send = (type, fields) => send(type, fields);
+  gui.render = render;
+  gui.setImageDistance = (d) => {
+    const slider = $('plane-distance');
+    slider.value = String(d);
+    slider.dispatchEvent(new Event('input'));
+  };
+}
+
+start().catch((e) => {
+  console.error(e);
+  const el = $('log');
+  if (el) log(el, `error: ${e.message}`, 'error');
+  gui.fatal = String(e.message ?? e);
+});

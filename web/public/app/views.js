@@ -1,0 +1,115 @@
+// The two camera views (live JPEG frames with the server's overlays), the controls that
+// command the simulation and reflect its state, and the log of errors and events.
+
+/**
+ * One camera's live image: the newest JPEG decoded into an <img> through a Blob URL (the
+ * previous URL revoked once the next image has loaded). A frame that arrives while one is
+ * decoding waits; a newer one replaces it (only the newest is shown).
+ */
+export class CameraView {
+  constructor(image, label, name, onImage) {
+    this.image = image;
+    this.label = label;
+    this.name = name;
+    this.onImage = onImage;
+    this.url = null;
+    this.decoding = false;
+    this.waiting = null;       // [header, blob]
+    this.received = 0;         // frames received
+    this.shown = 0;            // frames decoded and shown
+    this.image.addEventListener('load', () => this.loaded());
+    this.image.addEventListener('error', () => this.loaded());
+  }
+
+  frame(header, blob) {
+    this.received++;
+    if (this.decoding) { this.waiting = [header, blob]; return; }
+    this.show(header, blob);
+  }
+
+  show(header, blob) {
+    this.decoding = true;
+    this.header = header;
+    this.previousUrl = this.url;
+    this.url = URL.createObjectURL(blob);
+    this.image.src = this.url;
+  }
+
+  loaded() {
+    if (this.previousUrl) URL.revokeObjectURL(this.previousUrl);
+    this.previousUrl = null;
+    this.decoding = false;
+    this.shown++;
+    const h = this.header;
+    this.label.textContent = `${this.name} camera · ${h.width}×${h.height} · frame ${h.frame} · t ${Number(h.time).toFixed(2)} s`;
+    this.onImage?.(this.name);
+    if (this.waiting) {
+      const [header, blob] = this.waiting;
+      this.waiting = null;
+      this.show(header, blob);
+    }
+  }
+}
+
+/** A line in the page's log (errors in red). */
+export function log(element, text, level = 'info') {
+  const line = document.createElement('div');
+  line.className = `log-${level}`;
+  line.textContent = `${new Date().toLocaleTimeString()} ${text}`;
+  element.prepend(line);
+  while (element.childElementCount > 100) element.lastElementChild.remove();
+}
+
+/**
+ * The controls: effects, perception, pause/resume, step, speed, stop, and the image plane's
+ * distance. `send(type, fields)` sends a command; `onDistance(d)` moves the image planes.
+ */
+export class Controls {
+  constructor(root, send, onDistance) {
+    this.root = root;
+    const $ = (id) => root.querySelector(`#${id}`);
+    this.effects = { distortion: $('fx-distortion'), noise: $('fx-noise'), motion_blur: $('fx-blur') };
+    for (const [key, box] of Object.entries(this.effects)) {
+      box.addEventListener('change', () => send('effects', { [key]: box.checked }));
+    }
+    this.perception = $('perception');
+    this.perception.addEventListener('change', () => send('perception', { enabled: this.perception.checked }));
+    this.pause = $('pause');
+    this.pause.addEventListener('click', () => send(this.paused ? 'resume' : 'pause'));
+    this.step = $('step');
+    this.step.addEventListener('click', () => send('step', { count: 1 }));
+    $('stop').addEventListener('click', () => send('stop'));
+    this.speed = $('speed');
+    this.speed.addEventListener('change', () => send('speed', { factor: Number(this.speed.value) }));
+    this.distance = $('plane-distance');
+    this.distanceValue = $('plane-distance-value');
+    this.distance.addEventListener('input', () => {
+      const d = Number(this.distance.value);
+      this.distanceValue.textContent = `${d.toFixed(2)} m`;
+      onDistance(d);
+    });
+    this.paused = false;
+  }
+
+  /** Shows the server's state in the controls. */
+  reflect(state) {
+    for (const [key, box] of Object.entries(this.effects)) {
+      if (state.effects && key in state.effects) box.checked = !!state.effects[key];
+    }
+    if ('perception' in state) this.perception.checked = !!state.perception;
+    this.paused = !!state.paused;
+    this.pause.textContent = this.paused ? 'Resume' : 'Pause';
+    this.pause.classList.toggle('active', this.paused);
+    this.step.disabled = !this.paused;
+    if (Number.isFinite(state.speed) && document.activeElement !== this.speed) {
+      const options = [...this.speed.options].map((o) => Number(o.value));
+      if (!options.includes(state.speed)) {
+        const o = document.createElement('option');
+        o.value = String(state.speed);
+        o.textContent = `${state.speed}×`;
+        this.speed.append(o);
+      }
+      this.speed.value = String(state.speed);
+    }
+  }
+}
