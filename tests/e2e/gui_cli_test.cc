@@ -42,7 +42,8 @@ using tcp = asio::ip::tcp;
 const std::string kSource = SACCADE_SOURCE_DIR;
 const std::string kScene = kSource + "/scenes/astronaut_and_cat.yaml";
 
-// `saccade gui ...` in the background; the constructor waits for its address.
+// `saccade ARGS` (gui ..., demo --gui ...) in the background; the constructor waits for its
+// address.
 class GuiProcess {
  public:
   explicit GuiProcess(const std::vector<std::string>& args) {
@@ -52,7 +53,7 @@ class GuiProcess {
     posix_spawn_file_actions_init(&actions);
     posix_spawn_file_actions_adddup2(&actions, out[1], STDOUT_FILENO);
     posix_spawn_file_actions_addclose(&actions, out[0]);
-    std::vector<std::string> all = {SACCADE_BINARY, "gui"};
+    std::vector<std::string> all = {SACCADE_BINARY};
     all.insert(all.end(), args.begin(), args.end());
     std::vector<char*> argv;
     for (std::string& a : all) argv.push_back(a.data());
@@ -74,12 +75,22 @@ class GuiProcess {
     }
   }
   ~GuiProcess() {
+    Stop();
+    if (out_) fclose(out_);
+  }
+  // SIGTERM, then what it printed until it exited, and its exit status.
+  int Stop() {
+    int status = -1;
     if (pid_ > 0) {
       kill(pid_, SIGTERM);
-      int status = 0;
-      waitpid(pid_, &status, 0);
+      char line[4096];
+      while (std::fgets(line, sizeof line, out_) != nullptr) output_ += line;
+      int raw = 0;
+      waitpid(pid_, &raw, 0);
+      status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
+      pid_ = -1;
     }
-    if (out_) fclose(out_);
+    return status;
   }
   int port() const { return port_; }
   const std::string& output() const { return output_; }
@@ -167,7 +178,7 @@ double AxisErrorDeg(const json& state, const std::string& camera, const Eigen::V
 class GuiCliTest : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
-    gui_ = new GuiProcess({"--scene", kScene, "--port", "0", "--paused"});
+    gui_ = new GuiProcess({"gui", "--scene", kScene, "--port", "0", "--paused"});
   }
   static void TearDownTestSuite() {
     delete gui_;
@@ -334,6 +345,24 @@ TEST_F(GuiCliTest, PerceptionSwitchedOnFindsTheFaceAndFixatesIt) {
   // (WaitFor fails the test when no such state comes.)
   const json manual = client.State([](const json& s) { return !s["perception"].get<bool>(); });
   EXPECT_TRUE(manual["target"].is_null());  // no stale target drawn while the loop is off
+}
+
+TEST(GuiCli, DemoWithTheGuiRunsTheLoopUntilStoppedThenReports) {
+  GuiProcess demo({"demo", "--gui", "--scene", kScene, "--port", "0"});
+  ASSERT_GT(demo.port(), 0) << demo.output();
+  Client client(demo.port());
+  const json hello = client.WaitFor([](const json& m) { return m["type"] == "hello"; });
+  EXPECT_EQ(hello["mode"], "demo");
+  // Perception is on from the start: the loop fixates the astronaut by itself.
+  const json state = client.State([](const json& s) {
+    return s["perception"].get<bool>() && !s["fixation_error_deg"].is_null() &&
+           s["fixation_error_deg"]["left"].get<double>() < 0.5;
+  });
+  EXPECT_FALSE(state["paused"].get<bool>());
+  EXPECT_EQ(demo.Stop(), 0);
+  EXPECT_THAT(demo.output(), HasSubstr("fixated astronaut"));
+  EXPECT_THAT(demo.output(), HasSubstr("1 of 1 faces fixated"));
+  EXPECT_THAT(demo.output(), HasSubstr("images encoded"));
 }
 
 TEST(GuiCli, RefusesToListenBeyondLoopbackWithoutAToken) {
