@@ -462,3 +462,36 @@ describe('saccade gui with an access token', () => {
     await good.close();
   });
 });
+
+describe('saccade gui restarted', () => {
+  let browser, server;
+
+  before(async () => {
+    browser = await chromium.launch({ executablePath: '/usr/bin/chromium', args: kChromiumArgs });
+  });
+
+  after(async () => {
+    await browser?.close().catch(() => {});
+    await stopSaccade(server);
+  });
+
+  test('the page says it lost saccade, then reloads with the new scene when it is back', async () => {
+    const twoPictures = path.join(kRepo, 'scenes', 'astronaut_and_cat.yaml');
+    server = await startSaccade(['gui', '--scene', twoPictures, '--port', '0']);
+    const port = server.port;
+    const page = await openPage(browser, localUrl(server));
+    await waitReady(page);
+    const names = async () => page.evaluate(() => window.saccadeGui.scene.objects.map((o) => o.name));
+    assert.ok(!(await names()).includes('astronaut_near'));
+
+    await stopSaccade(server);
+    await page.waitForFunction(() => /disconnected/.test(document.getElementById('connection').textContent),
+      null, { timeout: 30_000 });
+    const reloaded = page.waitForEvent('load', { timeout: kReadyTimeoutMs });
+    server = await startSaccade(['gui', '--scene', kScene, '--port', String(port)]);
+    await reloaded;
+    await waitReady(page);
+    assert.ok((await names()).includes('astronaut_near'), 'the page shows the new scene');
+    await page.close();
+  });
+});

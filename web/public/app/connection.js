@@ -36,7 +36,14 @@ export class Connection {
     this.socket = new WebSocket(this.url);
     this.socket.binaryType = 'arraybuffer';
     this.socket.onmessage = (event) => this.receive(event.data);
-    this.socket.onclose = () => handlers.onClose?.();
+    this.socket.onclose = () => {
+      // Commands still waiting for a reply never get one: they fail.
+      for (const [id, waiting] of this.pending) {
+        waiting.resolve({ type: 'error', id, error: 'the connection closed before the reply' });
+      }
+      this.pending.clear();
+      handlers.onClose?.();
+    };
   }
 
   get open() { return this.socket.readyState === WebSocket.OPEN; }

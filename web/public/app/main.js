@@ -161,9 +161,21 @@ async function start() {
     },
     onEvent: (m) => log(logElement, m.message, m.level),
     onClose: () => {
-      $('connection').textContent = 'disconnected';
+      $('connection').textContent = 'disconnected: retrying';
       $('connection').className = 'badge bad';
-      log(logElement, 'connection closed', 'error');
+      log(logElement, 'connection closed; the page reloads once saccade serves again', 'error');
+      // saccade may come back (restarted, perhaps on another scene): ask every 2 s and
+      // reload the whole page when it answers, so that the scene is its new one.
+      const retry = async () => {
+        try {
+          await fetchApi('/api/scene');
+          location.reload();
+        } catch (e) {
+          if (e instanceof AccessError) { showAccessDenied(); return; }
+          setTimeout(retry, 2000);
+        }
+      };
+      setTimeout(retry, 2000);
     },
   });
   gui.connection = connection;
