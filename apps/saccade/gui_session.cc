@@ -125,7 +125,7 @@ double AxisErrorDeg(const geometry::Pose& X_WC, const Eigen::Vector3d& p_W) {
 
 GuiSession::GuiSession(runtime::Pipeline& pipeline, const scene::Scene& scene,
                        const std::string& scene_name, const GuiOptions& options)
-    : pipeline_(pipeline), scene_(scene), options_(options) {
+    : scene_(scene), options_(options) {
   paused_ = options.paused;
   speed_ = options.speed;
   perception_ = options.perception;
@@ -311,10 +311,6 @@ GuiSession::GuiSession(runtime::Pipeline& pipeline, const scene::Scene& scene,
   server_->SetDocument("/api/scene", "application/json", scene_json.dump());
   server_->SetCommandHandler(
       [this](const json& command, int64_t client) { return Handle(command, client); });
-  server_->SetWelcome([this] {
-    std::lock_guard lock(state_mutex_);
-    return state_text_.empty() ? std::vector<std::string>{} : std::vector{state_text_};
-  });
   server_->Start();
   encoder_ = std::thread([this] { EncodeLoop(); });
 }
@@ -618,14 +614,6 @@ json GuiSession::StateJson(const runtime::StepContext& context, const Latest& la
   return state;
 }
 
-void GuiSession::PublishState(const json& state) {
-  {
-    std::lock_guard lock(state_mutex_);
-    state_text_ = state.dump();
-  }
-  server_->PublishState(state);
-}
-
 void GuiSession::AfterStep(const runtime::StepContext& context, const Latest& latest,
                            const std::atomic<bool>& stop) {
   const double arrived = WallNow();
@@ -635,8 +623,7 @@ void GuiSession::AfterStep(const runtime::StepContext& context, const Latest& la
   sim_time_ = context.time + context.dt;
 
   ApplyQueued();
-  json state = StateJson(context, latest);
-  PublishState(state);
+  server_->PublishState(StateJson(context, latest));
 
   // The newest images to the encoder (it drops what it has not started on).
   const auto left = latest.images.find("left");
@@ -652,7 +639,6 @@ void GuiSession::AfterStep(const runtime::StepContext& context, const Latest& la
       to_encode_->target.reset();
       to_encode_->selection.reset();
     }
-    to_encode_header_ = {{"frame", frame}, {"time", context.time}};
     encode_cv_.notify_one();
   }
 
@@ -672,7 +658,7 @@ void GuiSession::AfterStep(const runtime::StepContext& context, const Latest& la
     if (pending || ++waited % 10 == 0) {
       // Commands while paused take effect (targets) and the page sees them.
       ApplyQueued();
-      PublishState(StateJson(context, latest));
+      server_->PublishState(StateJson(context, latest));
     }
     anchor_wall_ = -1.0;  // the clock restarts from here
   }
@@ -700,13 +686,11 @@ void GuiSession::AfterStep(const runtime::StepContext& context, const Latest& la
 void GuiSession::EncodeLoop() {
   while (true) {
     Latest latest;
-    json header;
     {
       std::unique_lock lock(encode_mutex_);
       encode_cv_.wait(lock, [this] { return encoder_stop_ || to_encode_.has_value(); });
       if (encoder_stop_) return;
       latest = std::move(*to_encode_);
-      header = to_encode_header_;
       to_encode_.reset();
     }
     try {
@@ -715,14 +699,14 @@ void GuiSession::EncodeLoop() {
         const cv::Mat bgr = Annotate(latest, camera, 1.0);
         std::vector<uint8_t> jpeg;
         cv::imencode(".jpg", bgr, jpeg, {cv::IMWRITE_JPEG_QUALITY, options_.jpeg_quality});
-        json h = header;
-        h["type"] = "frame";
-        h["camera"] = camera;
-        h["frame"] = image->metadata().frame_index;
-        h["width"] = bgr.cols;
-        h["height"] = bgr.rows;
-        h["overlay"] = true;
-        server_->PublishFrame(camera, h,
+        const json header = {{"type", "frame"},
+                             {"camera", camera},
+                             {"frame", image->metadata().frame_index},
+                             {"time", image->metadata().time},
+                             {"width", bgr.cols},
+                             {"height", bgr.rows},
+                             {"overlay", true}};
+        server_->PublishFrame(camera, header,
                               std::make_shared<const std::string>(jpeg.begin(), jpeg.end()));
       }
       ++frames_encoded_;

@@ -67,13 +67,11 @@ class GuiSession {
   void Enqueue(std::function<void()> action);
   void ApplyQueued();
   nlohmann::json StateJson(const runtime::StepContext& context, const Latest& latest);
-  void PublishState(const nlohmann::json& state);
   void EncodeLoop();
   head::JointState CurrentTargets() const;
   void CallHead(const std::string& method, const nlohmann::json& request);
   void SetPerception(bool enabled);  // simulation thread
 
-  runtime::Pipeline& pipeline_;
   const scene::Scene& scene_;
   GuiOptions options_;
   std::unique_ptr<server::GuiServer> server_;
@@ -109,16 +107,11 @@ class GuiSession {
   std::vector<double> step_walls_;  // recent AfterStep times, for steps per second
   int64_t last_frame_sent_ = -1;
 
-  // The newest state's text, for clients that connect later.
-  mutable std::mutex state_mutex_;
-  std::string state_text_;
-
   // The encoder thread and its one-slot mailbox.
   std::thread encoder_;
   std::mutex encode_mutex_;
   std::condition_variable encode_cv_;
   std::optional<Latest> to_encode_;
-  nlohmann::json to_encode_header_;
   bool encoder_stop_ = false;
   std::atomic<int64_t> frames_encoded_{0};
   std::vector<double> encode_walls_;  // encoder thread (encode_mutex_)

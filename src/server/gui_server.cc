@@ -235,10 +235,11 @@ struct ServerCore {
   ServerOptions options;
   std::vector<std::pair<std::string, fs::path>> mounts;  // prefix -> canonical folder
 
-  mutable std::mutex config_mutex;  // handler, documents, welcome
+  mutable std::mutex config_mutex;  // handler, documents, welcome, latest_state
   CommandHandler handler;
   std::map<std::string, std::shared_ptr<const Document>, std::less<>> documents;
   std::function<std::vector<std::string>()> welcome;
+  Text latest_state;  // the newest published state, for clients that connect later
 
   mutable std::mutex clients_mutex;
   std::map<int64_t, std::shared_ptr<WsSession>> clients;
@@ -380,9 +381,11 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
     hello["version"] = kProtocolVersion;
     hello["client"] = stats_.id;
     std::function<std::vector<std::string>()> welcome;
+    Text latest_state;
     {
       std::lock_guard lock(server_->config_mutex);
       welcome = server_->welcome;
+      latest_state = server_->latest_state;
     }
     std::vector<Text> texts{std::make_shared<const std::string>(
         hello.dump(-1, ' ', false, json::error_handler_t::replace))};
@@ -404,6 +407,11 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
       for (auto it = texts.rbegin(); it != texts.rend(); ++it) {
         texts_.push_front(*it);
         queued_bytes_ += (*it)->size();
+      }
+      // Then the newest state, unless one published during the handshake is already here.
+      if (!state_ && latest_state) {
+        state_ = latest_state;
+        queued_bytes_ += state_->size();
       }
       open_ = true;
     }
@@ -1084,6 +1092,10 @@ std::string GuiServer::url() const {
 void GuiServer::PublishState(const nlohmann::json& state) {
   const auto text = std::make_shared<const std::string>(
       state.dump(-1, ' ', false, json::error_handler_t::replace));
+  {
+    std::lock_guard lock(impl_->core.config_mutex);
+    impl_->core.latest_state = text;
+  }
   for (const auto& session : impl_->core.Snapshot()) session->OfferState(text);
 }
 

@@ -5,10 +5,6 @@
 // (web/tests/gui.test.mjs) drive the page itself.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
-#include <signal.h>
-#include <spawn.h>
-#include <sys/wait.h>
-#include <unistd.h>
 
 #include <Eigen/Geometry>
 #include <boost/asio/connect.hpp>
@@ -27,8 +23,6 @@
 
 #include "e2e/run_saccade.h"
 
-extern char** environ;
-
 namespace {
 
 namespace asio = boost::asio;
@@ -46,58 +40,28 @@ const std::string kScene = kSource + "/scenes/astronaut_and_cat.yaml";
 // address.
 class GuiProcess {
  public:
-  explicit GuiProcess(const std::vector<std::string>& args) {
-    int out[2];
-    EXPECT_EQ(pipe(out), 0);
-    posix_spawn_file_actions_t actions;
-    posix_spawn_file_actions_init(&actions);
-    posix_spawn_file_actions_adddup2(&actions, out[1], STDOUT_FILENO);
-    posix_spawn_file_actions_addclose(&actions, out[0]);
-    std::vector<std::string> all = {SACCADE_BINARY};
-    all.insert(all.end(), args.begin(), args.end());
-    std::vector<char*> argv;
-    for (std::string& a : all) argv.push_back(a.data());
-    argv.push_back(nullptr);
-    EXPECT_EQ(posix_spawn(&pid_, SACCADE_BINARY, &actions, nullptr, argv.data(), environ), 0);
-    posix_spawn_file_actions_destroy(&actions);
-    close(out[1]);
-    out_ = fdopen(out[0], "r");
+  explicit GuiProcess(std::vector<std::string> args)
+      : process_([&] {
+          args.insert(args.begin(), SACCADE_BINARY);
+          return args;
+        }()) {
     // The scene loads and the renderer starts first: up to a minute on a busy machine.
-    char line[4096];
-    while (std::fgets(line, sizeof line, out_) != nullptr) {
-      const std::string s(line);
-      output_ += s;
-      const auto at = s.find("http://127.0.0.1:");
-      if (s.rfind("gui: serving", 0) == 0 && at != std::string::npos) {
-        port_ = std::stoi(s.substr(at + std::strlen("http://127.0.0.1:")));
+    while (const std::optional<std::string> line = process_.ReadLine()) {
+      output_ += *line;
+      const auto at = line->find("http://127.0.0.1:");
+      if (line->rfind("gui: serving", 0) == 0 && at != std::string::npos) {
+        port_ = std::stoi(line->substr(at + std::strlen("http://127.0.0.1:")));
         break;
       }
     }
   }
-  ~GuiProcess() {
-    Stop();
-    if (out_) fclose(out_);
-  }
   // SIGTERM, then what it printed until it exited, and its exit status.
-  int Stop() {
-    int status = -1;
-    if (pid_ > 0) {
-      kill(pid_, SIGTERM);
-      char line[4096];
-      while (std::fgets(line, sizeof line, out_) != nullptr) output_ += line;
-      int raw = 0;
-      waitpid(pid_, &raw, 0);
-      status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
-      pid_ = -1;
-    }
-    return status;
-  }
+  int Stop() { return process_.Stop(&output_); }
   int port() const { return port_; }
   const std::string& output() const { return output_; }
 
  private:
-  pid_t pid_ = -1;
-  FILE* out_ = nullptr;
+  saccade::e2e::BackgroundProcess process_;
   int port_ = -1;
   std::string output_;
 };

@@ -4,21 +4,17 @@
 // pair -- each through a hardware file, as a user would switch them.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
-#include <signal.h>
-#include <spawn.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "e2e/run_saccade.h"
-
-extern char** environ;
 
 namespace {
 
@@ -47,41 +43,19 @@ fs::path TempDir(const std::string& name) {
 class Emulator {
  public:
   // `args` besides --link; returns once it has printed its first line.
-  Emulator(const fs::path& link, const std::vector<std::string>& args) {
-    int out[2];
-    EXPECT_EQ(pipe(out), 0);
-    posix_spawn_file_actions_t actions;
-    posix_spawn_file_actions_init(&actions);
-    posix_spawn_file_actions_adddup2(&actions, out[1], STDOUT_FILENO);
-    posix_spawn_file_actions_addclose(&actions, out[0]);
-    std::vector<std::string> all = {SACCADE_SERVO_EMULATOR, "--link", link.string()};
-    all.insert(all.end(), args.begin(), args.end());
-    std::vector<char*> argv;
-    for (std::string& a : all) argv.push_back(a.data());
-    argv.push_back(nullptr);
-    EXPECT_EQ(posix_spawn(&pid_, argv[0], &actions, nullptr, argv.data(), environ), 0);
-    posix_spawn_file_actions_destroy(&actions);
-    close(out[1]);
-    out_ = fdopen(out[0], "r");
-    char line[512] = {};
-    if (out_ == nullptr || fgets(line, sizeof line, out_) == nullptr) {
-      ADD_FAILURE() << "saccade-servo-emulator printed nothing";
-    }
-    first_line_ = line;
-  }
-  ~Emulator() {
-    if (pid_ > 0) {
-      kill(pid_, SIGTERM);
-      int status = 0;
-      waitpid(pid_, &status, 0);
-    }
-    if (out_ != nullptr) fclose(out_);
+  Emulator(const fs::path& link, std::vector<std::string> args)
+      : process_([&] {
+          args.insert(args.begin(), {SACCADE_SERVO_EMULATOR, "--link", link.string()});
+          return args;
+        }()) {
+    const std::optional<std::string> line = process_.ReadLine();
+    if (!line) ADD_FAILURE() << "saccade-servo-emulator printed nothing";
+    first_line_ = line.value_or("");
   }
   const std::string& first_line() const { return first_line_; }
 
  private:
-  pid_t pid_ = -1;
-  FILE* out_ = nullptr;
+  saccade::e2e::BackgroundProcess process_;
   std::string first_line_;
 };
 

@@ -90,8 +90,8 @@ class GuiServer {
   /// Serves `body` at the exact `path` (e.g. "/api/scene"); replaces an earlier one. Paths
   /// under /api/ need the token when one is set.
   void SetDocument(const std::string& path, const std::string& content_type, std::string body);
-  /// Sent to each client when it connects, after the hello (e.g. the latest state); called
-  /// on the I/O thread.
+  /// Sent to each client when it connects, after the hello (and before the newest published
+  /// state, which every new client gets); called on the I/O thread.
   void SetWelcome(std::function<std::vector<std::string>()> welcome);
 
   /// Binds (port 0: any free port) and starts the I/O thread. Throws Error naming the address
@@ -106,7 +106,8 @@ class GuiServer {
   /// "http://127.0.0.1:8080/" (with "?token=..." when a token is set).
   std::string url() const;
 
-  /// The newest state (a JSON text message) for every client; replaces one not yet sent.
+  /// The newest state (a JSON text message) for every client; replaces one not yet sent. A
+  /// client that connects later gets it too, after the hello.
   void PublishState(const nlohmann::json& state);
   /// The newest frame of `camera` for every client: a binary message made of a 4-byte
   /// little-endian header length, the header (JSON) and the payload (JPEG). Replaces one of
