@@ -110,7 +110,10 @@ TEST(HeadDriverTest, WatchdogHoldsThePositionWhenCommandsStop) {
   EXPECT_LT(rest.positions.pan, 85 * kDeg) << "the watchdog did not stop the saccade";
   EXPECT_NEAR(rest.targets.pan, rest.positions.pan, 1e-9);
   Sleep(0.1);
-  EXPECT_NEAR(driver.Read().positions.pan, rest.positions.pan, 1e-12);
+  // At rest within the motors' settling tolerance (1e-9 rad, as above): the last nanoradian of
+  // convergence may still come after `moving` went false (seen once under ASan on a busy
+  // machine: 5.8e-10 rad).
+  EXPECT_NEAR(driver.Read().positions.pan, rest.positions.pan, 1e-9);
   EXPECT_EQ(driver.Read().watchdog_trips, 1);  // holding already: it does not fire again
   // The next command moves again.
   driver.Command(Pan(0.0));
