@@ -12,6 +12,9 @@ cd "$(dirname "$0")/.."
 packages=(
   # toolchain
   g++ cmake ninja-build pkg-config clang-format
+  # the compiler cache (its directory, ~/.cache/ccache, lies outside the clone, so a fresh clone
+  # builds warm after any earlier build on the machine)
+  ccache
   # libraries (README lists what each is for)
   libeigen3-dev libyaml-cpp-dev nlohmann-json3-dev libcli11-dev libfmt-dev libspdlog-dev
   libopencv-core-dev libopencv-imgproc-dev libopencv-calib3d-dev libopencv-imgcodecs-dev
