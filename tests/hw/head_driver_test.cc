@@ -105,14 +105,18 @@ TEST(HeadDriverTest, WatchdogHoldsThePositionWhenCommandsStop) {
   const HeadStatus held = ReadUntil(driver, [](const HeadStatus& s) { return s.holding; });
   ASSERT_TRUE(held.holding);
   EXPECT_EQ(held.watchdog_trips, 1);
-  const HeadStatus rest = ReadUntil(driver, [](const HeadStatus& s) { return !s.moving; });
+  // At rest: slower than the `moving` threshold and settled on the hold's target. `moving`
+  // goes false at 0.5 deg/s, a few nanoradians before the profile ends (seen under load: the
+  // position 1.3e-9 rad short of the target when `moving` went false), so wait for both.
+  const HeadStatus rest = ReadUntil(driver, [](const HeadStatus& s) {
+    return !s.moving && std::abs(s.targets.pan - s.positions.pan) <= 1e-9;
+  });
+  EXPECT_FALSE(rest.moving);
   EXPECT_GT(rest.positions.pan, 0.1 * kDeg);
   EXPECT_LT(rest.positions.pan, 85 * kDeg) << "the watchdog did not stop the saccade";
   EXPECT_NEAR(rest.targets.pan, rest.positions.pan, 1e-9);
   Sleep(0.1);
-  // At rest within the motors' settling tolerance (1e-9 rad, as above): the last nanoradian of
-  // convergence may still come after `moving` went false (seen once under ASan on a busy
-  // machine: 5.8e-10 rad).
+  // Held: settled, it stays within the motors' settling tolerance (1e-9 rad, as above).
   EXPECT_NEAR(driver.Read().positions.pan, rest.positions.pan, 1e-9);
   EXPECT_EQ(driver.Read().watchdog_trips, 1);  // holding already: it does not fire again
   // The next command moves again.
