@@ -5,6 +5,7 @@
 
 #include "commands.h"
 #include "saccade/core/error.h"
+#include "saccade/core/log.h"
 
 int main(int argc, char** argv) {
   CLI::App app{
@@ -14,6 +15,13 @@ int main(int argc, char** argv) {
       "saccade"};
   app.require_subcommand(1);
   app.set_version_flag("--version", SACCADE_VERSION);
+  // The logger's level (core/log.h): before or after the subcommand.
+  std::string log_level;
+  app.add_option("--log-level", log_level,
+                 "Least severe log lines shown on stderr: trace, debug, info, warn, error or off "
+                 "(default info, or SACCADE_LOG_LEVEL)")
+      ->check(CLI::IsMember({"trace", "debug", "info", "warn", "warning", "error", "off"}));
+  app.fallthrough();
   namespace a = saccade::app;
   const std::vector<std::pair<CLI::App*, a::Runner>> commands = [&] {
     std::vector<std::pair<CLI::App*, a::Runner>> list;
@@ -25,6 +33,7 @@ int main(int argc, char** argv) {
     return list;
   }();
   CLI11_PARSE(app, argc, argv);
+  if (!log_level.empty()) saccade::log::SetLevel(saccade::log::ParseLevel(log_level));
   try {
     for (const auto& [sub, run] : commands) {
       if (sub->parsed()) return run();

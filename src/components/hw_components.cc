@@ -9,6 +9,7 @@
 #include "components/internal_params.h"
 #include "saccade/components/scene_cache.h"
 #include "saccade/core/error.h"
+#include "saccade/core/log.h"
 #include "saccade/head/kinematics.h"
 #include "saccade/hw/dynamixel_head.h"
 
@@ -147,7 +148,7 @@ void HwHead::Step(const runtime::StepContext& context) {
       // Counted by the driver and shown in the status; the loop goes on with the head safe.
       if (error.what() != last_rejection_) {
         last_rejection_ = error.what();
-        fmt::print(stderr, "hw.head '{}': {}\n", name(), last_rejection_);
+        log::Warn("hw.head '{}': {}", name(), last_rejection_);
       }
     }
   }
@@ -183,8 +184,8 @@ void HwHead::Report(const hw::HeadStatus& status) {
   if (status.fault != reported_fault_) {
     reported_fault_ = status.fault;
     if (!status.fault.empty()) {
-      fmt::print(stderr, "hw.head '{}': FAULT: {}; the head holds until the fault is cleared\n",
-                 name(), status.fault);
+      log::Error("hw.head '{}': FAULT: {}; the head holds until the fault is cleared", name(),
+                 status.fault);
     }
   }
 }
@@ -347,8 +348,8 @@ void HwCameras::Step(const runtime::StepContext& context) {
   dropped_right_ = source_->dropped_right();
   if (!pair) {
     ended_ = true;
-    fmt::print(stderr, "hw.cameras '{}': the camera sources ended after {} pairs ({}, {})\n",
-               name(), pairs_, left_spec_.uri, right_spec_.uri);
+    log::Info("hw.cameras '{}': the camera sources ended after {} pairs ({}, {})", name(), pairs_,
+              left_spec_.uri, right_spec_.uri);
     return;
   }
   const scene::Robot& robot = *scene_->robot();

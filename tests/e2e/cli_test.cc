@@ -151,6 +151,18 @@ TEST(Cli, BadInputsGiveClearErrors) {
   std::filesystem::remove_all(dir);
 }
 
+TEST(Cli, LogLevelIsCheckedAndTakenBeforeOrAfterTheSubcommand) {
+  const CommandRun loud = Saccade("--log-level loud fk --head " + kHead + " --joints 0 0 0 0");
+  EXPECT_NE(loud.status, 0);
+  EXPECT_THAT(loud.output, HasSubstr("--log-level: loud"));
+  for (const std::string& args : {"--log-level off fk --head " + kHead + " --joints 0 0 0 0",
+                                  "fk --head " + kHead + " --joints 0 0 0 0 --log-level debug"}) {
+    const CommandRun run = Saccade(args);
+    EXPECT_EQ(run.status, 0) << args << "\n" << run.output;
+    EXPECT_THAT(run.output, HasSubstr("left camera")) << args;
+  }
+}
+
 TEST(Cli, EverySubcommandHasHelp) {
   for (const char* sub : {"fk", "ik", "camera", "demo"}) {
     const CommandRun help = Saccade(std::string(sub) + " --help");

@@ -30,7 +30,7 @@
 //   timings.
 //   A fault (a servo's overload, a servo that stops answering, ...) does not stop the
 //   pipeline: the head holds, commands are rejected and counted, `status` names the fault,
-//   and it is printed once on stderr.
+//   and it is logged once (core/log.h, level error).
 //
 // hw.cameras -- the eye cameras as real camera sources (hw/camera_source.h: V4L2 devices,
 //   GStreamer pipelines, IIDC cameras, video files, image sequences and lists), paired by
@@ -46,7 +46,7 @@
 //   inputs:  joints (head.joints, optional; connect with delay 1 as for sim.cameras)
 //   outputs: left, right (runtime.image): one pair per step; time = the step's time (the
 //            capture time stays in the source: frame_index counts the pairs delivered)
-//   When a file or list ends (without loop), nothing more is emitted and a line on stderr
+//   When a file or list ends (without loop), nothing more is emitted and a log line (info)
 //   says so; a device error stops the pipeline with the camera and its uri named.
 #include <memory>
 #include <optional>
