@@ -253,7 +253,7 @@ int RunDemo(Options o) {
     spec.clock.rate_hz = 1.0 / dt;
   }
   runtime::Pipeline pipeline = runtime::Pipeline::Build(spec);
-  if (o.gui && o.gui_options.token.empty()) {
+  if (o.gui && o.gui_options.token.empty() && !o.gui_options.no_token) {
     if (const char* token = std::getenv("SACCADE_GUI_TOKEN")) o.gui_options.token = token;
   }
 
@@ -626,14 +626,23 @@ int RunDemo(Options o) {
 void AddGuiOptions(CLI::App* command, Options& o) {
   command
       ->add_option("--listen", o.gui_options.listen,
-                   "Address the GUI listens on; anything but a loopback address (127.0.0.1, "
-                   "::1) needs --token")
+                   "Address the GUI listens on; off loopback (127.0.0.1, ::1) a token is "
+                   "required, so --no-token is refused")
       ->capture_default_str();
   command->add_option("--port", o.gui_options.port, "TCP port of the GUI (0: any free port)")
       ->capture_default_str();
-  command->add_option("--token", o.gui_options.token,
-                      "Access token the page must present (in the printed address); default: "
-                      "$SACCADE_GUI_TOKEN. Required with a non-loopback --listen");
+  command->add_option(
+      "--token", o.gui_options.token,
+      "Access token the page and scripts must present (it is in the printed "
+      "address); default: $SACCADE_GUI_TOKEN, else a random one per run on loopback. "
+      "Required with a non-loopback --listen");
+  command->add_flag("--no-token", o.gui_options.no_token,
+                    "Serve without a token (loopback --listen only): any local program, and any "
+                    "page from this server, may then drive the head");
+  command->add_option("--allow-host", o.gui_options.allowed_hosts,
+                      "A host name the browser may use for this server besides localhost, "
+                      "loopback addresses and the --listen address (e.g. robot-head.local); "
+                      "repeatable. Other Host headers get 403 (DNS rebinding)");
   command
       ->add_option("--speed", o.gui_options.speed,
                    "Simulated seconds per wall second, at most (0.05 .. 10; the page changes it)")

@@ -165,6 +165,21 @@ GuiSession::GuiSession(runtime::Pipeline& pipeline, const scene::Scene& scene,
   server_options.address = options.listen;
   server_options.port = static_cast<uint16_t>(options.port);
   server_options.token = options.token;
+  server_options.allowed_hosts = options.allowed_hosts;
+  if (options.no_token) {
+    if (!options.token.empty()) throw InvalidArgument("gui: --no-token and --token contradict");
+    if (!server::IsLoopbackAddress(options.listen)) {
+      throw InvalidArgument("gui: --no-token is for loopback addresses only; --listen " +
+                            options.listen +
+                            " needs a token (--token TOKEN, or none for a "
+                            "random one)");
+    }
+  } else if (server_options.token.empty() && server::IsLoopbackAddress(options.listen)) {
+    // As Jupyter does: a random token in the printed address, so that another local user or a
+    // page that guesses the port cannot drive the head. (Off loopback the server refuses to
+    // start without a token given by the operator.)
+    server_options.token = server::GenerateToken();
+  }
   const fs::path web = ShippedFile("web");
   if (!fs::exists(web / "public" / "index.html")) {
     throw Error("gui: the page is missing: " + (web / "public" / "index.html").string());

@@ -36,9 +36,11 @@ namespace saccade::app {
 struct GuiOptions {
   std::string listen = "127.0.0.1";
   int port = 8080;
-  std::string token;
-  std::string mode = "demo";  ///< "demo" or "gui", told to the page
-  bool perception = true;     ///< the loop commands the head at start
+  std::string token;      ///< "" (and no no_token): a random one, printed in the address
+  bool no_token = false;  ///< loopback only: serve without a token
+  std::vector<std::string> allowed_hosts;  ///< Host names accepted besides loopback/listen
+  std::string mode = "demo";               ///< "demo" or "gui", told to the page
+  bool perception = true;                  ///< the loop commands the head at start
   bool paused = false;
   double speed = 1.0;  ///< simulated seconds per wall second at most
   int jpeg_quality = 80;

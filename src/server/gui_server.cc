@@ -30,6 +30,9 @@
 #include <thread>
 #include <utility>
 
+#include "saccade/core/log.h"
+#include "server/internal_access.h"
+
 namespace saccade::server {
 
 namespace asio = boost::asio;
@@ -228,11 +231,13 @@ class HttpSession;
 
 // The server's state, shared by the sessions (GuiServer::Impl is private to GuiServer).
 struct ServerCore {
-  explicit ServerCore(ServerOptions o) : options(std::move(o)) {}
+  explicit ServerCore(ServerOptions o)
+      : options(std::move(o)), host_policy{options.address, options.allowed_hosts} {}
 
   // Declared first: destroyed last, after every socket that uses it.
   asio::io_context ioc{1};
   ServerOptions options;
+  internal::HostPolicy host_policy;
   std::vector<std::pair<std::string, fs::path>> mounts;  // prefix -> canonical folder
 
   mutable std::mutex config_mutex;  // handler, documents, welcome, latest_state
@@ -769,6 +774,22 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
       SendText(req, http::status::bad_request, "bad request target\n");
       return;
     }
+    // Only this server's own page, by name (Host) and origin (Origin), before anything else:
+    // see gui_server.h, "Security".
+    {
+      const auto host_field = req.find(http::field::host);
+      const std::string_view host =
+          host_field == req.end() ? std::string_view() : View(host_field->value());
+      const auto origin_field = req.find(http::field::origin);
+      const bool has_origin = origin_field != req.end();
+      std::string why;
+      if (!internal::HostAllowed(host, server.host_policy, &why) ||
+          !internal::OriginAllowed(has_origin ? View(origin_field->value()) : std::string_view(),
+                                   has_origin, host, &why)) {
+        SendForbidden(req, path, why);
+        return;
+      }
+    }
     const bool is_api = path == "/api" || path.starts_with("/api/");
     const bool is_ws = path == "/ws";
     const bool needs_token = !server.options.token.empty() && (is_api || is_ws);
@@ -827,6 +848,20 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
       return;
     }
     ServeFile(req, path);
+  }
+
+  void SendForbidden(const Request& req, const std::string& path, const std::string& why) {
+    beast::error_code ec;
+    const tcp::endpoint peer = stream_.socket().remote_endpoint(ec);
+    log::Warn("GUI server: 403 for {} ({} {}): {}",
+              ec ? std::string("an unknown peer") : EndpointText(peer),
+              std::string(View(req.method_string())), path, why);
+    http::response<http::string_body> res{http::status::forbidden, req.version()};
+    res.set(http::field::content_type, "text/plain; charset=utf-8");
+    res.set(http::field::cache_control, "no-store");
+    res.keep_alive(false);
+    res.body() = "403: " + why + "\n";
+    Send(std::move(res));
   }
 
   void SendUnauthorized(const Request& req) {
@@ -992,6 +1027,13 @@ GuiServer::GuiServer(ServerOptions options) : impl_(std::make_unique<Impl>(std::
                           ", not a loopback address, requires an access token (--token TOKEN "
                           "or SACCADE_GUI_TOKEN)");
   }
+  for (const std::string& host : o.allowed_hosts) {
+    if (host.empty() || internal::HostName(host) != host) {
+      throw InvalidArgument("GuiServer: allowed host '" + host +
+                            "' is not a host name (expected e.g. robot-head.local, without "
+                            "scheme, port or path, in lower case)");
+    }
+  }
   if (o.max_message_bytes == 0 || o.max_clients < 1 || o.max_queued_messages == 0) {
     throw InvalidArgument(
         "GuiServer: max_message_bytes, max_clients and max_queued_messages must be positive, got " +
@@ -1060,7 +1102,7 @@ void GuiServer::Start() {
         return;
       } catch (const std::exception& e) {
         // A bug in a handler; the server goes on serving the others.
-        std::fprintf(stderr, "saccade: GUI server: %s\n", e.what());
+        log::Error("GUI server: {}", e.what());
       }
     }
   });
@@ -1129,6 +1171,8 @@ std::vector<ClientStats> GuiServer::clients() const {
   for (const auto& session : impl_->core.Snapshot()) out.push_back(session->stats());
   return out;
 }
+
+std::string GenerateToken() { return internal::RandomToken(); }
 
 bool IsLoopbackAddress(const std::string& address) {
   if (address == "localhost") return true;

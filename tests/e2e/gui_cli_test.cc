@@ -51,6 +51,12 @@ class GuiProcess {
       const auto at = line->find("http://127.0.0.1:");
       if (line->rfind("gui: serving", 0) == 0 && at != std::string::npos) {
         port_ = std::stoi(line->substr(at + std::strlen("http://127.0.0.1:")));
+        // The access token in the printed address (a random one per run unless --no-token).
+        const auto token = line->find("?token=", at);
+        if (token != std::string::npos) {
+          const auto begin = token + std::strlen("?token=");
+          token_ = line->substr(begin, line->find_first_of(" \t", begin) - begin);
+        }
         break;
       }
     }
@@ -58,20 +64,29 @@ class GuiProcess {
   // SIGTERM, then what it printed until it exited, and its exit status.
   int Stop() { return process_.Stop(&output_); }
   int port() const { return port_; }
+  const std::string& token() const { return token_; }
+  // `target` with the access token, as the page sends it.
+  std::string WithToken(const std::string& target) const {
+    if (token_.empty()) return target;
+    return target + (target.find('?') == std::string::npos ? "?" : "&") + "token=" + token_;
+  }
   const std::string& output() const { return output_; }
 
  private:
   saccade::e2e::BackgroundProcess process_;
   int port_ = -1;
+  std::string token_;
   std::string output_;
 };
 
-http::response<http::string_body> Get(int port, const std::string& target) {
+// GET `target` as it is, naming `host` in the Host header.
+http::response<http::string_body> GetRaw(int port, const std::string& target,
+                                         const std::string& host = "127.0.0.1") {
   asio::io_context io;
   tcp::socket socket(io);
   socket.connect(tcp::endpoint(asio::ip::make_address("127.0.0.1"), static_cast<uint16_t>(port)));
   http::request<http::string_body> request(http::verb::get, target, 11);
-  request.set(http::field::host, "127.0.0.1");
+  request.set(http::field::host, host);
   http::write(socket, request);
   beast::flat_buffer buffer;
   http::response<http::string_body> response;
@@ -79,13 +94,21 @@ http::response<http::string_body> Get(int port, const std::string& target) {
   return response;
 }
 
+// GET `target` with the process's token, as the page asks.
+http::response<http::string_body> Get(const GuiProcess& gui, const std::string& target,
+                                      const std::string& host = "127.0.0.1") {
+  return GetRaw(gui.port(), gui.WithToken(target), host);
+}
+
 // A WebSocket client that reads until a message it wants arrives.
 class Client {
  public:
-  explicit Client(int port) : ws_(io_) {
+  // Connects with the process's token, as the page does.
+  explicit Client(const GuiProcess& gui) : ws_(io_) {
     tcp::socket& socket = ws_.next_layer();
-    socket.connect(tcp::endpoint(asio::ip::make_address("127.0.0.1"), static_cast<uint16_t>(port)));
-    ws_.handshake("127.0.0.1", "/ws");
+    socket.connect(
+        tcp::endpoint(asio::ip::make_address("127.0.0.1"), static_cast<uint16_t>(gui.port())));
+    ws_.handshake("127.0.0.1", gui.WithToken("/ws"));
   }
   // The next text message satisfying `want` (binary frames go to frames_), within 120 s.
   json WaitFor(const std::function<bool(const json&)>& want) {
@@ -154,7 +177,7 @@ GuiProcess* GuiCliTest::gui_ = nullptr;
 
 TEST_F(GuiCliTest, ServesTheSceneAndItsMeshesAsTheRendererLoadedThem) {
   ASSERT_GT(gui_->port(), 0) << gui_->output();
-  const auto scene_response = Get(gui_->port(), "/api/scene");
+  const auto scene_response = Get(*gui_, "/api/scene");
   ASSERT_EQ(scene_response.result_int(), 200);
   const json scene = json::parse(scene_response.body());
   EXPECT_EQ(scene["protocol"], "saccade-gui");
@@ -174,29 +197,29 @@ TEST_F(GuiCliTest, ServesTheSceneAndItsMeshesAsTheRendererLoadedThem) {
       const std::size_t v = mesh["vertices"], i = mesh["indices"];
       expected += v * 6 * 4 + (mesh["uvs"].get<bool>() ? v * 2 * 4 : 0) + i * 4;
     }
-    const auto bin = Get(gui_->port(), model["url"].get<std::string>());
+    const auto bin = Get(*gui_, model["url"].get<std::string>());
     EXPECT_EQ(bin.result_int(), 200) << model["url"];
     EXPECT_EQ(bin.body().size(), expected) << model["url"];
     for (const json& material : model["materials"]) {
       if (material["texture"].is_null()) continue;
-      const auto png = Get(gui_->port(), material["texture"].get<std::string>());
+      const auto png = Get(*gui_, material["texture"].get<std::string>());
       ASSERT_EQ(png.result_int(), 200);
       EXPECT_EQ(png.body().substr(1, 3), "PNG");
     }
   }
   // The page and three.js come from the repository, not the internet.
-  const auto page = Get(gui_->port(), "/");
+  const auto page = Get(*gui_, "/");
   EXPECT_EQ(page.result_int(), 200);
   EXPECT_THAT(page.body(), HasSubstr("/vendor/three/"));
-  EXPECT_EQ(Get(gui_->port(), "/vendor/three/build/three.module.js").result_int(), 200);
+  EXPECT_EQ(Get(*gui_, "/vendor/three/build/three.module.js").result_int(), 200);
 }
 
 TEST_F(GuiCliTest, RejectsJointsOutsideTheLimitsAndMovesNothing) {
   ASSERT_GT(gui_->port(), 0) << gui_->output();
-  Client client(gui_->port());
+  Client client(*gui_);
   const json hello = client.WaitFor([](const json& m) { return m["type"] == "hello"; });
   EXPECT_EQ(hello["protocol"], "saccade-gui");
-  const json scene = json::parse(Get(gui_->port(), "/api/scene").body());
+  const json scene = json::parse(Get(*gui_, "/api/scene").body());
   const double pan_max = scene["head"]["joints"][0]["max"];
   const json before = client.State();
   EXPECT_TRUE(before["paused"].get<bool>());
@@ -229,7 +252,7 @@ TEST_F(GuiCliTest, RejectsJointsOutsideTheLimitsAndMovesNothing) {
 
 TEST_F(GuiCliTest, DirectAndInverseKinematicsMoveTheHead) {
   ASSERT_GT(gui_->port(), 0) << gui_->output();
-  Client client(gui_->port());
+  Client client(*gui_);
   json reply = client.Command({{"type", "joints"}, {"positions", {{"pan", 0.2}, {"tilt", 0.05}}}});
   ASSERT_EQ(reply["type"], "reply") << reply;
   EXPECT_DOUBLE_EQ(reply["targets"]["pan"].get<double>(), 0.2);
@@ -242,7 +265,7 @@ TEST_F(GuiCliTest, DirectAndInverseKinematicsMoveTheHead) {
   EXPECT_FALSE(state["perception"].get<bool>());
 
   // Fixate the cat's picture: both optical axes end on the point.
-  const json scene = json::parse(Get(gui_->port(), "/api/scene").body());
+  const json scene = json::parse(Get(*gui_, "/api/scene").body());
   Eigen::Vector3d p_W = Eigen::Vector3d::Zero();
   for (const json& o : scene["objects"]) {
     if (o["name"] == "chelsea") p_W = Matrix(o["X_WO"]).block<3, 1>(0, 3);
@@ -261,7 +284,7 @@ TEST_F(GuiCliTest, DirectAndInverseKinematicsMoveTheHead) {
 
 TEST_F(GuiCliTest, SwitchesEffectsAndStreamsJpegFrames) {
   ASSERT_GT(gui_->port(), 0) << gui_->output();
-  Client client(gui_->port());
+  Client client(*gui_);
   json error = client.Command({{"type", "effects"}, {"noise", "off"}});
   EXPECT_THAT(error["error"].get<std::string>(), HasSubstr("noise must be true or false"));
   json reply = client.Command({{"type", "effects"}, {"noise", false}});
@@ -285,7 +308,7 @@ TEST_F(GuiCliTest, SwitchesEffectsAndStreamsJpegFrames) {
 
 TEST_F(GuiCliTest, PerceptionSwitchedOnFindsTheFaceAndFixatesIt) {
   ASSERT_GT(gui_->port(), 0) << gui_->output();
-  Client client(gui_->port());
+  Client client(*gui_);
   json reply = client.Command({{"type", "perception"}, {"enabled", "yes"}});
   EXPECT_THAT(reply["error"].get<std::string>(), HasSubstr("enabled must be true or false"));
   reply = client.Command({{"type", "perception"}, {"enabled", true}});
@@ -314,7 +337,7 @@ TEST_F(GuiCliTest, PerceptionSwitchedOnFindsTheFaceAndFixatesIt) {
 TEST(GuiCli, DemoWithTheGuiRunsTheLoopUntilStoppedThenReports) {
   GuiProcess demo({"demo", "--gui", "--scene", kScene, "--port", "0"});
   ASSERT_GT(demo.port(), 0) << demo.output();
-  Client client(demo.port());
+  Client client(demo);
   const json hello = client.WaitFor([](const json& m) { return m["type"] == "hello"; });
   EXPECT_EQ(hello["mode"], "demo");
   // Perception is on from the start: the loop fixates the astronaut by itself (at 0.12 s of
@@ -330,6 +353,84 @@ TEST(GuiCli, DemoWithTheGuiRunsTheLoopUntilStoppedThenReports) {
   EXPECT_THAT(demo.output(), HasSubstr("fixated astronaut"));
   EXPECT_THAT(demo.output(), HasSubstr("1 of 1 faces fixated"));
   EXPECT_THAT(demo.output(), HasSubstr("images encoded"));
+}
+
+// The handshake's HTTP status for a raw WebSocket to `target` naming `host` and `origin`, as a
+// page of another origin (or a DNS-rebinding page) would open it; 101 when it opened.
+int WebSocketStatus(const GuiProcess& gui, const std::string& target, const std::string& host,
+                    const std::string& origin) {
+  asio::io_context io;
+  websocket::stream<tcp::socket> ws(io);
+  ws.next_layer().connect(
+      tcp::endpoint(asio::ip::make_address("127.0.0.1"), static_cast<uint16_t>(gui.port())));
+  ws.set_option(websocket::stream_base::decorator(
+      [origin](websocket::request_type& req) { req.set(http::field::origin, origin); }));
+  websocket::response_type response;
+  beast::error_code ec;
+  // (Boost 1.74's synchronous handshake leaves `response` empty when the upgrade is declined.)
+  ws.async_handshake(response, host, target, [&ec](beast::error_code e) { ec = e; });
+  io.run();
+  if (!ec) {
+    // Opened: what the attack was after. Send it, so that a regression shows as a moved head.
+    ws.text(true);
+    ws.write(
+        asio::buffer(std::string(R"({"type": "joints", "id": 1, "positions": {"pan": 0.3}})")));
+  }
+  return response.result_int();
+}
+
+TEST_F(GuiCliTest, APageOfAnotherOriginCannotDriveTheHead) {
+  ASSERT_GT(gui_->port(), 0) << gui_->output();
+  // A random token per run on loopback, in the printed address.
+  ASSERT_EQ(gui_->token().size(), 32u) << gui_->output();
+  Client client(*gui_);
+  EXPECT_EQ(client.Command({{"type", "step"}})["type"], "reply");
+  const double pan_before = client.State()["joints"]["targets"]["pan"].get<double>();
+  const std::string port = std::to_string(gui_->port());
+  // The attack as reported: Host and Origin of the foreign page. Even with the token (which
+  // such a page cannot know), the Host and the Origin refuse it.
+  EXPECT_EQ(WebSocketStatus(*gui_, gui_->WithToken("/ws"), "evil.example.com:" + port,
+                            "http://evil.example.com"),
+            403);
+  // A page elsewhere that opens ws://127.0.0.1:PORT: the Host is ours, its Origin is not.
+  EXPECT_EQ(WebSocketStatus(*gui_, gui_->WithToken("/ws"), "127.0.0.1:" + port,
+                            "http://evil.example.com"),
+            403);
+  // Our own origin without the token: 401.
+  EXPECT_EQ(WebSocketStatus(*gui_, "/ws", "127.0.0.1:" + port, "http://127.0.0.1:" + port), 401);
+  // A DNS-rebinding page reading the scene.
+  EXPECT_EQ(Get(*gui_, "/api/scene", "evil.example.com:" + port).result_int(), 403);
+  EXPECT_EQ(Get(*gui_, "/", "evil.example.com:" + port).result_int(), 403);
+  // Nothing moved: a step later the pan target is what it was.
+  EXPECT_EQ(client.Command({{"type", "step"}})["type"], "reply");
+  EXPECT_EQ(client.State()["joints"]["targets"]["pan"].get<double>(), pan_before);
+  // The page's own origin with the token opens.
+  EXPECT_EQ(WebSocketStatus(*gui_, gui_->WithToken("/ws"), "127.0.0.1:" + port,
+                            "http://127.0.0.1:" + port),
+            101);
+}
+
+TEST_F(GuiCliTest, EachRunHasItsOwnTokenAndNoTokenServesWithout) {
+  ASSERT_GT(gui_->port(), 0) << gui_->output();
+  EXPECT_EQ(Get(*gui_, "/api/scene").result_int(), 200);
+  GuiProcess bare({"gui", "--scene", kScene, "--port", "0", "--paused", "--no-token"});
+  ASSERT_GT(bare.port(), 0) << bare.output();
+  EXPECT_EQ(bare.token(), "") << bare.output();
+  EXPECT_EQ(Get(bare, "/api/scene").result_int(), 200);
+  GuiProcess second({"gui", "--scene", kScene, "--port", "0", "--paused"});
+  ASSERT_GT(second.port(), 0) << second.output();
+  ASSERT_EQ(second.token().size(), 32u) << second.output();
+  EXPECT_NE(second.token(), gui_->token());
+  // The first run's token does not open the second.
+  EXPECT_EQ(GetRaw(second.port(), "/api/scene?token=" + gui_->token()).result_int(), 401);
+  EXPECT_EQ(GetRaw(second.port(), "/api/scene").result_int(), 401);
+}
+
+TEST(GuiCli, NoTokenIsRefusedBeyondLoopback) {
+  const saccade::e2e::CommandRun run =
+      saccade::e2e::Saccade("gui --scene " + kScene + " --listen 0.0.0.0 --port 0 --no-token");
+  EXPECT_EQ(run.status, 1) << run.output;
+  EXPECT_THAT(run.output, HasSubstr("--no-token is for loopback addresses only"));
 }
 
 TEST(GuiCli, RefusesToListenBeyondLoopbackWithoutAToken) {

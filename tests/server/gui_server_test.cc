@@ -5,6 +5,7 @@
 
 #include "saccade/server/gui_server.h"
 
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -24,6 +25,8 @@
 #include <string>
 #include <thread>
 #include <vector>
+
+#include "server/internal_access.h"
 
 namespace saccade::server {
 namespace {
@@ -153,18 +156,20 @@ class WsClient {
  public:
   WsClient() : ws_(ioc_) {}
 
-  // The handshake's HTTP status: 101 when it succeeded.
-  int Connect(uint16_t port, const std::string& target = "/ws", const std::string& bearer = "") {
+  // The handshake's HTTP status: 101 when it succeeded. `host` is the Host header sent;
+  // `origin`, when not empty, the Origin header (as a browser sends it).
+  int Connect(uint16_t port, const std::string& target = "/ws", const std::string& bearer = "",
+              const std::string& host = "127.0.0.1", const std::string& origin = "") {
     beast::get_lowest_layer(ws_).connect(tcp::endpoint(asio::ip::make_address("127.0.0.1"), port));
-    if (!bearer.empty()) {
-      ws_.set_option(websocket::stream_base::decorator([bearer](websocket::request_type& req) {
-        req.set(http::field::authorization, "Bearer " + bearer);
-      }));
-    }
+    ws_.set_option(
+        websocket::stream_base::decorator([bearer, origin](websocket::request_type& req) {
+          if (!bearer.empty()) req.set(http::field::authorization, "Bearer " + bearer);
+          if (!origin.empty()) req.set(http::field::origin, origin);
+        }));
     ws_.read_message_max(64 * 1024 * 1024);
     websocket::response_type res;
     bool done = false;
-    ws_.async_handshake(res, "127.0.0.1", target, [&](beast::error_code, ...) { done = true; });
+    ws_.async_handshake(res, host, target, [&](beast::error_code, ...) { done = true; });
     if (!RunUntil(ioc_, done)) return -1;
     return res.result_int();
   }
@@ -538,6 +543,123 @@ TEST_F(TokenTest, ApiNeedsTheTokenStaticFilesDoNot) {
 // ------------------------------------------------------------------------------------------
 // WebSocket: hello, commands, errors
 // ------------------------------------------------------------------------------------------
+
+// ---------------------------------------------------------------------------------------------
+// Access: only this server's own page (issue 18: a page of another origin drove the head).
+// ---------------------------------------------------------------------------------------------
+
+TEST(GuiServerAccessTest, HostNamesAreLowerCaseWithoutPortOrBrackets) {
+  EXPECT_EQ(internal::HostName("Example.COM:8080"), "example.com");
+  EXPECT_EQ(internal::HostName("127.0.0.1"), "127.0.0.1");
+  EXPECT_EQ(internal::HostName("[::1]:80"), "::1");
+  EXPECT_EQ(internal::HostName("::1"), "");  // IPv6 needs brackets in a Host header
+  EXPECT_EQ(internal::HostName("[::1"), "");
+  EXPECT_EQ(internal::HostName("evil.com/x"), "");
+  EXPECT_EQ(internal::HostName(""), "");
+}
+
+TEST(GuiServerAccessTest, HostPolicyAcceptsLoopbackTheListenAddressAndAllowedNamesOnly) {
+  std::string why;
+  const internal::HostPolicy loopback{"127.0.0.1", {}};
+  for (const char* host :
+       {"127.0.0.1:8080", "localhost:8080", "LOCALHOST", "127.1.2.3", "[::1]:8"}) {
+    EXPECT_TRUE(internal::HostAllowed(host, loopback, &why)) << host << ": " << why;
+  }
+  for (const char* host : {"evil.example.com:8080", "192.168.1.20:8080", "localhost.evil.com",
+                           "127.0.0.1.evil.com", ""}) {
+    EXPECT_FALSE(internal::HostAllowed(host, loopback, &why)) << host;
+  }
+  EXPECT_FALSE(internal::HostAllowed("evil.example.com:8080", loopback, &why));
+  EXPECT_THAT(why, ::testing::HasSubstr("'evil.example.com:8080' is not this server"));
+
+  const internal::HostPolicy lab{"192.168.1.20", {"robot-head.local"}};
+  EXPECT_TRUE(internal::HostAllowed("192.168.1.20:8080", lab, &why));
+  EXPECT_TRUE(internal::HostAllowed("Robot-Head.local:8080", lab, &why));
+  EXPECT_FALSE(internal::HostAllowed("192.168.1.21:8080", lab, &why));
+  EXPECT_FALSE(internal::HostAllowed("robot-head.local.evil.com", lab, &why));
+
+  // On every interface: any address literal (a page from one is this server's own), no name.
+  const internal::HostPolicy any{"0.0.0.0", {}};
+  EXPECT_TRUE(internal::HostAllowed("10.1.2.3:8080", any, &why));
+  EXPECT_TRUE(internal::HostAllowed("[fe80::1]:8080", any, &why));
+  EXPECT_FALSE(internal::HostAllowed("rebind.evil.com:8080", any, &why));
+}
+
+TEST(GuiServerAccessTest, OriginMustBeThePageOfTheHostAsked) {
+  std::string why;
+  EXPECT_TRUE(internal::OriginAllowed("", false, "127.0.0.1:8080", &why));  // not a browser
+  EXPECT_TRUE(internal::OriginAllowed("http://127.0.0.1:8080", true, "127.0.0.1:8080", &why));
+  EXPECT_TRUE(internal::OriginAllowed("http://LocalHost:8080", true, "localhost:8080", &why));
+  EXPECT_FALSE(internal::OriginAllowed("http://evil.example.com", true, "127.0.0.1:8080", &why));
+  EXPECT_THAT(why, ::testing::HasSubstr("'http://evil.example.com'"));
+  EXPECT_FALSE(internal::OriginAllowed("http://127.0.0.1:9090", true, "127.0.0.1:8080", &why));
+  EXPECT_FALSE(internal::OriginAllowed("https://127.0.0.1:8080", true, "127.0.0.1:8080", &why));
+  EXPECT_FALSE(internal::OriginAllowed("null", true, "127.0.0.1:8080", &why));
+  EXPECT_FALSE(internal::OriginAllowed("", true, "127.0.0.1:8080", &why));
+}
+
+TEST(GuiServerAccessTest, GeneratedTokensAre128RandomBitsInHex) {
+  const std::string a = GenerateToken();
+  const std::string b = GenerateToken();
+  EXPECT_EQ(a.size(), 32u);
+  EXPECT_EQ(a.find_first_not_of("0123456789abcdef"), std::string::npos) << a;
+  EXPECT_NE(a, b);
+}
+
+TEST(GuiServerAccessTest, AnAllowedHostThatIsNotANameThrowsNamingIt) {
+  ServerOptions options = LocalOptions();
+  options.allowed_hosts = {"http://robot-head.local:8080"};
+  try {
+    GuiServer server(options);
+    FAIL() << "no exception";
+  } catch (const InvalidArgument& e) {
+    EXPECT_THAT(e.what(), ::testing::HasSubstr("'http://robot-head.local:8080'"));
+  }
+}
+
+class AccessTest : public ServerTest {};
+
+TEST_F(AccessTest, AForeignHostIs403OnThePageTheApiAndTheWebSocketAndIsLogged) {
+  const std::string evil = "evil.example.com:" + std::to_string(server_->port());
+  ::testing::internal::CaptureStderr();
+  EXPECT_EQ(Get(server_->port(), "/api/status", {{http::field::host, evil}}).status, 403);
+  const HttpResult page = Get(server_->port(), "/", {{http::field::host, evil}});
+  EXPECT_EQ(page.status, 403);
+  EXPECT_THAT(page.body, ::testing::HasSubstr("Host 'evil.example.com"));
+  WsClient ws;
+  EXPECT_EQ(ws.Connect(server_->port(), "/ws", "", evil, "http://" + evil), 403);
+  const std::string log = ::testing::internal::GetCapturedStderr();
+  EXPECT_THAT(log, ::testing::HasSubstr("403 for 127.0.0.1:"));
+  EXPECT_THAT(log, ::testing::HasSubstr("(GET /ws): the Host 'evil.example.com"));
+  EXPECT_EQ(server_->client_count(), 0);
+}
+
+TEST_F(AccessTest, AWebSocketFromAnotherOriginIs403AndNoCommandArrives) {
+  const std::string host = "127.0.0.1:" + std::to_string(server_->port());
+  for (const std::string origin : {"http://evil.example.com", "null", "http://127.0.0.1:1"}) {
+    WsClient ws;
+    EXPECT_EQ(ws.Connect(server_->port(), "/ws", "", host, origin), 403) << origin;
+  }
+  EXPECT_EQ(handled_, 0);
+  EXPECT_EQ(server_->client_count(), 0);
+  // The page's own origin, by address or by name, and a script that sends no Origin, connect.
+  WsClient own, by_name, script;
+  EXPECT_EQ(own.Connect(server_->port(), "/ws", "", host, "http://" + host), 101);
+  const std::string named = "localhost:" + std::to_string(server_->port());
+  EXPECT_EQ(by_name.Connect(server_->port(), "/ws", "", named, "http://" + named), 101);
+  EXPECT_EQ(script.Connect(server_->port()), 101);
+}
+
+TEST_F(AccessTest, AllowedHostNamesAreServed) {
+  ServerOptions options = LocalOptions();
+  options.allowed_hosts = {"robot-head.local"};
+  Make(options);
+  const std::string host = "robot-head.local:" + std::to_string(server_->port());
+  EXPECT_EQ(Get(server_->port(), "/api/status", {{http::field::host, host}}).status, 200);
+  WsClient ws;
+  EXPECT_EQ(ws.Connect(server_->port(), "/ws", "", host, "http://" + host), 101);
+  EXPECT_EQ(Get(server_->port(), "/api/status", {{http::field::host, "other.local"}}).status, 403);
+}
 
 TEST(GuiServerWsTest, HelloCarriesProtocolClientAndExtraFieldsThenWelcome) {
   ServerOptions options = LocalOptions();

@@ -12,6 +12,7 @@ import { after, before, describe, test } from 'node:test';
 import assert from 'node:assert/strict';
 import { spawn } from 'node:child_process';
 import fs from 'node:fs';
+import http from 'node:http';
 import os from 'node:os';
 import path from 'node:path';
 import { fileURLToPath } from 'node:url';
@@ -403,6 +404,82 @@ describe('saccade gui (portraits.yaml)', () => {
   });
 });
 
+describe('a page of another origin (issue 18)', () => {
+  let browser, server, evil;
+
+  before(async () => {
+    // evil.example.com resolves to this machine, as a DNS-rebinding name would.
+    browser = await chromium.launch({ executablePath: '/usr/bin/chromium',
+      args: [...kChromiumArgs, '--host-resolver-rules=MAP evil.example.com 127.0.0.1'] });
+    server = await startSaccade(['gui', '--scene', kScene, '--port', '0']);
+    // The foreign page, served from another origin on this machine.
+    evil = http.createServer((req, res) => {
+      res.writeHead(200, { 'Content-Type': 'text/html' });
+      res.end('<!doctype html><title>evil</title><p>nothing to see');
+    });
+    await new Promise((resolve) => evil.listen(0, '127.0.0.1', resolve));
+  });
+
+  after(async () => {
+    await browser?.close().catch(() => {});
+    await stopSaccade(server);
+    evil?.close();
+  });
+
+  test('cannot open the WebSocket, read the scene or move the head, even knowing the token', async () => {
+    const token = server.url.searchParams.get('token');
+    assert.match(token ?? '', /^[0-9a-f]{32}$/, `a random token in ${server.url.href}`);
+    const own = await openPage(browser, server.url.href);
+    await waitReady(own);
+    const before = await own.evaluate(() => window.saccadeGui.state.joints.targets.pan);
+
+    const attacker = await browser.newPage();
+    for (const origin of [`http://127.0.0.1:${evil.address().port}/`,
+                          `http://evil.example.com:${evil.address().port}/`]) {
+      await attacker.goto(origin);
+      const result = await attacker.evaluate(async ({ port, token }) => {
+        const socket = await new Promise((resolve) => {
+          const ws = new WebSocket(`ws://127.0.0.1:${port}/ws?token=${token}`);
+          const r = { opened: false };
+          ws.onopen = () => {
+            r.opened = true;
+            ws.send(JSON.stringify({ type: 'joints', id: 1, positions: { pan: 0.3 } }));
+            setTimeout(() => resolve(r), 1000);
+          };
+          ws.onclose = () => resolve(r);
+        });
+        let read = null;
+        try {
+          read = (await fetch(`http://127.0.0.1:${port}/api/scene?token=${token}`)).status;
+        } catch (e) {
+          read = 'blocked';
+        }
+        return { socket, read };
+      }, { port: server.port, token });
+      assert.equal(result.socket.opened, false, `a page at ${origin} opened the WebSocket`);
+      assert.equal(result.read, 'blocked', `a page at ${origin} read the scene`);
+    }
+    // DNS rebinding: the attacker's name now points at saccade itself.
+    const rebound = await attacker.goto(`http://evil.example.com:${server.port}/api/scene?token=${token}`);
+    assert.equal(rebound.status(), 403);
+    const page = await attacker.goto(`http://evil.example.com:${server.port}/`);
+    assert.equal(page.status(), 403);
+    await attacker.close();
+
+    // Nothing moved: two steps after the attack the pan target is what it was.
+    const after = await own.evaluate(async (from) => {
+      const t = performance.now();
+      while (window.saccadeGui.state.step < from + 2 && performance.now() - t < 60000) {
+        await new Promise((r) => setTimeout(r, 50));
+      }
+      return window.saccadeGui.state.joints.targets.pan;
+    }, await own.evaluate(() => window.saccadeGui.state.step));
+    assert.equal(after, before, 'the pan target changed');
+    assert.ok(Math.abs(after - 0.3) > 1e-6);
+    await own.close();
+  });
+});
+
 describe('saccade gui with an access token', () => {
   let browser, server;
 
@@ -477,9 +554,11 @@ describe('saccade gui restarted', () => {
 
   test('the page says it lost saccade, then reloads with the new scene when it is back', async () => {
     const twoPictures = path.join(kRepo, 'scenes', 'astronaut_and_cat.yaml');
-    server = await startSaccade(['gui', '--scene', twoPictures, '--port', '0']);
+    // The same token for both runs (as an operator keeps a bookmarked address across restarts);
+    // without --token each run has a random one and the reloaded page would be refused.
+    server = await startSaccade(['gui', '--scene', twoPictures, '--port', '0', '--token', 'keep']);
     const port = server.port;
-    const page = await openPage(browser, localUrl(server));
+    const page = await openPage(browser, localUrl(server, '?token=keep'));
     await waitReady(page);
     const names = async () => page.evaluate(() => window.saccadeGui.scene.objects.map((o) => o.name));
     assert.ok(!(await names()).includes('astronaut_near'));
@@ -488,7 +567,7 @@ describe('saccade gui restarted', () => {
     await page.waitForFunction(() => /disconnected/.test(document.getElementById('connection').textContent),
       null, { timeout: 30_000 });
     const reloaded = page.waitForEvent('load', { timeout: kReadyTimeoutMs });
-    server = await startSaccade(['gui', '--scene', kScene, '--port', String(port)]);
+    server = await startSaccade(['gui', '--scene', kScene, '--port', String(port), '--token', 'keep']);
     await reloaded;
     await waitReady(page);
     assert.ok((await names()).includes('astronaut_near'), 'the page shows the new scene');

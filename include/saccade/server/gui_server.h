@@ -11,13 +11,26 @@
 // fewer frames, never a slower caller, and its memory stays bounded however slow it is.
 // The command handler runs on the I/O thread; it must not block for long (queue the work).
 //
-// Security: it listens on 127.0.0.1 unless told otherwise. Listening on any other address
-// requires an access token (Start throws without one); when a token is set, every WebSocket
-// connection and every /api/ request must present it (`?token=...` or the header
-// `Authorization: Bearer ...`), or gets 401. The page itself and static files need no token
-// (they hold no state). Messages larger than max_message_bytes, malformed JSON, a missing or
-// unknown `type`, and ids that do not increase get an error reply naming what was wrong; the
-// connection and every other client go on.
+// Security (docs/gui-protocol.md, "Security"): the threat is a web page of another origin
+// that the operator happens to visit, which could otherwise open a WebSocket to the GUI on
+// 127.0.0.1 and move the head (the real robot's servos with a hardware file), or read the
+// scene through a DNS-rebinding name. So:
+// - Every request must name this server in its Host header: localhost, a loopback address,
+//   the listen address (any IP address when listening on 0.0.0.0 or ::), or a name of
+//   `allowed_hosts`. Anything else gets 403 and a log line (core/log.h) naming the peer.
+// - A request that carries an Origin header (browsers send one on every WebSocket and on
+//   cross-origin requests) must come from this server's own page: Origin equal to
+//   "http://" + its Host. Anything else gets 403 and a log line. Programs that send no Origin
+//   (scripts) are left to the token.
+// - It listens on 127.0.0.1 unless told otherwise. Listening on any other address requires an
+//   access token (the constructor throws without one). When a token is set, every WebSocket
+//   connection and every /api/ request must present it (`?token=...` or the header
+//   `Authorization: Bearer ...`), or gets 401. The page itself and static files need no token
+//   (they hold no state). The applications set a random token (GenerateToken) on loopback too,
+//   unless told not to, and print it in the page's address, as Jupyter does.
+// Messages larger than max_message_bytes, malformed JSON, a missing or unknown `type`, and ids
+// that do not increase get an error reply naming what was wrong; the connection and every
+// other client go on.
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -38,6 +51,9 @@ struct ServerOptions {
   /// Access token; required (non-empty) when `address` is not a loopback address. When set,
   /// WebSocket connections and /api/ requests must present it.
   std::string token;
+  /// Host names (no port) accepted in the Host header besides loopback names and addresses and
+  /// the listen address, e.g. the machine's name on a lab network ("robot-head.local").
+  std::vector<std::string> allowed_hosts;
   /// URL prefix ("/", "/vendor/three/") -> folder. The longest matching prefix serves; a
   /// path that leaves its folder (.., symlinks out) is 404. "/" serves index.html for "/".
   std::vector<std::pair<std::string, std::string>> mounts;
@@ -124,6 +140,10 @@ class GuiServer {
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
+
+/// A fresh access token: 128 bits from the kernel's random source, as 32 hex digits. Throws
+/// Error when the kernel gives none.
+std::string GenerateToken();
 
 /// True for 127.0.0.0/8, ::1 and "localhost".
 bool IsLoopbackAddress(const std::string& address);
