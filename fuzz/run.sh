@@ -43,7 +43,14 @@ for source in "${sources[@]}"; do
 done
 if ((${#stale[@]} > 0)); then
   echo "fuzz: compiling ${#stale[@]} sources with $cxx"
-  export FLAGS="${flags[*]}" OUT="$out" CXX_FUZZ="$cxx"
+  # Through ccache when it is there (paths are relative to the repository, so a fresh clone
+  # hits the cache of an earlier one).
+  compile="$cxx"
+  if command -v ccache >/dev/null; then
+    compile="ccache $cxx"
+    export CCACHE_BASEDIR="$root" CCACHE_NOHASHDIR=true
+  fi
+  export FLAGS="${flags[*]}" OUT="$out" CXX_FUZZ="$compile"
   printf '%s\n' "${stale[@]}" | xargs -P 2 -I{} sh -c \
     '$CXX_FUZZ $FLAGS -c "$1" -o "$OUT/obj/$(echo "$1" | tr / _).o"' _ {}
 fi

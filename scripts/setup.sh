@@ -4,6 +4,8 @@
 #
 #   bash scripts/setup.sh [BUILD_DIR] [extra cmake args...]
 #
+# SACCADE_BUILD_TARGET=T builds only target T (e.g. tests_unit) instead of everything.
+#
 # Runs as root (or through sudo when it is there). Nothing is downloaded at run time: every
 # asset comes from these packages.
 set -euo pipefail
@@ -97,4 +99,8 @@ shift || true
 werror=OFF
 [ "${CI:-}" = "true" ] && werror=ON
 cmake -S . -B "$build_dir" -G Ninja -DSACCADE_WERROR="$werror" "$@" >/dev/null
-cmake --build "$build_dir"
+if [ -n "${SACCADE_BUILD_TARGET:-}" ]; then
+  cmake --build "$build_dir" --target "$SACCADE_BUILD_TARGET"
+else
+  cmake --build "$build_dir"
+fi

@@ -253,6 +253,10 @@ PipelineSpec ParsePipeline(const std::string& text, const std::string& source,
   const Entry components = root.Get("components");
   const std::vector<Entry> entries = components.AsSequence("components");
   if (entries.empty()) components.Fail("expected at least one component, got an empty list");
+  if (entries.size() > static_cast<std::size_t>(kMaxComponents)) {
+    components.Fail(fmt::format("{} components, more than the {} a pipeline may have",
+                                entries.size(), kMaxComponents));
+  }
   std::map<std::string, int> lines;  // name -> line of its first use
   for (const Entry& entry : entries) {
     ComponentSpec component = ParseComponent(entry);

@@ -11,15 +11,19 @@
 #include <assimp/DefaultLogger.hpp>
 #include <assimp/Importer.hpp>
 #include <assimp/LogStream.hpp>
+#include <cctype>
 #include <cmath>
 #include <exception>
+#include <fstream>
 #include <mutex>
+#include <sstream>
 #include <system_error>
 #include <utility>
 
 #include "internal_assets.h"
 #include "internal_mesh.h"
 #include "saccade/core/error.h"
+#include "saccade/scene/limits.h"
 
 namespace saccade::scene::internal {
 namespace {
@@ -124,6 +128,64 @@ const aiScene* Import(Assimp::Importer& importer, const std::string& name, std::
   return scene;
 }
 
+// A PLY file's header against the model limits and the file's size, before Assimp allocates
+// what the header claims (Assimp reserves for every declared element: a 200-byte file that
+// declares 50 million faces took 3 GB and a minute and a half). Each property of an element
+// takes at least one byte (binary) or two characters (ASCII: a digit and a separator), so a
+// header declaring more than the file can hold is a lie. Other formats: nothing to do here.
+void CheckPlyHeader(const fs::path& path, const std::string& name) {
+  std::ifstream in(path, std::ios::binary);
+  std::string line;
+  if (!std::getline(in, line) || line.substr(0, 3) != "ply") return;
+  std::error_code ec;
+  const auto file_bytes = static_cast<int64_t>(fs::file_size(path, ec));
+  if (ec) return;  // Assimp reports what it cannot read
+  const auto fail = [&](const std::string& what) { throw FileError(name, 0, "", what); };
+  bool ascii = false;
+  std::string element;
+  int64_t count = 0, properties = 0, least_bytes = 0;
+  const auto close_element = [&] { least_bytes += count * properties * (ascii ? 2 : 1); };
+  for (int lines = 0; std::getline(in, line) && lines < 10000; ++lines) {
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    std::istringstream words(line);
+    std::string word;
+    words >> word;
+    if (word == "format") {
+      std::string kind;
+      words >> kind;
+      ascii = kind == "ascii";
+    } else if (word == "element") {
+      close_element();
+      words >> element >> count;
+      properties = 0;
+      if (!words || count < 0) fail("PLY header: malformed element line '" + line + "'");
+      if (element == "vertex" && count > kMaxModelVertices) {
+        fail(
+            fmt::format("the PLY header declares {} vertices, more than the {} a model may have "
+                        "(scene/limits.h)",
+                        count, kMaxModelVertices));
+      }
+      if (element == "face" && count > kMaxModelTriangles) {
+        fail(
+            fmt::format("the PLY header declares {} faces, more than the {} triangles a model "
+                        "may have (scene/limits.h)",
+                        count, kMaxModelTriangles));
+      }
+    } else if (word == "property") {
+      ++properties;
+    } else if (word == "end_header") {
+      close_element();
+      if (least_bytes > file_bytes) {
+        fail(
+            fmt::format("the PLY header declares elements that need at least {} bytes, but the "
+                        "file holds {} (a truncated file or a lying header)",
+                        least_bytes, file_bytes));
+      }
+      return;
+    }
+  }
+}
+
 class ModelReader {
  public:
   ModelReader(const fs::path& path, const std::shared_ptr<const Texture>& texture_override,
@@ -134,6 +196,7 @@ class ModelReader {
     Assimp::Importer importer;
     importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE,
                                 aiPrimitiveType_POINT | aiPrimitiveType_LINE);
+    CheckPlyHeader(path_, name_);
     std::string reason;
     bool data_loss = false;
     const aiScene* scene = Import(importer, name_, &reason, &data_loss);
@@ -151,6 +214,18 @@ class ModelReader {
     if ((scene->mFlags & AI_SCENE_FLAGS_INCOMPLETE) != 0 || scene->mNumMeshes == 0 ||
         scene->mMeshes == nullptr) {
       Fail("the model has no triangles (points and lines are not drawn)");
+    }
+    int64_t triangles = 0, vertices = 0;
+    for (unsigned m = 0; m < scene->mNumMeshes; ++m) {
+      if (scene->mMeshes[m] == nullptr) continue;
+      triangles += scene->mMeshes[m]->mNumFaces;
+      vertices += scene->mMeshes[m]->mNumVertices;
+    }
+    if (triangles > kMaxModelTriangles || vertices > kMaxModelVertices) {
+      Fail(
+          fmt::format("{} triangles and {} vertices, more than the {} and {} a model may have "
+                      "(scene/limits.h)",
+                      triangles, vertices, kMaxModelTriangles, kMaxModelVertices));
     }
     scene_ = scene;
     Model model;

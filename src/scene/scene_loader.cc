@@ -20,6 +20,7 @@
 #include "internal_robot_body.h"
 #include "saccade/core/error.h"
 #include "saccade/geometry/calibration_io.h"
+#include "saccade/scene/limits.h"
 #include "saccade/scene/scene.h"
 
 namespace saccade::scene {
@@ -129,7 +130,12 @@ class SceneReader {
     std::vector<std::optional<Entry>> id_entries;
     std::map<std::string, std::string> object_names;  // name -> key path
     if (const auto e = top.Find("objects")) {
-      for (const Entry& item : e->AsSequence("objects")) {
+      const std::vector<Entry> items = e->AsSequence("objects");
+      if (items.size() > static_cast<std::size_t>(kMaxObjects)) {
+        e->Fail(fmt::format("{} objects, more than the {} a scene may hold", items.size(),
+                            kMaxObjects));
+      }
+      for (const Entry& item : items) {
         std::optional<Entry> id_entry;
         objects.push_back(ReadObject(item, &id_entry, object_names));
         id_entries.push_back(id_entry);
@@ -144,12 +150,31 @@ class SceneReader {
       robot = ReadRobot(*e, &cameras, &robot_id_entry);
       for (const CameraSpec& camera : cameras) {
         camera_names.emplace(camera.name, "the robot's " + camera.name + " eye camera");
+        const auto calibration =
+            e->Find("cameras") ? e->Find("cameras")->Find(camera.name.c_str()) : std::nullopt;
+        CheckImageBudget(camera, calibration ? *calibration : e->Get("head"));
       }
     }
     if (const auto e = top.Find("cameras")) {
-      for (const Entry& item : e->AsSequence("cameras")) {
-        cameras.push_back(ReadWorldCamera(item, camera_names));
+      const std::vector<Entry> items = e->AsSequence("cameras");
+      if (items.size() + cameras.size() > static_cast<std::size_t>(kMaxCameras)) {
+        e->Fail(fmt::format("{} cameras, more than the {} a scene may hold",
+                            items.size() + cameras.size(), kMaxCameras));
       }
+      for (const Entry& item : items) {
+        cameras.push_back(ReadWorldCamera(item, camera_names));
+        CheckImageBudget(cameras.back(), item.Get("calibration"));
+      }
+    }
+    int64_t pixels = 0;
+    for (const CameraSpec& camera : cameras) {
+      pixels += int64_t{camera.model.intrinsics().width()} * camera.model.intrinsics().height();
+    }
+    if (pixels > kMaxScenePixels) {
+      top.Fail(
+          fmt::format("the cameras have {:.1f} Mpx together, more than the {:.0f} Mpx that "
+                      "saccade renders at once (scene/limits.h)",
+                      pixels * 1e-6, kMaxScenePixels * 1e-6));
     }
 
     AssignIds(objects, id_entries, robot ? &*robot : nullptr, robot_id_entry);
@@ -621,6 +646,25 @@ class SceneReader {
     return camera;
   }
 
+  // A camera's image against the renderer's largest image and memory budget (scene/limits.h),
+  // before anything is allocated for it; `where` is its calibration (or the head file).
+  static void CheckImageBudget(const CameraSpec& camera, const Entry& where) {
+    const int w = camera.model.intrinsics().width();
+    const int h = camera.model.intrinsics().height();
+    if (w > kMaxImageSide || h > kMaxImageSide) {
+      where.Fail(
+          fmt::format("camera '{}' is {}x{} px: a side above {} px, the largest image "
+                      "saccade renders",
+                      camera.name, w, h, kMaxImageSide));
+    }
+    if (int64_t{w} * h > kMaxImagePixels) {
+      where.Fail(
+          fmt::format("camera '{}' is {}x{} px = {:.1f} Mpx, more than the {:.0f} Mpx a "
+                      "camera may have (its render targets take up to 64 bytes a pixel)",
+                      camera.name, w, h, int64_t{w} * h * 1e-6, kMaxImagePixels * 1e-6));
+    }
+  }
+
   // --- robot --------------------------------------------------------------------------
   Robot ReadRobot(const Entry& e, std::vector<CameraSpec>* cameras,
                   std::optional<Entry>* id_entry) {
@@ -660,17 +704,15 @@ class SceneReader {
     // servo mapping kept).
     std::optional<head::HeadDescription> placed;
     try {
-      placed.emplace(description->name(), description->geometry(),
-                     std::array<head::JointLimits, 4>{description->limits(head::Joint::kPan),
-                                                      description->limits(head::Joint::kTilt),
-                                                      description->limits(head::Joint::kLeft),
-                                                      description->limits(head::Joint::kRight)},
-                     X_WB, left, right,
-                     std::array<std::optional<head::ServoMapping>, 4>{
-                         description->servo(head::Joint::kPan),
-                         description->servo(head::Joint::kTilt),
-                         description->servo(head::Joint::kLeft),
-                         description->servo(head::Joint::kRight)});
+      placed.emplace(
+          description->name(), description->geometry(),
+          std::array<head::JointLimits, 4>{
+              description->limits(head::Joint::kPan), description->limits(head::Joint::kTilt),
+              description->limits(head::Joint::kLeft), description->limits(head::Joint::kRight)},
+          X_WB, left, right,
+          std::array<std::optional<head::ServoMapping>, 4>{
+              description->servo(head::Joint::kPan), description->servo(head::Joint::kTilt),
+              description->servo(head::Joint::kLeft), description->servo(head::Joint::kRight)});
     } catch (const InvalidArgument& error) {
       e.Fail(error.what());
     }

@@ -64,6 +64,13 @@ std::shared_ptr<const Texture> DecodeTexture(const uint8_t* data, std::size_t si
   if (!stbi_info_from_memory(data, length, &width, &height, &channels)) {
     throw FileError(source, 0, "", fmt::format("not a readable image: {}", stbi_failure_reason()));
   }
+  if (width > kMaxImageSide || height > kMaxImageSide ||
+      int64_t{width} * height > kMaxImagePixels) {
+    throw FileError(source, 0, "",
+                    fmt::format("the embedded image is {}x{} px, larger than saccade reads ({} px "
+                                "a side; core/image_io.h)",
+                                width, height, kMaxImageSide));
+  }
   const int wanted = (channels == 2 || channels == 4) ? 4 : 3;
   std::unique_ptr<stbi_uc, void (*)(void*)> pixels(
       stbi_load_from_memory(data, length, &width, &height, &channels, wanted), stbi_image_free);

@@ -1,12 +1,13 @@
 #include "saccade/core/image_io.h"
 
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
 #include <unistd.h>
+#include <zlib.h>
 
 #include <filesystem>
 #include <fstream>
-
-#include <gmock/gmock.h>
-#include <gtest/gtest.h>
+#include <iterator>
 #include <opencv2/imgcodecs.hpp>
 
 #include "saccade/core/error.h"
@@ -30,7 +31,8 @@ class ImageIoTest : public ::testing::Test {
 
 Image Gradient(PixelFormat format, int width, int height) {
   Image image(width, height, format);
-  for (std::size_t i = 0; i < image.size_bytes(); ++i) image.data()[i] = static_cast<uint8_t>(i * 7 + 3);
+  for (std::size_t i = 0; i < image.size_bytes(); ++i)
+    image.data()[i] = static_cast<uint8_t>(i * 7 + 3);
   return image;
 }
 
@@ -77,6 +79,36 @@ TEST_F(ImageIoTest, MissingAndCorruptFilesNameTheFile) {
     FAIL() << "no error";
   } catch (const FileError& e) {
     EXPECT_THAT(e.what(), HasSubstr("corrupt.png"));
+  }
+}
+
+TEST_F(ImageIoTest, AnImageLargerThanTheLimitIsRefusedFromItsHeader) {
+  // A real PNG whose IHDR (CRC included) states 100000 x 100000 pixels: the size is refused
+  // before anything is decoded or allocated (issue 18). Written as a large image would be,
+  // then its IHDR patched: the CRC is recomputed so that the header is well-formed.
+  WritePng(Gradient(PixelFormat::kRgb8, 4, 4).view(), dir_ / "huge.png");
+  std::string bytes;
+  {
+    std::ifstream in(dir_ / "huge.png", std::ios::binary);
+    bytes.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  }
+  ASSERT_EQ(bytes.substr(12, 4), "IHDR");
+  const auto put32 = [&](std::size_t at, uint32_t v) {
+    for (int i = 0; i < 4; ++i) bytes[at + i] = static_cast<char>((v >> (24 - 8 * i)) & 0xff);
+  };
+  put32(16, 100000);
+  put32(20, 100000);
+  const uLong crc = crc32(0, reinterpret_cast<const Bytef*>(bytes.data() + 12), 17);
+  put32(29, static_cast<uint32_t>(crc));
+  std::ofstream(dir_ / "huge.png", std::ios::binary) << bytes;
+  try {
+    ReadImage(dir_ / "huge.png");
+    FAIL() << "no exception";
+  } catch (const FileError& e) {
+    EXPECT_NE(std::string(e.what()).find("huge.png: the image is 100000x100000 px, larger than "
+                                         "saccade reads (16384 px a side"),
+              std::string::npos)
+        << e.what();
   }
 }
 

@@ -163,6 +163,56 @@ TEST(Cli, LogLevelIsCheckedAndTakenBeforeOrAfterTheSubcommand) {
   }
 }
 
+// Issue 18's hostile inputs, through the real program: each a clear error naming the file,
+// line and key, exit status 1, never a signal (a 200000 x 200000 camera used to abort it with
+// std::bad_alloc; a PLY header of 50 million faces took 3 GB and 98 s to refuse).
+TEST(Cli, HugeInputsAreRefusedWithAClearErrorAndExitOne) {
+  const auto dir = TempDir() / "hostile";
+  std::filesystem::create_directories(dir);
+  const auto write = [&](const std::string& name, const std::string& text) {
+    std::ofstream(dir / name, std::ios::binary) << text;
+    return (dir / name).string();
+  };
+  // A PNG signature and an IHDR (with its CRC) stating 100000 x 100000 pixels.
+  std::string png = "\x89PNG\r\n\x1a\n";
+  png += std::string("\0\0\0\x0dIHDR\0\x01\x86\xa0\0\x01\x86\xa0\x08\x02\0\0\0", 25);
+  png += std::string("\x43\x2a\x3d\x35", 4);  // CRC-32 of "IHDR" and its 13 bytes
+  write("huge.png", png);
+  write("huge.ply",
+        "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+        "property float z\nelement face 50000000\nproperty list uchar int vertex_indices\n"
+        "end_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n");
+  std::string pipeline = "clock: {mode: simulated, step: 0.04, steps: 1}\ncomponents:\n";
+  for (int i = 0; i < 10000; ++i) {
+    pipeline += "  - {name: c" + std::to_string(i) + ", type: vision.stereo_faces}\n";
+  }
+  struct Case {
+    std::string command, expected;
+  };
+  const std::vector<Case> cases = {
+      {"render --frames 1 --force --out " + (dir / "out").string() + " --scene " +
+           write("camera.yaml",
+                 "cameras:\n  - name: huge\n    calibration: {width: 200000, height: 200000, "
+                 "fx: 1e5, fy: 1e5}\n    look_at: {eye: [0, 0, 1], target: [1, 0, 1]}\n"),
+       "camera.yaml:3: cameras[0].calibration: camera 'huge' is 200000x200000 px"},
+      {"render --frames 1 --force --out " + (dir / "out").string() + " --scene " +
+           write("picture.yaml",
+                 "objects:\n  - {name: poster, kind: picture, image: huge.png, height: 1}\n"),
+       "huge.png: the image is 100000x100000 px, larger than saccade reads"},
+      {"render --frames 1 --force --out " + (dir / "out").string() + " --scene " +
+           write("model.yaml", "objects:\n  - {name: blob, kind: model, file: huge.ply}\n"),
+       "huge.ply: the PLY header declares 50000000 faces"},
+      {"demo --pipeline " + write("pipeline.yaml", pipeline),
+       "pipeline.yaml:3: components: 10000 components, more than the 1000"},
+  };
+  for (const Case& c : cases) {
+    const CommandRun run = Saccade(c.command);
+    EXPECT_EQ(run.status, 1) << c.command << "\n" << run.output;  // 1, not a signal's 128+
+    EXPECT_THAT(run.output, HasSubstr(c.expected)) << c.command;
+  }
+  std::filesystem::remove_all(dir.parent_path());
+}
+
 TEST(Cli, EverySubcommandHasHelp) {
   for (const char* sub : {"fk", "ik", "camera", "demo"}) {
     const CommandRun help = Saccade(std::string(sub) + " --help");

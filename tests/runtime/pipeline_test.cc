@@ -126,6 +126,17 @@ TEST(PipelineLoaderTest, UnknownComponentTypeListsKnownTypes) {
                "known types: test.image_sink, test.random, test.recorder"});
 }
 
+TEST(PipelineLoaderTest, TooManyComponentsAreRefusedBeforeAnyIsBuilt) {
+  std::string text = "components:\n";
+  for (int i = 0; i <= kMaxComponents; ++i) {
+    text += "  - {name: c" + std::to_string(i) + ", type: test.source}\n";
+  }
+  const std::string error = LoadError(text);
+  EXPECT_NE(error.find("loop.yaml:2: components: 1001 components, more than the 1000"),
+            std::string::npos)
+      << error;
+}
+
 TEST(PipelineLoaderTest, DuplicateComponentNameRejected) {
   const std::string text = R"(components:
   - name: source

@@ -1,6 +1,7 @@
 // Model files through the scene loader: loaded once, textures found, and every malformed
 // model rejected with the scene key and the model's path (assimp-testmodels' broken files).
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -181,6 +182,23 @@ TEST_F(ModelLoaderTest, RejectsEmptyAndTruncatedFiles) {
   ExpectRejected(dir_.Write("half.glb", bytes.substr(0, bytes.size() / 2)).string(), {});
   // Not a model at all.
   ExpectRejected(dir_.Write("notes.obj", "hello\n").string(), {});
+}
+
+TEST_F(ModelLoaderTest, RejectsAPlyHeaderThatClaimsMoreThanAModelMayHaveBeforeReadingIt) {
+  // Issue 18: a 200-byte PLY declaring 50 million faces took Assimp 3 GB and 98 s to refuse.
+  const std::string header =
+      "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\n"
+      "property float y\nproperty float z\nelement face {}\n"
+      "property list uchar int vertex_indices\nend_header\n"
+      "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
+  ExpectRejected(dir_.Write("huge.ply", fmt::format(fmt::runtime(header), 50'000'000)).string(),
+                 {"the PLY header declares 50000000 faces, more than the 10000000 triangles"});
+  // Within the limit, but more than the file can hold: a lie (or a truncated file).
+  ExpectRejected(dir_.Write("lying.ply", fmt::format(fmt::runtime(header), 1'000'000)).string(),
+                 {"need at least 2000018 bytes, but the file holds"});
+  // The honest one loads.
+  const auto honest = dir_.Write("one.ply", fmt::format(fmt::runtime(header), 1));
+  EXPECT_EQ(Load(OneModel(honest.string())).objects().size(), 1u);
 }
 
 TEST_F(ModelLoaderTest, RejectsModelsWithoutTriangles) {

@@ -1,6 +1,7 @@
 // Scene files: what a valid file gives, and the message of every kind of bad input (file,
 // line, key path, what was expected).
 
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -10,6 +11,7 @@
 #include "saccade/core/error.h"
 #include "saccade/core/image_io.h"
 #include "saccade/geometry/calibration_io.h"
+#include "saccade/scene/limits.h"
 #include "saccade/scene/scene.h"
 #include "scene/scene_test_util.h"
 
@@ -678,6 +680,59 @@ TEST_F(SceneLoaderTest, BadSensorsNameTheFileLineAndKey) {
               "robot.cameras.left.sensor.noise", {"unknown key 'noise'"});
   ExpectError(eye("exposure_ms: 8", "exposure_ms: 8\n        blur_samples: 0"), "blur_samples: 0",
               "robot.cameras.left.sensor.blur_samples", {"expected an integer in [1, 64]"});
+}
+
+}  // namespace
+}  // namespace saccade::scene
+
+namespace saccade::scene {
+namespace {
+
+// Issue 18: a camera of 200000 x 200000 pixels aborted the process (std::bad_alloc) when the
+// renderer allocated for it. Sizes are checked when the scene loads, with the key named.
+class SceneLimitsTest : public ::testing::Test {
+ protected:
+  static FileError Error(const std::string& text) {
+    try {
+      Scene::FromYamlString(text, "limits.yaml", std::filesystem::temp_directory_path());
+    } catch (const FileError& error) {
+      return error;
+    }
+    ADD_FAILURE() << "no FileError for:\n" << text;
+    return FileError("", 0, "", "");
+  }
+  static std::string Camera(const std::string& name, int width, int height) {
+    return "  - name: " + name + "\n    calibration: {width: " + std::to_string(width) +
+           ", height: " + std::to_string(height) +
+           ", fx: 1000, fy: 1000}\n    look_at: {eye: [0, 0, 1], target: [1, 0, 1]}\n";
+  }
+};
+
+TEST_F(SceneLimitsTest, AHugeCameraIsRefusedAtItsCalibrationBeforeRendering) {
+  const FileError side = Error("cameras:\n" + Camera("huge", 200000, 200000));
+  EXPECT_EQ(side.line(), 3) << side.what();
+  EXPECT_EQ(side.key(), "cameras[0].calibration") << side.what();
+  EXPECT_THAT(side.what(),
+              ::testing::HasSubstr("camera 'huge' is 200000x200000 px: a side above 16384 px"));
+  // Within the side but beyond the pixels of one camera.
+  const FileError pixels = Error("cameras:\n" + Camera("wide", 16384, 8192));
+  EXPECT_THAT(pixels.what(),
+              ::testing::HasSubstr("16384x8192 px = 134.2 Mpx, more than the 67 Mpx"));
+  // The largest camera allowed loads.
+  EXPECT_NO_THROW(Scene::FromYamlString("cameras:\n" + Camera("big", 8192, 8192), "ok.yaml",
+                                        std::filesystem::temp_directory_path()));
+}
+
+TEST_F(SceneLimitsTest, CamerasTogetherAndTheirNumberAreBounded) {
+  std::string five = "cameras:\n";
+  for (int i = 0; i < 5; ++i) five += Camera("c" + std::to_string(i), 8192, 8192);
+  const FileError total = Error(five);
+  EXPECT_THAT(total.what(), ::testing::HasSubstr("the cameras have 335.5 Mpx together"));
+  std::string many = "cameras:\n";
+  for (int i = 0; i < kMaxCameras + 1; ++i) many += Camera("c" + std::to_string(i), 64, 48);
+  const FileError count = Error(many);
+  EXPECT_EQ(count.key(), "cameras") << count.what();
+  EXPECT_THAT(count.what(), ::testing::HasSubstr("65 cameras, more than the 64"));
 }
 
 }  // namespace

@@ -50,6 +50,10 @@
 
 namespace saccade::runtime {
 
+/// Components of one pipeline (each is built, configured and stepped in order; a loop of the
+/// seed's kind has about ten).
+inline constexpr int kMaxComponents = 1000;
+
 enum class ClockMode { kSimulated, kRealtime };
 enum class OnError { kStop, kContinue };
 
