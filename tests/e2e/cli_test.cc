@@ -176,7 +176,7 @@ TEST(Cli, HugeInputsAreRefusedWithAClearErrorAndExitOne) {
   // A PNG signature and an IHDR (with its CRC) stating 100000 x 100000 pixels.
   std::string png = "\x89PNG\r\n\x1a\n";
   png += std::string("\0\0\0\x0dIHDR\0\x01\x86\xa0\0\x01\x86\xa0\x08\x02\0\0\0", 25);
-  png += std::string("\x43\x2a\x3d\x35", 4);  // CRC-32 of "IHDR" and its 13 bytes
+  png += std::string("\x27\x30\x9c\x9f", 4);  // CRC-32 of "IHDR" and its 13 bytes
   write("huge.png", png);
   write("huge.ply",
         "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
