@@ -15,7 +15,7 @@
 #include <vector>
 
 #include "saccade/core/error.h"
-#include "saccade/hw/servo_emulator.h"
+#include "servo_emulator/servo_emulator.h"
 
 namespace saccade::hw {
 namespace {

@@ -14,7 +14,7 @@
 #include "hw/driver_test_util.h"
 #include "saccade/hw/dynamixel_protocol.h"
 #include "saccade/hw/hw_error.h"
-#include "saccade/hw/servo_emulator.h"
+#include "servo_emulator/servo_emulator.h"
 
 namespace saccade::hw {
 namespace {

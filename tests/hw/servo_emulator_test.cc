@@ -1,5 +1,5 @@
 // The emulator's control-table rules, in-process (ServoEmulator::Process, no terminal).
-#include "saccade/hw/servo_emulator.h"
+#include "servo_emulator/servo_emulator.h"
 
 #include <gtest/gtest.h>
 #include <unistd.h>

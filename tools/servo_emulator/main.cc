@@ -20,7 +20,7 @@
 
 #include "saccade/core/error.h"
 #include "saccade/hw/dynamixel_protocol.h"
-#include "saccade/hw/servo_emulator.h"
+#include "servo_emulator/servo_emulator.h"
 
 namespace {
 

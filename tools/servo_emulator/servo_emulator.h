@@ -1,7 +1,9 @@
 #pragma once
 // An emulated bus of X-series servos (XM430-W350, model 1020) speaking DYNAMIXEL Protocol 2.0
 // on a pseudo-terminal: for the tests, and for users without the robot
-// (apps/servo_emulator: saccade-servo-emulator).
+// (tools/servo_emulator/main.cc: saccade-servo-emulator). A tool, not part of the production
+// hw library (DESIGN.md): the library saccade_servo_emulator, linked by the program and the
+// tests.
 //
 // Start() opens a PseudoTerminal and serves its master from a background thread; programs
 // open the slave (or the symbolic link) as their serial port, at any baud rate. Process()

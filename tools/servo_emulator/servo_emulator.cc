@@ -1,4 +1,4 @@
-#include "saccade/hw/servo_emulator.h"
+#include "servo_emulator/servo_emulator.h"
 
 #include <errno.h>
 #include <fcntl.h>
