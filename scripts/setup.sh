@@ -96,9 +96,10 @@ fi
 
 build_dir="${1:-build}"
 shift || true
-werror=OFF
-[ "${CI:-}" = "true" ] && werror=ON
-cmake -S . -B "$build_dir" -G Ninja -DSACCADE_WERROR="$werror" "$@" >/dev/null
+# Warnings are errors here as in CI (g++ 12 on Debian 12 builds the tree without one): the same
+# flags as CI's, so that ccache serves CI's fresh clone from a developer's build and back.
+# SACCADE_WERROR=OFF in the environment turns it off.
+cmake -S . -B "$build_dir" -G Ninja -DSACCADE_WERROR="${SACCADE_WERROR:-ON}" "$@" >/dev/null
 if [ -n "${SACCADE_BUILD_TARGET:-}" ]; then
   cmake --build "$build_dir" --target "$SACCADE_BUILD_TARGET"
 else

@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # The README's second command: set up, build, and run every test.
-# With CI=true: warnings are errors, the scene loader is fuzzed briefly (libFuzzer), and the
-# unit tests run a second time under AddressSanitizer and UndefinedBehaviorSanitizer (build-asan/,
-# which builds the unit tier only). Each phase's wall time is printed as it ends, and all of
+# Warnings are errors (scripts/setup.sh). With CI=true: the scene loader is fuzzed briefly
+# (libFuzzer), and the unit tests run a second time under AddressSanitizer and
+# UndefinedBehaviorSanitizer (build-asan/, which builds the unit tier only). Each phase's wall time is printed as it ends, and all of
 # them at the end, also when a phase fails. Compiles go through ccache (scripts/setup.sh).
 set -euo pipefail
 cd "$(dirname "$0")/.."

@@ -199,7 +199,7 @@ Runner AddFkCommand(CLI::App& app) {
       ->expected(4)
       ->required();
   fk->add_flag("--deg", o->degrees, "Joint angles are in degrees");
-  fk->add_flag("--json", o->json, "Print JSON (stable interface, see README)");
+  fk->add_flag("--json", o->json, "Print JSON (stable interface, docs/cli.md)");
   return [o] { return RunFk(o->head, o->joints, o->degrees, o->json); };
 }
 
@@ -223,7 +223,7 @@ Runner AddIkCommand(CLI::App& app) {
   ik->add_option("--mode", o->mode, "symmetric (left = -right) or independent (pan held at 0)")
       ->check(CLI::IsMember({"symmetric", "independent"}))
       ->capture_default_str();
-  ik->add_flag("--json", o->json, "Print JSON (stable interface, see README)");
+  ik->add_flag("--json", o->json, "Print JSON (stable interface, docs/cli.md)");
   return [o] { return RunIk(o->head, o->target, o->mode, o->json); };
 }
 
@@ -246,7 +246,7 @@ Runner AddCameraCommand(CLI::App& app) {
       ->capture_default_str();
   camera->add_option("--far", o->far, "Far clip plane of the OpenGL projection (m)")
       ->capture_default_str();
-  camera->add_flag("--json", o->json, "Print JSON (stable interface, see README)");
+  camera->add_flag("--json", o->json, "Print JSON (stable interface, docs/cli.md)");
   return [o] { return RunCamera(o->calibration, o->near, o->far, o->json); };
 }
 

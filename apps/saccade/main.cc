@@ -1,5 +1,5 @@
 // saccade: the command-line program. Thin: every subcommand parses its options, calls the
-// libraries and prints text for people or --json for scripts (README documents the JSON).
+// libraries and prints text for people or --json for scripts (docs/cli.md documents the JSON).
 
 #include <cstdio>
 
