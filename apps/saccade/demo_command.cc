@@ -30,11 +30,11 @@
 #include "saccade/components/hw_components.h"
 #include "saccade/components/messages.h"
 #include "saccade/components/register.h"
-#include "saccade/components/scene_cache.h"
 #include "saccade/components/sim_components.h"
 #include "saccade/core/error.h"
 #include "saccade/runtime/pipeline.h"
 #include "saccade/runtime/scheduler.h"
+#include "saccade/scene/scene.h"
 #include "saccade/vision/image_camera.h"
 
 namespace saccade::app {
@@ -238,10 +238,11 @@ int RunDemo(Options o) {
   }
   runtime::PipelineSpec spec = runtime::LoadPipelineFile(o.pipeline, o.hardware);
   if (!o.scene.empty()) {
-    // --scene replaces every component's `scene` parameter (absolute: the pipeline file's
-    // folder is not the user's).
+    // --scene replaces the pipeline's scene and every component's own `scene` parameter
+    // (absolute: the pipeline file's folder is not the user's).
     const std::string scene = fs::absolute(o.scene).lexically_normal().string();
     if (!fs::exists(scene)) throw InvalidArgument("demo: --scene " + o.scene + ": no such file");
+    spec.resources["scene"] = runtime::ResourceSpec{scene, "--scene", 0};
     for (runtime::ComponentSpec& c : spec.components) {
       if (c.params.is_object() && c.params.contains("scene")) c.params["scene"] = scene;
     }

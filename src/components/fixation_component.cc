@@ -1,7 +1,7 @@
 #include "saccade/components/fixation_component.h"
 
 #include "components/internal_params.h"
-#include "saccade/components/scene_cache.h"
+#include "components/internal_scene.h"
 #include "saccade/head/kinematics.h"
 
 namespace saccade::components {
@@ -12,13 +12,13 @@ FixationComponent::FixationComponent()
 
 void FixationComponent::Configure(const nlohmann::json& params) {
   internal::Params p(params);
-  const std::string path = ResolvePath(p.RequiredString("scene"));
+  const internal::SceneRef scene = internal::SceneOf(*this, p);
   pursuit_ = p.Bool("pursuit", true);
   min_pursuit_speed_ = p.Number("min_pursuit_speed_m_s", 0.02, 0.0, 1e6);
   smoothing_ = p.Number("velocity_smoothing", 0.5, 0.0, 1.0);
   p.Finish();
-  scene_ = LoadSharedScene(path);
-  last_joints_ = RobotOf(*scene_, path).initial_joints;
+  scene_ = scene.scene;
+  last_joints_ = internal::RobotOf(*scene_, scene.path).initial_joints;
 }
 
 head::JointState FixationComponent::Solve(const Eigen::Vector3d& p_W,

@@ -7,7 +7,7 @@
 #include <cstdio>
 
 #include "components/internal_params.h"
-#include "saccade/components/scene_cache.h"
+#include "components/internal_scene.h"
 #include "saccade/core/error.h"
 #include "saccade/core/log.h"
 #include "saccade/head/kinematics.h"
@@ -74,7 +74,8 @@ HwHead::HwHead()
 
 void HwHead::Configure(const nlohmann::json& params) {
   internal::Params p(params);
-  const std::string path = ResolvePath(p.RequiredString("scene"));
+  const internal::SceneRef scene = internal::SceneOf(*this, p);
+  const std::string& path = scene.path;
   driver_kind_ = p.Choice("driver", "", {"dynamixel", "simulated"});
   if (driver_kind_.empty()) {
     throw InvalidArgument("parameter 'driver' is required: dynamixel or simulated");
@@ -91,8 +92,8 @@ void HwHead::Configure(const nlohmann::json& params) {
         "parameter 'port' is required for the dynamixel driver (the serial port, e.g. "
         "/dev/ttyUSB0, or the path saccade-servo-emulator prints)");
   }
-  scene_ = LoadSharedScene(path);
-  const scene::Robot& robot = RobotOf(*scene_, path);
+  scene_ = scene.scene;
+  const scene::Robot& robot = internal::RobotOf(*scene_, path);
   if (driver_kind_ == "dynamixel" && !robot.head.HasServos()) {
     throw InvalidArgument(fmt::format(
         "the dynamixel driver needs a servo mapping for every joint (joints.<joint>.servo in "
@@ -297,7 +298,8 @@ void HwCameras::Configure(const nlohmann::json& params) {
   const bool has_cameras = flat.contains("cameras");
   flat.erase("cameras");
   internal::Params p(params.is_null() ? params : flat);
-  const std::string path = ResolvePath(p.RequiredString("scene"));
+  const internal::SceneRef scene = internal::SceneOf(*this, p);
+  const std::string& path = scene.path;
   max_skew_s_ = p.Number("max_skew_s", 0.02, 0.0, 3600.0);
   p.Finish();
   if (!has_cameras) {
@@ -324,8 +326,8 @@ void HwCameras::Configure(const nlohmann::json& params) {
   const std::string base_dir = ResolvePath(".");
   left_spec_ = ReadSource(cameras["left"], "left", base_dir);
   right_spec_ = ReadSource(cameras["right"], "right", base_dir);
-  scene_ = LoadSharedScene(path);
-  RobotOf(*scene_, path);
+  scene_ = scene.scene;
+  internal::RobotOf(*scene_, path);
 }
 
 void HwCameras::Start() {

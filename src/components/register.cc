@@ -1,5 +1,6 @@
 #include "saccade/components/register.h"
 
+#include "components/internal_scene.h"
 #include "saccade/components/fixation_component.h"
 #include "saccade/components/hw_components.h"
 #include "saccade/components/messages.h"
@@ -10,6 +11,7 @@ namespace saccade::components {
 
 void RegisterComponents(runtime::ComponentRegistry& registry) {
   RegisterMessages();
+  internal::RegisterSceneResource(registry);
   if (registry.Has("sim.cameras")) return;
   registry.Register<SimCameras>("sim.cameras", "renders the scene's cameras (OpenGL/EGL)");
   registry.Register<SimHead>("sim.head", "the head's motors under velocity/acceleration limits");

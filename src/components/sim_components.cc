@@ -4,7 +4,7 @@
 #include <cstdint>
 
 #include "components/internal_params.h"
-#include "saccade/components/scene_cache.h"
+#include "components/internal_scene.h"
 #include "saccade/core/error.h"
 
 namespace saccade::components {
@@ -26,7 +26,8 @@ SimCameras::SimCameras() : joints_(AddInput<JointStateMessage>("joints")) {}
 
 void SimCameras::Configure(const nlohmann::json& params) {
   internal::Params p(params);
-  const std::string path = ResolvePath(p.RequiredString("scene"));
+  const internal::SceneRef scene = internal::SceneOf(*this, p);
+  const std::string& path = scene.path;
   options_.cameras = p.Strings("cameras", {"left", "right"});
   options_.distortion = p.Bool("distortion", true);
   options_.noise = p.Bool("noise", true);
@@ -36,7 +37,7 @@ void SimCameras::Configure(const nlohmann::json& params) {
   p.Finish();
   std::string error;
   if (!options_.IsValid(&error)) throw InvalidArgument(error);
-  scene_ = LoadSharedScene(path);
+  scene_ = scene.scene;
   for (const std::string& camera : options_.cameras) {
     if (scene_->FindCamera(camera) == nullptr) {
       throw InvalidArgument("parameter 'cameras': scene '" + path + "' has no camera '" + camera +
@@ -119,10 +120,10 @@ JointStateMessage SimHead::State(double time) const {
 
 void SimHead::Configure(const nlohmann::json& params) {
   internal::Params p(params);
-  const std::string path = ResolvePath(p.RequiredString("scene"));
+  const internal::SceneRef scene = internal::SceneOf(*this, p);
   p.Finish();
-  scene_ = LoadSharedScene(path);
-  RobotOf(*scene_, path);
+  scene_ = scene.scene;
+  internal::RobotOf(*scene_, scene.path);
 }
 
 void SimHead::Start() {

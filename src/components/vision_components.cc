@@ -5,7 +5,7 @@
 #include <vector>
 
 #include "components/internal_params.h"
-#include "saccade/components/scene_cache.h"
+#include "components/internal_scene.h"
 #include "saccade/core/error.h"
 #include "saccade/head/kinematics.h"
 #include "saccade/vision/image_camera.h"
@@ -167,7 +167,7 @@ AttentionComponent::AttentionComponent()
 
 void AttentionComponent::Configure(const nlohmann::json& params) {
   internal::Params p(params);
-  const std::string path = ResolvePath(p.RequiredString("scene"));
+  const internal::SceneRef scene = internal::SceneOf(*this, p);
   ior_options_.fixation_time_s = p.Number("fixation_time_s", 2.0, 1e-6, 1e6);
   ior_options_.radius_m = p.Number("radius_m", 0.15, 1e-6, 1e6);
   ior_options_.suppression_time_s = p.Number("suppression_time_s", 60.0, 1e-6, 1e9);
@@ -177,8 +177,8 @@ void AttentionComponent::Configure(const nlohmann::json& params) {
   home_distance_m_ = p.Number("home_distance_m", 3.0, 0.1, 1e3);
   p.Finish();
   ior_.emplace(ior_options_);
-  scene_ = LoadSharedScene(path);
-  RobotOf(*scene_, path);
+  scene_ = scene.scene;
+  internal::RobotOf(*scene_, scene.path);
 }
 
 void AttentionComponent::Step(const runtime::StepContext& context) {

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <filesystem>
 
+#include "saccade/runtime/component_registry.h"
+
 namespace saccade::runtime {
 namespace {
 
@@ -20,6 +22,13 @@ std::string Component::ResolvePath(const std::string& path) const {
   const std::filesystem::path p(path);
   if (p.is_absolute() || base_dir_.empty() || path.empty()) return path;
   return (std::filesystem::path(base_dir_) / p).lexically_normal().string();
+}
+
+Resources& Component::resources() {
+  if (!resources_) {
+    resources_ = std::make_shared<Resources>(ComponentRegistry::Global().resource_loaders());
+  }
+  return *resources_;
 }
 
 InputBase* Component::FindInput(const std::string& name) const {

@@ -24,6 +24,16 @@ void ComponentRegistry::Register(const std::string& type, Factory factory,
   entries_.insert(it, {type, Entry{std::move(factory), std::move(description)}});
 }
 
+void ComponentRegistry::RegisterResource(const std::string& kind, ResourceLoader loader) {
+  if (kind.empty() || !loader.load) {
+    throw InvalidArgument("ComponentRegistry::RegisterResource: empty kind or loader");
+  }
+  if (!resources_.emplace(kind, std::move(loader)).second) {
+    throw InvalidArgument("ComponentRegistry::RegisterResource: resource '" + kind +
+                          "' is already registered");
+  }
+}
+
 bool ComponentRegistry::Has(const std::string& type) const {
   return std::any_of(entries_.begin(), entries_.end(),
                      [&](const auto& entry) { return entry.first == type; });

@@ -134,15 +134,29 @@ void ParseTypeAndParams(const Entry& e, ComponentSpec* spec) {
   }
 }
 
-// A hardware file: component name -> its type and params.
-std::map<std::string, ComponentSpec> LoadHardware(const std::string& path) {
+// `scene: FILE` at the top of a pipeline or hardware file, resolved against its folder.
+std::optional<ResourceSpec> ParseScene(const Entry& root, const std::string& file) {
+  const auto scene = root.Find("scene");
+  if (!scene) return std::nullopt;
+  const std::filesystem::path relative = scene->AsNonEmptyString();
+  return ResourceSpec{relative.is_absolute()
+                          ? relative.string()
+                          : (std::filesystem::path(file).parent_path() / relative).string(),
+                      file, scene->line()};
+}
+
+// A hardware file: component name -> its type and params; `scene` its scene, if it names one.
+std::map<std::string, ComponentSpec> LoadHardware(const std::string& path,
+                                                  std::optional<ResourceSpec>* scene) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw FileError(path, 0, "", "cannot open the hardware file");
   std::ostringstream text;
   text << in.rdbuf();
   const YAML::Node root_node = saccade::internal::ParseYaml(text.str(), path);
   const Entry root(root_node, "", &path, 1);
-  root.ExpectMap({"components"}, "a hardware file {components: {name: {type, params}}}");
+  root.ExpectMap({"scene", "components"},
+                 "a hardware file {scene, components: {name: {type, params}}}");
+  *scene = ParseScene(root, path);
   const Entry components = root.Get("components");
   if (!components.IsMap() || components.node().size() == 0) {
     components.Fail("expected a map of components {name: {type, params}}, got " +
@@ -234,10 +248,11 @@ PipelineSpec ParsePipeline(const std::string& text, const std::string& source,
                            const std::string& hardware) {
   const YAML::Node root_node = saccade::internal::ParseYaml(text, source);
   const Entry root(root_node, "", &source, 1);
-  root.ExpectMap({"clock", "seed", "on_error", "hardware", "components"},
-                 "a pipeline {clock, seed, on_error, hardware, components}");
+  root.ExpectMap({"clock", "seed", "on_error", "scene", "hardware", "components"},
+                 "a pipeline {clock, seed, on_error, scene, hardware, components}");
   PipelineSpec spec;
   spec.file = source;
+  if (auto scene = ParseScene(root, source)) spec.resources["scene"] = std::move(*scene);
   if (const auto clock = root.Find("clock")) spec.clock = ParseClock(*clock);
   if (const auto seed = root.Find("seed")) spec.seed = seed->AsUint64();
   if (const auto on_error = root.Find("on_error")) {
@@ -281,7 +296,9 @@ PipelineSpec ParsePipeline(const std::string& text, const std::string& source,
   std::map<std::string, ComponentSpec> parts;
   if (!spec.hardware_file.empty()) {
     try {
-      parts = LoadHardware(spec.hardware_file);
+      std::optional<ResourceSpec> scene;
+      parts = LoadHardware(spec.hardware_file, &scene);
+      if (scene) spec.resources["scene"] = std::move(*scene);  // the hardware file's wins
     } catch (const FileError& error) {
       if (hardware.empty() && hardware_entry && error.line() == 0) {
         hardware_entry->Fail(error.what());  // a missing file: name the pipeline's line too
@@ -377,6 +394,18 @@ Pipeline Pipeline::Build(const PipelineSpec& spec, const ComponentRegistry& regi
     }
   }
 
+  // The shared resources, loaded before any component so that a bad file is reported at the
+  // line that names it.
+  pipeline.resources_ = std::make_shared<Resources>(registry.resource_loaders());
+  for (const auto& [kind, resource] : spec.resources) {
+    try {
+      pipeline.resources_->SetDefault(kind, resource.path);
+      pipeline.resources_->LoadDefault(kind);
+    } catch (const Error& error) {
+      throw FileError(resource.file, resource.line, kind, error.what());
+    }
+  }
+
   // Relative paths in params resolve against the pipeline file's folder.
   const std::string base_dir = std::filesystem::path(file).parent_path().string();
   // Create and configure, in order.
@@ -397,7 +426,8 @@ Pipeline Pipeline::Build(const PipelineSpec& spec, const ComponentRegistry& regi
     component->Initialise(c.name, ComponentSeed(spec.seed, c.name),
                           c.params_file.empty()
                               ? base_dir
-                              : std::filesystem::path(c.params_file).parent_path().string());
+                              : std::filesystem::path(c.params_file).parent_path().string(),
+                          pipeline.resources_);
     try {
       component->Configure(c.params);
     } catch (const std::exception& error) {

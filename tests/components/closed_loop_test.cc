@@ -13,9 +13,9 @@
 #include "saccade/components/face_truth.h"
 #include "saccade/components/messages.h"
 #include "saccade/components/register.h"
-#include "saccade/components/scene_cache.h"
 #include "saccade/runtime/pipeline.h"
 #include "saccade/runtime/scheduler.h"
+#include "saccade/scene/scene.h"
 #include "saccade/vision/image_camera.h"
 
 namespace saccade::components {
@@ -60,11 +60,11 @@ struct LoopRun {
 LoopRun RunLoop(const std::string& scene_file, double seconds, bool stop_when_all_done = true) {
   RegisterComponents();
   runtime::PipelineSpec spec = runtime::LoadPipelineFile(kSource + "/pipelines/demo.yaml");
-  for (runtime::ComponentSpec& c : spec.components) {
-    if (c.params.contains("scene")) c.params["scene"] = scene_file;
-  }
+  spec.resources["scene"] = runtime::ResourceSpec{scene_file, "closed_loop_test", 0};
   runtime::Pipeline pipeline = runtime::Pipeline::Build(spec);
-  const std::shared_ptr<const scene::Scene> scene = LoadSharedScene(scene_file);
+  // The scene every component of the pipeline works in (loaded once, by the pipeline).
+  const std::shared_ptr<const scene::Scene> scene =
+      pipeline.resources().Default<scene::Scene>("scene");
   const std::vector<PictureFace> pictures = FindPictureFaces(*scene);
 
   LoopRun out;
@@ -146,7 +146,8 @@ LoopRun RunLoop(const std::string& scene_file, double seconds, bool stop_when_al
 
 std::vector<std::string> Faces(const std::string& scene_file) {
   std::vector<std::string> names;
-  for (const PictureFace& p : FindPictureFaces(*LoadSharedScene(scene_file))) {
+  for (const PictureFace& p :
+       FindPictureFaces(*std::make_shared<const scene::Scene>(scene::Scene::Load(scene_file)))) {
     if (p.has_face) names.push_back(p.name);
   }
   return names;
@@ -176,7 +177,7 @@ TEST(ClosedLoop, FixatesEveryPortraitInTurnClosestFirstAndNeverTheCat) {
   std::sort(sorted_faces.begin(), sorted_faces.end());
   EXPECT_EQ(sorted_fixated, sorted_faces);
   // Closest first: the visiting order is the order of distance from the head.
-  const auto scene_ptr = LoadSharedScene(scene);
+  const auto scene_ptr = std::make_shared<const scene::Scene>(scene::Scene::Load(scene));
   std::vector<double> distance;
   for (const std::string& name : fixated) {
     for (const PictureFace& p : FindPictureFaces(*scene_ptr)) {

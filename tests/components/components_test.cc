@@ -12,7 +12,6 @@
 #include "saccade/components/face_truth.h"
 #include "saccade/components/messages.h"
 #include "saccade/components/register.h"
-#include "saccade/components/scene_cache.h"
 #include "saccade/core/error.h"
 #include "saccade/head/kinematics.h"
 #include "saccade/runtime/pipeline.h"
@@ -36,16 +35,26 @@ constexpr double kTriangulationToleranceM = 0.03;
 // IK solutions are exact to ~1e-9 rad (kinematics.h); FK of them back to the point.
 constexpr double kIkToleranceM = 1e-6;
 
-/// The scene, held for the whole test program (LoadSharedScene keeps it only while held).
+/// The resources every component of this test program shares, as a pipeline's components do:
+/// the scene is loaded once.
+std::shared_ptr<runtime::Resources> SharedResources() {
+  RegisterComponents();
+  static const std::shared_ptr<runtime::Resources> resources =
+      std::make_shared<runtime::Resources>(runtime::ComponentRegistry::Global().resource_loaders());
+  return resources;
+}
+
+/// The scene, as the components see it.
 const scene::Scene& Scene() {
-  static const std::shared_ptr<const scene::Scene> scene = LoadSharedScene(kScene);
+  static const std::shared_ptr<const scene::Scene> scene =
+      SharedResources()->Load<scene::Scene>("scene", kScene);
   return *scene;
 }
 
 std::unique_ptr<Component> Make(const std::string& type, const json& params) {
   RegisterComponents();
   std::unique_ptr<Component> c = runtime::ComponentRegistry::Global().Create(type);
-  c->Initialise(type, 1);
+  c->Initialise(type, 1, {}, SharedResources());
   c->Configure(params);
   return c;
 }

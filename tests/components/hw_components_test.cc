@@ -16,7 +16,6 @@
 #include "saccade/components/face_truth.h"
 #include "saccade/components/messages.h"
 #include "saccade/components/register.h"
-#include "saccade/components/scene_cache.h"
 #include "saccade/core/error.h"
 #include "saccade/core/image_io.h"
 #include "saccade/geometry/calibration_io.h"
@@ -24,6 +23,7 @@
 #include "saccade/render/renderer.h"
 #include "saccade/runtime/pipeline.h"
 #include "saccade/runtime/scheduler.h"
+#include "saccade/scene/scene.h"
 #include "saccade/vision/image_camera.h"
 
 namespace saccade::components {
@@ -103,7 +103,8 @@ components:
   EXPECT_TRUE(summary.errors.empty());
   // 13 pairs in the list (no 10), then the end: nothing more.
   ASSERT_EQ(images->size(), 26u);
-  const std::shared_ptr<const scene::Scene> scene = LoadSharedScene(kScene);
+  const std::shared_ptr<const scene::Scene> scene =
+      std::make_shared<const scene::Scene>(scene::Scene::Load(kScene));
   const head::HeadDescription& head = scene->robot()->head;
   for (std::size_t i = 0; i < images->size(); i += 2) {
     const Image& left = *(*images)[i].image;
@@ -135,7 +136,8 @@ TEST_F(HwComponentsTest, RenderedPortraitsPlayedAsRealCamerasTriangulateTheFace)
   // "Real" camera files: the simulator's two eye images of the portraits, written as PNG with
   // a calibration file each -- then read back by hw.cameras and run through the perception
   // components, which know nothing of the scene.
-  const std::shared_ptr<const scene::Scene> scene = LoadSharedScene(kScene);
+  const std::shared_ptr<const scene::Scene> scene =
+      std::make_shared<const scene::Scene>(scene::Scene::Load(kScene));
   {
     render::RendererOptions options;
     options.cameras = {"left", "right"};

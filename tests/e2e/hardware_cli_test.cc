@@ -63,16 +63,15 @@ class Emulator {
 fs::path ServoHardware(const fs::path& dir, const fs::path& port, bool mirror,
                        const std::string& scene = kTwoPictures) {
   const fs::path file = dir / "servos.yaml";
-  std::ofstream(file) << "components:\n"
+  std::ofstream(file) << "scene: " << scene
+                      << "\n"
+                         "components:\n"
                          "  cameras:\n"
                          "    type: sim.cameras\n"
-                         "    params: {scene: "
-                      << scene
-                      << "}\n"
                          "  head:\n"
                          "    type: hw.head\n"
-                         "    params: {scene: "
-                      << scene << ", driver: dynamixel, port: " << port.string()
+                         "    params: {driver: dynamixel, port: "
+                      << port.string()
                       << ", watchdog_s: 1.0, mirror: " << (mirror ? "true" : "false") << "}\n";
   return file;
 }

@@ -2,7 +2,7 @@
 // control.fixation -- turns the 3D target into joint commands (seed section 3 and appendix A:
 // inverse kinematics, pan then tilt then symmetric vergence): a saccade to a new target, smooth
 // pursuit (position plus the joint velocities that follow the target's motion) of a moving one.
-//   params: scene (required: the head), pursuit true,
+//   params: scene (the pipeline's unless given: the head), pursuit true,
 //           min_pursuit_speed_m_s 0.02 (slower targets get saccades: triangulation jitter is
 //           not motion), velocity_smoothing 0.5 (0 .. 1: weight of the newest velocity)
 //   inputs: target (vision.target, required)

@@ -6,8 +6,8 @@
 // hw.head -- a head driver (hw/head_driver.h) as the pipeline's head, with the driver's
 //   safety rules: non-finite commands rejected, targets clamped to the joint limits and
 //   velocities limited (reported), the watchdog, the emergency stop, faults.
-//   params:  scene (required): the scene whose robot it is (its head description, with the
-//              servo mapping for dynamixel)
+//   params:  scene: the pipeline's unless given; its robot is the head (its head description,
+//              with the servo mapping for dynamixel)
 //            driver (required): dynamixel | simulated (SimHeadDriver: the simulated motors on
 //              the wall clock, to try a pipeline without a device)
 //            port: the serial port (dynamixel, required), e.g. /dev/ttyUSB0; baud: 1000000
@@ -37,7 +37,7 @@
 //   time stamp (hw/stereo_source.h), delivering the same images with the same metadata as
 //   sim.cameras: K and distortion from each camera's calibration file, X_WC and the joints
 //   from the head's forward kinematics at the joints of this step.
-//   params:  scene (required): the scene whose robot carries the cameras
+//   params:  scene: the pipeline's unless given; its robot carries the cameras
 //            cameras (required): {left: SOURCE, right: SOURCE}, each SOURCE
 //              {uri (required), calibration, calibration_index 0, fps 0, loop false,
 //               first 0, every 1} as hw::CameraSourceSpec documents; relative paths resolve

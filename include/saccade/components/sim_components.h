@@ -4,7 +4,7 @@
 // same ports (issue 7).
 //
 // sim.cameras -- renders the scene's cameras (seed: cameraCapture through the FBO).
-//   params:  scene (required): scene file, relative to the pipeline file
+//   params:  scene: the pipeline's scene (its `scene:` line) unless given, relative to the file
 //            cameras: [left, right]      which cameras, one output each (named as the camera)
 //            distortion, noise, motion_blur: true   the scene's effects, each switchable
 //            msaa: 0 (0, 2, 4, 8); lod_max_error_px: 0.25
@@ -14,8 +14,8 @@
 //
 // sim.head -- the head's four motors under their velocity and acceleration limits
 //   (head/motors.h): saccades and smooth pursuit, never outside the joint limits.
-//   params:  scene (required): the scene whose robot it is (its head and initial joints)
-//   inputs:  command (head.command, optional): the latest command, applied when it arrives
+//   params:  scene: the pipeline's unless given; its robot is the head (description, initial
+//   joints) inputs:  command (head.command, optional): the latest command, applied when it arrives
 //   outputs: joints (head.joints): the state at the end of the step (time + dt), i.e. at the
 //            next step's time, which is when the cameras see it. The motors advance by the
 //            time since the last state: dt in simulated time, the wall time in real time.

@@ -22,7 +22,7 @@
 //   (then it is suppressed for suppression_time_s) or unseen for lost_after_s. With nothing to
 //   look at for explore_after_s, it sends the head home (a point home_distance_m straight
 //   ahead of its base), from where it looks for faces again.
-//   params: scene (required: the head), fixation_time_s 2, radius_m 0.15,
+//   params: scene (the pipeline's unless given: the head), fixation_time_s 2, radius_m 0.15,
 //           suppression_time_s 60, lost_after_s 1.5, fixation_tolerance_m 0.05,
 //           explore_after_s 0.5, home_distance_m 3
 //   inputs: candidates (vision.candidates, required), joints (head.joints, delay 1)

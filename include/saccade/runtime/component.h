@@ -21,6 +21,7 @@
 #include "saccade/runtime/bus.h"
 #include "saccade/runtime/message.h"
 #include "saccade/runtime/port.h"
+#include "saccade/runtime/resources.h"
 
 namespace saccade::runtime {
 
@@ -122,13 +123,20 @@ class Component {
     return typed ? &typed->method() : nullptr;
   }
 
-  /// Sets the name, the seed and the folder that relative paths in the params resolve
-  /// against (the pipeline file's); the pipeline calls this before Configure.
-  void Initialise(std::string name, uint64_t seed, std::string base_dir = {}) {
+  /// Sets the name, the seed, the folder that relative paths in the params resolve against
+  /// (the pipeline file's) and the pipeline's shared resources; the pipeline calls this
+  /// before Configure.
+  void Initialise(std::string name, uint64_t seed, std::string base_dir = {},
+                  std::shared_ptr<Resources> resources = nullptr) {
     name_ = std::move(name);
     seed_ = seed;
     base_dir_ = std::move(base_dir);
+    resources_ = std::move(resources);
   }
+
+  /// The pipeline's shared resources (resources.h). A component made outside a pipeline gets
+  /// resources of its own, with the loaders of ComponentRegistry::Global() and no defaults.
+  Resources& resources();
 
   /// `path` as given when absolute or when there is no base folder; else relative to the
   /// pipeline file's folder.
@@ -174,6 +182,7 @@ class Component {
   std::string name_;
   uint64_t seed_ = 0;
   std::string base_dir_;
+  std::shared_ptr<Resources> resources_;
   bool enabled_ = true;
   std::vector<std::unique_ptr<InputBase>> inputs_;
   std::vector<std::unique_ptr<OutputBase>> outputs_;

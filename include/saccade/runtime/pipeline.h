@@ -15,8 +15,8 @@
 //         image: cameras.left                          # <component>.<output>
 //         joints: {from: motors.joints, delay: 1}      # delivered at the next step
 //
-// Relative paths in params (e.g. `scene: ../scenes/portraits.yaml`) resolve against the
-// pipeline file's folder (Component::ResolvePath).
+// Relative paths in params (e.g. `calibration: left.yml`) resolve against the pipeline file's
+// folder (Component::ResolvePath).
 //
 // Hardware files: the one line that swaps the simulated robot for the real one (issue 7).
 //
@@ -28,9 +28,16 @@
 // A hardware file names the components that stand for the robot, with their type and params
 // (relative paths in those params resolve against the hardware file's folder):
 //
+//   scene: ../scenes/portraits.yaml          # the world and its robot (below)
 //   components:
-//     cameras: {type: sim.cameras, params: {scene: ../scenes/portraits.yaml}}
-//     head: {type: sim.head, params: {scene: ../scenes/portraits.yaml}}
+//     cameras: {type: sim.cameras, params: {cameras: [left, right]}}
+//     head: {type: sim.head}
+//
+// Shared resources (resources.h): `scene: FILE` at the top of a pipeline file or of its
+// hardware file (which then wins; relative to that file) names the scene once. The pipeline
+// loads it before building any component and hands it to those that ask
+// (Component::resources()); a component's own `scene` parameter, where it has one, names
+// another file of the same kind, loaded once per pipeline as well.
 //
 // The pipeline keeps the order and the connections; every component without a type must be
 // in the hardware file, and every component of the hardware file must be in the pipeline.
@@ -87,6 +94,13 @@ struct ComponentSpec {
   std::string params_file;
 };
 
+/// A shared resource named at the top of a pipeline or hardware file.
+struct ResourceSpec {
+  std::string path;  ///< as resolved against its file's folder
+  std::string file;  ///< the file that names it, for messages
+  int line = 0;
+};
+
 /// A parsed (not yet built) pipeline file.
 struct PipelineSpec {
   std::string file;  ///< for messages
@@ -95,6 +109,8 @@ struct PipelineSpec {
   OnError on_error = OnError::kStop;
   std::vector<ComponentSpec> components;
   std::string hardware_file;  ///< the hardware file used ("" when none)
+  /// Shared resources by kind ("scene"), from the pipeline file or its hardware file.
+  std::map<std::string, ResourceSpec> resources;
 };
 
 /// Parses pipeline YAML; checks its shape (keys, types, ranges, duplicate names), and reads
@@ -129,6 +145,8 @@ class Pipeline {
   ~Pipeline();
 
   const PipelineSpec& spec() const { return spec_; }
+  /// The shared resources the components were given (resources.h).
+  Resources& resources() const { return *resources_; }
   /// Components in execution order.
   const std::vector<std::unique_ptr<Component>>& components() const { return components_; }
   /// nullptr when there is none of that name.
@@ -155,6 +173,7 @@ class Pipeline {
   Pipeline() = default;
 
   PipelineSpec spec_;
+  std::shared_ptr<Resources> resources_;
   std::vector<std::unique_ptr<Component>> components_;
   // Boxed so that the delivery callbacks' pointer stays valid when the pipeline moves.
   std::unique_ptr<double> delivery_seconds_ = std::make_unique<double>(0.0);
