@@ -26,11 +26,9 @@
 #include "gui_session.h"
 #include "overlay.h"
 #include "saccade/components/face_truth.h"
-#include "saccade/components/fixation_component.h"
-#include "saccade/components/hw_components.h"
 #include "saccade/components/messages.h"
 #include "saccade/components/register.h"
-#include "saccade/components/sim_components.h"
+#include "saccade/components/roles.h"
 #include "saccade/core/error.h"
 #include "saccade/runtime/pipeline.h"
 #include "saccade/runtime/scheduler.h"
@@ -260,26 +258,31 @@ int RunDemo(Options o) {
 
   // Where the cameras and the fixation controller run, and the scene the cameras render:
   // simulated cameras give ground truth; real ones (hw.cameras) give none.
-  std::optional<std::size_t> cameras_index, fixation_index;
-  const components::SimCameras* sim_cameras = nullptr;
-  const components::HwCameras* hw_cameras = nullptr;
-  for (std::size_t i = 0; i < pipeline.components().size(); ++i) {
-    const runtime::Component* c = pipeline.components()[i].get();
-    if (!cameras_index && (dynamic_cast<const components::SimCameras*>(c) ||
-                           dynamic_cast<const components::HwCameras*>(c))) {
-      cameras_index = i;
-      sim_cameras = dynamic_cast<const components::SimCameras*>(c);
-      hw_cameras = dynamic_cast<const components::HwCameras*>(c);
-    }
-    if (dynamic_cast<const components::FixationComponent*>(c)) fixation_index = i;
-  }
-  if (!cameras_index) {
+  // The robot by its roles (components/roles.h). The loop's latency runs from the cameras to
+  // the component that commands the head (the source of the head's `command` input).
+  std::string cameras_name, head_name;
+  const components::EyeCamerasRole* cameras =
+      pipeline.FindRole<components::EyeCamerasRole>(&cameras_name);
+  if (!cameras) {
     throw InvalidArgument("demo: pipeline " + o.pipeline +
-                          " has no cameras (a sim.cameras or hw.cameras component)");
+                          " has no eye cameras (a sim.cameras or hw.cameras component)");
   }
-  const bool truth = sim_cameras != nullptr;
+  pipeline.FindRole<components::HeadRole>(&head_name);
+  std::optional<std::size_t> cameras_index, fixation_index;
+  std::string commander;
+  for (const runtime::ComponentSpec& c : spec.components) {
+    if (c.name != head_name) continue;
+    for (const runtime::ConnectionSpec& input : c.inputs) {
+      if (input.to_input == "command") commander = input.from_component;
+    }
+  }
+  for (std::size_t i = 0; i < spec.components.size(); ++i) {
+    if (spec.components[i].name == cameras_name) cameras_index = i;
+    if (!commander.empty() && spec.components[i].name == commander) fixation_index = i;
+  }
+  const bool truth = cameras->rendered() != nullptr;
   // Real cameras: the scene only carries the robot; its pictures are not what they see.
-  const scene::Scene& scene = truth ? sim_cameras->scene() : hw_cameras->scene();
+  const scene::Scene& scene = cameras->scene();
   const std::vector<PictureFace> pictures =
       truth ? components::FindPictureFaces(scene) : std::vector<PictureFace>{};
   int faces_total = 0;
@@ -539,6 +542,7 @@ int RunDemo(Options o) {
   for (const Fixation& f : fixations) fixations_json.push_back(FixationJson(f));
   json errors = json::array();
   for (const runtime::StepError& e : summary.errors) errors.push_back(e.ToString());
+  const std::optional<components::CameraPairCounts> pair_counts = cameras->pair_counts();
   json report = {
       {"pipeline", o.pipeline},
       {"scene", o.scene.empty() ? json(nullptr) : json(o.scene)},
@@ -557,10 +561,10 @@ int RunDemo(Options o) {
       {"errors", errors},
       {"hardware", spec.hardware_file.empty() ? json(nullptr) : json(spec.hardware_file)},
       {"ground_truth", truth},
-      {"cameras", hw_cameras ? json({{"pairs", hw_cameras->pairs()},
-                                     {"dropped_left", hw_cameras->dropped_left()},
-                                     {"dropped_right", hw_cameras->dropped_right()}})
-                             : json(nullptr)},
+      {"cameras", pair_counts ? json({{"pairs", pair_counts->pairs},
+                                      {"dropped_left", pair_counts->dropped_left},
+                                      {"dropped_right", pair_counts->dropped_right}})
+                              : json(nullptr)},
       {"head", head_status ? runtime::MessageTraits<HeadStatusMessage>::ToJson(*head_status)
                            : json(nullptr)},
       {"interrupted", g_stop.load() && faces_fixated < faces_total}};
@@ -583,7 +587,7 @@ int RunDemo(Options o) {
       fmt::print("\n{} faces fixated in {:.2f} s ({} steps, {:.1f} s wall)\n", faces_fixated,
                  summary.sim_time + dt, summary.steps, summary.wall_seconds);
     }
-    if (hw_cameras) fmt::print("cameras: {}\n", hw_cameras->Describe());
+    if (pair_counts) fmt::print("cameras: {}\n", cameras->Describe());
     if (head_status) {
       const HeadStatusMessage& h = *head_status;
       fmt::print(

@@ -12,8 +12,6 @@
 #include <opencv2/imgproc.hpp>
 
 #include "commands.h"
-#include "saccade/components/hw_components.h"
-#include "saccade/components/sim_components.h"
 #include "saccade/core/error.h"
 #include "saccade/head/kinematics.h"
 #include "saccade/vision/image_camera.h"
@@ -135,27 +133,17 @@ GuiSession::GuiSession(runtime::Pipeline& pipeline, const scene::Scene& scene,
   if (options.port < 0 || options.port > 65535) {
     throw InvalidArgument(fmt::format("--port must be in [0, 65535], got {}", options.port));
   }
+  // The robot, by its roles; perception is every component that does not stand for it.
+  head_ = pipeline.FindRole<components::HeadRole>();
+  hw_head_ = head_ != nullptr && head_->has_emergency_stop();
+  cameras_ = pipeline.FindRole<components::EyeCamerasRole>();
+  rendered_ = cameras_ != nullptr && cameras_->rendered() != nullptr;
   for (const auto& component : pipeline.components()) {
-    runtime::Component* c = component.get();
-    const runtime::MethodBase* move = c->FindMethod("move");
-    if (!head_ && move && move->request_type() == runtime::MessageName<JointCommand>()) {
-      head_ = c;
-      hw_head_ = c->FindMethod("estop") != nullptr;
-    }
-    if (auto* cameras = dynamic_cast<components::SimCameras*>(c); cameras && !sim_cameras_) {
-      sim_cameras_ = cameras;
-    }
+    if (components::IsRobotRole(*component)) continue;
+    perception_components_.push_back(component.get());
+    component->SetEnabled(options.perception);
   }
-  // Perception: every component that is not the robot (the cameras and the head).
-  for (const auto& component : pipeline.components()) {
-    runtime::Component* c = component.get();
-    if (c != head_ && !dynamic_cast<components::SimCameras*>(c) &&
-        !dynamic_cast<components::HwCameras*>(c)) {
-      perception_components_.push_back(c);
-      c->SetEnabled(options.perception);
-    }
-  }
-  if (sim_cameras_) effects_ = sim_cameras_->options();
+  if (rendered_) effects_ = *cameras_->rendered();
   Tap<HeadStatusMessage>(pipeline, [this](const HeadStatusMessage& m) {
     head_status_ = runtime::MessageTraits<HeadStatusMessage>::ToJson(m);
   });
@@ -320,7 +308,7 @@ GuiSession::GuiSession(runtime::Pipeline& pipeline, const scene::Scene& scene,
                            {"head", {{"joints", joints}}},
                            {"cameras", cameras},
                            {"commands",
-                            {{"effects", sim_cameras_ != nullptr},
+                            {{"effects", rendered_},
                              {"perception", !perception_components_.empty()},
                              {"estop", hw_head_}}}};
   server_->SetDocument("/api/scene", "application/json", scene_json.dump());
@@ -381,12 +369,6 @@ void GuiSession::ApplyQueued() {
 void GuiSession::SetPerception(bool enabled) {
   for (runtime::Component* c : perception_components_) c->SetEnabled(enabled);
   perception_ = enabled;
-}
-
-void GuiSession::CallHead(const std::string& method, const json& request) {
-  const runtime::MethodBase* m = head_ ? head_->FindMethod(method) : nullptr;
-  if (!m) throw Error("gui: the head has no method '" + method + "'");
-  m->CallJson(request);
 }
 
 json GuiSession::Handle(const json& command, int64_t client) {
@@ -464,7 +446,7 @@ json GuiSession::Handle(const json& command, int64_t client) {
       c.time = sim_time_;
       c.positions = target;
       c.velocities = {0.0, 0.0, 0.0, 0.0};
-      CallHead("move", runtime::MessageTraits<JointCommand>::ToJson(c));
+      head_->Move(c);
     });
     reply["perception"] = false;
     return reply;
@@ -478,7 +460,7 @@ json GuiSession::Handle(const json& command, int64_t client) {
     return {{"perception", enabled}};
   }
   if (type == "effects") {
-    if (!sim_cameras_) {
+    if (!rendered_) {
       throw CommandError("effects: the cameras are not simulated: they have no effects to switch");
     }
     for (const auto& [name, value] : command.items()) {
@@ -495,7 +477,7 @@ json GuiSession::Handle(const json& command, int64_t client) {
     effects_.distortion = d;
     effects_.noise = n;
     effects_.motion_blur = b;
-    Enqueue([this, d, n, b] { sim_cameras_->SetEffects(d, n, b); });
+    Enqueue([this, d, n, b] { cameras_->SetEffects(d, n, b); });
     return {{"effects", {{"distortion", d}, {"noise", n}, {"motion_blur", b}}}};
   }
   if (type == "pause") {
@@ -541,7 +523,13 @@ json GuiSession::Handle(const json& command, int64_t client) {
     }
     Enqueue([this, type] {
       SetPerception(false);
-      CallHead(type, json::object());
+      if (type == "stop") {
+        head_->StopHead();
+      } else if (type == "estop") {
+        head_->EmergencyStop();
+      } else {
+        head_->ClearFault();
+      }
     });
     return {{"perception", false}};
   }
@@ -559,8 +547,8 @@ json GuiSession::StateJson(const runtime::StepContext& context, const Latest& la
                 {"speed", speed_.load()},
                 {"perception", perception_.load()},
                 {"manual", !perception_.load()}};
-  if (sim_cameras_) {
-    const render::RendererOptions& o = sim_cameras_->options();
+  if (rendered_) {
+    const render::RendererOptions& o = *cameras_->rendered();
     state["effects"] = {
         {"distortion", o.distortion}, {"noise", o.noise}, {"motion_blur", o.motion_blur}};
   } else {

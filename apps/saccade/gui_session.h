@@ -22,14 +22,11 @@
 #include <vector>
 
 #include "overlay.h"
+#include "saccade/components/roles.h"
 #include "saccade/render/renderer.h"
 #include "saccade/runtime/pipeline.h"
 #include "saccade/scene/scene.h"
 #include "saccade/server/gui_server.h"
-
-namespace saccade::components {
-class SimCameras;
-}  // namespace saccade::components
 
 namespace saccade::app {
 
@@ -71,7 +68,6 @@ class GuiSession {
   nlohmann::json StateJson(const runtime::StepContext& context, const Latest& latest);
   void EncodeLoop();
   head::JointState CurrentTargets() const;
-  void CallHead(const std::string& method, const nlohmann::json& request);
   void SetPerception(bool enabled);  // simulation thread
 
   const scene::Scene& scene_;
@@ -79,8 +75,9 @@ class GuiSession {
   std::unique_ptr<server::GuiServer> server_;
 
   // The components the GUI drives (nullptr when the pipeline has none).
-  runtime::Component* head_ = nullptr;
-  components::SimCameras* sim_cameras_ = nullptr;
+  components::HeadRole* head_ = nullptr;  // the robot's roles (components/roles.h)
+  components::EyeCamerasRole* cameras_ = nullptr;
+  bool rendered_ = false;  // the cameras are rendered: effects exist
   std::vector<runtime::Component*> perception_components_;  // all but cameras and head
   bool hw_head_ = false;
 

@@ -19,41 +19,32 @@ HwHead::HwHead()
     : command_(AddInput<JointCommand>("command")),
       joints_(AddOutput<JointStateMessage>("joints")),
       status_(AddOutput<HeadStatusMessage>("status")) {
+  // The methods (for scripts and other processes) are the HeadRole's, by name.
   AddMethod<runtime::Empty, JointStateMessage>(
-      "state", [this](const runtime::Empty&) { return Joints(Driver().Read(), time_); },
+      "state", [this](const runtime::Empty&) { return HeadState(); },
       "the joints now (measured; the virtual head's in mirror mode)");
   AddMethod<JointCommand, JointStateMessage>(
-      "move",
-      [this](const JointCommand& command) {
-        Send(command.positions, command.velocities);  // throws CommandRejected
-        return Joints(Driver().Read(), time_);
-      },
+      "move", [this](const JointCommand& command) { return Move(command); },
       "a saccade or pursuit command, checked, clamped and limited by the driver");
   AddMethod<runtime::Empty, HeadStatusMessage>(
       "stop",
       [this](const runtime::Empty&) {
-        Driver().Stop();
-        if (virtual_) virtual_->Reset(virtual_->positions(), virtual_->velocities());
+        StopHead();
         return Status(Driver().Read(), time_);
       },
       "brakes every joint and holds where it stops");
   AddMethod<runtime::Empty, HeadStatusMessage>(
       "estop",
       [this](const runtime::Empty&) {
-        Driver().EmergencyStop();
-        if (virtual_) virtual_->Reset(virtual_->positions(), virtual_->velocities());
+        EmergencyStop();
         return Status(Driver().Read(), time_);
       },
       "emergency stop: holds and rejects every command until `clear`");
   AddMethod<runtime::Empty, HeadStatusMessage>(
       "clear",
       [this](const runtime::Empty&) {
-        Driver().ClearFault();
-        reported_fault_.clear();
-        const hw::HeadStatus status = Driver().Read();
-        // Mirror: the virtual head restarts where the device is, so that it does not jump.
-        if (virtual_) virtual_->Reset(status.positions);
-        return Status(status, time_);
+        ClearFault();
+        return Status(Driver().Read(), time_);
       },
       "clears an emergency stop or a fault (reboots faulty servos); holds where it is");
   AddMethod<runtime::Empty, HeadStatusMessage>(
@@ -138,6 +129,30 @@ void HwHead::Send(const head::JointState& positions, const head::JointState& vel
   }
   const hw::CommandReport report = Driver().Command(positions, velocities);
   if (report.any()) last_limit_ = report.description;
+}
+
+JointStateMessage HwHead::HeadState() { return Joints(Driver().Read(), time_); }
+
+JointStateMessage HwHead::Move(const JointCommand& command) {
+  Send(command.positions, command.velocities);  // throws CommandRejected
+  return Joints(Driver().Read(), time_);
+}
+
+void HwHead::StopHead() {
+  Driver().Stop();
+  if (virtual_) virtual_->Reset(virtual_->positions(), virtual_->velocities());
+}
+
+void HwHead::EmergencyStop() {
+  Driver().EmergencyStop();
+  if (virtual_) virtual_->Reset(virtual_->positions(), virtual_->velocities());
+}
+
+void HwHead::ClearFault() {
+  Driver().ClearFault();
+  reported_fault_.clear();
+  // Mirror: the virtual head restarts where the device is, so that it does not jump.
+  if (virtual_) virtual_->Reset(Driver().Read().positions);
 }
 
 void HwHead::Step(const runtime::StepContext& context) {

@@ -82,24 +82,35 @@ void SimCameras::Stop() { renderer_.reset(); }
 
 SimHead::SimHead()
     : command_(AddInput<JointCommand>("command")), joints_(AddOutput<JointStateMessage>("joints")) {
+  // The methods (for scripts and other processes) are the HeadRole's, by name.
   AddMethod<runtime::Empty, JointStateMessage>(
-      "state", [this](const runtime::Empty&) { return State(time_); },
+      "state", [this](const runtime::Empty&) { return HeadState(); },
       "the joints now (positions, velocities, targets)");
   AddMethod<JointCommand, JointStateMessage>(
-      "move",
-      [this](const JointCommand& command) {
-        Motors().SetTarget(command.positions, command.velocities);  // clamps, or throws on NaN
-        return State(time_);
-      },
+      "move", [this](const JointCommand& command) { return Move(command); },
       "a saccade or pursuit command, clamped to the joint limits; replies with the targets");
   AddMethod<runtime::Empty, JointStateMessage>(
       "stop",
       [this](const runtime::Empty&) {
-        // Brake every joint at its acceleration limit and hold where it stops.
-        Motors().Reset(motors_->positions(), motors_->velocities());
-        return State(time_);
+        StopHead();
+        return HeadState();
       },
       "brakes every joint and holds where it stops");
+}
+
+JointStateMessage SimHead::HeadState() {
+  Motors();  // throws when not started
+  return State(time_);
+}
+
+JointStateMessage SimHead::Move(const JointCommand& command) {
+  Motors().SetTarget(command.positions, command.velocities);  // clamps, or throws on NaN
+  return State(time_);
+}
+
+void SimHead::StopHead() {
+  // Brake every joint at its acceleration limit and hold where it stops.
+  Motors().Reset(motors_->positions(), motors_->velocities());
 }
 
 head::Motors& SimHead::Motors() {

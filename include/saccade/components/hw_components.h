@@ -53,6 +53,7 @@
 #include <string>
 
 #include "saccade/components/messages.h"
+#include "saccade/components/roles.h"
 #include "saccade/head/motors.h"
 #include "saccade/hw/head_driver.h"
 #include "saccade/hw/stereo_source.h"
@@ -61,7 +62,7 @@
 
 namespace saccade::components {
 
-class HwHead : public runtime::Component {
+class HwHead : public runtime::Component, public HeadRole {
  public:
   HwHead();
   void Configure(const nlohmann::json& params) override;
@@ -71,6 +72,14 @@ class HwHead : public runtime::Component {
 
   /// The driver, once started (tests, tools).
   hw::HeadDriver* driver() { return driver_.get(); }
+
+  // HeadRole.
+  JointStateMessage HeadState() override;
+  JointStateMessage Move(const JointCommand& command) override;
+  void StopHead() override;
+  bool has_emergency_stop() const override { return true; }
+  void EmergencyStop() override;
+  void ClearFault() override;
 
  private:
   hw::HeadDriver& Driver();  // throws when not started
@@ -99,7 +108,7 @@ class HwHead : public runtime::Component {
   std::string last_rejection_;
 };
 
-class HwCameras : public runtime::Component {
+class HwCameras : public runtime::Component, public EyeCamerasRole {
  public:
   HwCameras();
   void Configure(const nlohmann::json& params) override;
@@ -110,13 +119,16 @@ class HwCameras : public runtime::Component {
   /// The pair source, once started (tests, tools).
   const hw::StereoSource* source() const { return source_.get(); }
   /// The scene whose robot carries the cameras (not what they see).
-  const scene::Scene& scene() const { return *scene_; }
+  const scene::Scene& scene() const override { return *scene_; }
   /// Pairs delivered, and frames dropped for want of a partner within max_skew_s, so far.
   int64_t pairs() const { return pairs_; }
   int64_t dropped_left() const { return dropped_left_; }
   int64_t dropped_right() const { return dropped_right_; }
   /// A line for people: "25 pairs from <left uri> and <right uri>, 0 + 0 frames dropped".
-  std::string Describe() const;
+  std::string Describe() const override;
+  std::optional<CameraPairCounts> pair_counts() const override {
+    return CameraPairCounts{pairs_, dropped_left_, dropped_right_};
+  }
 
  private:
   runtime::Input<JointStateMessage>& joints_;

@@ -29,6 +29,7 @@
 #include <vector>
 
 #include "saccade/components/messages.h"
+#include "saccade/components/roles.h"
 #include "saccade/head/motors.h"
 #include "saccade/render/renderer.h"
 #include "saccade/runtime/component.h"
@@ -51,7 +52,7 @@ class DebugFault : public runtime::Component {
   std::string message_;
 };
 
-class SimCameras : public runtime::Component {
+class SimCameras : public runtime::Component, public EyeCamerasRole {
  public:
   SimCameras();
   void Configure(const nlohmann::json& params) override;
@@ -59,11 +60,12 @@ class SimCameras : public runtime::Component {
   void Step(const runtime::StepContext& context) override;
   void Stop() override;
 
-  const scene::Scene& scene() const { return *scene_; }
+  const scene::Scene& scene() const override { return *scene_; }
   /// Switches the scene's effects (the GUI's toggles); the next Step renders with them (it
   /// makes a new renderer). Call from the thread that runs the pipeline.
-  void SetEffects(bool distortion, bool noise, bool motion_blur);
+  void SetEffects(bool distortion, bool noise, bool motion_blur) override;
   const render::RendererOptions& options() const { return options_; }
+  const render::RendererOptions* rendered() const override { return &options_; }
 
  private:
   runtime::Input<JointStateMessage>& joints_;
@@ -74,7 +76,7 @@ class SimCameras : public runtime::Component {
   bool options_changed_ = false;
 };
 
-class SimHead : public runtime::Component {
+class SimHead : public runtime::Component, public HeadRole {
  public:
   SimHead();
   void Configure(const nlohmann::json& params) override;
@@ -82,6 +84,11 @@ class SimHead : public runtime::Component {
   void Step(const runtime::StepContext& context) override;
 
   const head::Motors& motors() const { return *motors_; }
+
+  // HeadRole.
+  JointStateMessage HeadState() override;
+  JointStateMessage Move(const JointCommand& command) override;
+  void StopHead() override;
 
  private:
   head::Motors& Motors();  // throws when not started

@@ -157,6 +157,19 @@ class Pipeline {
     return dynamic_cast<T*>(Find(name));
   }
 
+  /// The first component that implements the interface `Role` (the robot's roles:
+  /// components/roles.h), with its name; nullptr when none does.
+  template <typename Role>
+  Role* FindRole(std::string* name = nullptr) const {
+    for (const auto& component : components_) {
+      if (auto* role = dynamic_cast<Role*>(component.get())) {
+        if (name) *name = component->name();
+        return role;
+      }
+    }
+    return nullptr;
+  }
+
   /// Calls `component`'s `method` with a JSON request and returns the JSON reply (seed 5.4:
   /// methods are one-to-one with a reply or an error). Call between steps, from the thread
   /// that runs the pipeline. Throws MethodError naming what is unknown (the component, or the
