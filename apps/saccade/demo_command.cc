@@ -30,6 +30,7 @@
 #include "saccade/components/register.h"
 #include "saccade/components/roles.h"
 #include "saccade/core/error.h"
+#include "saccade/core/streaming_stats.h"
 #include "saccade/runtime/pipeline.h"
 #include "saccade/runtime/scheduler.h"
 #include "saccade/scene/scene.h"
@@ -95,23 +96,6 @@ double AxisErrorDeg(const Image& image, const Eigen::Vector3d& p_W) {
   const Eigen::Vector3d axis = X_WC.linear().col(2);
   const Eigen::Vector3d to = (p_W - X_WC.translation()).normalized();
   return std::acos(std::clamp(axis.dot(to), -1.0, 1.0)) * kRadToDeg;
-}
-
-struct Stats {
-  double median = 0.0, p95 = 0.0, mean = 0.0, max = 0.0;
-};
-Stats Summarise(std::vector<double> v) {
-  Stats s;
-  if (v.empty()) return s;
-  std::sort(v.begin(), v.end());
-  const auto at = [&](double q) {
-    return v[std::min(v.size() - 1, static_cast<std::size_t>(q * (v.size() - 1) + 0.5))];
-  };
-  s.median = at(0.5);
-  s.p95 = at(0.95);
-  s.max = v.back();
-  for (double x : v) s.mean += x / static_cast<double>(v.size());
-  return s;
 }
 
 /// Writes the annotated frames: frames/NNNNNN.jpg, demo.avi (MJPEG), fixation PNGs.
@@ -327,7 +311,7 @@ int RunDemo(Options o) {
 
   std::vector<Fixation> fixations;
   std::map<std::string, std::map<std::string, int>> decoy_rejections;  // picture -> reason -> n
-  std::vector<double> loop_latency_ms;
+  StreamingStats loop_latency_ms;  // constant memory however long the run
 
   runtime::RunOptions run;
   // With the GUI the loop runs until Ctrl-C (or SIGTERM).
@@ -344,7 +328,7 @@ int RunDemo(Options o) {
     // loop's own time in this step.
     double total = overhead;
     for (std::size_t i = *cameras_index + 1; i <= *fixation_index; ++i) total += seconds[i];
-    loop_latency_ms.push_back(1e3 * total);
+    loop_latency_ms.Add(1e3 * total);
   };
   run.after_step = [&](const runtime::StepContext& context) {
     const double t = context.time;
@@ -537,7 +521,9 @@ int RunDemo(Options o) {
                       {"mean_ms", c.mean_ms},
                       {"max_ms", c.max_ms}});
   }
-  const Stats latency = Summarise(loop_latency_ms);
+  struct {
+    double median, p95;
+  } const latency{loop_latency_ms.Quantile(0.5), loop_latency_ms.Quantile(0.95)};
   json fixations_json = json::array();
   for (const Fixation& f : fixations) fixations_json.push_back(FixationJson(f));
   json errors = json::array();

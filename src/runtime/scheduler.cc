@@ -9,6 +9,8 @@
 #include <thread>
 #include <utility>
 
+#include "saccade/core/streaming_stats.h"
+
 namespace saccade::runtime {
 namespace {
 
@@ -23,20 +25,10 @@ struct Stats {
   double max = 0.0;
 };
 
-// Milliseconds from seconds; p95 by nearest rank.
-Stats Summarise(std::vector<double> seconds) {
-  Stats stats;
-  if (seconds.empty()) return stats;
-  std::sort(seconds.begin(), seconds.end());
-  double sum = 0.0;
-  for (double s : seconds) sum += s;
-  const std::size_t n = seconds.size();
-  stats.mean = 1e3 * sum / static_cast<double>(n);
-  stats.median = 1e3 * (n % 2 == 1 ? seconds[n / 2] : 0.5 * (seconds[n / 2 - 1] + seconds[n / 2]));
-  const auto rank = static_cast<std::size_t>(std::ceil(0.95 * static_cast<double>(n)));
-  stats.p95 = 1e3 * seconds[std::max<std::size_t>(rank, 1) - 1];
-  stats.max = 1e3 * seconds.back();
-  return stats;
+// Milliseconds from seconds; median and p95 by nearest rank, within 1 % (streaming_stats.h).
+Stats Summarise(const StreamingStats& seconds) {
+  return {1e3 * seconds.mean(), 1e3 * seconds.Quantile(0.5), 1e3 * seconds.Quantile(0.95),
+          1e3 * seconds.max()};
 }
 
 std::string What(const std::exception_ptr& error) {
@@ -60,7 +52,7 @@ std::string StepError::ToString() const {
 
 std::string RunSummary::BriefReport() const {
   return fmt::format("{} steps, {} errors{}, overhead {:.4f} ms/step ({:.2f}% of the loop){}",
-                     steps, errors.size(), stopped_on_error ? " (stopped on error)" : "",
+                     steps, errors_total, stopped_on_error ? " (stopped on error)" : "",
                      overhead_mean_ms, 100.0 * overhead_share,
                      overruns > 0 ? fmt::format(", {} overruns", overruns) : "");
 }
@@ -92,13 +84,16 @@ RunSummary RunPipeline(Pipeline& pipeline, const RunOptions& options) {
   const std::size_t n = components.size();
 
   RunSummary summary;
-  std::vector<std::vector<double>> step_seconds(n);
-  std::vector<double> overhead_seconds;
+  // Constant memory however long the run (core/streaming_stats.h).
+  std::vector<StreamingStats> step_seconds(n);
+  StreamingStats overhead_seconds;
   std::vector<double> step_own;  // this step's component times, for options.step_timing
   std::vector<int64_t> error_counts(n, 0);
   const auto report = [&](StepError error) {
     if (options.on_error) options.on_error(error);
-    summary.errors.push_back(std::move(error));
+    ++summary.errors_total;
+    if (summary.errors.size() < RunSummary::kMaxKeptErrors)
+      summary.errors.push_back(std::move(error));
   };
 
   const Clock::time_point run_start = Clock::now();
@@ -156,14 +151,14 @@ RunSummary RunPipeline(Pipeline& pipeline, const RunOptions& options) {
         const double own =
             std::max(0.0, Seconds(Clock::now() - start) - pipeline.TakeDeliverySeconds());
         for (const auto& input : component.inputs()) input->MarkSeen();
-        step_seconds[i].push_back(own);
+        step_seconds[i].Add(own);
         step_own.push_back(own);
         component_seconds += own;
         if (stop_now) break;
       }
       const double loop = Seconds(Clock::now() - tick_start);
       const double overhead = std::max(0.0, loop - component_seconds);
-      overhead_seconds.push_back(overhead);
+      overhead_seconds.Add(overhead);
       total_component += component_seconds;
       total_overhead += overhead;
       summary.steps = k + 1;
@@ -200,11 +195,10 @@ RunSummary RunPipeline(Pipeline& pipeline, const RunOptions& options) {
 
   for (std::size_t i = 0; i < n; ++i) {
     const Stats stats = Summarise(step_seconds[i]);
-    summary.components.push_back({components[i]->name(),
-                                  static_cast<int64_t>(step_seconds[i].size()), stats.mean,
+    summary.components.push_back({components[i]->name(), step_seconds[i].count(), stats.mean,
                                   stats.median, stats.p95, stats.max, error_counts[i]});
   }
-  const Stats overhead = Summarise(std::move(overhead_seconds));
+  const Stats overhead = Summarise(overhead_seconds);
   summary.overhead_mean_ms = overhead.mean;
   summary.overhead_median_ms = overhead.median;
   summary.overhead_p95_ms = overhead.p95;

@@ -220,6 +220,30 @@ TEST(SchedulerTest, ThrowingComponentWithContinueCountsErrors) {
   EXPECT_EQ(pipeline.Find<Thrower>("after")->stops, 1);
 }
 
+TEST(SchedulerTest, ALongFailingRunKeepsTheFirstErrorsAndCountsThemAll) {
+  // A component that fails at every step of a long run (on_error: continue): the summary keeps
+  // the first kMaxKeptErrors and counts every one; the timings count every step (issue 18:
+  // memory for statistics is bounded).
+  std::string text = WithOnError("continue");
+  text.replace(text.find("{at: 2}"), 7, "{at: 0, every: true}");
+  text.replace(text.find("steps: 6"), 8, "steps: 5000");
+  Pipeline pipeline = Load(text);
+  int64_t reported = 0;
+  RunOptions options;
+  options.on_error = [&](const StepError&) { ++reported; };
+  const RunSummary summary = RunPipeline(pipeline, options);
+  EXPECT_EQ(summary.steps, 5000);
+  EXPECT_EQ(summary.errors_total, 5000);
+  EXPECT_EQ(reported, 5000);
+  ASSERT_EQ(summary.errors.size(), RunSummary::kMaxKeptErrors);
+  EXPECT_EQ(summary.errors.back().step, static_cast<int64_t>(RunSummary::kMaxKeptErrors) - 1);
+  EXPECT_EQ(summary.components[1].steps, 5000);
+  EXPECT_EQ(summary.components[1].errors, 5000);
+  EXPECT_LE(summary.components[0].median_ms, summary.components[0].p95_ms);
+  EXPECT_LE(summary.components[0].p95_ms, summary.components[0].max_ms);
+  EXPECT_NE(summary.BriefReport().find("5000 errors"), std::string::npos) << summary.BriefReport();
+}
+
 TEST(SchedulerTest, FailingStartStopsOnlyStartedComponents) {
   class BadStart : public Component {
    public:

@@ -39,11 +39,15 @@ struct ComponentTiming {
 
 /// What a run did and where its time went.
 struct RunSummary {
-  int64_t steps = 0;                        ///< steps completed (the failing step included)
-  double sim_time = 0.0;                    ///< s: context time of the last step
-  double wall_seconds = 0.0;                ///< from Start to the end of Stop
-  bool stopped_on_error = false;            ///< on_error: stop ended the run
-  std::vector<StepError> errors;            ///< every failure, in order
+  int64_t steps = 0;              ///< steps completed (the failing step included)
+  double sim_time = 0.0;          ///< s: context time of the last step
+  double wall_seconds = 0.0;      ///< from Start to the end of Stop
+  bool stopped_on_error = false;  ///< on_error: stop ended the run
+  /// The first kMaxKeptErrors failures, in order (every one goes to RunOptions::on_error);
+  /// errors_total counts them all, so a run that fails at every step keeps constant memory.
+  std::vector<StepError> errors;
+  int64_t errors_total = 0;
+  static constexpr std::size_t kMaxKeptErrors = 100;
   std::vector<ComponentTiming> components;  ///< in execution order
   /// Per step, the loop's time outside components' own work: message delivery, the
   /// scheduler's bookkeeping (not the real-time sleep). Mean, median and p95 in ms.
