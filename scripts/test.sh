@@ -21,7 +21,7 @@ begin() {
 }
 end() {
   local took=$(($(date +%s) - phase_start))
-  phases+=("$(printf '%-44s %4d:%02d' "$current" $((took / 60)) $((took % 60)))")
+  phases+=("$(printf '%-50s %4d:%02d' "$current" $((took / 60)) $((took % 60)))")
   echo "== $current: $((took / 60)) min $((took % 60)) s"
   current=""
 }
@@ -40,7 +40,7 @@ summary() {
   echo
   echo "== phases (wall clock, min:s)"
   for p in "${phases[@]}"; do echo "  $p"; done
-  printf '  %-44s %4d:%02d\n' "total" $((took / 60)) $((took % 60))
+  printf '  %-50s %4d:%02d\n' "total" $((took / 60)) $((took % 60))
   if [ "$status" -ne 0 ]; then
     echo "== FAILED (status $status) in: ${failed_phase:-?}"
   fi
