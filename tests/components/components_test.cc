@@ -414,7 +414,10 @@ TEST(ComponentParams, UnknownMissingAndOutOfRangeParametersAreNamed) {
             "reject_cats, require_eyes, scale_factor)");
   EXPECT_EQ(message("vision.camshift", json::object()),
             "parameter 'eye': expected one of left, right, got ''");
-  EXPECT_EQ(message("sim.head", json::object()), "parameter 'scene' is required");
+  // No scene: neither the parameter nor the pipeline (resources.h) names one.
+  EXPECT_EQ(message("sim.head", json::object()),
+            "no scene: name it once at the top of the pipeline or hardware file (scene: FILE), or "
+            "give this component the parameter 'scene'");
   EXPECT_EQ(message("vision.attention", {{"scene", kScene}, {"fixation_time_s", -1}}),
             "parameter 'fixation_time_s': expected a number in [1e-06, 1000000], got -1");
   EXPECT_EQ(message("sim.cameras", {{"scene", kScene}, {"cameras", {"left", "middle"}}}),
