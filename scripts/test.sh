@@ -34,7 +34,7 @@ cache_figures() {
   fi
 }
 summary() {
-  local status=$?
+  local status=$1
   [ -n "$current" ] && end
   local took=$(($(date +%s) - run_start))
   echo
@@ -48,7 +48,7 @@ summary() {
   if [ -s "${results:-}" ]; then grep -E "tests passed|tests failed out of" "$results" | tail -1; fi
   return "$status"
 }
-trap 'failed_phase="$current"; summary' EXIT
+trap 'status=$?; failed_phase="$current"; summary "$status"' EXIT
 
 begin "setup and build (build/)"
 bash scripts/setup.sh build

@@ -125,8 +125,14 @@ class Recorder {
   ~Recorder() { writer_.release(); }
 
   void Write(int64_t step, const cv::Mat& bgr) {
-    cv::imwrite((dir_ / "frames" / fmt::format("{:06d}.jpg", step)).string(), bgr,
-                {cv::IMWRITE_JPEG_QUALITY, 85});
+    // Written whole or not at all (a temporary file renamed into place): a recording cut by a
+    // kill keeps only whole frames.
+    const fs::path frame = dir_ / "frames" / fmt::format("{:06d}.jpg", step);
+    const fs::path partial = dir_ / "frames" / fmt::format(".{:06d}.tmp.jpg", step);
+    if (!cv::imwrite(partial.string(), bgr, {cv::IMWRITE_JPEG_QUALITY, 85})) {
+      throw Error("demo: cannot write " + frame.string());
+    }
+    fs::rename(partial, frame);
     if (!writer_.isOpened()) {
       writer_.open((dir_ / "demo.avi").string(), cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), fps_,
                    bgr.size());
