@@ -9,8 +9,10 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "saccade/geometry/json.h"
 #include "saccade/geometry/pose.h"
 #include "saccade/head/head_description.h"
+#include "saccade/head/json.h"
 
 namespace saccade::app {
 
@@ -32,9 +34,8 @@ inline constexpr double kDegToRad = M_PI / 180.0;
 /// it is there, else from the source tree saccade was built from.
 std::string ShippedFile(const std::string& relative);
 
-nlohmann::json JointsJson(const head::JointState& q);
-nlohmann::json VectorJson(const Eigen::Vector3d& v);
-/// {"position": [...], "rotation": [[...]x3], "quaternion_wxyz": [...]}.
+/// {"position": [...], "rotation": [[...]x3], "quaternion_wxyz": [...]}: a pose for people
+/// (the 4x4 matrix is ToJson's form, geometry/json.h).
 nlohmann::json PoseJson(const geometry::Pose& X);
 /// Joint angles from 4 command-line values, radians or degrees.
 head::JointState JointsFromArgs(const std::vector<double>& values, bool degrees);

@@ -11,17 +11,11 @@ std::string ShippedFile(const std::string& relative) {
   return (std::filesystem::path(SACCADE_SOURCE_DIR) / relative).string();
 }
 
-json JointsJson(const head::JointState& q) {
-  return {{"pan", q.pan}, {"tilt", q.tilt}, {"left", q.left}, {"right", q.right}};
-}
-
-json VectorJson(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()}; }
-
 json PoseJson(const geometry::Pose& X) {
   json rotation = json::array();
   for (int r = 0; r < 3; ++r) rotation.push_back({X(r, 0), X(r, 1), X(r, 2)});
   const Eigen::Quaterniond q(X.linear());
-  return {{"position", VectorJson(X.translation())},
+  return {{"position", ToJson<Eigen::Vector3d>(X.translation())},
           {"rotation", rotation},
           {"quaternion_wxyz", {q.w(), q.x(), q.y(), q.z()}}};
 }

@@ -31,6 +31,7 @@
 #include "saccade/components/roles.h"
 #include "saccade/core/error.h"
 #include "saccade/core/streaming_stats.h"
+#include "saccade/runtime/component_reference.h"
 #include "saccade/runtime/pipeline.h"
 #include "saccade/runtime/scheduler.h"
 #include "saccade/scene/scene.h"
@@ -64,6 +65,7 @@ struct Options {
   bool realtime = false;
   bool keep_going = false;
   bool list = false;
+  bool markdown = false;
   bool gui = false;
   GuiOptions gui_options;
 };
@@ -192,11 +194,11 @@ json FixationJson(const Fixation& f) {
   if (f.fixated_at) {
     j["fixated_at_s"] = *f.fixated_at;
     j["time_to_fixate_s"] = *f.fixated_at - f.selected_at;
-    j["target_W"] = VectorJson(f.p_W);
+    j["target_W"] = ToJson<Eigen::Vector3d>(f.p_W);
     j["target_source"] = f.source;
     j["distance_m"] = f.distance_m;
     if (f.has_truth) {
-      j["truth_W"] = VectorJson(f.truth_W);
+      j["truth_W"] = ToJson<Eigen::Vector3d>(f.truth_W);
       j["error_3d_m"] = f.error_3d_m;
       j["eye_error_deg"] = {{"left", f.left_error_deg}, {"right", f.right_error_deg}};
       if (f.dwell_samples > 0) {
@@ -214,11 +216,13 @@ json FixationJson(const Fixation& f) {
 int RunDemo(Options o) {
   components::RegisterComponents();
   if (o.list) {
-    const runtime::ComponentRegistry& registry = runtime::ComponentRegistry::Global();
-    for (const std::string& type : registry.Types()) {
-      fmt::print("{:<24} {}\n", type, registry.Description(type));
+    const auto reference = runtime::DescribeComponents(runtime::ComponentRegistry::Global());
+    if (o.json) {
+      fmt::print("{}\n", runtime::ComponentsJson(reference).dump(2));
+    } else {
+      fmt::print("{}", o.markdown ? runtime::ComponentsMarkdown(reference)
+                                  : runtime::ComponentsText(reference));
     }
-    fmt::print("Ports and parameters: include/saccade/components/*.h\n");
     return 0;
   }
   if (!(o.duration > 0.0) || !std::isfinite(o.duration)) {
@@ -710,7 +714,10 @@ Runner AddDemoCommand(CLI::App& app) {
                  "Run on the wall clock at the pipeline's rate instead of simulated time");
   demo->add_flag("--keep-going", o->keep_going,
                  "Continue after a component fails (the pipeline's on_error: continue)");
-  demo->add_flag("--list-components", o->list, "List the component types a pipeline can use");
+  demo->add_flag("--list-components", o->list,
+                 "List the component types a pipeline can use: ports, methods and parameters "
+                 "(with --json: as JSON; with --markdown: docs/components.md)");
+  demo->add_flag("--markdown", o->markdown, "With --list-components: print it as Markdown");
   demo->add_flag("--gui", o->gui,
                  "Serve the browser GUI (prints its address) and run until Ctrl-C; see "
                  "`saccade gui --help`");

@@ -13,6 +13,8 @@
 
 #include "commands.h"
 #include "saccade/core/error.h"
+#include "saccade/geometry/json.h"
+#include "saccade/head/json.h"
 #include "saccade/head/kinematics.h"
 #include "saccade/vision/image_camera.h"
 
@@ -38,13 +40,9 @@ json MatrixJson(const geometry::Pose& X) {
   return m;
 }
 
-json Vec(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()}; }
 json Vec(const Eigen::Vector3f& v) { return {v.x(), v.y(), v.z()}; }
 json Vec(const Eigen::Vector4f& v) { return {v.x(), v.y(), v.z(), v.w()}; }
 
-json JointsObject(const head::JointState& q) {
-  return {{"pan", q.pan}, {"tilt", q.tilt}, {"left", q.left}, {"right", q.right}};
-}
 
 const char* LinkName(scene::RobotPart::Link link) {
   switch (link) {
@@ -230,7 +228,7 @@ GuiSession::GuiSession(runtime::Pipeline& pipeline, const scene::Scene& scene,
     objects.push_back({{"name", o.name},
                        {"id", o.id},
                        {"model", add_model(o.model)},
-                       {"scale", Vec(o.scale)},
+                       {"scale", ToJson(o.scale)},
                        {"X_WO", MatrixJson(o.motion.PoseAt(0.0))},
                        {"moving", !o.motion.IsStatic()}});
   }
@@ -242,7 +240,7 @@ GuiSession::GuiSession(runtime::Pipeline& pipeline, const scene::Scene& scene,
       parts.push_back({{"link", LinkName(p.link)},
                        {"model", add_model(p.model)},
                        {"X_LinkPart", MatrixJson(p.X_LinkPart)},
-                       {"scale", Vec(p.scale)}});
+                       {"scale", ToJson(p.scale)}});
     }
     robot = {{"visible", scene_.robot()->visible}, {"parts", parts}};
     for (head::Joint j : head::kAllJoints) {
@@ -261,8 +259,8 @@ GuiSession::GuiSession(runtime::Pipeline& pipeline, const scene::Scene& scene,
     lights.push_back({{"type", type},
                       {"color", Vec(l.color)},
                       {"intensity", l.intensity},
-                      {"direction", Vec(l.direction_W)},
-                      {"position", Vec(l.position_W)},
+                      {"direction", ToJson(l.direction_W)},
+                      {"position", ToJson(l.position_W)},
                       {"attenuation", l.attenuation}});
   }
   const scene::Ground& g = scene_.ground();
@@ -415,7 +413,7 @@ json GuiSession::Handle(const json& command, int64_t client) {
               head::JointName(j), target[j], target[j] * kRadToDeg, l.min, l.max));
         }
       }
-      reply = {{"targets", JointsObject(target)}};
+      reply = {{"targets", ToJson(target)}};
     } else {
       const json& p = command.contains("p_W") ? command["p_W"] : json();
       if (!p.is_array() || p.size() != 3) {
@@ -433,7 +431,7 @@ json GuiSession::Handle(const json& command, int64_t client) {
                                        p_W.x(), p_W.y(), p_W.z(), solution.message));
       }
       target = solution.joints;
-      reply = {{"targets", JointsObject(target)},
+      reply = {{"targets", ToJson(target)},
                {"axis_error_deg", solution.axis_error * kRadToDeg}};
     }
     {
@@ -557,9 +555,9 @@ json GuiSession::StateJson(const runtime::StepContext& context, const Latest& la
   std::optional<head::HeadFrames> frames;
   if (latest.joints && scene_.robot()) {
     const JointStateMessage& j = *latest.joints;
-    state["joints"] = {{"positions", JointsObject(j.positions)},
-                       {"targets", JointsObject(j.targets)},
-                       {"velocities", JointsObject(j.velocities)},
+    state["joints"] = {{"positions", ToJson(j.positions)},
+                       {"targets", ToJson(j.targets)},
+                       {"velocities", ToJson(j.velocities)},
                        {"arrived", j.arrived}};
     frames = head::ForwardKinematics(scene_.robot()->head, j.positions);
     state["frames"] = {
@@ -567,7 +565,7 @@ json GuiSession::StateJson(const runtime::StepContext& context, const Latest& la
         {"X_WC", MatrixJson(frames->X_WC)},        {"left_eye", MatrixJson(frames->X_WL)},
         {"right_eye", MatrixJson(frames->X_WR)},   {"left", MatrixJson(frames->X_WCamLeft)},
         {"right", MatrixJson(frames->X_WCamRight)}};
-    state["fixation_W"] = frames->p_WFixation ? Vec(*frames->p_WFixation) : json(nullptr);
+    state["fixation_W"] = frames->p_WFixation ? ToJson(*frames->p_WFixation) : json(nullptr);
     std::lock_guard lock(joints_mutex_);
     if (perception_) targets_ = j.targets;  // partial hand commands start from here
   } else {
@@ -577,7 +575,7 @@ json GuiSession::StateJson(const runtime::StepContext& context, const Latest& la
   }
   if (perception_ && latest.target && latest.target->valid) {
     state["target"] = {
-        {"valid", true}, {"p_W", Vec(latest.target->p_W)}, {"id", latest.target->target_id}};
+        {"valid", true}, {"p_W", ToJson(latest.target->p_W)}, {"id", latest.target->target_id}};
     if (frames) {
       state["fixation_error_deg"] = {
           {"left", AxisErrorDeg(frames->X_WCamLeft, latest.target->p_W)},

@@ -24,10 +24,8 @@ using saccade::head::HeadDescription;
 using saccade::head::JointState;
 
 json JointsDegJson(const JointState& q) {
-  return {{"pan", q.pan * kRadToDeg},
-          {"tilt", q.tilt * kRadToDeg},
-          {"left", q.left * kRadToDeg},
-          {"right", q.right * kRadToDeg}};
+  return ToJson(JointState{q.pan * kRadToDeg, q.tilt * kRadToDeg, q.left * kRadToDeg,
+                           q.right * kRadToDeg});
 }
 
 std::string FormatVector(const Eigen::Vector3d& v) {
@@ -64,11 +62,11 @@ int RunFk(const std::string& head_path, const std::vector<double>& joint_values,
   const bool within = head.WithinLimits(q);
   if (as_json) {
     json out = {{"head", head.name()},
-                {"joints", JointsJson(q)},
+                {"joints", ToJson(q)},
                 {"within_limits", within},
                 {"cameras",
                  {{"left", PoseJson(frames.X_WCamLeft)}, {"right", PoseJson(frames.X_WCamRight)}}},
-                {"fixation", frames.p_WFixation ? VectorJson(*frames.p_WFixation) : json(nullptr)}};
+                {"fixation", frames.p_WFixation ? ToJson<Eigen::Vector3d>(*frames.p_WFixation) : json(nullptr)}};
     std::cout << out.dump(2) << "\n";
     return 0;
   }
@@ -94,12 +92,12 @@ int RunIk(const std::string& head_path, const std::vector<double>& target, const
   const auto result = saccade::head::SolveFixation(head, p_W, options);
   if (as_json) {
     json out = {{"head", head.name()},
-                {"target", VectorJson(p_W)},
+                {"target", ToJson<Eigen::Vector3d>(p_W)},
                 {"mode", mode},
                 {"reachable", result.reachable()},
                 {"reachability", saccade::head::ToString(result.reachability)},
                 {"message", result.message},
-                {"joints", JointsJson(result.joints)},
+                {"joints", ToJson(result.joints)},
                 {"joints_deg", JointsDegJson(result.joints)},
                 {"axis_error_rad", result.axis_error},
                 {"iterations", result.iterations}};

@@ -1,6 +1,5 @@
 #include "saccade/components/fixation_component.h"
 
-#include "components/internal_params.h"
 #include "components/internal_scene.h"
 #include "saccade/head/kinematics.h"
 
@@ -8,15 +7,19 @@ namespace saccade::components {
 
 FixationComponent::FixationComponent()
     : target_(AddInput<TargetMessage>("target", /*required=*/true)),
-      command_(AddOutput<JointCommand>("command")) {}
+      command_(AddOutput<JointCommand>("command")) {
+  DeclareParam("scene", &scene_param_, internal::kSceneParamDoc).Path();
+  DeclareParam("pursuit", &pursuit_, "follow a moving target (else saccades only)");
+  DeclareParam("min_pursuit_speed_m_s", &min_pursuit_speed_,
+               "slower targets get saccades: triangulation jitter is not motion")
+      .Range(0.0, 1e6)
+      .Unit("m/s");
+  DeclareParam("velocity_smoothing", &smoothing_, "weight of the newest velocity estimate")
+      .Range(0.0, 1.0);
+}
 
-void FixationComponent::Configure(const nlohmann::json& params) {
-  internal::Params p(params);
-  const internal::SceneRef scene = internal::SceneOf(*this, p);
-  pursuit_ = p.Bool("pursuit", true);
-  min_pursuit_speed_ = p.Number("min_pursuit_speed_m_s", 0.02, 0.0, 1e6);
-  smoothing_ = p.Number("velocity_smoothing", 0.5, 0.0, 1.0);
-  p.Finish();
+void FixationComponent::Configured() {
+  const internal::SceneRef scene = internal::SceneOf(*this, scene_param_);
   scene_ = scene.scene;
   last_joints_ = internal::RobotOf(*scene_, scene.path).initial_joints;
 }

@@ -6,7 +6,6 @@
 #include <cmath>
 #include <cstdio>
 
-#include "components/internal_params.h"
 #include "components/internal_scene.h"
 #include "saccade/core/error.h"
 #include "saccade/core/log.h"
@@ -61,23 +60,32 @@ HwHead::HwHead()
         return Status(Driver().Read(), time_);
       },
       "unpowers the motors (the joints can be moved by hand)");
+  DeclareParam("scene", &scene_param_, internal::kSceneParamDoc).Path();
+  DeclareParam("driver", &driver_kind_,
+               "dynamixel: the servos on a serial bus; simulated: the simulated motors on the "
+               "wall clock, to try a pipeline without a device")
+      .Choices({"dynamixel", "simulated"})
+      .Required();
+  DeclareParam("port", &port_,
+               "the serial port (dynamixel, required), e.g. /dev/ttyUSB0, or the path "
+               "saccade-servo-emulator prints");
+  DeclareParam("baud", &baud_, "the bus's baud rate").Range(9600, 10500000).Unit("baud");
+  DeclareParam("timeout_ms", &timeout_ms_, "each bus transaction's time-out")
+      .Range(0.1, 10000.0)
+      .Unit("ms");
+  DeclareParam("retries", &retries_, "retries of a failed bus transaction").Range(0, 100);
+  DeclareParam("watchdog_s", &safety_.watchdog_s,
+               "with no command for this long the head holds; 0: off")
+      .Range(0.0, 3600.0)
+      .Unit("s");
+  DeclareParam("mirror", &mirror_,
+               "commands move a virtual head (what the cameras see and `joints` reports); the "
+               "device follows it every step, within its limits");
 }
 
-void HwHead::Configure(const nlohmann::json& params) {
-  internal::Params p(params);
-  const internal::SceneRef scene = internal::SceneOf(*this, p);
+void HwHead::Configured() {
+  const internal::SceneRef scene = internal::SceneOf(*this, scene_param_);
   const std::string& path = scene.path;
-  driver_kind_ = p.Choice("driver", "", {"dynamixel", "simulated"});
-  if (driver_kind_.empty()) {
-    throw InvalidArgument("parameter 'driver' is required: dynamixel or simulated");
-  }
-  port_ = p.String("port", "");
-  baud_ = static_cast<int>(p.Integer("baud", 1000000, 9600, 10500000));
-  timeout_ms_ = p.Number("timeout_ms", 20.0, 0.1, 10000.0);
-  retries_ = static_cast<int>(p.Integer("retries", 2, 0, 100));
-  safety_.watchdog_s = p.Number("watchdog_s", 0.5, 0.0, 3600.0);
-  mirror_ = p.Bool("mirror", false);
-  p.Finish();
   if (driver_kind_ == "dynamixel" && port_.empty()) {
     throw InvalidArgument(
         "parameter 'port' is required for the dynamixel driver (the serial port, e.g. "
@@ -262,24 +270,29 @@ hw::CameraSourceSpec ReadSource(const nlohmann::json& json, const std::string& n
                     "got {}",
                     key, json.dump()));
   }
-  internal::Params p(json);
   hw::CameraSourceSpec spec;
   spec.name = name;
+  runtime::ParamTable p;
+  p.Declare("uri", &spec.uri, "the source (hw/camera_source.h)").Required();
+  p.Declare("calibration", &spec.calibration, "calibration file").Path();
+  p.Declare("calibration_index", &spec.calibration_index, "camera in a stereo calibration")
+      .Range(0, 2);
+  p.Declare("fps", &spec.fps, "pace of a file source; 0: as fast as asked")
+      .Range(0.0, 1e6)
+      .Unit("Hz");
+  p.Declare("loop", &spec.loop, "start a file source again at its end");
+  p.Declare("first", &spec.first, "frames skipped at the start").Range(0, 1000000);
+  p.Declare("every", &spec.every, "every n-th frame").Range(1, 1000000);
   try {
-    spec.uri = p.RequiredString("uri");
-    spec.calibration = p.String("calibration", "");
-    spec.calibration_index = static_cast<int>(p.Integer("calibration_index", 0, 0, 2));
-    spec.fps = p.Number("fps", 0.0, 0.0, 1e6);
-    spec.loop = p.Bool("loop", false);
-    spec.first = static_cast<int>(p.Integer("first", 0, 0, 1000000));
-    spec.every = static_cast<int>(p.Integer("every", 1, 1, 1000000));
-    p.Finish();
+    p.Apply(json);
   } catch (const InvalidArgument& error) {
-    // "parameter 'uri': ..." -> "parameter 'cameras.left.uri': ..."
+    // "parameter 'uri': ..." -> "parameter 'cameras.left.uri': ...", and so for "unknown
+    // parameter 'url'".
     std::string message = error.what();
     const std::string from = "parameter '";
-    if (message.rfind(from, 0) == 0)
-      message.insert(from.size(), key + ".");
+    const std::size_t at = message.find(from);
+    if (at != std::string::npos && at <= std::string("unknown ").size())
+      message.insert(at + from.size(), key + ".");
     else
       message = key + ": " + message;
     throw InvalidArgument(message);
@@ -305,27 +318,22 @@ void SetPose(Image& image, const geometry::Pose& X_WC, const head::JointState& j
 HwCameras::HwCameras()
     : joints_(AddInput<JointStateMessage>("joints")),
       left_(AddOutput<runtime::ImageMessage>("left")),
-      right_(AddOutput<runtime::ImageMessage>("right")) {}
+      right_(AddOutput<runtime::ImageMessage>("right")) {
+  DeclareParam("scene", &scene_param_, internal::kSceneParamDoc).Path();
+  DeclareParam("cameras", &cameras_,
+               "{left: SOURCE, right: SOURCE}, each SOURCE {uri (required), calibration, "
+               "calibration_index 0, fps 0, loop false, first 0, every 1} as "
+               "hw::CameraSourceSpec documents; paths relative to the pipeline file")
+      .Required();
+  DeclareParam("max_skew_s", &max_skew_s_, "the most the two time stamps of a pair may differ")
+      .Range(0.0, 3600.0)
+      .Unit("s");
+}
 
-void HwCameras::Configure(const nlohmann::json& params) {
-  // `cameras` is a nested map, read below; the rest through the Params reader.
-  nlohmann::json flat = params.is_object() ? params : nlohmann::json::object();
-  const bool has_cameras = flat.contains("cameras");
-  flat.erase("cameras");
-  internal::Params p(params.is_null() ? params : flat);
-  const internal::SceneRef scene = internal::SceneOf(*this, p);
+void HwCameras::Configured() {
+  const internal::SceneRef scene = internal::SceneOf(*this, scene_param_);
   const std::string& path = scene.path;
-  max_skew_s_ = p.Number("max_skew_s", 0.02, 0.0, 3600.0);
-  p.Finish();
-  if (!has_cameras) {
-    throw InvalidArgument(
-        "parameter 'cameras' is required: {left: {uri: ..., calibration: ...}, right: {...}}");
-  }
-  const nlohmann::json& cameras = params["cameras"];
-  if (!cameras.is_object()) {
-    throw InvalidArgument("parameter 'cameras': expected {left: {...}, right: {...}}, got " +
-                          cameras.dump());
-  }
+  const nlohmann::json& cameras = cameras_;
   for (const auto& [key, value] : cameras.items()) {
     (void)value;
     if (key != "left" && key != "right") {

@@ -5,10 +5,10 @@
 
 namespace saccade::components::internal {
 
-SceneRef SceneOf(runtime::Component& component, Params& p) {
+SceneRef SceneOf(runtime::Component& component, const std::string& scene_param) {
   runtime::Resources& resources = component.resources();
-  if (p.Has("scene")) {
-    const std::string path = component.ResolvePath(p.RequiredString("scene"));
+  if (!scene_param.empty()) {
+    const std::string path = component.ResolvePath(scene_param);
     return {resources.Load<scene::Scene>("scene", path), path};
   }
   if (const auto path = resources.DefaultPath("scene")) {

@@ -5,7 +5,6 @@
 #include <memory>
 #include <string>
 
-#include "components/internal_params.h"
 #include "saccade/runtime/component.h"
 #include "saccade/runtime/component_registry.h"
 #include "saccade/scene/scene.h"
@@ -17,9 +16,14 @@ struct SceneRef {
   std::string path;  ///< its file, for messages
 };
 
-/// Reads the optional parameter `scene` from `p`. Throws InvalidArgument when neither the
-/// parameter nor the pipeline names a scene; the scene loader's FileError passes through.
-SceneRef SceneOf(runtime::Component& component, Params& p);
+/// The documentation of the `scene` parameter, the same in every component that has one.
+inline constexpr const char* kSceneParamDoc =
+    "the scene (its robot is the head); the pipeline's `scene:` when not given";
+
+/// The scene of the component's `scene` parameter (`scene_param`, relative to the pipeline
+/// file) when given, else the pipeline's. Throws InvalidArgument when neither names a scene;
+/// the scene loader's FileError passes through.
+SceneRef SceneOf(runtime::Component& component, const std::string& scene_param);
 
 /// The scene's robot; throws InvalidArgument naming the file when it has none.
 const scene::Robot& RobotOf(const scene::Scene& scene, const std::string& path);

@@ -3,38 +3,40 @@
 #include <algorithm>
 #include <cstdint>
 
-#include "components/internal_params.h"
 #include "components/internal_scene.h"
 #include "saccade/core/error.h"
 
 namespace saccade::components {
 
-void DebugFault::Configure(const nlohmann::json& params) {
-  internal::Params p(params);
-  if (!p.Has("at_step")) throw InvalidArgument("parameter 'at_step' is required");
-  at_step_ = p.Integer("at_step", 0, 0, INT64_MAX);
-  message_ = p.String("message", "injected fault");
-  every_ = p.Bool("every", false);
-  p.Finish();
+DebugFault::DebugFault() {
+  DeclareParam("at_step", &at_step_, "the step at which Step throws").Min(0).Required();
+  DeclareParam("message", &message_, "the error's message");
+  DeclareParam("every", &every_, "throw at every later step too");
 }
 
 void DebugFault::Step(const runtime::StepContext& context) {
   if (context.step == at_step_ || (every_ && context.step > at_step_)) throw Error(message_);
 }
 
-SimCameras::SimCameras() : joints_(AddInput<JointStateMessage>("joints")) {}
+SimCameras::SimCameras() : joints_(AddInput<JointStateMessage>("joints")) {
+  options_.cameras = {"left", "right"};
+  DeclareParam("scene", &scene_param_, internal::kSceneParamDoc).Path();
+  DeclareParam("cameras", &options_.cameras,
+               "the scene's cameras to render, one image output each, named as the camera");
+  DeclareParam("distortion", &options_.distortion, "the calibrations' lens distortion");
+  DeclareParam("noise", &options_.noise, "sensor noise, seeded per camera and frame");
+  DeclareParam("motion_blur", &options_.motion_blur, "blur over each camera's exposure");
+  DeclareParam("msaa", &options_.msaa_samples, "multisample anti-aliasing: 0, 2, 4 or 8 samples")
+      .Range(0, 8);
+  DeclareParam("lod_max_error_px", &options_.lod_max_error_px,
+               "level of detail: the largest screen error of a simplified model")
+      .Range(0.0, 1e6)
+      .Unit("px");
+}
 
-void SimCameras::Configure(const nlohmann::json& params) {
-  internal::Params p(params);
-  const internal::SceneRef scene = internal::SceneOf(*this, p);
+void SimCameras::Configured() {
+  const internal::SceneRef scene = internal::SceneOf(*this, scene_param_);
   const std::string& path = scene.path;
-  options_.cameras = p.Strings("cameras", {"left", "right"});
-  options_.distortion = p.Bool("distortion", true);
-  options_.noise = p.Bool("noise", true);
-  options_.motion_blur = p.Bool("motion_blur", true);
-  options_.msaa_samples = static_cast<int>(p.Integer("msaa", 0, 0, 8));
-  options_.lod_max_error_px = p.Number("lod_max_error_px", 0.25, 0.0, 1e6);
-  p.Finish();
   std::string error;
   if (!options_.IsValid(&error)) throw InvalidArgument(error);
   scene_ = scene.scene;
@@ -82,6 +84,7 @@ void SimCameras::Stop() { renderer_.reset(); }
 
 SimHead::SimHead()
     : command_(AddInput<JointCommand>("command")), joints_(AddOutput<JointStateMessage>("joints")) {
+  DeclareParam("scene", &scene_param_, internal::kSceneParamDoc).Path();
   // The methods (for scripts and other processes) are the HeadRole's, by name.
   AddMethod<runtime::Empty, JointStateMessage>(
       "state", [this](const runtime::Empty&) { return HeadState(); },
@@ -129,10 +132,8 @@ JointStateMessage SimHead::State(double time) const {
   return out;
 }
 
-void SimHead::Configure(const nlohmann::json& params) {
-  internal::Params p(params);
-  const internal::SceneRef scene = internal::SceneOf(*this, p);
-  p.Finish();
+void SimHead::Configured() {
+  const internal::SceneRef scene = internal::SceneOf(*this, scene_param_);
   scene_ = scene.scene;
   internal::RobotOf(*scene_, scene.path);
 }

@@ -4,7 +4,6 @@
 #include <span>
 #include <vector>
 
-#include "components/internal_params.h"
 #include "components/internal_scene.h"
 #include "saccade/core/error.h"
 #include "saccade/head/kinematics.h"
@@ -34,11 +33,11 @@ void ImageFilterComponent::Step(const runtime::StepContext&) {
   out_.Emit(runtime::ImageMessage{std::make_shared<const Image>(Apply(*in_.value().image))});
 }
 
-void UndistortComponent::Configure(const nlohmann::json& params) {
-  internal::Params p(params);
-  options_.bilinear = p.Bool("bilinear", true);
-  options_.border_value = static_cast<int>(p.Integer("border_value", 0, 0, 255));
-  p.Finish();
+UndistortComponent::UndistortComponent() {
+  DeclareParam("bilinear", &options_.bilinear, "bilinear interpolation (else nearest pixel)");
+  DeclareParam("border_value", &options_.border_value,
+               "grey level of the pixels that no source pixel maps to")
+      .Range(0, 255);
 }
 
 Image UndistortComponent::Apply(const Image& image) {
@@ -54,39 +53,47 @@ Image UndistortComponent::Apply(const Image& image) {
   return undistorter_->Apply(image);
 }
 
-void MedianComponent::Configure(const nlohmann::json& params) {
-  internal::Params p(params);
-  vision::MedianFilter::Options options;
-  options.kernel_size = static_cast<int>(p.Integer("kernel_size", 3, 3, 255));
-  p.Finish();
-  filter_ = vision::MedianFilter(options);
+MedianComponent::MedianComponent() {
+  DeclareParam("kernel_size", &options_.kernel_size, "side of the square window, odd")
+      .Range(3, 255)
+      .Unit("px");
 }
 
-void SharpenComponent::Configure(const nlohmann::json& params) {
-  internal::Params p(params);
-  vision::Sharpener::Options options;
-  options.amount = p.Number("amount", 1.0, 0.0, 100.0);
-  options.sigma = p.Number("sigma", 1.0, 1e-6, 50.0);
-  p.Finish();
-  filter_ = vision::Sharpener(options);
+void MedianComponent::Configured() { filter_ = vision::MedianFilter(options_); }
+
+SharpenComponent::SharpenComponent() {
+  DeclareParam("amount", &options_.amount, "weight of the detail added back (unsharp mask)")
+      .Range(0.0, 100.0);
+  DeclareParam("sigma", &options_.sigma, "Gaussian blur whose difference is the detail")
+      .Range(1e-6, 50.0)
+      .Unit("px");
 }
+
+void SharpenComponent::Configured() { filter_ = vision::Sharpener(options_); }
 
 // ---- detection -----------------------------------------------------------------------------
 
 FaceDetectorComponent::FaceDetectorComponent()
     : image_(AddInput<runtime::ImageMessage>("image", /*required=*/true)),
-      faces_(AddOutput<FacesMessage>("faces")) {}
+      faces_(AddOutput<FacesMessage>("faces")) {
+  DeclareParam("min_neighbors", &options_.min_neighbors, "overlapping hits needed to keep a box")
+      .Range(0, 1000);
+  DeclareParam("scale_factor", &options_.scale_factor, "size step between pyramid levels")
+      .Range(1.0001, 4.0);
+  DeclareParam("min_size_px", &options_.min_size_px, "smallest face side")
+      .Range(1, 100000)
+      .Unit("px");
+  DeclareParam("max_size_px", &options_.max_size_px, "largest face side; 0: no limit")
+      .Range(0, 100000)
+      .Unit("px");
+  DeclareParam("reject_cats", &reject_cats_, "reject boxes that the cat-face cascade also finds");
+  DeclareParam("require_eyes", &require_eyes_, "reject boxes without an eye inside");
+}
 
-void FaceDetectorComponent::Configure(const nlohmann::json& params) {
-  internal::Params p(params);
-  vision::FaceDetector::Options options;
-  options.min_neighbors = static_cast<int>(p.Integer("min_neighbors", 3, 0, 1000));
-  options.scale_factor = p.Number("scale_factor", 1.1, 1.0001, 4.0);
-  options.min_size_px = static_cast<int>(p.Integer("min_size_px", 30, 1, 100000));
-  options.max_size_px = static_cast<int>(p.Integer("max_size_px", 0, 0, 100000));
-  if (!p.Bool("reject_cats", true)) options.cat_cascade_path = "";
-  if (!p.Bool("require_eyes", true)) options.eye_cascade_path = "";
-  p.Finish();
+void FaceDetectorComponent::Configured() {
+  vision::FaceDetector::Options options = options_;
+  if (!reject_cats_) options.cat_cascade_path = "";
+  if (!require_eyes_) options.eye_cascade_path = "";
   detector_ = std::make_unique<vision::FaceDetector>(options);
 }
 
@@ -105,18 +112,30 @@ void FaceDetectorComponent::Step(const runtime::StepContext&) {
 StereoFacesComponent::StereoFacesComponent()
     : left_(AddInput<FacesMessage>("left", /*required=*/true)),
       right_(AddInput<FacesMessage>("right", /*required=*/true)),
-      candidates_(AddOutput<CandidatesMessage>("candidates")) {}
+      candidates_(AddOutput<CandidatesMessage>("candidates")) {
+  // A human face's width as the cascade boxes it (the library accepts any width).
+  options_.min_width_m = 0.08;
+  options_.max_width_m = 0.4;
+  DeclareParam("max_reprojection_px", &options_.max_reprojection_px,
+               "largest reprojection error of a left/right pair")
+      .Range(1e-6, 1e6)
+      .Unit("px");
+  DeclareParam("min_depth_m", &options_.min_depth_m, "nearest depth of a pair")
+      .Range(1e-6, 1e6)
+      .Unit("m");
+  DeclareParam("max_depth_m", &options_.max_depth_m, "farthest depth of a pair")
+      .Range(1e-6, 1e6)
+      .Unit("m");
+  DeclareParam("min_width_m", &options_.min_width_m, "narrowest face; 0: no limit")
+      .Range(0.0, 1e6)
+      .Unit("m");
+  DeclareParam("max_width_m", &options_.max_width_m, "widest face; 0: no limit")
+      .Range(0.0, 1e6)
+      .Unit("m");
+}
 
-void StereoFacesComponent::Configure(const nlohmann::json& params) {
-  internal::Params p(params);
-  vision::StereoAssociator::Options options;
-  options.max_reprojection_px = p.Number("max_reprojection_px", 4.0, 1e-6, 1e6);
-  options.min_depth_m = p.Number("min_depth_m", 0.1, 1e-6, 1e6);
-  options.max_depth_m = p.Number("max_depth_m", 20.0, 1e-6, 1e6);
-  options.min_width_m = p.Number("min_width_m", 0.08, 0.0, 1e6);
-  options.max_width_m = p.Number("max_width_m", 0.4, 0.0, 1e6);
-  p.Finish();
-  associator_ = vision::StereoAssociator(options);  // throws with IsValid's message
+void StereoFacesComponent::Configured() {
+  associator_ = vision::StereoAssociator(options_);  // throws with IsValid's message
 }
 
 void StereoFacesComponent::Step(const runtime::StepContext& context) {
@@ -163,19 +182,38 @@ AttentionComponent::AttentionComponent()
         return runtime::Text{"forgot the target and " + std::to_string(n) + " suppressed places"};
       },
       "forgets the target and what inhibition of return suppresses: every face is new again");
+  ior_options_.suppression_time_s = 60.0;  // a minute: the demo's faces are not seen twice
+  DeclareParam("scene", &scene_param_, internal::kSceneParamDoc).Path();
+  DeclareParam("fixation_time_s", &ior_options_.fixation_time_s,
+               "dwell on a face before it is suppressed")
+      .Range(1e-6, 1e6)
+      .Unit("s");
+  DeclareParam("radius_m", &ior_options_.radius_m, "size of a fixated or suppressed place")
+      .Range(1e-6, 1e6)
+      .Unit("m");
+  DeclareParam("suppression_time_s", &ior_options_.suppression_time_s,
+               "how long a fixated place stays suppressed")
+      .Range(1e-6, 1e9)
+      .Unit("s");
+  DeclareParam("lost_after_s", &lost_after_s_, "a target unseen this long is dropped")
+      .Range(0.0, 1e6)
+      .Unit("s");
+  DeclareParam("fixation_tolerance_m", &fixation_tolerance_m_,
+               "the head fixates a target when its fixation point is this close")
+      .Range(1e-6, 1e6)
+      .Unit("m");
+  DeclareParam("explore_after_s", &explore_after_s_,
+               "with nothing to look at this long, the head goes home")
+      .Range(0.0, 1e6)
+      .Unit("s");
+  DeclareParam("home_distance_m", &home_distance_m_,
+               "home: a point this far straight ahead of the head's base")
+      .Range(0.1, 1e3)
+      .Unit("m");
 }
 
-void AttentionComponent::Configure(const nlohmann::json& params) {
-  internal::Params p(params);
-  const internal::SceneRef scene = internal::SceneOf(*this, p);
-  ior_options_.fixation_time_s = p.Number("fixation_time_s", 2.0, 1e-6, 1e6);
-  ior_options_.radius_m = p.Number("radius_m", 0.15, 1e-6, 1e6);
-  ior_options_.suppression_time_s = p.Number("suppression_time_s", 60.0, 1e-6, 1e9);
-  lost_after_s_ = p.Number("lost_after_s", 1.5, 0.0, 1e6);
-  fixation_tolerance_m_ = p.Number("fixation_tolerance_m", 0.05, 1e-6, 1e6);
-  explore_after_s_ = p.Number("explore_after_s", 0.5, 0.0, 1e6);
-  home_distance_m_ = p.Number("home_distance_m", 3.0, 0.1, 1e3);
-  p.Finish();
+void AttentionComponent::Configured() {
+  const internal::SceneRef scene = internal::SceneOf(*this, scene_param_);
   ior_.emplace(ior_options_);
   scene_ = scene.scene;
   internal::RobotOf(*scene_, scene.path);
@@ -268,14 +306,20 @@ void AttentionComponent::Step(const runtime::StepContext& context) {
 CamShiftComponent::CamShiftComponent()
     : image_(AddInput<runtime::ImageMessage>("image", /*required=*/true)),
       selection_(AddInput<SelectionMessage>("selection", /*required=*/true)),
-      track_(AddOutput<TrackMessage>("track")) {}
+      track_(AddOutput<TrackMessage>("track")) {
+  DeclareParam("eye", &eye_, "the eye whose image and box it tracks")
+      .Choices({"left", "right"})
+      .Required();
+  DeclareParam("min_mass_ratio", &options_.min_mass_ratio,
+               "the track is lost when the window's hue mass falls below this share of the seed's")
+      .Range(0.0, 0.999);
+  DeclareParam("reseed_fraction", &reseed_fraction_,
+               "re-seed when a detection lies farther than this share of its width from the track")
+      .Range(0.0, 100.0);
+}
 
-void CamShiftComponent::Configure(const nlohmann::json& params) {
-  internal::Params p(params);
-  left_ = p.Choice("eye", "", {"left", "right"}) == "left";
-  options_.min_mass_ratio = p.Number("min_mass_ratio", options_.min_mass_ratio, 0.0, 0.999);
-  reseed_fraction_ = p.Number("reseed_fraction", 0.5, 0.0, 100.0);
-  p.Finish();
+void CamShiftComponent::Configured() {
+  left_ = eye_ == "left";
   tracker_ = std::make_unique<vision::CamShiftTracker>(options_);
 }
 
@@ -327,14 +371,17 @@ TriangulateComponent::TriangulateComponent()
     : left_(AddInput<TrackMessage>("left", /*required=*/true)),
       right_(AddInput<TrackMessage>("right", /*required=*/true)),
       selection_(AddInput<SelectionMessage>("selection", /*required=*/true)),
-      target_(AddOutput<TargetMessage>("target")) {}
-
-void TriangulateComponent::Configure(const nlohmann::json& params) {
-  internal::Params p(params);
-  max_reprojection_px_ = p.Number("max_reprojection_px", 4.0, 1e-6, 1e6);
-  prefer_tracks_ = p.Choice("prefer", "detections", {"tracks", "detections"}) == "tracks";
-  p.Finish();
+      target_(AddOutput<TargetMessage>("target")) {
+  DeclareParam("max_reprojection_px", &max_reprojection_px_,
+               "largest reprojection error of the two tracks' triangulation")
+      .Range(1e-6, 1e6)
+      .Unit("px");
+  DeclareParam("prefer", &prefer_,
+               "detections: the tracks only bridge frames without one; tracks: always the tracks")
+      .Choices({"detections", "tracks"});
 }
+
+void TriangulateComponent::Configured() { prefer_tracks_ = prefer_ == "tracks"; }
 
 void TriangulateComponent::Step(const runtime::StepContext& context) {
   const SelectionMessage* selection = selection_.get();

@@ -18,6 +18,11 @@ bool IsIdentifier(const std::string& name) {
 
 }  // namespace
 
+void Component::Configure(const nlohmann::json& params) {
+  params_.Apply(params);
+  Configured();
+}
+
 std::string Component::ResolvePath(const std::string& path) const {
   const std::filesystem::path p(path);
   if (p.is_absolute() || base_dir_.empty() || path.empty()) return path;

@@ -7,11 +7,6 @@
 namespace saccade::runtime {
 namespace {
 
-std::string Expect(const nlohmann::json& value, const char* type, const char* key,
-                   const char* what) {
-  return fmt::format("{}: field '{}': expected {}, got {}", type, key, what, value.dump());
-}
-
 MessageRegistry MakeGlobal() {
   MessageRegistry registry;
   registry.Register<Tick>();
@@ -23,52 +18,6 @@ MessageRegistry MakeGlobal() {
 }
 
 }  // namespace
-
-const nlohmann::json& JsonField(const nlohmann::json& json, const char* type, const char* key) {
-  if (!json.is_object()) {
-    throw Error(fmt::format("{}: expected a JSON object, got {}", type, json.dump()));
-  }
-  const auto it = json.find(key);
-  if (it == json.end()) throw Error(fmt::format("{}: missing field '{}'", type, key));
-  return *it;
-}
-
-double JsonNumber(const nlohmann::json& json, const char* type, const char* key) {
-  const nlohmann::json& value = JsonField(json, type, key);
-  if (!value.is_number()) throw Error(Expect(value, type, key, "a number"));
-  return value.get<double>();
-}
-
-int64_t JsonInteger(const nlohmann::json& json, const char* type, const char* key) {
-  const nlohmann::json& value = JsonField(json, type, key);
-  if (!value.is_number_integer()) throw Error(Expect(value, type, key, "an integer"));
-  return value.get<int64_t>();
-}
-
-bool JsonBool(const nlohmann::json& json, const char* type, const char* key) {
-  const nlohmann::json& value = JsonField(json, type, key);
-  if (!value.is_boolean()) throw Error(Expect(value, type, key, "true or false"));
-  return value.get<bool>();
-}
-
-std::string JsonString(const nlohmann::json& json, const char* type, const char* key) {
-  const nlohmann::json& value = JsonField(json, type, key);
-  if (!value.is_string()) throw Error(Expect(value, type, key, "a string"));
-  return value.get<std::string>();
-}
-
-std::vector<double> JsonNumbers(const nlohmann::json& json, const char* type, const char* key,
-                                std::size_t n) {
-  const nlohmann::json& value = JsonField(json, type, key);
-  const std::string what = fmt::format("an array of {} numbers", n);
-  if (!value.is_array() || value.size() != n) throw Error(Expect(value, type, key, what.c_str()));
-  std::vector<double> out;
-  for (const nlohmann::json& item : value) {
-    if (!item.is_number()) throw Error(Expect(value, type, key, what.c_str()));
-    out.push_back(item.get<double>());
-  }
-  return out;
-}
 
 MessageRegistry& MessageRegistry::Global() {
   static MessageRegistry registry = MakeGlobal();
@@ -91,20 +40,6 @@ void MessageRegistry::Add(MessageType type) {
   types_.emplace(std::move(name), std::move(type));
 }
 
-nlohmann::json MessageTraits<Tick>::ToJson(const Tick& m) {
-  return {{"step", m.step}, {"time", m.time}};
-}
-
-Tick MessageTraits<Tick>::FromJson(const nlohmann::json& j) {
-  return {JsonInteger(j, kName, "step"), JsonNumber(j, kName, "time")};
-}
-
-nlohmann::json MessageTraits<Value>::ToJson(const Value& m) { return {{"value", m.value}}; }
-
-Value MessageTraits<Value>::FromJson(const nlohmann::json& j) {
-  return {JsonNumber(j, kName, "value")};
-}
-
 nlohmann::json MessageTraits<Empty>::ToJson(const Empty&) { return nlohmann::json::object(); }
 
 Empty MessageTraits<Empty>::FromJson(const nlohmann::json& j) {
@@ -112,12 +47,6 @@ Empty MessageTraits<Empty>::FromJson(const nlohmann::json& j) {
     throw Error(fmt::format("{}: expected {{}}, got {}", kName, j.dump()));
   }
   return {};
-}
-
-nlohmann::json MessageTraits<Text>::ToJson(const Text& m) { return {{"text", m.text}}; }
-
-Text MessageTraits<Text>::FromJson(const nlohmann::json& j) {
-  return {JsonString(j, kName, "text")};
 }
 
 nlohmann::json MessageTraits<ImageMessage>::ToJson(const ImageMessage& m) {
@@ -132,15 +61,15 @@ nlohmann::json MessageTraits<ImageMessage>::ToJson(const ImageMessage& m) {
 
 ImageMessage MessageTraits<ImageMessage>::FromJson(const nlohmann::json& j) {
   if (j.is_null()) return {};
-  const int64_t width = JsonInteger(j, kName, "width");
-  const int64_t height = JsonInteger(j, kName, "height");
+  const int64_t width = DecodeField<int64_t>(j, kName, "width");
+  const int64_t height = DecodeField<int64_t>(j, kName, "height");
   for (const auto& [key, side] : {std::pair{"width", width}, std::pair{"height", height}}) {
     if (side < 0 || side > kMaxJsonImageSide) {
       throw Error(fmt::format("{}: field '{}': expected an integer in [0, {}], got {}", kName, key,
                               kMaxJsonImageSide, side));
     }
   }
-  const std::string format_name = JsonString(j, kName, "format");
+  const std::string format_name = DecodeField<std::string>(j, kName, "format");
   PixelFormat format = PixelFormat::kRgb8;
   bool known = false;
   std::string expected;
@@ -157,9 +86,9 @@ ImageMessage MessageTraits<ImageMessage>::FromJson(const nlohmann::json& j) {
                             format_name));
   }
   // Every field is checked before the pixels are allocated.
-  std::string camera = JsonString(j, kName, "camera");
-  const int64_t frame_index = JsonInteger(j, kName, "frame_index");
-  const double time = JsonNumber(j, kName, "time");
+  std::string camera = DecodeField<std::string>(j, kName, "camera");
+  const int64_t frame_index = DecodeField<int64_t>(j, kName, "frame_index");
+  const double time = DecodeField<double>(j, kName, "time");
   auto image = std::make_shared<Image>(static_cast<int>(width), static_cast<int>(height), format);
   image->metadata().camera = std::move(camera);
   image->metadata().frame_index = frame_index;

@@ -413,7 +413,8 @@ TEST(ComponentParams, UnknownMissingAndOutOfRangeParametersAreNamed) {
             "unknown parameter 'min_neighbours' (known: max_size_px, min_neighbors, min_size_px, "
             "reject_cats, require_eyes, scale_factor)");
   EXPECT_EQ(message("vision.camshift", json::object()),
-            "parameter 'eye': expected one of left, right, got ''");
+            "parameter 'eye' is required: one of left, right (the eye whose image and box it "
+            "tracks)");
   // No scene: neither the parameter nor the pipeline (resources.h) names one.
   EXPECT_EQ(message("sim.head", json::object()),
             "no scene: name it once at the top of the pipeline or hardware file (scene: FILE), or "

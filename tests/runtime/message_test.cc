@@ -22,9 +22,7 @@ template <>
 struct MessageTraits<Target> {
   static constexpr const char* kName = "test.target";
   static nlohmann::json ToJson(const Target& m) { return {{"x", m.x}}; }
-  static Target FromJson(const nlohmann::json& j) {
-    return {JsonField(j, kName, "x").get<double>()};
-  }
+  static Target FromJson(const nlohmann::json& j) { return {DecodeField<double>(j, kName, "x")}; }
 };
 
 namespace {

@@ -2,14 +2,13 @@
 // control.fixation -- turns the 3D target into joint commands (seed section 3 and appendix A:
 // inverse kinematics, pan then tilt then symmetric vergence): a saccade to a new target, smooth
 // pursuit (position plus the joint velocities that follow the target's motion) of a moving one.
-//   params: scene (the pipeline's unless given: the head), pursuit true,
-//           min_pursuit_speed_m_s 0.02 (slower targets get saccades: triangulation jitter is
-//           not motion), velocity_smoothing 0.5 (0 .. 1: weight of the newest velocity)
+//   params: declared in the constructor (docs/components.md lists them)
 //   inputs: target (vision.target, required)
 //   outputs: command (head.command), for every new valid target
 //   The command is always within the joint limits (IK clamps; the motors clamp again).
 #include <memory>
 #include <optional>
+#include <string>
 
 #include "saccade/components/messages.h"
 #include "saccade/runtime/component.h"
@@ -20,10 +19,13 @@ namespace saccade::components {
 class FixationComponent : public runtime::Component {
  public:
   FixationComponent();
-  void Configure(const nlohmann::json& params) override;
   void Step(const runtime::StepContext& context) override;
 
+ protected:
+  void Configured() override;
+
  private:
+  std::string scene_param_;
   head::JointState Solve(const Eigen::Vector3d& p_W, const head::JointState& seed) const;
 
   runtime::Input<TargetMessage>& target_;

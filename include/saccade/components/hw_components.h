@@ -6,16 +6,10 @@
 // hw.head -- a head driver (hw/head_driver.h) as the pipeline's head, with the driver's
 //   safety rules: non-finite commands rejected, targets clamped to the joint limits and
 //   velocities limited (reported), the watchdog, the emergency stop, faults.
-//   params:  scene: the pipeline's unless given; its robot is the head (its head description,
-//              with the servo mapping for dynamixel)
-//            driver (required): dynamixel | simulated (SimHeadDriver: the simulated motors on
-//              the wall clock, to try a pipeline without a device)
-//            port: the serial port (dynamixel, required), e.g. /dev/ttyUSB0; baud: 1000000
-//            timeout_ms: 20, retries: 2 (each bus transaction)
-//            watchdog_s: 0.5 (0: off)
-//            mirror: false -- mirror mode (seed: popeyeRobot): commands move a virtual
-//              (simulated) head, which is what the cameras see and what `joints` reports;
-//              the device follows the virtual head's positions every step, within its limits.
+//   Its scene's robot is the head (its head description, with the servo mapping for
+//   dynamixel). Parameters: declared in the constructor (docs/components.md). Mirror mode
+//   (seed: popeyeRobot): commands move a virtual (simulated) head, which is what the cameras
+//   see and what `joints` reports; the device follows the virtual head every step.
 //   inputs:  command (head.command, optional): sent to the device (or the virtual head).
 //   outputs: joints (head.joints): the device's measured joints (mirror: the virtual
 //              head's) at the step's time; status (head.status): the driver's safety state.
@@ -37,12 +31,8 @@
 //   time stamp (hw/stereo_source.h), delivering the same images with the same metadata as
 //   sim.cameras: K and distortion from each camera's calibration file, X_WC and the joints
 //   from the head's forward kinematics at the joints of this step.
-//   params:  scene: the pipeline's unless given; its robot carries the cameras
-//            cameras (required): {left: SOURCE, right: SOURCE}, each SOURCE
-//              {uri (required), calibration, calibration_index 0, fps 0, loop false,
-//               first 0, every 1} as hw::CameraSourceSpec documents; relative paths resolve
-//               against the pipeline (or hardware) file
-//            max_skew_s: 0.02 -- the most the two time stamps of a pair may differ
+//   Its scene's robot carries the cameras. Parameters: declared in the constructor
+//   (docs/components.md); each camera's SOURCE map is read by a table of its own.
 //   inputs:  joints (head.joints, optional; connect with delay 1 as for sim.cameras)
 //   outputs: left, right (runtime.image): one pair per step; time = the step's time (the
 //            capture time stays in the source: frame_index counts the pairs delivered)
@@ -65,7 +55,6 @@ namespace saccade::components {
 class HwHead : public runtime::Component, public HeadRole {
  public:
   HwHead();
-  void Configure(const nlohmann::json& params) override;
   void Start() override;
   void Step(const runtime::StepContext& context) override;
   void Stop() override;
@@ -81,6 +70,9 @@ class HwHead : public runtime::Component, public HeadRole {
   void EmergencyStop() override;
   void ClearFault() override;
 
+ protected:
+  void Configured() override;
+
  private:
   hw::HeadDriver& Driver();  // throws when not started
   void Send(const head::JointState& positions, const head::JointState& velocities);
@@ -92,6 +84,7 @@ class HwHead : public runtime::Component, public HeadRole {
   runtime::Output<JointStateMessage>& joints_;
   runtime::Output<HeadStatusMessage>& status_;
   std::shared_ptr<const scene::Scene> scene_;
+  std::string scene_param_;
   std::string driver_kind_;
   std::string port_;
   int baud_ = 1000000;
@@ -111,7 +104,6 @@ class HwHead : public runtime::Component, public HeadRole {
 class HwCameras : public runtime::Component, public EyeCamerasRole {
  public:
   HwCameras();
-  void Configure(const nlohmann::json& params) override;
   void Start() override;
   void Step(const runtime::StepContext& context) override;
   void Stop() override;
@@ -130,7 +122,12 @@ class HwCameras : public runtime::Component, public EyeCamerasRole {
     return CameraPairCounts{pairs_, dropped_left_, dropped_right_};
   }
 
+ protected:
+  void Configured() override;
+
  private:
+  std::string scene_param_;
+  nlohmann::json cameras_;
   runtime::Input<JointStateMessage>& joints_;
   runtime::Output<runtime::ImageMessage>& left_;
   runtime::Output<runtime::ImageMessage>& right_;

@@ -13,11 +13,15 @@
 #include <nlohmann/json.hpp>
 #include <opencv2/core.hpp>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "saccade/core/image.h"
+#include "saccade/geometry/json.h"
 #include "saccade/head/head_description.h"
+#include "saccade/head/json.h"
 #include "saccade/runtime/message.h"
+#include "saccade/vision/json.h"
 
 namespace saccade::components {
 
@@ -140,62 +144,118 @@ void RegisterMessages();
 
 }  // namespace saccade::components
 
+// Each message lists its fields once; its JSON form follows (runtime/message.h). The codecs
+// of the fields' types: core/json_codec.h (numbers, strings, lists, images), head/json.h
+// (joints), geometry/json.h (points), vision/json.h (boxes, image points).
+namespace saccade {
+
+template <>
+struct JsonCodec<components::FacesMessage::Face> : JsonObjectCodec<components::FacesMessage::Face> {
+  using T = components::FacesMessage::Face;
+  static constexpr auto kFields =
+      std::make_tuple(JsonField("box", &T::box), JsonField("neighbors", &T::neighbors),
+                      JsonField("rejected", &T::rejected), JsonField("reason", &T::reason));
+};
+
+template <>
+struct JsonCodec<components::FaceCandidate> : JsonObjectCodec<components::FaceCandidate> {
+  using T = components::FaceCandidate;
+  static constexpr auto kFields = std::make_tuple(
+      JsonField("p_W", &T::p_W), JsonField("left_box", &T::left_box),
+      JsonField("right_box", &T::right_box), JsonField("distance_m", &T::distance_m),
+      JsonField("reprojection_px", &T::reprojection_px), JsonField("gap_m", &T::gap_m),
+      JsonField("width_m", &T::width_m));
+};
+
+}  // namespace saccade
+
 namespace saccade::runtime {
 
 template <>
-struct MessageTraits<components::JointStateMessage> {
+struct MessageTraits<components::JointStateMessage> : FieldMessage<components::JointStateMessage> {
+  using T = components::JointStateMessage;
   static constexpr const char* kName = "head.joints";
-  static nlohmann::json ToJson(const components::JointStateMessage& m);
-  static components::JointStateMessage FromJson(const nlohmann::json& j);
+  static constexpr auto kFields = std::make_tuple(
+      JsonField("time", &T::time), JsonField("positions", &T::positions),
+      JsonField("velocities", &T::velocities), JsonField("targets", &T::targets),
+      JsonField("arrived", &T::arrived), JsonField("clamped_commands", &T::clamped_commands));
 };
 
 template <>
-struct MessageTraits<components::JointCommand> {
+struct MessageTraits<components::JointCommand> : FieldMessage<components::JointCommand> {
+  using T = components::JointCommand;
   static constexpr const char* kName = "head.command";
-  static nlohmann::json ToJson(const components::JointCommand& m);
-  static components::JointCommand FromJson(const nlohmann::json& j);
+  static constexpr auto kFields = std::make_tuple(
+      JsonField("time", &T::time), JsonField("positions", &T::positions),
+      JsonField("velocities", &T::velocities), JsonField("target_id", &T::target_id));
 };
 
 template <>
-struct MessageTraits<components::HeadStatusMessage> {
+struct MessageTraits<components::HeadStatusMessage> : FieldMessage<components::HeadStatusMessage> {
+  using T = components::HeadStatusMessage;
   static constexpr const char* kName = "head.status";
-  static nlohmann::json ToJson(const components::HeadStatusMessage& m);
-  static components::HeadStatusMessage FromJson(const nlohmann::json& j);
+  static constexpr auto kFields = std::make_tuple(
+      JsonField("time", &T::time), JsonField("driver", &T::driver),
+      JsonField("positions", &T::positions), JsonField("velocities", &T::velocities),
+      JsonField("targets", &T::targets), JsonField("torque", &T::torque),
+      JsonField("holding", &T::holding), JsonField("emergency_stopped", &T::emergency_stopped),
+      JsonField("fault", &T::fault), JsonField("commands", &T::commands),
+      JsonField("rejected_commands", &T::rejected_commands),
+      JsonField("limited_commands", &T::limited_commands),
+      JsonField("watchdog_trips", &T::watchdog_trips), JsonField("last_limit", &T::last_limit),
+      JsonField("mirror", &T::mirror));
 };
 
 template <>
-struct MessageTraits<components::FacesMessage> {
+struct MessageTraits<components::FacesMessage> : FieldMessage<components::FacesMessage> {
+  using T = components::FacesMessage;
   static constexpr const char* kName = "vision.faces";
-  static nlohmann::json ToJson(const components::FacesMessage& m);
-  static components::FacesMessage FromJson(const nlohmann::json& j);
+  static constexpr auto kFields =
+      std::make_tuple(JsonField("image", &T::image), JsonField("faces", &T::faces));
 };
 
 template <>
-struct MessageTraits<components::CandidatesMessage> {
+struct MessageTraits<components::CandidatesMessage> : FieldMessage<components::CandidatesMessage> {
+  using T = components::CandidatesMessage;
   static constexpr const char* kName = "vision.candidates";
-  static nlohmann::json ToJson(const components::CandidatesMessage& m);
-  static components::CandidatesMessage FromJson(const nlohmann::json& j);
+  static constexpr auto kFields =
+      std::make_tuple(JsonField("time", &T::time), JsonField("frame_index", &T::frame_index),
+                      JsonField("candidates", &T::candidates));
 };
 
 template <>
-struct MessageTraits<components::SelectionMessage> {
+struct MessageTraits<components::SelectionMessage> : FieldMessage<components::SelectionMessage> {
+  using T = components::SelectionMessage;
   static constexpr const char* kName = "vision.selection";
-  static nlohmann::json ToJson(const components::SelectionMessage& m);
-  static components::SelectionMessage FromJson(const nlohmann::json& j);
+  static constexpr auto kFields = std::make_tuple(
+      JsonField("time", &T::time), JsonField("frame_index", &T::frame_index),
+      JsonField("valid", &T::valid), JsonField("target_id", &T::target_id),
+      JsonField("p_W", &T::p_W), JsonField("boxes_fresh", &T::boxes_fresh),
+      JsonField("left_box", &T::left_box), JsonField("right_box", &T::right_box),
+      JsonField("fixating", &T::fixating), JsonField("exploring", &T::exploring),
+      JsonField("dwell_s", &T::dwell_s), JsonField("suppressed_W", &T::suppressed_W));
 };
 
 template <>
-struct MessageTraits<components::TrackMessage> {
+struct MessageTraits<components::TrackMessage> : FieldMessage<components::TrackMessage> {
+  using T = components::TrackMessage;
   static constexpr const char* kName = "vision.track";
-  static nlohmann::json ToJson(const components::TrackMessage& m);
-  static components::TrackMessage FromJson(const nlohmann::json& j);
+  static constexpr auto kFields =
+      std::make_tuple(JsonField("image", &T::image), JsonField("target_id", &T::target_id),
+                      JsonField("tracking", &T::tracking), JsonField("window", &T::window),
+                      JsonField("center", &T::center), JsonField("reseeded", &T::reseeded),
+                      JsonField("reason", &T::reason));
 };
 
 template <>
-struct MessageTraits<components::TargetMessage> {
+struct MessageTraits<components::TargetMessage> : FieldMessage<components::TargetMessage> {
+  using T = components::TargetMessage;
   static constexpr const char* kName = "vision.target";
-  static nlohmann::json ToJson(const components::TargetMessage& m);
-  static components::TargetMessage FromJson(const nlohmann::json& j);
+  static constexpr auto kFields = std::make_tuple(
+      JsonField("time", &T::time), JsonField("frame_index", &T::frame_index),
+      JsonField("valid", &T::valid), JsonField("target_id", &T::target_id),
+      JsonField("p_W", &T::p_W), JsonField("source", &T::source),
+      JsonField("reprojection_px", &T::reprojection_px), JsonField("gap_m", &T::gap_m));
 };
 
 }  // namespace saccade::runtime

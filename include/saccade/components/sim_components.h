@@ -3,19 +3,18 @@
 // from a scene, and the head's motors. The real robot replaces them by components with the
 // same ports (issue 7).
 //
-// sim.cameras -- renders the scene's cameras (seed: cameraCapture through the FBO).
-//   params:  scene: the pipeline's scene (its `scene:` line) unless given, relative to the file
-//            cameras: [left, right]      which cameras, one output each (named as the camera)
-//            distortion, noise, motion_blur: true   the scene's effects, each switchable
-//            msaa: 0 (0, 2, 4, 8); lod_max_error_px: 0.25
+// Each declares its parameters in its constructor (docs/components.md is printed from them).
+//
+// sim.cameras -- renders the scene's cameras (seed: cameraCapture through the FBO), one image
+//   output per camera of its `cameras` parameter.
 //   inputs:  joints (head.joints, optional): the head's state at this step's time; connect
 //            it from sim.head with delay 1. Without it, the scene's initial joints.
 //   outputs: <camera> (runtime.image) per camera, shared; frame index = step.
 //
 // sim.head -- the head's four motors under their velocity and acceleration limits
 //   (head/motors.h): saccades and smooth pursuit, never outside the joint limits.
-//   params:  scene: the pipeline's unless given; its robot is the head (description, initial
-//   joints) inputs:  command (head.command, optional): the latest command, applied when it arrives
+//   Its scene's robot is the head (description, initial joints).
+//   inputs:  command (head.command, optional): the latest command, applied when it arrives
 //   outputs: joints (head.joints): the state at the end of the step (time + dt), i.e. at the
 //            next step's time, which is when the cameras see it. The motors advance by the
 //            time since the last state: dt in simulated time, the wall time in real time.
@@ -40,22 +39,20 @@ namespace saccade::components {
 /// debug.fault -- fault injection, to see how a pipeline and its tools handle a failing
 /// component: throws saccade::Error(`message`) in its Step at step `at_step` (and, with
 /// `every: true`, at every later step). No ports.
-///   params: at_step (required, >= 0), message "injected fault", every false
 class DebugFault : public runtime::Component {
  public:
-  void Configure(const nlohmann::json& params) override;
+  DebugFault();
   void Step(const runtime::StepContext& context) override;
 
  private:
   int64_t at_step_ = 0;
   bool every_ = false;
-  std::string message_;
+  std::string message_ = "injected fault";
 };
 
 class SimCameras : public runtime::Component, public EyeCamerasRole {
  public:
   SimCameras();
-  void Configure(const nlohmann::json& params) override;
   void Start() override;
   void Step(const runtime::StepContext& context) override;
   void Stop() override;
@@ -67,7 +64,11 @@ class SimCameras : public runtime::Component, public EyeCamerasRole {
   const render::RendererOptions& options() const { return options_; }
   const render::RendererOptions* rendered() const override { return &options_; }
 
+ protected:
+  void Configured() override;
+
  private:
+  std::string scene_param_;
   runtime::Input<JointStateMessage>& joints_;
   std::vector<runtime::Output<runtime::ImageMessage>*> outputs_;
   std::shared_ptr<const scene::Scene> scene_;
@@ -79,7 +80,6 @@ class SimCameras : public runtime::Component, public EyeCamerasRole {
 class SimHead : public runtime::Component, public HeadRole {
  public:
   SimHead();
-  void Configure(const nlohmann::json& params) override;
   void Start() override;
   void Step(const runtime::StepContext& context) override;
 
@@ -90,7 +90,11 @@ class SimHead : public runtime::Component, public HeadRole {
   JointStateMessage Move(const JointCommand& command) override;
   void StopHead() override;
 
+ protected:
+  void Configured() override;
+
  private:
+  std::string scene_param_;
   head::Motors& Motors();  // throws when not started
   JointStateMessage State(double time) const;
 

@@ -1,20 +1,16 @@
 #pragma once
 // Perception as pipeline components (seed Fig. 2, middle block; section 5.2: featuresHaar,
-// camshiftTracking, triangulation). Each wraps a class of `vision` and documents its ports:
+// camshiftTracking, triangulation). Each wraps a class of `vision` and documents its ports;
+// each declares its parameters in its constructor (docs/components.md is printed from them).
 //
 // vision.undistort / vision.median / vision.sharpen -- pre-processing (seed Fig. 2).
 //   inputs: image (runtime.image, required); outputs: image (runtime.image), a new image with
-//   the same metadata (undistort: distortion "none"). Params: undistort {bilinear: true};
-//   median {kernel_size: 3}; sharpen {amount: 1.0, sigma: 1.0} (vision/*.h give the ranges).
+//   the same metadata (undistort: distortion "none").
 //
 // vision.face_detector -- Haar faces with the cat and eye checks (vision/face_detector.h).
-//   params: min_neighbors 3, scale_factor 1.1, min_size_px 30, max_size_px 0,
-//           reject_cats true, require_eyes true
 //   inputs: image (runtime.image, required); outputs: faces (vision.faces), every new image.
 //
 // vision.stereo_faces -- associates the left and right faces and triangulates them (seed 4.2).
-//   params: max_reprojection_px 4, min_depth_m 0.1, max_depth_m 20, min_width_m 0.08,
-//           max_width_m 0.4 (a human face's width as the cascade boxes it)
 //   inputs: left, right (vision.faces, required); outputs: candidates (vision.candidates)
 //
 // vision.attention -- chooses the face to look at: the closest one that inhibition of return
@@ -22,9 +18,6 @@
 //   (then it is suppressed for suppression_time_s) or unseen for lost_after_s. With nothing to
 //   look at for explore_after_s, it sends the head home (a point home_distance_m straight
 //   ahead of its base), from where it looks for faces again.
-//   params: scene (the pipeline's unless given: the head), fixation_time_s 2, radius_m 0.15,
-//           suppression_time_s 60, lost_after_s 1.5, fixation_tolerance_m 0.05,
-//           explore_after_s 0.5, home_distance_m 3
 //   inputs: candidates (vision.candidates, required), joints (head.joints, delay 1)
 //   outputs: selection (vision.selection)
 //   methods: reset (runtime.empty -> runtime.text): forgets the target and every suppressed
@@ -33,7 +26,6 @@
 // vision.camshift -- one eye's CamShift track of the selected face (vision/camshift_tracker.h),
 //   seeded by its detection box, re-seeded when a detection of the same target lies farther
 //   than reseed_fraction of its width from the track, re-detected when lost.
-//   params: eye (required: left | right), min_mass_ratio 0.3, reseed_fraction 0.5
 //   inputs: image (runtime.image, required), selection (vision.selection, required)
 //   outputs: track (vision.track)
 //
@@ -43,7 +35,6 @@
 //   selection's last point. `prefer: tracks` uses the tracks even when detections exist:
 //   measured on the portraits, CamShift's window slides down onto the neck's skin, 22 mm
 //   off the face centre at 2.2 m against 4 mm for the detections.
-//   params: max_reprojection_px 4, prefer (detections | tracks: detections)
 //   inputs: left, right (vision.track, required), selection (vision.selection, required)
 //   outputs: target (vision.target)
 #include <array>
@@ -81,7 +72,7 @@ class ImageFilterComponent : public runtime::Component {
 
 class UndistortComponent : public ImageFilterComponent {
  public:
-  void Configure(const nlohmann::json& params) override;
+  UndistortComponent();
 
  protected:
   Image Apply(const Image& image) override;
@@ -95,33 +86,42 @@ class UndistortComponent : public ImageFilterComponent {
 
 class MedianComponent : public ImageFilterComponent {
  public:
-  void Configure(const nlohmann::json& params) override;
+  MedianComponent();
 
  protected:
+  void Configured() override;
   Image Apply(const Image& image) override { return filter_.Apply(image); }
 
  private:
+  vision::MedianFilter::Options options_;
   vision::MedianFilter filter_;
 };
 
 class SharpenComponent : public ImageFilterComponent {
  public:
-  void Configure(const nlohmann::json& params) override;
+  SharpenComponent();
 
  protected:
+  void Configured() override;
   Image Apply(const Image& image) override { return filter_.Apply(image); }
 
  private:
+  vision::Sharpener::Options options_;
   vision::Sharpener filter_;
 };
 
 class FaceDetectorComponent : public runtime::Component {
  public:
   FaceDetectorComponent();
-  void Configure(const nlohmann::json& params) override;
   void Step(const runtime::StepContext& context) override;
 
+ protected:
+  void Configured() override;
+
  private:
+  vision::FaceDetector::Options options_;
+  bool reject_cats_ = true;
+  bool require_eyes_ = true;
   runtime::Input<runtime::ImageMessage>& image_;
   runtime::Output<FacesMessage>& faces_;
   std::unique_ptr<vision::FaceDetector> detector_;
@@ -130,10 +130,13 @@ class FaceDetectorComponent : public runtime::Component {
 class StereoFacesComponent : public runtime::Component {
  public:
   StereoFacesComponent();
-  void Configure(const nlohmann::json& params) override;
   void Step(const runtime::StepContext& context) override;
 
+ protected:
+  void Configured() override;
+
  private:
+  vision::StereoAssociator::Options options_;
   runtime::Input<FacesMessage>& left_;
   runtime::Input<FacesMessage>& right_;
   runtime::Output<CandidatesMessage>& candidates_;
@@ -143,10 +146,13 @@ class StereoFacesComponent : public runtime::Component {
 class AttentionComponent : public runtime::Component {
  public:
   AttentionComponent();
-  void Configure(const nlohmann::json& params) override;
   void Step(const runtime::StepContext& context) override;
 
+ protected:
+  void Configured() override;
+
  private:
+  std::string scene_param_;
   runtime::Input<CandidatesMessage>& candidates_;
   runtime::Input<JointStateMessage>& joints_;
   runtime::Output<SelectionMessage>& selection_;
@@ -166,10 +172,13 @@ class AttentionComponent : public runtime::Component {
 class CamShiftComponent : public runtime::Component {
  public:
   CamShiftComponent();
-  void Configure(const nlohmann::json& params) override;
   void Step(const runtime::StepContext& context) override;
 
+ protected:
+  void Configured() override;
+
  private:
+  std::string eye_;
   runtime::Input<runtime::ImageMessage>& image_;
   runtime::Input<SelectionMessage>& selection_;
   runtime::Output<TrackMessage>& track_;
@@ -183,10 +192,13 @@ class CamShiftComponent : public runtime::Component {
 class TriangulateComponent : public runtime::Component {
  public:
   TriangulateComponent();
-  void Configure(const nlohmann::json& params) override;
   void Step(const runtime::StepContext& context) override;
 
+ protected:
+  void Configured() override;
+
  private:
+  std::string prefer_ = "detections";
   runtime::Input<TrackMessage>& left_;
   runtime::Input<TrackMessage>& right_;
   runtime::Input<SelectionMessage>& selection_;

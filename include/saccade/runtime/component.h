@@ -2,8 +2,10 @@
 // Components: the units a pipeline runs in order, with a lifecycle and typed ports.
 //
 // Lifecycle, driven by the pipeline and the scheduler:
-//   constructor (declare fixed ports) -> Configure(params) (may declare more ports)
-//   -> Start() -> Step(context) once per tick, in pipeline order -> Stop().
+//   constructor (declare fixed ports and the parameters) -> Configure(params) (may declare
+//   more ports) -> Start() -> Step(context) once per tick, in pipeline order -> Stop().
+// Parameters are declared once with DeclareParam (params.h); the default Configure applies
+// the pipeline file's `params` to them, then calls Configured() for what follows from them.
 // Stop() is called on every component whose Start() returned, also after an error.
 //
 // Ports are declared with AddInput<T> / AddOutput<T> (port.h); methods (seed section 5.4:
@@ -20,6 +22,7 @@
 
 #include "saccade/runtime/bus.h"
 #include "saccade/runtime/message.h"
+#include "saccade/runtime/params.h"
 #include "saccade/runtime/port.h"
 #include "saccade/runtime/resources.h"
 
@@ -92,9 +95,12 @@ class Component {
   /// This component's seed (see StepContext::seed); set before Configure.
   uint64_t seed() const { return seed_; }
 
-  /// Reads the parameters (the pipeline file's `params`, {} when absent). Throws
-  /// saccade::Error naming the parameter on bad values; the loader adds file and line.
-  virtual void Configure(const nlohmann::json& params) { (void)params; }
+  /// Reads the parameters (the pipeline file's `params`, null when absent). Throws
+  /// saccade::Error naming the parameter on bad values; the loader adds file and line. The
+  /// default applies `params` to the declared parameters, then calls Configured().
+  virtual void Configure(const nlohmann::json& params);
+  /// The declared parameters (params.h).
+  const ParamTable& param_table() const { return params_; }
   /// Acquires resources; called once before the first Step.
   virtual void Start() {}
   /// One tick. May throw: the scheduler reports the component, the step and the message.
@@ -143,6 +149,16 @@ class Component {
   std::string ResolvePath(const std::string& path) const;
 
  protected:
+  /// Declares the parameter `name`, which sets `*member` (see params.h); the member's current
+  /// value is its default. Call it from the constructor.
+  template <typename T>
+  ParamDecl DeclareParam(const std::string& name, T* member, std::string doc) {
+    return params_.Declare(name, member, std::move(doc));
+  }
+  /// Called by the default Configure once the declared members are set: check combinations,
+  /// load resources, declare ports that depend on the parameters. Throws like Configure.
+  virtual void Configured() {}
+
   /// Declares an output. Throws InvalidArgument when the name is taken or not an identifier.
   template <Message T>
   Output<T>& AddOutput(const std::string& name) {
@@ -184,6 +200,7 @@ class Component {
   std::string base_dir_;
   std::shared_ptr<Resources> resources_;
   bool enabled_ = true;
+  ParamTable params_;
   std::vector<std::unique_ptr<InputBase>> inputs_;
   std::vector<std::unique_ptr<OutputBase>> outputs_;
   std::vector<std::unique_ptr<MethodBase>> methods_;

@@ -3,13 +3,19 @@
 // the browser link and a later distributed transport. In one process messages are never
 // serialised; JSON is only for crossing a process boundary.
 //
-// A module makes its type a message by specialising MessageTraits:
+// A module makes its type a message by specialising MessageTraits with its name and its
+// fields, each listed once; the JSON form follows (core/json_codec.h gives the codec of each
+// field's type):
 //
-//   template <> struct saccade::runtime::MessageTraits<my::Target> {
+//   template <> struct saccade::runtime::MessageTraits<my::Target>
+//       : saccade::runtime::FieldMessage<my::Target> {
 //     static constexpr const char* kName = "vision.target";
-//     static nlohmann::json ToJson(const my::Target& m);
-//     static my::Target FromJson(const nlohmann::json& j);  // throws saccade::Error
+//     static constexpr auto kFields = std::make_tuple(
+//         JsonField("time", &my::Target::time), JsonField("p_W", &my::Target::p_W));
 //   };
+//
+// (A type with a form of its own gives static ToJson and FromJson instead; FromJson throws
+// saccade::Error naming the message type and the field.)
 //
 // and, to let type-erased code (the server) find it by name, registers it once:
 // MessageRegistry::Global().Register<my::Target>().
@@ -22,10 +28,12 @@
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "saccade/core/error.h"
 #include "saccade/core/image.h"
+#include "saccade/core/json_codec.h"
 
 namespace saccade::runtime {
 
@@ -46,6 +54,16 @@ template <Message T>
 const char* MessageName() {
   return MessageTraits<T>::kName;
 }
+
+/// ToJson and FromJson of a message that lists its fields as MessageTraits<M>::kFields (the
+/// file comment). Every field is required in FromJson, except images (metadata only).
+template <typename M>
+struct FieldMessage {
+  static nlohmann::json ToJson(const M& m) { return EncodeFields(m, MessageTraits<M>::kFields); }
+  static M FromJson(const nlohmann::json& j) {
+    return DecodeFields<M>(j, MessageTraits<M>::kName, MessageTraits<M>::kFields);
+  }
+};
 
 /// Type-erased JSON conversion of one message type, as the registry holds it.
 struct MessageType {
@@ -128,30 +146,17 @@ struct ImageMessage {
 /// Largest width or height FromJson accepts for an ImageMessage (guards the allocation).
 inline constexpr int kMaxJsonImageSide = 16384;
 
-/// Reads a required field of a JSON object, naming the message type and field on error.
-/// Throws saccade::Error ("<type>: field '<key>': expected <what>").
-const nlohmann::json& JsonField(const nlohmann::json& json, const char* type, const char* key);
-/// A required field of the given kind; throws saccade::Error as JsonField, naming what was got.
-double JsonNumber(const nlohmann::json& json, const char* type, const char* key);
-int64_t JsonInteger(const nlohmann::json& json, const char* type, const char* key);
-bool JsonBool(const nlohmann::json& json, const char* type, const char* key);
-std::string JsonString(const nlohmann::json& json, const char* type, const char* key);
-/// A required array of exactly `n` numbers.
-std::vector<double> JsonNumbers(const nlohmann::json& json, const char* type, const char* key,
-                                std::size_t n);
-
 template <>
-struct MessageTraits<Tick> {
+struct MessageTraits<Tick> : FieldMessage<Tick> {
   static constexpr const char* kName = "runtime.tick";
-  static nlohmann::json ToJson(const Tick& m);
-  static Tick FromJson(const nlohmann::json& j);
+  static constexpr auto kFields =
+      std::make_tuple(JsonField("step", &Tick::step), JsonField("time", &Tick::time));
 };
 
 template <>
-struct MessageTraits<Value> {
+struct MessageTraits<Value> : FieldMessage<Value> {
   static constexpr const char* kName = "runtime.value";
-  static nlohmann::json ToJson(const Value& m);
-  static Value FromJson(const nlohmann::json& j);
+  static constexpr auto kFields = std::make_tuple(JsonField("value", &Value::value));
 };
 
 template <>
@@ -162,10 +167,9 @@ struct MessageTraits<Empty> {
 };
 
 template <>
-struct MessageTraits<Text> {
+struct MessageTraits<Text> : FieldMessage<Text> {
   static constexpr const char* kName = "runtime.text";
-  static nlohmann::json ToJson(const Text& m);
-  static Text FromJson(const nlohmann::json& j);
+  static constexpr auto kFields = std::make_tuple(JsonField("text", &Text::text));
 };
 
 template <>
