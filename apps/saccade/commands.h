@@ -31,7 +31,8 @@ inline constexpr double kRadToDeg = 180.0 / M_PI;
 inline constexpr double kDegToRad = M_PI / 180.0;
 
 /// A file shipped with saccade (robots/popeye.yaml, scenes/...): from the working directory if
-/// it is there, else from the source tree saccade was built from.
+/// it is there, else from the source tree saccade was built from, else from the installed
+/// data (share/saccade).
 std::string ShippedFile(const std::string& relative);
 
 /// {"position": [...], "rotation": [[...]x3], "quaternion_wxyz": [...]}: a pose for people

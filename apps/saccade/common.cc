@@ -7,8 +7,13 @@ namespace saccade::app {
 using nlohmann::json;
 
 std::string ShippedFile(const std::string& relative) {
-  if (std::filesystem::exists(relative)) return relative;
-  return (std::filesystem::path(SACCADE_SOURCE_DIR) / relative).string();
+  namespace fs = std::filesystem;
+  if (fs::exists(relative)) return relative;
+  // The source tree it was built from; else where `cmake --install` put the data.
+  const fs::path source = fs::path(SACCADE_SOURCE_DIR) / relative;
+  const fs::path installed = fs::path(SACCADE_DATA_DIR) / relative;
+  if (!fs::exists(source) && fs::exists(installed)) return installed.string();
+  return source.string();
 }
 
 json PoseJson(const geometry::Pose& X) {

@@ -43,7 +43,6 @@ json MatrixJson(const geometry::Pose& X) {
 json Vec(const Eigen::Vector3f& v) { return {v.x(), v.y(), v.z()}; }
 json Vec(const Eigen::Vector4f& v) { return {v.x(), v.y(), v.z(), v.w()}; }
 
-
 const char* LinkName(scene::RobotPart::Link link) {
   switch (link) {
     case scene::RobotPart::Link::kBase:
@@ -431,8 +430,7 @@ json GuiSession::Handle(const json& command, int64_t client) {
                                        p_W.x(), p_W.y(), p_W.z(), solution.message));
       }
       target = solution.joints;
-      reply = {{"targets", ToJson(target)},
-               {"axis_error_deg", solution.axis_error * kRadToDeg}};
+      reply = {{"targets", ToJson(target)}, {"axis_error_deg", solution.axis_error * kRadToDeg}};
     }
     {
       std::lock_guard lock(joints_mutex_);

@@ -24,8 +24,8 @@ using saccade::head::HeadDescription;
 using saccade::head::JointState;
 
 json JointsDegJson(const JointState& q) {
-  return ToJson(JointState{q.pan * kRadToDeg, q.tilt * kRadToDeg, q.left * kRadToDeg,
-                           q.right * kRadToDeg});
+  return ToJson(
+      JointState{q.pan * kRadToDeg, q.tilt * kRadToDeg, q.left * kRadToDeg, q.right * kRadToDeg});
 }
 
 std::string FormatVector(const Eigen::Vector3d& v) {
@@ -66,7 +66,8 @@ int RunFk(const std::string& head_path, const std::vector<double>& joint_values,
                 {"within_limits", within},
                 {"cameras",
                  {{"left", PoseJson(frames.X_WCamLeft)}, {"right", PoseJson(frames.X_WCamRight)}}},
-                {"fixation", frames.p_WFixation ? ToJson<Eigen::Vector3d>(*frames.p_WFixation) : json(nullptr)}};
+                {"fixation", frames.p_WFixation ? ToJson<Eigen::Vector3d>(*frames.p_WFixation)
+                                                : json(nullptr)}};
     std::cout << out.dump(2) << "\n";
     return 0;
   }

@@ -21,10 +21,10 @@
 
 #include "commands.h"
 #include "saccade/core/error.h"
-#include "saccade/geometry/json.h"
-#include "saccade/head/json.h"
 #include "saccade/core/image_io.h"
 #include "saccade/geometry/calibration_io.h"
+#include "saccade/geometry/json.h"
+#include "saccade/head/json.h"
 #include "saccade/render/renderer.h"
 #include "saccade/scene/scene.h"
 
@@ -243,7 +243,8 @@ json FrameJson(int64_t index, double time, const std::vector<render::Frame>& fra
                   {"distortion", {{"model", m.distortion_model}, {"coefficients", m.distortion}}},
                   {"X_WC", MatrixJson(m.X_WC.data(), 4, 4)}};
     if (m.has_joints) {
-      entry["joints"] = ToJson(head::JointState{m.joints[0], m.joints[1], m.joints[2], m.joints[3]});
+      entry["joints"] =
+          ToJson(head::JointState{m.joints[0], m.joints[1], m.joints[2], m.joints[3]});
     }
     if (truth.depth) entry["depth"] = DepthFile(m.camera, index);
     if (truth.ids) entry["ids"] = IdsFile(m.camera, index);
