@@ -23,14 +23,14 @@
 #include <vector>
 
 #include "commands.h"
-#include "gui_session.h"
-#include "overlay.h"
 #include "saccade/components/face_truth.h"
 #include "saccade/components/messages.h"
 #include "saccade/components/register.h"
 #include "saccade/components/roles.h"
 #include "saccade/core/error.h"
 #include "saccade/core/streaming_stats.h"
+#include "saccade/gui/overlay.h"
+#include "saccade/gui/session.h"
 #include "saccade/runtime/component_reference.h"
 #include "saccade/runtime/pipeline.h"
 #include "saccade/runtime/scheduler.h"
@@ -49,6 +49,11 @@ using components::PictureFace;
 using components::SelectionMessage;
 using components::TargetMessage;
 using components::TrackMessage;
+using gui::Annotate;
+using gui::GuiOptions;
+using gui::GuiSession;
+using gui::Latest;
+using gui::Tap;
 using nlohmann::json;
 
 std::atomic<bool> g_stop{false};
@@ -309,6 +314,7 @@ int RunDemo(Options o) {
 
   std::unique_ptr<GuiSession> gui;
   if (o.gui) {
+    o.gui_options.web_dir = ShippedFile("web");
     gui = std::make_unique<GuiSession>(
         pipeline, scene, o.scene.empty() ? fs::path(o.pipeline).filename().string() : o.scene,
         o.gui_options);

@@ -13,7 +13,7 @@
 #include "saccade/core/image.h"
 #include "saccade/runtime/pipeline.h"
 
-namespace saccade::app {
+namespace saccade::gui {
 
 using components::FacesMessage;
 using components::JointStateMessage;
@@ -48,4 +48,4 @@ void Tap(runtime::Pipeline& pipeline, Slot slot) {
 /// scaled by `scale` (0.5: half size). Black when the eye has no image yet.
 cv::Mat Annotate(const Latest& latest, const std::string& camera, double scale);
 
-}  // namespace saccade::app
+}  // namespace saccade::gui

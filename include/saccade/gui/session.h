@@ -21,14 +21,14 @@
 #include <thread>
 #include <vector>
 
-#include "overlay.h"
 #include "saccade/components/roles.h"
+#include "saccade/gui/overlay.h"
 #include "saccade/render/renderer.h"
 #include "saccade/runtime/pipeline.h"
 #include "saccade/scene/scene.h"
 #include "saccade/server/gui_server.h"
 
-namespace saccade::app {
+namespace saccade::gui {
 
 struct GuiOptions {
   std::string listen = "127.0.0.1";
@@ -41,6 +41,8 @@ struct GuiOptions {
   bool paused = false;
   double speed = 1.0;  ///< simulated seconds per wall second at most
   int jpeg_quality = 80;
+  /// The page's folder: public/ (index.html, app/) and node_modules/three.
+  std::string web_dir = "web";
 };
 
 class GuiSession {
@@ -116,4 +118,4 @@ class GuiSession {
   std::vector<double> encode_walls_;  // encoder thread (encode_mutex_)
 };
 
-}  // namespace saccade::app
+}  // namespace saccade::gui

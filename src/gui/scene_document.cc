@@ -1,0 +1,214 @@
+#include <fmt/format.h>
+
+#include <map>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <string>
+
+#include "gui/internal_scene_document.h"
+#include "saccade/core/error.h"
+#include "saccade/geometry/json.h"
+#include "saccade/head/json.h"
+
+namespace saccade::gui::internal {
+namespace {
+
+using nlohmann::json;
+
+json Vec(const Eigen::Vector3f& v) { return {v.x(), v.y(), v.z()}; }
+json Vec(const Eigen::Vector4f& v) { return {v.x(), v.y(), v.z(), v.w()}; }
+
+const char* LinkName(scene::RobotPart::Link link) {
+  switch (link) {
+    case scene::RobotPart::Link::kBase:
+      return "base";
+    case scene::RobotPart::Link::kNeck:
+      return "neck";
+    case scene::RobotPart::Link::kCyclopean:
+      return "cyclopean";
+    case scene::RobotPart::Link::kLeftEye:
+      return "left_eye";
+    case scene::RobotPart::Link::kRightEye:
+      return "right_eye";
+  }
+  return "base";
+}
+
+/// A texture as PNG bytes.
+std::string EncodePng(const Image& image) {
+  cv::Mat bgr;
+  uint8_t* data = const_cast<uint8_t*>(image.data());
+  if (image.format() == PixelFormat::kRgb8) {
+    cv::cvtColor(cv::Mat(image.height(), image.width(), CV_8UC3, data), bgr, cv::COLOR_RGB2BGR);
+  } else if (image.format() == PixelFormat::kRgba8) {
+    cv::cvtColor(cv::Mat(image.height(), image.width(), CV_8UC4, data), bgr, cv::COLOR_RGBA2BGRA);
+  } else if (image.format() == PixelFormat::kGray8) {
+    bgr = cv::Mat(image.height(), image.width(), CV_8UC1, data).clone();
+  } else {
+    throw Error(std::string("gui: cannot send a texture of format ") + ToString(image.format()));
+  }
+  std::vector<uint8_t> png;
+  cv::imencode(".png", bgr, png);
+  return std::string(png.begin(), png.end());
+}
+
+template <typename T>
+void Append(std::string& out, const T* data, std::size_t count) {
+  out.append(reinterpret_cast<const char*>(data), count * sizeof(T));
+}
+
+/// The meshes of a model, as /api/models/N.bin (docs/gui-protocol.md).
+std::string ModelBinary(const scene::Model& model) {
+  std::string out;
+  for (const scene::Mesh& mesh : model.meshes) {
+    for (const Eigen::Vector3f& p : mesh.positions) Append(out, p.data(), 3);
+    for (const Eigen::Vector3f& n : mesh.normals) Append(out, n.data(), 3);
+    for (const Eigen::Vector2f& uv : mesh.uvs) Append(out, uv.data(), 2);
+    Append(out, mesh.indices.data(), mesh.indices.size());
+  }
+  return out;
+}
+
+}  // namespace
+
+/// A pose as 16 numbers, row-major (docs/gui-protocol.md).
+json MatrixJson(const geometry::Pose& X) {
+  json m = json::array();
+  for (int r = 0; r < 4; ++r) {
+    for (int c = 0; c < 4; ++c) m.push_back(X.matrix()(r, c));
+  }
+  return m;
+}
+
+json PublishScene(const scene::Scene& scene, const std::string& scene_name, const std::string& mode,
+                  const json& commands, server::GuiServer& server) {
+  // The scene: models and textures once, as the renderer has them.
+  std::map<const scene::Model*, int> model_index;
+  std::map<const scene::Texture*, int> texture_index;
+  json models = json::array();
+  const auto add_model = [&](const std::shared_ptr<const scene::Model>& model) {
+    if (!model) return -1;
+    if (const auto it = model_index.find(model.get()); it != model_index.end()) return it->second;
+    const int index = static_cast<int>(models.size());
+    model_index[model.get()] = index;
+    json materials = json::array();
+    for (const scene::Material& m : model->materials) {
+      json texture = nullptr;
+      if (m.texture) {
+        auto [it, added] =
+            texture_index.emplace(m.texture.get(), static_cast<int>(texture_index.size()));
+        if (added) {
+          server.SetDocument(fmt::format("/api/textures/{}.png", it->second), "image/png",
+                             EncodePng(m.texture->image));
+        }
+        texture = fmt::format("/api/textures/{}.png", it->second);
+      }
+      materials.push_back({{"base_color", Vec(m.base_color)},
+                           {"texture", texture},
+                           {"specular", m.specular},
+                           {"shininess", m.shininess}});
+    }
+    json meshes = json::array();
+    for (const scene::Mesh& mesh : model->meshes) {
+      meshes.push_back({{"vertices", mesh.positions.size()},
+                        {"indices", mesh.indices.size()},
+                        {"uvs", !mesh.uvs.empty()},
+                        {"material", mesh.material}});
+    }
+    const std::string url = fmt::format("/api/models/{}.bin", index);
+    server.SetDocument(url, "application/octet-stream", ModelBinary(*model));
+    models.push_back(
+        {{"source", model->source},
+         {"url", url},
+         {"bounds",
+          {Vec(Eigen::Vector3f(model->bounds.min())), Vec(Eigen::Vector3f(model->bounds.max()))}},
+         {"materials", materials},
+         {"meshes", meshes}});
+    return index;
+  };
+  json objects = json::array();
+  for (const scene::Object& o : scene.objects()) {
+    objects.push_back({{"name", o.name},
+                       {"id", o.id},
+                       {"model", add_model(o.model)},
+                       {"scale", ToJson(o.scale)},
+                       {"X_WO", MatrixJson(o.motion.PoseAt(0.0))},
+                       {"moving", !o.motion.IsStatic()}});
+  }
+  json robot = nullptr;
+  json joints = json::array();
+  if (scene.robot()) {
+    json parts = json::array();
+    for (const scene::RobotPart& p : scene.robot()->parts) {
+      parts.push_back({{"link", LinkName(p.link)},
+                       {"model", add_model(p.model)},
+                       {"X_LinkPart", MatrixJson(p.X_LinkPart)},
+                       {"scale", ToJson(p.scale)}});
+    }
+    robot = {{"visible", scene.robot()->visible}, {"parts", parts}};
+    for (head::Joint j : head::kAllJoints) {
+      const head::JointLimits& l = scene.robot()->head.limits(j);
+      joints.push_back({{"name", head::JointName(j)},
+                        {"min", l.min},
+                        {"max", l.max},
+                        {"max_velocity", l.max_velocity}});
+    }
+  }
+  json lights = json::array();
+  for (const scene::Light& l : scene.lights()) {
+    const char* type = l.type == scene::Light::Type::kAmbient       ? "ambient"
+                       : l.type == scene::Light::Type::kDirectional ? "directional"
+                                                                    : "point";
+    lights.push_back({{"type", type},
+                      {"color", Vec(l.color)},
+                      {"intensity", l.intensity},
+                      {"direction", ToJson(l.direction_W)},
+                      {"position", ToJson(l.position_W)},
+                      {"attenuation", l.attenuation}});
+  }
+  const scene::Ground& g = scene.ground();
+  const char* pattern = g.pattern == scene::Ground::Pattern::kPlain  ? "plain"
+                        : g.pattern == scene::Ground::Pattern::kGrid ? "grid"
+                                                                     : "checker";
+  json cameras = json::array();
+  for (const scene::CameraSpec& c : scene.cameras()) {
+    const geometry::Intrinsics& k = c.model.intrinsics();
+    const char* eye = c.mount == scene::CameraMount::kLeftEye    ? "left"
+                      : c.mount == scene::CameraMount::kRightEye ? "right"
+                                                                 : "world";
+    cameras.push_back(
+        {{"name", c.name},
+         {"eye", eye},
+         {"width", k.width()},
+         {"height", k.height()},
+         {"K", {k.fx(), k.skew(), k.cx(), 0.0, k.fy(), k.cy(), 0.0, 0.0, 1.0}},
+         {"model", c.model.distortion().model() == geometry::DistortionModel::kFisheye ? "fisheye"
+                                                                                       : "radtan"},
+         {"X_WC", MatrixJson(c.X_WC)},
+         {"near", c.clip.near},
+         {"far", c.clip.far}});
+  }
+  return {{"protocol", server::kProtocolName},
+          {"version", server::kProtocolVersion},
+          {"mode", mode},
+          {"name", scene_name},
+          {"time", 0.0},
+          {"background", Vec(scene.background())},
+          {"ground",
+           {{"enabled", g.enabled},
+            {"size", g.size},
+            {"pattern", pattern},
+            {"cell", g.cell},
+            {"line_width", g.line_width},
+            {"color", Vec(g.color)},
+            {"color2", Vec(g.color2)}}},
+          {"lights", lights},
+          {"models", models},
+          {"objects", objects},
+          {"robot", robot},
+          {"head", {{"joints", joints}}},
+          {"cameras", cameras},
+          {"commands", commands}};
+}
+
+}  // namespace saccade::gui::internal
