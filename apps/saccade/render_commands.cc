@@ -22,9 +22,9 @@
 #include "commands.h"
 #include "saccade/core/error.h"
 #include "saccade/core/image_io.h"
-#include "saccade/geometry/calibration_io.h"
 #include "saccade/geometry/json.h"
 #include "saccade/head/json.h"
+#include "saccade/render/dataset.h"
 #include "saccade/render/renderer.h"
 #include "saccade/scene/scene.h"
 
@@ -58,310 +58,6 @@ class ProgressBar {
   bool enabled_;
 };
 
-json MatrixJson(const double* m, int rows, int cols) {
-  json out = json::array();
-  for (int r = 0; r < rows; ++r) {
-    json row = json::array();
-    for (int c = 0; c < cols; ++c) row.push_back(m[r * cols + c]);
-    out.push_back(row);
-  }
-  return out;
-}
-
-json MatrixJson(const Eigen::Matrix4d& m) {
-  json out = json::array();
-  for (int r = 0; r < 4; ++r) out.push_back({m(r, 0), m(r, 1), m(r, 2), m(r, 3)});
-  return out;
-}
-
-// --- ground truth ------------------------------------------------------------------------
-
-/// What `render --truth` asked for.
-struct TruthRequest {
-  bool depth = false;
-  bool ids = false;
-  bool boxes = false;
-  bool Any() const { return depth || ids || boxes; }
-};
-
-constexpr const char* kTruthItems = "depth, ids, boxes";
-// 16-bit PNGs: depth in millimetres up to 65.535 m, ids up to 65535.
-constexpr uint16_t kMaxPng16 = 65535;
-constexpr double kMillimetresPerMetre = 1000.0;
-
-/// "depth,ids,boxes" (any subset, any order) to a request. Throws InvalidArgument naming the
-/// bad item and the valid ones.
-TruthRequest ParseTruth(const std::string& list) {
-  TruthRequest truth;
-  std::size_t begin = 0;
-  while (begin <= list.size()) {
-    const std::size_t end = std::min(list.find(',', begin), list.size());
-    const std::string item = list.substr(begin, end - begin);
-    if (item == "depth") {
-      truth.depth = true;
-    } else if (item == "ids") {
-      truth.ids = true;
-    } else if (item == "boxes") {
-      truth.boxes = true;
-    } else {
-      throw InvalidArgument(
-          item.empty()
-              ? fmt::format("render: --truth '{}': an empty item; expected a comma-separated list "
-                            "of {}",
-                            list, kTruthItems)
-              : fmt::format("render: --truth: unknown item '{}'; expected a comma-separated list "
-                            "of {}",
-                            item, kTruthItems));
-    }
-    begin = end + 1;
-  }
-  return truth;
-}
-
-/// The 16-bit id images hold ids up to 65535: refuses a scene with a larger id that the
-/// images could show, naming it, before anything is rendered.
-void CheckIdsFitPng16(const scene::Scene& scene, const render::RendererOptions& options) {
-  const auto refuse = [](const std::string& owner, uint32_t id) {
-    throw InvalidArgument(
-        fmt::format("render: --truth ids: {} has instance id {}, and the id images are 16-bit PNGs "
-                    "(ids up to {}); give it a smaller id in the scene",
-                    owner, id, kMaxPng16));
-  };
-  for (const scene::Object& object : scene.objects()) {
-    if (object.id > kMaxPng16) refuse("object '" + object.name + "'", object.id);
-  }
-  const auto& robot = scene.robot();
-  if (robot && robot->visible && options.draw_robot && robot->id > kMaxPng16) {
-    refuse("the robot", robot->id);
-  }
-}
-
-/// A truth image of a frame, checked against what was asked for: a missing or malformed one
-/// is the renderer's fault (saccade::Error), not the user's.
-const Image& TruthImage(const std::shared_ptr<const Image>& image, const render::Frame& frame,
-                        const char* what, PixelFormat format) {
-  const std::string& camera = frame.color->metadata().camera;
-  if (image == nullptr) {
-    throw Error(fmt::format(
-        "render: internal error: the renderer returned no {} image for camera {} although "
-        "--truth asked for one",
-        what, camera));
-  }
-  if (image->format() != format || image->width() != frame.color->width() ||
-      image->height() != frame.color->height()) {
-    throw Error(
-        fmt::format("render: internal error: camera {}'s {} image is {} {}x{}, expected {} {}x{}",
-                    camera, what, ToString(image->format()), image->width(), image->height(),
-                    ToString(format), frame.color->width(), frame.color->height()));
-  }
-  return *image;
-}
-
-/// kFloat32 depth (metres) to kGray16 millimetres, rounded to nearest: 0 where there is no
-/// surface, at least 1 where there is one, 65535 for 65.535 m and beyond.
-Image DepthToMillimetres(const Image& depth) {
-  Image out(depth.width(), depth.height(), PixelFormat::kGray16);
-  for (int y = 0; y < depth.height(); ++y) {
-    const uint8_t* in = depth.row(y);
-    auto* row = reinterpret_cast<uint16_t*>(out.row(y));
-    for (int x = 0; x < depth.width(); ++x) {
-      float z = 0.0f;
-      std::memcpy(&z, in + 4 * static_cast<std::size_t>(x), sizeof z);
-      const double mm = std::round(static_cast<double>(z) * kMillimetresPerMetre);
-      if (!(z > 0.0f)) {
-        row[x] = 0;  // no surface (or not a number)
-      } else if (mm >= kMaxPng16) {
-        row[x] = kMaxPng16;
-      } else {
-        row[x] = std::max<uint16_t>(1, static_cast<uint16_t>(mm));  // 0 means no surface
-      }
-    }
-  }
-  return out;
-}
-
-/// kUint32 ids to kGray16. The scene's ids were checked to fit (CheckIdsFitPng16); a larger
-/// one here is the renderer's fault.
-Image IdsToPng16(const Image& ids, const std::string& camera) {
-  Image out(ids.width(), ids.height(), PixelFormat::kGray16);
-  uint32_t largest = 0;
-  for (int y = 0; y < ids.height(); ++y) {
-    const uint8_t* in = ids.row(y);
-    auto* row = reinterpret_cast<uint16_t*>(out.row(y));
-    for (int x = 0; x < ids.width(); ++x) {
-      uint32_t id = 0;
-      std::memcpy(&id, in + 4 * static_cast<std::size_t>(x), sizeof id);
-      largest = std::max(largest, id);
-      row[x] = static_cast<uint16_t>(id);
-    }
-  }
-  if (largest > kMaxPng16) {
-    throw Error(fmt::format("render: internal error: camera {}'s id image holds id {} (> {})",
-                            camera, largest, kMaxPng16));
-  }
-  return out;
-}
-
-/// The objects seen in a frame (pixels > 0): id, name, 2D box, pixels and pose.
-json ObjectsJson(const render::Frame& frame, bool scene_has_objects) {
-  if (frame.objects.empty() && scene_has_objects) {
-    throw Error(fmt::format(
-        "render: internal error: the renderer returned no object truth for camera {} although "
-        "--truth boxes asked for it",
-        frame.color->metadata().camera));
-  }
-  json objects = json::array();
-  for (const render::ObjectTruth& o : frame.objects) {
-    if (o.pixels <= 0) continue;
-    objects.push_back({{"id", o.id},
-                       {"name", o.name},
-                       {"box", {o.x_min, o.y_min, o.x_max, o.y_max}},
-                       {"pixels", o.pixels},
-                       {"X_CO", MatrixJson(o.X_CO)},
-                       {"X_WO", MatrixJson(o.X_WO)}});
-  }
-  return objects;
-}
-
-std::string DepthFile(const std::string& camera, int64_t index) {
-  return fmt::format("{}/depth/{:06d}.png", camera, index);
-}
-std::string IdsFile(const std::string& camera, int64_t index) {
-  return fmt::format("{}/ids/{:06d}.png", camera, index);
-}
-
-/// One line of frames.jsonl: a frame index, its time and every camera's image and metadata.
-json FrameJson(int64_t index, double time, const std::vector<render::Frame>& frames,
-               const TruthRequest& truth, bool scene_has_objects) {
-  json cameras = json::object();
-  for (const auto& frame : frames) {
-    const ImageMetadata& m = frame.color->metadata();
-    json entry = {{"file", fmt::format("{}/{:06d}.png", m.camera, index)},
-                  {"width", frame.color->width()},
-                  {"height", frame.color->height()},
-                  {"K", MatrixJson(m.K.data(), 3, 3)},
-                  {"distortion", {{"model", m.distortion_model}, {"coefficients", m.distortion}}},
-                  {"X_WC", MatrixJson(m.X_WC.data(), 4, 4)}};
-    if (m.has_joints) {
-      entry["joints"] =
-          ToJson(head::JointState{m.joints[0], m.joints[1], m.joints[2], m.joints[3]});
-    }
-    if (truth.depth) entry["depth"] = DepthFile(m.camera, index);
-    if (truth.ids) entry["ids"] = IdsFile(m.camera, index);
-    if (truth.boxes) entry["objects"] = ObjectsJson(frame, scene_has_objects);
-    cameras[m.camera] = entry;
-  }
-  return {{"frame", index}, {"time", time}, {"cameras", cameras}};
-}
-
-/// The output folder: created if missing; one that already holds saccade output is refused
-/// unless `force`, in which case the old output of these cameras is removed first.
-void PrepareOutput(const fs::path& out, const std::vector<std::string>& cameras,
-                   const TruthRequest& truth, bool force) {
-  std::error_code error;
-  if (fs::exists(out) && !fs::is_directory(out)) {
-    throw InvalidArgument(
-        fmt::format("render: --out {}: exists and is not a folder", out.string()));
-  }
-  std::vector<fs::path> existing;
-  if (fs::exists(out / "frames.jsonl")) existing.push_back(out / "frames.jsonl");
-  for (const auto& camera : cameras) {
-    if (fs::exists(out / camera)) existing.push_back(out / camera);
-    if (fs::exists(out / (camera + ".yaml"))) existing.push_back(out / (camera + ".yaml"));
-  }
-  if (fs::exists(out / "stereo.yaml")) existing.push_back(out / "stereo.yaml");
-  if (!existing.empty() && !force) {
-    throw InvalidArgument(
-        fmt::format("render: --out {} already holds output ({}); pass --force to replace it",
-                    out.string(), existing.front().filename().string()));
-  }
-  // Only our own frames: a camera folder holding anything else keeps it.
-  const auto remove_frames = [](const fs::path& folder) {
-    if (!fs::is_directory(folder)) return;
-    for (const auto& entry : fs::directory_iterator(folder)) {
-      if (entry.path().extension() == ".png") fs::remove(entry.path());
-    }
-  };
-  for (const auto& path : existing) {
-    if (fs::is_directory(path)) {
-      remove_frames(path);
-      for (const char* truth_folder : {"depth", "ids"}) {
-        remove_frames(path / truth_folder);
-        std::error_code ignored;
-        fs::remove(path / truth_folder, ignored);  // only when left empty
-      }
-    } else {
-      fs::remove(path);
-    }
-  }
-  fs::create_directories(out, error);
-  if (error) {
-    throw FileError(out.string(), 0, "",
-                    fmt::format("cannot create the folder: {}", error.message()));
-  }
-  for (const auto& camera : cameras) {
-    fs::create_directories(out / camera);
-    if (truth.depth) fs::create_directories(out / camera / "depth");
-    if (truth.ids) fs::create_directories(out / camera / "ids");
-  }
-}
-
-/// The camera model a frame was rendered with: the camera's K and the distortion its metadata
-/// says was rendered ("none" when RendererOptions::distortion was off or the lens has none).
-geometry::CameraModel RenderedModel(const scene::CameraSpec& camera, const ImageMetadata& m) {
-  geometry::DistortionModel model = geometry::DistortionModel::kNone;
-  if (m.distortion_model == geometry::ToString(geometry::DistortionModel::kRadialTangential)) {
-    model = geometry::DistortionModel::kRadialTangential;
-  } else if (m.distortion_model == geometry::ToString(geometry::DistortionModel::kFisheye)) {
-    model = geometry::DistortionModel::kFisheye;
-  } else if (m.distortion_model != geometry::ToString(geometry::DistortionModel::kNone)) {
-    throw Error(fmt::format("render: internal error: camera {}'s frame says distortion '{}'",
-                            camera.name, m.distortion_model));
-  }
-  return geometry::CameraModel(camera.model.intrinsics(),
-                               geometry::Distortion::FromCoefficients(model, m.distortion));
-}
-
-/// DIR/<camera>.yaml for every camera and DIR/stereo.yaml for a head's eyes, describing the
-/// images as rendered (the first frames' metadata): K, and the lens distortion whenever it
-/// was rendered.
-void WriteCalibrations(const scene::Scene& scene, const scene::SceneState& state,
-                       const std::vector<render::Frame>& frames, bool distortion_on,
-                       const fs::path& out) {
-  std::optional<geometry::CameraModel> left, right;
-  for (const render::Frame& frame : frames) {
-    const ImageMetadata& m = frame.color->metadata();
-    const scene::CameraSpec* camera = scene.FindCamera(m.camera);
-    if (camera == nullptr) {
-      throw Error("render: internal error: a frame of unknown camera '" + m.camera + "'");
-    }
-    const geometry::CameraModel model = RenderedModel(*camera, m);
-    if (distortion_on && !camera->model.distortion().IsIdentity() &&
-        model.distortion().model() == geometry::DistortionModel::kNone) {
-      // Only a renderer without lens effects does this; the files then say what the images are.
-      fmt::print(stderr,
-                 "warning: camera {}: the renderer did not apply its {} distortion; its images "
-                 "and calibration file are pinhole (K only)\n",
-                 m.camera, geometry::ToString(camera->model.distortion().model()));
-    }
-    geometry::WriteCameraCalibration({model, m.camera}, out / (m.camera + ".yaml"),
-                                     geometry::CalibrationFormat::kOpenCvYaml);
-    if (camera->mount == scene::CameraMount::kLeftEye) left = model;
-    if (camera->mount == scene::CameraMount::kRightEye) right = model;
-  }
-  // The stereo pair's extrinsics at these joints (cv::stereoCalibrate's R, T).
-  if (!left || !right) return;
-  if (left->intrinsics().width() != right->intrinsics().width() ||
-      left->intrinsics().height() != right->intrinsics().height()) {
-    return;  // OpenCV's stereo files hold one image size
-  }
-  const geometry::Pose X_RL = scene.CameraPose(*scene.FindCamera("right"), state).inverse() *
-                              scene.CameraPose(*scene.FindCamera("left"), state);
-  geometry::StereoCalibration stereo{*left, *right, X_RL.linear(), X_RL.translation()};
-  geometry::WriteStereoCalibration(stereo, out / "stereo.yaml",
-                                   geometry::CalibrationFormat::kOpenCvYaml);
-}
-
 struct RenderOptions {
   std::string scene;
   std::string out;
@@ -387,48 +83,20 @@ scene::SceneState StateFor(const scene::Scene& scene, const std::vector<double>&
   return state;
 }
 
-/// Writes one camera's images of frame i: colour, and depth and ids when asked for.
-void WriteFrameImages(const render::Frame& frame, int i, const TruthRequest& truth,
-                      const fs::path& out) {
-  const std::string& camera = frame.color->metadata().camera;
-  std::vector<std::future<void>> writes;
-  writes.push_back(std::async(std::launch::async, [&] {
-    WritePng(frame.color->view(), out / camera / fmt::format("{:06d}.png", i));
-  }));
-  if (truth.depth) {
-    const Image& depth = TruthImage(frame.depth, frame, "depth", PixelFormat::kFloat32);
-    writes.push_back(std::async(std::launch::async, [&] {
-      WritePng(DepthToMillimetres(depth).view(), out / DepthFile(camera, i));
-    }));
-  }
-  if (truth.ids) {
-    const Image& ids = TruthImage(frame.ids, frame, "id", PixelFormat::kUint32);
-    writes.push_back(std::async(std::launch::async, [&] {
-      WritePng(IdsToPng16(ids, camera).view(), out / IdsFile(camera, i));
-    }));
-  }
-  for (auto& w : writes) w.get();  // rethrows a write error
-}
-
 int RunRender(const RenderOptions& o) {
   const bool truth_given = o.truth_option != nullptr && o.truth_option->count() > 0;
-  const TruthRequest truth = truth_given ? ParseTruth(o.truth) : TruthRequest{};
+  const render::TruthRequest truth =
+      truth_given ? render::TruthRequest::Parse(o.truth) : render::TruthRequest{};
   const scene::Scene scene = scene::Scene::Load(o.scene);
   const scene::SceneState initial = StateFor(scene, o.joints, o.degrees);
   render::RendererOptions options = o.renderer;
   options.cameras = o.cameras;
-  options.truth_depth = truth.depth;
-  options.truth_ids = truth.ids || truth.boxes;  // the boxes come from the id image
-  options.truth_objects = truth.boxes;
-  if (truth.ids) CheckIdsFitPng16(scene, options);
+  render::ApplyTruth(truth, &options);
+  if (truth.ids) render::CheckIdsFitPng16(scene, options);
   auto renderer = render::MakeRenderer(scene, options);
   const std::vector<std::string>& cameras = renderer->camera_names();
   const fs::path out(o.out);
-  PrepareOutput(out, cameras, truth, o.force);
-  const bool scene_has_objects = !scene.objects().empty();
-
-  std::ofstream index(out / "frames.jsonl");
-  if (!index) throw FileError((out / "frames.jsonl").string(), 0, "", "cannot write");
+  render::DatasetWriter writer(scene, cameras, truth, out, o.force, options.distortion);
   auto previous_int = std::signal(SIGINT, OnInterrupt);
   auto previous_term = std::signal(SIGTERM, OnInterrupt);
 
@@ -444,24 +112,7 @@ int RunRender(const RenderOptions& o) {
   renderer->Submit(state_at(0), 0);
   for (int i = 0; i < o.frames && !g_interrupted; ++i) {
     if (i + 1 < o.frames) renderer->Submit(state_at(i + 1), i + 1);
-    std::vector<render::Frame> frames = renderer->Retrieve();
-    // The calibration files describe the images as rendered: the first frame says how.
-    if (i == 0) WriteCalibrations(scene, initial, frames, options.distortion, out);
-    // Checked first: a frame whose truth is missing fails before any of its images is written.
-    for (const auto& frame : frames) {
-      if (truth.depth) TruthImage(frame.depth, frame, "depth", PixelFormat::kFloat32);
-      if (truth.ids) TruthImage(frame.ids, frame, "id", PixelFormat::kUint32);
-    }
-    const json line = FrameJson(i, state_at(i).time, frames, truth, scene_has_objects);
-    std::vector<std::future<void>> writes;
-    for (const auto& frame : frames) {
-      writes.push_back(std::async(std::launch::async, [&out, &frame, &truth, i] {
-        WriteFrameImages(frame, i, truth, out);
-      }));
-    }
-    for (auto& w : writes) w.get();  // rethrows a write error
-    // The index line comes last: a frame listed in frames.jsonl has all its images.
-    index << line.dump() << "\n" << std::flush;
+    writer.Write(i, state_at(i).time, initial, renderer->Retrieve());
     ++written;
     const double seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
