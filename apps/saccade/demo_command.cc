@@ -23,13 +23,14 @@
 #include <vector>
 
 #include "commands.h"
-#include "saccade/components/face_truth.h"
+#include "saccade/components/fixation_scoring.h"
 #include "saccade/components/messages.h"
 #include "saccade/components/register.h"
 #include "saccade/components/roles.h"
 #include "saccade/core/error.h"
 #include "saccade/core/streaming_stats.h"
 #include "saccade/gui/overlay.h"
+#include "saccade/gui/recording.h"
 #include "saccade/gui/session.h"
 #include "saccade/runtime/component_reference.h"
 #include "saccade/runtime/pipeline.h"
@@ -43,17 +44,20 @@ namespace {
 namespace fs = std::filesystem;
 using components::CandidatesMessage;
 using components::FacesMessage;
+using components::Fixation;
+using components::FixationJson;
 using components::HeadStatusMessage;
 using components::JointStateMessage;
-using components::PictureFace;
+using components::Latest;
 using components::SelectionMessage;
+using components::Tap;
 using components::TargetMessage;
 using components::TrackMessage;
 using gui::Annotate;
+using gui::Compose;
 using gui::GuiOptions;
 using gui::GuiSession;
-using gui::Latest;
-using gui::Tap;
+using gui::Recorder;
 using nlohmann::json;
 
 std::atomic<bool> g_stop{false};
@@ -76,148 +80,6 @@ struct Options {
 };
 
 /// One attended target, from its selection to the end of its dwell.
-struct Fixation {
-  int64_t target_id = -1;
-  double selected_at = 0.0;
-  std::optional<double> fixated_at;
-  bool completed = false;  // inhibition of return suppressed it
-  std::string object = "unknown";
-  bool is_face = false;
-  bool has_truth = false;  // the simulated scene gave the true face centre
-  std::string source;
-  Eigen::Vector3d p_W = Eigen::Vector3d::Zero();
-  Eigen::Vector3d truth_W = Eigen::Vector3d::Zero();
-  double distance_m = 0.0;
-  double error_3d_m = 0.0;
-  double left_error_deg = 0.0;
-  double right_error_deg = 0.0;
-  // Over the dwell (pursuit of a moving face): per-eye angular error, mean and max.
-  int dwell_samples = 0;
-  double dwell_sum_deg[2] = {0.0, 0.0};
-  double dwell_max_deg[2] = {0.0, 0.0};
-};
-
-/// Angle (degrees) between a camera's optical axis and the direction to p_W.
-double AxisErrorDeg(const Image& image, const Eigen::Vector3d& p_W) {
-  const geometry::Pose X_WC = vision::CameraPoseOf(image);
-  const Eigen::Vector3d axis = X_WC.linear().col(2);
-  const Eigen::Vector3d to = (p_W - X_WC.translation()).normalized();
-  return std::acos(std::clamp(axis.dot(to), -1.0, 1.0)) * kRadToDeg;
-}
-
-/// Writes the annotated frames: frames/NNNNNN.jpg, demo.avi (MJPEG), fixation PNGs.
-class Recorder {
- public:
-  Recorder(const fs::path& dir, double fps, bool force) : dir_(dir), fps_(fps) {
-    if (fs::exists(dir) && !fs::is_directory(dir)) {
-      throw InvalidArgument("demo: --record " + dir.string() + ": exists and is not a folder");
-    }
-    const bool used = fs::exists(dir / "summary.json") || fs::exists(dir / "frames") ||
-                      fs::exists(dir / "demo.avi");
-    if (used && !force) {
-      throw InvalidArgument("demo: --record " + dir.string() +
-                            " already holds a recording; pass --force to replace it");
-    }
-    if (used) {
-      fs::remove_all(dir / "frames");
-      fs::remove(dir / "demo.avi");
-      fs::remove(dir / "summary.json");
-      for (const auto& entry : fs::directory_iterator(dir)) {
-        if (entry.path().filename().string().rfind("fixation_", 0) == 0) fs::remove(entry.path());
-      }
-    }
-    fs::create_directories(dir / "frames");
-  }
-
-  ~Recorder() { writer_.release(); }
-
-  void Write(int64_t step, const cv::Mat& bgr) {
-    // Written whole or not at all (a temporary file renamed into place): a recording cut by a
-    // kill keeps only whole frames.
-    const fs::path frame = dir_ / "frames" / fmt::format("{:06d}.jpg", step);
-    const fs::path partial = dir_ / "frames" / fmt::format(".{:06d}.tmp.jpg", step);
-    if (!cv::imwrite(partial.string(), bgr, {cv::IMWRITE_JPEG_QUALITY, 85})) {
-      throw Error("demo: cannot write " + frame.string());
-    }
-    fs::rename(partial, frame);
-    if (!writer_.isOpened()) {
-      writer_.open((dir_ / "demo.avi").string(), cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), fps_,
-                   bgr.size());
-      if (!writer_.isOpened()) {
-        throw Error("demo: cannot write " + (dir_ / "demo.avi").string() +
-                    " (OpenCV's MJPEG writer failed)");
-      }
-    }
-    writer_.write(bgr);
-    ++frames_;
-  }
-
-  void WriteFixation(int index, const std::string& object, const cv::Mat& bgr) {
-    cv::imwrite((dir_ / fmt::format("fixation_{}_{}.png", index, object)).string(), bgr);
-  }
-
-  /// summary.json, atomically (a reader never sees half of it).
-  void WriteSummary(const json& summary) {
-    const fs::path tmp = dir_ / ".summary.json.tmp";
-    {
-      std::ofstream out(tmp);
-      out << summary.dump(2) << "\n";
-      if (!out) throw FileError(tmp.string(), 0, "", "cannot write");
-    }
-    fs::rename(tmp, dir_ / "summary.json");
-  }
-
-  int64_t frames() const { return frames_; }
-
- private:
-  fs::path dir_;
-  double fps_;
-  cv::VideoWriter writer_;
-  int64_t frames_ = 0;
-};
-
-cv::Mat Compose(const Latest& latest, double time, const std::string& status) {
-  cv::Mat left = Annotate(latest, "left", 0.5);
-  cv::Mat right = Annotate(latest, "right", 0.5);
-  if (right.rows != left.rows) cv::resize(right, right, cv::Size(right.cols, left.rows));
-  cv::Mat both;
-  cv::hconcat(left, right, both);
-  cv::Mat out(both.rows + 36, both.cols, CV_8UC3, cv::Scalar(30, 30, 30));
-  both.copyTo(out(cv::Rect(0, 36, both.cols, both.rows)));
-  cv::putText(out, fmt::format("t = {:6.2f} s   {}", time, status), cv::Point(10, 25),
-              cv::FONT_HERSHEY_SIMPLEX, 0.7, cv::Scalar(255, 255, 255), 2);
-  return out;
-}
-
-json FixationJson(const Fixation& f) {
-  json j = {{"target_id", f.target_id},
-            {"object", f.object},
-            {"is_face", f.is_face},
-            {"selected_at_s", f.selected_at},
-            {"fixated", f.fixated_at.has_value()},
-            {"completed", f.completed}};
-  if (f.fixated_at) {
-    j["fixated_at_s"] = *f.fixated_at;
-    j["time_to_fixate_s"] = *f.fixated_at - f.selected_at;
-    j["target_W"] = ToJson<Eigen::Vector3d>(f.p_W);
-    j["target_source"] = f.source;
-    j["distance_m"] = f.distance_m;
-    if (f.has_truth) {
-      j["truth_W"] = ToJson<Eigen::Vector3d>(f.truth_W);
-      j["error_3d_m"] = f.error_3d_m;
-      j["eye_error_deg"] = {{"left", f.left_error_deg}, {"right", f.right_error_deg}};
-      if (f.dwell_samples > 0) {
-        j["dwell_eye_error_deg"] = {{"samples", f.dwell_samples},
-                                    {"left_mean", f.dwell_sum_deg[0] / f.dwell_samples},
-                                    {"right_mean", f.dwell_sum_deg[1] / f.dwell_samples},
-                                    {"left_max", f.dwell_max_deg[0]},
-                                    {"right_max", f.dwell_max_deg[1]}};
-      }
-    }
-  }
-  return j;
-}
-
 int RunDemo(Options o) {
   components::RegisterComponents();
   if (o.list) {
@@ -282,28 +144,15 @@ int RunDemo(Options o) {
   const bool truth = cameras->rendered() != nullptr;
   // Real cameras: the scene only carries the robot; its pictures are not what they see.
   const scene::Scene& scene = cameras->scene();
-  const std::vector<PictureFace> pictures =
-      truth ? components::FindPictureFaces(scene) : std::vector<PictureFace>{};
-  int faces_total = 0;
-  for (const PictureFace& p : pictures) faces_total += p.has_face ? 1 : 0;
+  components::FixationScorer scorer(scene, truth);
+  const int faces_total = scorer.faces_total();
   if (!truth && !o.json) {
     fmt::print("real cameras ({}): no ground truth; fixations are reported as triangulated\n",
                spec.components[*cameras_index].type);
   }
 
   Latest latest;
-  Tap<runtime::ImageMessage>(pipeline, [&](const runtime::ImageMessage& m) {
-    if (m.image) latest.images[m.image->metadata().camera] = m.image;
-  });
-  Tap<FacesMessage>(pipeline, [&](const FacesMessage& m) {
-    if (m.image) latest.faces[m.image->metadata().camera] = m;
-  });
-  Tap<TrackMessage>(pipeline, [&](const TrackMessage& m) {
-    if (m.image) latest.tracks[m.image->metadata().camera] = m;
-  });
-  Tap<SelectionMessage>(pipeline, [&](const SelectionMessage& m) { latest.selection = m; });
-  Tap<TargetMessage>(pipeline, [&](const TargetMessage& m) { latest.target = m; });
-  Tap<JointStateMessage>(pipeline, [&](const JointStateMessage& m) { latest.joints = m; });
+  components::TapLoopOutputs(pipeline, &latest);
   std::optional<HeadStatusMessage> head_status;
   Tap<HeadStatusMessage>(pipeline, [&](const HeadStatusMessage& m) {
     if (!o.json && m.fault != (head_status ? head_status->fault : "") && !m.fault.empty()) {
@@ -325,8 +174,6 @@ int RunDemo(Options o) {
   std::unique_ptr<Recorder> recorder;
   if (!o.record.empty()) recorder = std::make_unique<Recorder>(o.record, 1.0 / dt, o.force);
 
-  std::vector<Fixation> fixations;
-  std::map<std::string, std::map<std::string, int>> decoy_rejections;  // picture -> reason -> n
   StreamingStats loop_latency_ms;  // constant memory however long the run
 
   runtime::RunOptions run;
@@ -348,108 +195,10 @@ int RunDemo(Options o) {
   };
   run.after_step = [&](const runtime::StepContext& context) {
     const double t = context.time;
-    // Rejected detections on a decoy picture (the cat), by reason.
-    for (const auto& [camera, faces] : latest.faces) {
-      if (!faces.image || faces.image->metadata().frame_index != context.step) continue;
-      for (const FacesMessage::Face& face : faces.faces) {
-        if (!face.rejected) continue;
-        for (const PictureFace& p : pictures) {
-          if (p.has_face) continue;
-          const auto box = components::ProjectedBox(scene, scene.objects()[p.object], *faces.image);
-          const double cx = face.box.x + face.box.width / 2.0;
-          const double cy = face.box.y + face.box.height / 2.0;
-          if (box && cx >= (*box)[0] && cx <= (*box)[2] && cy >= (*box)[1] && cy <= (*box)[3]) {
-            ++decoy_rejections[p.name][face.reason];
-          }
-        }
-      }
-    }
-
-    std::string status = "looking for faces";
-    const SelectionMessage* sel = latest.selection ? &*latest.selection : nullptr;
-    bool fixated_now = false;
-    if (sel != nullptr && sel->valid && !sel->exploring) {
-      if (fixations.empty() || fixations.back().target_id != sel->target_id) {
-        Fixation f;
-        f.target_id = sel->target_id;
-        f.selected_at = t;
-        fixations.push_back(f);
-      }
-      Fixation& f = fixations.back();
-      status = fmt::format("target {}: {}", f.target_id, sel->fixating ? "fixating" : "saccade");
-      const auto left = latest.images.find("left");
-      const auto right = latest.images.find("right");
-      const bool eyes = left != latest.images.end() && right != latest.images.end();
-      if (sel->fixating && eyes) {
-        if (!f.fixated_at) {
-          // Identify the object: the nearest face centre (or decoy picture) to the target.
-          f.fixated_at = t;
-          f.p_W = latest.target && latest.target->valid ? latest.target->p_W : sel->p_W;
-          f.source = latest.target ? latest.target->source : "selection";
-          f.distance_m = (f.p_W - 0.5 * (vision::CameraPoseOf(*left->second).translation() +
-                                         vision::CameraPoseOf(*right->second).translation()))
-                             .norm();
-          double best = 0.35;
-          for (const PictureFace& p : pictures) {
-            scene::SceneState state = scene.InitialState();
-            state.time = t;
-            const Eigen::Vector3d ref =
-                p.has_face ? components::FaceCentreAt(scene, p, t)
-                           : scene.ObjectPose(scene.objects()[p.object], state).translation();
-            const double d = (ref - f.p_W).norm();
-            if (d < best) {
-              best = d;
-              f.object = p.name;
-              f.is_face = p.has_face;
-              f.truth_W = ref;
-            }
-          }
-          if (!truth) {
-            // Real cameras: every target attention picks is a face the detectors found.
-            f.object = fmt::format("face {}", f.target_id);
-            f.is_face = true;
-          }
-          f.has_truth = truth && f.is_face;
-          if (f.has_truth) {
-            f.error_3d_m = (f.p_W - f.truth_W).norm();
-            f.left_error_deg = AxisErrorDeg(*left->second, f.truth_W);
-            f.right_error_deg = AxisErrorDeg(*right->second, f.truth_W);
-          }
-          fixated_now = true;
-        }
-        if (f.has_truth) {
-          // Pursuit: how well the eyes stay on the (possibly moving) true face centre.
-          const PictureFace* p = nullptr;
-          for (const PictureFace& q : pictures) {
-            if (q.name == f.object) p = &q;
-          }
-          const Eigen::Vector3d truth = components::FaceCentreAt(scene, *p, t);
-          const double e[2] = {AxisErrorDeg(*left->second, truth),
-                               AxisErrorDeg(*right->second, truth)};
-          for (int k = 0; k < 2; ++k) {
-            f.dwell_sum_deg[k] += e[k];
-            f.dwell_max_deg[k] = std::max(f.dwell_max_deg[k], e[k]);
-          }
-          ++f.dwell_samples;
-        }
-      }
-      if (f.fixated_at) {
-        for (const Eigen::Vector3d& s : sel->suppressed_W) {
-          if ((s - f.p_W).norm() < 0.2) f.completed = true;
-        }
-      }
-    } else if (sel != nullptr && sel->exploring) {
-      status = "exploring: looking straight ahead";
-    }
-    // Earlier targets the selection moved away from are complete once suppressed too.
-    if (sel != nullptr) {
-      for (Fixation& f : fixations) {
-        if (!f.fixated_at || f.completed) continue;
-        for (const Eigen::Vector3d& s : sel->suppressed_W) {
-          if ((s - f.p_W).norm() < 0.2) f.completed = true;
-        }
-      }
-    }
+    const components::FixationScorer::Step scored = scorer.Update(context.step, t, latest);
+    const bool fixated_now = scored.fixated_now;
+    const std::string& status = scored.status;
+    const std::vector<Fixation>& fixations = scorer.fixations();
 
     if (fixated_now) {
       const Fixation& f = fixations.back();
@@ -480,19 +229,9 @@ int RunDemo(Options o) {
       }
     }
     // Done once every face has been fixated and let go.
-    int done = 0;
-    for (const PictureFace& p : pictures) {
-      if (!p.has_face) continue;
-      for (const Fixation& f : fixations) {
-        if (f.object == p.name && f.completed) {
-          ++done;
-          break;
-        }
-      }
-    }
     if (gui) {
       gui->AfterStep(context, latest, g_stop);
-    } else if (faces_total > 0 && done == faces_total) {
+    } else if (faces_total > 0 && scorer.faces_done() == faces_total) {
       g_stop = true;
     }
   };
@@ -508,27 +247,8 @@ int RunDemo(Options o) {
   const bool nothing_ran = summary.steps == 0 && !summary.errors.empty();
 
   // ---- the report ----
-  int faces_fixated = 0;
-  std::vector<std::string> seen;
-  for (const Fixation& f : fixations) {
-    if (f.fixated_at && f.is_face && std::find(seen.begin(), seen.end(), f.object) == seen.end()) {
-      seen.push_back(f.object);
-      ++faces_fixated;
-    }
-  }
-  json decoys = json::array();
-  for (const PictureFace& p : pictures) {
-    if (p.has_face) continue;
-    bool fixated = false;
-    for (const Fixation& f : fixations) fixated = fixated || (f.fixated_at && f.object == p.name);
-    int rejected = 0;
-    for (const auto& [reason, n] : decoy_rejections[p.name]) rejected += n;
-    decoys.push_back({{"name", p.name},
-                      {"fixated", fixated},
-                      {"rejected", !fixated},
-                      {"rejected_detections", rejected},
-                      {"by_reason", decoy_rejections[p.name]}});
-  }
+  const int faces_fixated = scorer.faces_fixated();
+  const json decoys = scorer.DecoysJson();
   json stages = json::array();
   for (const runtime::ComponentTiming& c : summary.components) {
     stages.push_back({{"name", c.name},
@@ -541,7 +261,7 @@ int RunDemo(Options o) {
     double median, p95;
   } const latency{loop_latency_ms.Quantile(0.5), loop_latency_ms.Quantile(0.95)};
   json fixations_json = json::array();
-  for (const Fixation& f : fixations) fixations_json.push_back(FixationJson(f));
+  for (const Fixation& f : scorer.fixations()) fixations_json.push_back(FixationJson(f));
   json errors = json::array();
   for (const runtime::StepError& e : summary.errors) errors.push_back(e.ToString());
   const std::optional<components::CameraPairCounts> pair_counts = cameras->pair_counts();
