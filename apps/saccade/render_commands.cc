@@ -24,12 +24,18 @@
 #include "saccade/core/image_io.h"
 #include "saccade/geometry/json.h"
 #include "saccade/head/json.h"
+#include "saccade/render/benchmark.h"
 #include "saccade/render/dataset.h"
 #include "saccade/render/renderer.h"
 #include "saccade/scene/scene.h"
 
 namespace saccade::app {
 namespace {
+
+using render::EffectRun;
+using render::kBenchPanRate;
+using render::Measure;
+using render::Measurement;
 
 using nlohmann::json;
 namespace fs = std::filesystem;
@@ -145,122 +151,20 @@ struct BenchOptions {
   bool effect_table = true;
 };
 
-// The head's pan rate while timing motion blur: fast enough that an exposure of a few
-// milliseconds smears the image by pixels, so that the blur's sub-frames are really drawn.
-constexpr double kBenchPanRate = 2.0;  // rad/s
-
-/// One timed run: `frames` stereo frames after `warmup`, pipelined as `render` does.
-struct Measurement {
-  std::string device;
-  std::vector<std::string> cameras;
-  int frames = 0;
-  double seconds = 0.0;
-  int64_t pixels = 0;
-  // Per frame, milliseconds (RenderStats).
-  double update_ms = 0.0, draw_ms = 0.0, effects_ms = 0.0, readback_ms = 0.0;
-
-  double fps() const { return frames / std::max(seconds, 1e-9); }
-  double ms_per_frame() const { return 1000.0 * seconds / std::max(frames, 1); }
-};
-
-Measurement Measure(const scene::Scene& scene, const render::RendererOptions& options,
-                    const head::JointState& joint_velocities, int frames, int warmup) {
-  auto renderer = render::MakeRenderer(scene, options);
-  scene::SceneState initial = scene.InitialState();
-  initial.joint_velocities = joint_velocities;
-  auto state_at = [&](int i) {
-    scene::SceneState state = initial;
-    state.time = i / 30.0;
-    return state;
-  };
-  for (int i = 0; i < warmup; ++i) renderer->Render(state_at(i), i);
-  const render::RenderStats before = renderer->stats();
-  const ProgressBar progress(frames);
-  const auto start = std::chrono::steady_clock::now();
-  renderer->Submit(state_at(0), 0);
-  Measurement m;
-  for (int i = 0; i < frames; ++i) {
-    if (i + 1 < frames) renderer->Submit(state_at(i + 1), i + 1);
-    for (const auto& frame : renderer->Retrieve()) {
-      m.pixels += static_cast<int64_t>(frame.color->width()) * frame.color->height();
-    }
-    if (i % 10 == 9) {
-      const double s =
-          std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-      progress.Update(i + 1, (i + 1) / s);
-    }
-  }
-  m.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  progress.Finish();
-  const render::RenderStats& after = renderer->stats();
-  m.frames = frames;
-  m.update_ms = (after.scene_update_ms - before.scene_update_ms) / frames;
-  m.draw_ms = (after.draw_ms - before.draw_ms) / frames;
-  m.effects_ms = (after.effects_ms - before.effects_ms) / frames;
-  m.readback_ms = (after.readback_ms - before.readback_ms) / frames;
-  m.device = renderer->DeviceDescription();
-  m.cameras = renderer->camera_names();
-  return m;
-}
-
-/// One row of the effect table: a run with one effect on (or all, or none).
-struct EffectRun {
-  const char* name;   ///< JSON key
-  const char* label;  ///< text table
-  render::RendererOptions options;
-  bool moving = false;       ///< the head pans at kBenchPanRate during the exposure
-  std::string unconfigured;  ///< why the scene gives this effect nothing to do; empty: run
-  std::optional<Measurement> result;
-};
-
-/// The runs of the effect table, all on `base`'s other options (MSAA, LOD, cameras).
-std::vector<EffectRun> EffectRuns(const scene::Scene& scene, const render::RendererOptions& base,
-                                  const std::vector<std::string>& cameras) {
-  bool has_distortion = false, has_noise = false, has_blur = false;
-  for (const auto& name : cameras) {
-    const scene::CameraSpec& camera = *scene.FindCamera(name);
-    has_distortion = has_distortion || !camera.model.distortion().IsIdentity();
-    has_noise = has_noise || camera.sensor.HasNoise();
-    has_blur = has_blur || camera.sensor.HasBlur();
-  }
-  render::RendererOptions off = base;
-  off.distortion = off.noise = off.motion_blur = false;
-  off.truth_depth = off.truth_ids = off.truth_objects = false;
-  render::RendererOptions distortion = off, noise = off, blur = off, truth = off, all = off;
-  distortion.distortion = true;
-  noise.noise = true;
-  blur.motion_blur = true;
-  truth.truth_depth = truth.truth_ids = truth.truth_objects = true;
-  all.distortion = all.noise = all.motion_blur = true;
-  all.truth_depth = all.truth_ids = all.truth_objects = true;
-  const auto unless = [](bool configured, const char* why) {
-    return configured ? std::string() : std::string(why);
-  };
-  std::vector<EffectRun> runs;
-  const auto add = [&runs](const char* name, const char* label,
-                           const render::RendererOptions& options, bool moving,
-                           std::string unconfigured) {
-    runs.push_back(EffectRun{name, label, options, moving, std::move(unconfigured), std::nullopt});
-  };
-  add("off", "effects off", off, false, "");
-  add("distortion", "lens distortion", distortion, false,
-      unless(has_distortion, "no camera of the scene has a lens distortion"));
-  add("noise", "sensor noise", noise, false,
-      unless(has_noise, "no camera of the scene has read or shot noise"));
-  add("motion_blur", "motion blur, pan 2 rad/s", blur, true,
-      unless(has_blur,
-             "blur is not configured: no camera of the scene has an exposure (sensor: "
-             "exposure_ms) with blur_samples > 1"));
-  add("truth", "truth depth+ids+boxes", truth, false, "");
-  add("all", "everything, pan 2 rad/s", all, true, "");
-  return runs;
-}
-
 int RunBench(const BenchOptions& o) {
   const scene::Scene scene = scene::Scene::Load(o.scene);
   if (scene.cameras().empty()) throw InvalidArgument("bench: the scene has no cameras");
+  std::optional<ProgressBar> bar;
+  const auto progress = [&bar, &o](int done, double fps) {
+    if (!bar) bar.emplace(o.frames);
+    bar->Update(done, fps);
+    if (done == o.frames) {
+      bar->Finish();
+      bar.reset();
+    }
+  };
   // The first figure: the options as given, the head still.
-  const Measurement main = Measure(scene, o.renderer, {}, o.frames, o.warmup);
+  const Measurement main = Measure(scene, o.renderer, {}, o.frames, o.warmup, progress);
   std::vector<EffectRun> runs;
   if (o.effect_table) {
     runs = EffectRuns(scene, o.renderer, main.cameras);
@@ -268,7 +172,7 @@ int RunBench(const BenchOptions& o) {
     for (EffectRun& run : runs) {
       if (!run.unconfigured.empty()) continue;
       run.result = Measure(scene, run.options, run.moving ? panning : head::JointState{}, o.frames,
-                           o.warmup);
+                           o.warmup, progress);
     }
   }
   const double off_ms =

@@ -214,19 +214,4 @@ json FixationScorer::DecoysJson() const {
   return decoys;
 }
 
-void TapLoopOutputs(runtime::Pipeline& pipeline, Latest* latest) {
-  Tap<runtime::ImageMessage>(pipeline, [latest](const runtime::ImageMessage& m) {
-    if (m.image) latest->images[m.image->metadata().camera] = m.image;
-  });
-  Tap<FacesMessage>(pipeline, [latest](const FacesMessage& m) {
-    if (m.image) latest->faces[m.image->metadata().camera] = m;
-  });
-  Tap<TrackMessage>(pipeline, [latest](const TrackMessage& m) {
-    if (m.image) latest->tracks[m.image->metadata().camera] = m;
-  });
-  Tap<SelectionMessage>(pipeline, [latest](const SelectionMessage& m) { latest->selection = m; });
-  Tap<TargetMessage>(pipeline, [latest](const TargetMessage& m) { latest->target = m; });
-  Tap<JointStateMessage>(pipeline, [latest](const JointStateMessage& m) { latest->joints = m; });
-}
-
 }  // namespace saccade::components
