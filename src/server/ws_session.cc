@@ -1,0 +1,376 @@
+#include "saccade/core/log.h"
+#include "server/internal_ws_session.h"
+
+namespace saccade::server::internal_gui {
+
+WsSession::WsSession(ServerCore* server, tcp::socket socket, int64_t id)
+    : server_(server), ws_(std::move(socket)) {
+  stats_.id = id;
+  boost::system::error_code ec;
+  const auto endpoint = beast::get_lowest_layer(ws_).socket().remote_endpoint(ec);
+  if (!ec) stats_.peer = EndpointText(endpoint);
+}
+
+void WsSession::Run(http::request<http::string_body> req) {
+  beast::get_lowest_layer(ws_).expires_after(kHttpTimeout);
+  ws_.set_option(websocket::stream_base::decorator(
+      [](websocket::response_type& res) { res.set(http::field::server, kServerName); }));
+  ws_.read_message_max(server_->options.max_message_bytes * kHardMessageFactor);
+  ws_.async_accept(req, [self = shared_from_this()](beast::error_code ec) { self->OnAccept(ec); });
+}
+
+void WsSession::OfferState(const Text& state) {
+  bool kick = false;
+  {
+    std::lock_guard lock(mutex_);
+    if (closed_) return;
+    if (state_) {
+      ++stats_.states_skipped;
+      queued_bytes_ -= state_->size();
+    }
+    state_ = state;
+    queued_bytes_ += state->size();
+    kick = NeedsKickLocked();
+  }
+  if (kick) PostKick();
+}
+
+void WsSession::OfferFrame(const std::string& camera, const Frame& frame) {
+  bool kick = false;
+  {
+    std::lock_guard lock(mutex_);
+    if (closed_) return;
+    auto [it, inserted] = frames_.try_emplace(camera, frame);
+    if (!inserted) {
+      ++stats_.frames_skipped;
+      queued_bytes_ -= it->second.bytes();
+      it->second = frame;
+    }
+    queued_bytes_ += frame.bytes();
+    kick = NeedsKickLocked();
+  }
+  if (kick) PostKick();
+}
+
+void WsSession::OfferText(const Text& text) {
+  bool kick = false;
+  {
+    std::lock_guard lock(mutex_);
+    if (closed_) return;
+    QueueTextLocked(text);
+    kick = NeedsKickLocked();
+  }
+  if (kick) PostKick();
+}
+
+ClientStats WsSession::stats() const {
+  std::lock_guard lock(mutex_);
+  ClientStats s = stats_;
+  s.queued_bytes = queued_bytes_;
+  return s;
+}
+
+void WsSession::Close() {
+  {
+    std::lock_guard lock(mutex_);
+    if (closed_) return;
+    closed_ = true;
+    texts_.clear();
+    state_.reset();
+    frames_.clear();
+    queued_bytes_ = in_flight_bytes_;
+  }
+  server_->RemoveClient(stats_.id);
+  beast::error_code ec;
+  beast::get_lowest_layer(ws_).socket().shutdown(tcp::socket::shutdown_both, ec);
+  beast::get_lowest_layer(ws_).close();
+}
+
+void WsSession::OnAccept(beast::error_code ec) {
+  if (ec || server_->stopping) {
+    Close();
+    return;
+  }
+  // Beast's own WebSocket timeouts stay off: a slow reader must not be dropped, and Stop()
+  // closes the sockets itself.
+  beast::get_lowest_layer(ws_).expires_never();
+  json hello = server_->options.hello.is_object() ? server_->options.hello : json::object();
+  hello["type"] = "hello";
+  hello["protocol"] = kProtocolName;
+  hello["version"] = kProtocolVersion;
+  hello["client"] = stats_.id;
+  std::function<std::vector<std::string>()> welcome;
+  Text latest_state;
+  {
+    std::lock_guard lock(server_->config_mutex);
+    welcome = server_->welcome;
+    latest_state = server_->latest_state;
+  }
+  std::vector<Text> texts{std::make_shared<const std::string>(
+      hello.dump(-1, ' ', false, json::error_handler_t::replace))};
+  if (welcome) {
+    try {
+      for (std::string& text : welcome()) {
+        texts.push_back(std::make_shared<const std::string>(std::move(text)));
+      }
+    } catch (const std::exception& e) {
+      const json event = {
+          {"type", "event"}, {"level", "error"}, {"message", std::string("welcome: ") + e.what()}};
+      texts.push_back(std::make_shared<const std::string>(event.dump()));
+    }
+  }
+  {
+    std::lock_guard lock(mutex_);
+    // The hello goes before anything published during the handshake.
+    for (auto it = texts.rbegin(); it != texts.rend(); ++it) {
+      texts_.push_front(*it);
+      queued_bytes_ += (*it)->size();
+    }
+    // Then the newest state, unless one published during the handshake is already here.
+    if (!state_ && latest_state) {
+      state_ = latest_state;
+      queued_bytes_ += state_->size();
+    }
+    open_ = true;
+  }
+  MaybeWrite();
+  DoRead();
+}
+
+void WsSession::DoRead() {
+  ws_.async_read(read_buffer_, [self = shared_from_this()](beast::error_code ec, std::size_t) {
+    self->OnRead(ec);
+  });
+}
+
+void WsSession::OnRead(beast::error_code ec) {
+  if (ec) {
+    Close();
+    return;
+  }
+  const std::size_t size = read_buffer_.size();
+  {
+    std::lock_guard lock(mutex_);
+    ++stats_.commands;
+  }
+  const std::size_t limit = server_->options.max_message_bytes;
+  if (!ws_.got_text()) {
+    SendError(nullptr, "binary messages are not commands");
+  } else if (size > limit) {
+    SendError(nullptr, "message of " + std::to_string(size) +
+                           " bytes is larger than the limit of " + std::to_string(limit) +
+                           " bytes");
+  } else {
+    const auto data = read_buffer_.data();
+    HandleCommand(std::string_view(static_cast<const char*>(data.data()), data.size()));
+  }
+  read_buffer_.consume(size);
+  if (read_buffer_.capacity() > 2 * limit) read_buffer_.shrink_to_fit();
+  if (!IsClosed()) DoRead();
+}
+
+void WsSession::HandleCommand(std::string_view text) {
+  if (const int depth = NestingDepth(text); depth > kMaxNesting) {
+    SendError(nullptr, "malformed JSON: nested " + std::to_string(depth) +
+                           " levels deep, at most " + std::to_string(kMaxNesting));
+    return;
+  }
+  json command;
+  try {
+    command = json::parse(text);
+  } catch (const json::exception& e) {
+    SendError(nullptr, std::string("malformed JSON: ") + e.what());
+    return;
+  }
+  if (!command.is_object()) {
+    SendError(nullptr, "a command must be a JSON object, got " + JsonTypeName(command));
+    return;
+  }
+  // The id, when there is a valid one, goes into every error below.
+  json id = nullptr;
+  const auto id_it = command.find("id");
+  const bool id_ok =
+      id_it != command.end() && id_it->is_number_integer() &&
+      !(id_it->is_number_unsigned() &&
+        id_it->get<uint64_t>() > static_cast<uint64_t>(std::numeric_limits<int64_t>::max()));
+  if (id_ok) id = id_it->get<int64_t>();
+  const auto type_it = command.find("type");
+  if (type_it == command.end()) {
+    SendError(id, "missing field 'type' (a string naming the command)");
+    return;
+  }
+  if (!type_it->is_string()) {
+    SendError(id, "field 'type' must be a string, got " + JsonTypeName(*type_it));
+    return;
+  }
+  if (id_it == command.end()) {
+    SendError(nullptr, "missing field 'id' (an integer that grows with each command)");
+    return;
+  }
+  if (!id_ok) {
+    SendError(nullptr, "field 'id' must be an integer (int64), got " +
+                           (id_it->is_number_integer() ? std::string("an out-of-range number")
+                                                       : JsonTypeName(*id_it)));
+    return;
+  }
+  const int64_t id_value = id.get<int64_t>();
+  if (last_id_ && id_value <= *last_id_) {
+    SendError(
+        id, "out of order: id " + std::to_string(id_value) + " after " + std::to_string(*last_id_));
+    return;
+  }
+  last_id_ = id_value;
+
+  CommandHandler handler;
+  {
+    std::lock_guard lock(server_->config_mutex);
+    handler = server_->handler;
+  }
+  if (!handler) {
+    SendError(id, "this server takes no commands (no command handler)");
+    return;
+  }
+  json reply;
+  try {
+    json result = handler(command, stats_.id);
+    if (result.is_object()) {
+      reply = std::move(result);
+    } else {
+      reply = json::object();
+      if (!result.is_null()) reply["result"] = std::move(result);
+    }
+  } catch (const std::exception& e) {
+    SendError(id, e.what());
+    return;
+  } catch (...) {
+    SendError(id, "command failed with an unknown exception");
+    return;
+  }
+  reply["type"] = "reply";
+  reply["id"] = id_value;
+  reply["ok"] = true;
+  QueueOwnText(reply);
+}
+
+void WsSession::SendError(json id, const std::string& message) {
+  {
+    std::lock_guard lock(mutex_);
+    ++stats_.errors;
+  }
+  QueueOwnText(json{{"type", "error"}, {"id", std::move(id)}, {"error", message}});
+}
+
+void WsSession::QueueOwnText(const json& message) {
+  std::string text;
+  try {
+    text = message.dump(-1, ' ', false, json::error_handler_t::replace);
+  } catch (const std::exception& e) {
+    text = json{{"type", "error"}, {"id", nullptr}, {"error", e.what()}}.dump();
+  }
+  {
+    std::lock_guard lock(mutex_);
+    if (closed_) return;
+    QueueTextLocked(std::make_shared<const std::string>(std::move(text)));
+  }
+  MaybeWrite();
+}
+
+bool WsSession::IsClosed() const {
+  std::lock_guard lock(mutex_);
+  return closed_;
+}
+
+void WsSession::QueueTextLocked(const Text& text) {
+  while (!texts_.empty() && texts_.size() >= server_->options.max_queued_messages) {
+    DropOldestLocked();
+  }
+  texts_.push_back(text);
+  queued_bytes_ += text->size();
+}
+
+void WsSession::DropOldestLocked() {
+  queued_bytes_ -= texts_.front()->size();
+  texts_.pop_front();
+  ++stats_.messages_dropped;
+}
+
+bool WsSession::NeedsKickLocked() {
+  if (!open_ || closed_ || writing_ || kick_pending_) return false;
+  kick_pending_ = true;
+  return true;
+}
+
+void WsSession::PostKick() {
+  asio::post(ws_.get_executor(), [self = shared_from_this()] {
+    {
+      std::lock_guard lock(self->mutex_);
+      self->kick_pending_ = false;
+    }
+    self->MaybeWrite();
+  });
+}
+
+void WsSession::MaybeWrite() {
+  enum class Kind { kText, kState, kFrame } kind;
+  {
+    std::lock_guard lock(mutex_);
+    if (!open_ || closed_ || writing_) return;
+    if (!texts_.empty()) {
+      kind = Kind::kText;
+      out_text_ = std::move(texts_.front());
+      texts_.pop_front();
+      in_flight_bytes_ = out_text_->size();
+    } else if (state_) {
+      kind = Kind::kState;
+      out_text_ = std::move(state_);
+      state_.reset();
+      in_flight_bytes_ = out_text_->size();
+    } else if (!frames_.empty()) {
+      kind = Kind::kFrame;
+      auto it = frames_.upper_bound(last_camera_);
+      if (it == frames_.end()) it = frames_.begin();
+      last_camera_ = it->first;
+      out_frame_ = std::move(it->second);
+      frames_.erase(it);
+      in_flight_bytes_ = out_frame_.bytes();
+    } else {
+      return;
+    }
+    writing_ = true;
+  }
+  auto self = shared_from_this();
+  if (kind == Kind::kFrame) {
+    ws_.binary(true);
+    std::array<asio::const_buffer, 2> buffers = {
+        asio::buffer(*out_frame_.head),
+        out_frame_.payload ? asio::buffer(*out_frame_.payload) : asio::const_buffer()};
+    ws_.async_write(buffers, [self](beast::error_code ec, std::size_t) { self->OnWrite(ec, 2); });
+  } else {
+    ws_.text(true);
+    const int what = kind == Kind::kState ? 1 : 0;
+    ws_.async_write(asio::buffer(*out_text_),
+                    [self, what](beast::error_code ec, std::size_t) { self->OnWrite(ec, what); });
+  }
+}
+
+void WsSession::OnWrite(beast::error_code ec, int what) {
+  {
+    std::lock_guard lock(mutex_);
+    writing_ = false;
+    queued_bytes_ -= in_flight_bytes_;
+    in_flight_bytes_ = 0;
+    if (!ec) {
+      if (what == 1) ++stats_.states_sent;
+      if (what == 2) ++stats_.frames_sent;
+    }
+  }
+  out_text_.reset();
+  out_frame_ = Frame{};
+  if (ec) {
+    Close();
+    return;
+  }
+  MaybeWrite();
+}
+
+}  // namespace saccade::server::internal_gui
