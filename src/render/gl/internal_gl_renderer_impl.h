@@ -1,0 +1,244 @@
+#pragma once
+// The OpenGL renderer's class and the parts its files share (private to render/gl):
+//   internal_gl_renderer.cc  set-up, programs, lights, Submit, the effect passes, Render
+//   internal_draw.cc         the colour pass and the truth pass, through one item visitor
+//   internal_readback.cc     Retrieve: one readback path for every camera, the metadata
+//   internal_truth.cc        depth, ids and each object's box and pose
+//   internal_pixels.cc       RGBA to RGB
+#include <epoxy/gl.h>
+
+#include <array>
+#include <chrono>
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "render/gl/internal_camera_target.h"
+#include "render/gl/internal_effects.h"
+#include "render/gl/internal_egl_context.h"
+#include "render/gl/internal_gl_util.h"
+#include "render/gl/internal_gpu_resources.h"
+#include "saccade/core/error.h"
+#include "saccade/head/kinematics.h"
+#include "saccade/render/renderer.h"
+
+namespace saccade::render::gl {
+
+using Clock = std::chrono::steady_clock;
+
+inline double Milliseconds(Clock::time_point from, Clock::time_point to) {
+  return std::chrono::duration<double, std::milli>(to - from).count();
+}
+
+// Per-vertex (Gouraud) lighting is used on meshes whose mean edge is at most this long on
+// screen: over a triangle that small, interpolated lighting and per-fragment lighting differ
+// by far less than one 8-bit step for smooth surfaces (internal_shaders.h).
+inline constexpr double kPerVertexMaxEdgePx = 2.0;
+
+// Images kept per camera for reuse once the caller has let go of them (no allocation and no
+// page faults per frame in steady state).
+inline constexpr std::size_t kPooledImagesPerCamera = 4;
+
+// The pose of a robot part's link in a state.
+inline const geometry::Pose& LinkPose(const head::HeadFrames& frames, scene::RobotPart::Link link) {
+  switch (link) {
+    case scene::RobotPart::Link::kBase:
+      return frames.X_WB;
+    case scene::RobotPart::Link::kNeck:
+      return frames.X_WN;
+    case scene::RobotPart::Link::kCyclopean:
+      return frames.X_WC;
+    case scene::RobotPart::Link::kLeftEye:
+      return frames.X_WL;
+    case scene::RobotPart::Link::kRightEye:
+      return frames.X_WR;
+  }
+  return frames.X_WB;
+}
+
+// Uniform locations of the lights, common to every program.
+struct LightUniforms {
+  GLint ambient = -1, directional_direction = -1, directional_color = -1, point_position = -1,
+        point_color = -1;
+  void Find(GLuint program) {
+    ambient = Uniform(program, "u_ambient");
+    directional_direction = Uniform(program, "u_directional_direction");
+    directional_color = Uniform(program, "u_directional_color");
+    point_position = Uniform(program, "u_point_position");
+    point_color = Uniform(program, "u_point_color");
+  }
+};
+
+// Variant bits of the mesh program (internal_shaders.h).
+enum MeshVariant : int { kTextured = 1, kShiny = 2, kPerVertex = 4, kTwoSided = 8 };
+
+struct MeshProgram {
+  GLuint program = 0;
+  GLint mvp = -1, mv = -1, normal = -1;
+  GLint base_color = -1, specular = -1, shininess = -1;
+  LightUniforms lights;
+  int64_t lights_pass = -1;  // the camera pass whose lights are set
+};
+
+struct GroundProgram {
+  GLuint program = 0;
+  GLint mvp = -1, mv = -1, normal_eye = -1;
+  LightUniforms lights;
+};
+
+// Something drawn with the mesh programs: an object or a robot part.
+struct DrawItem {
+  const GpuModel* model = nullptr;
+  int object = -1;  // index into scene.objects(), or -1 for a robot part
+  int part = -1;    // index into robot.parts
+  Eigen::Vector3d scale{1.0, 1.0, 1.0};
+  Eigen::Vector3d center_model = Eigen::Vector3d::Zero();  // bounds centre (model frame)
+  double radius_model = 0.0;                               // bounds half diagonal, scaled
+};
+
+// Column-major float copy of a double matrix, for glUniformMatrix*.
+template <int N>
+std::array<float, N * N> ToFloat(const Eigen::Matrix<double, N, N>& m) {
+  std::array<float, N * N> out;
+  Eigen::Map<Eigen::Matrix<float, N, N>>(out.data()) = m.template cast<float>();
+  return out;
+}
+
+// The 8 corners of `box` all lie outside one plane of the clip volume.
+inline bool OutsideFrustum(const Eigen::Matrix4d& mvp, const Eigen::AlignedBox3f& box) {
+  int outside[6] = {0, 0, 0, 0, 0, 0};
+  for (int corner = 0; corner < 8; ++corner) {
+    const Eigen::Vector3f c = box.corner(static_cast<Eigen::AlignedBox3f::CornerType>(corner));
+    const Eigen::Vector4d p = mvp * Eigen::Vector4d(c.x(), c.y(), c.z(), 1.0);
+    outside[0] += p.x() < -p.w();
+    outside[1] += p.x() > p.w();
+    outside[2] += p.y() < -p.w();
+    outside[3] += p.y() > p.w();
+    outside[4] += p.z() < -p.w();
+    outside[5] += p.z() > p.w();
+  }
+  return std::any_of(std::begin(outside), std::end(outside), [](int n) { return n == 8; });
+}
+
+// Maps a slot's pixel buffer for reading; throws, naming the GL error, when it cannot (the
+// buffer is then unmapped). `what` follows "glMapBufferRange failed" in the message.
+template <class Buffers>
+const uint8_t* MapOrThrow(const Buffers& buffers, int slot, const char* what) {
+  const auto* pixels = static_cast<const uint8_t*>(buffers.Map(slot));
+  if (pixels == nullptr) {
+    const GLenum error = glGetError();
+    buffers.Unmap();
+    throw Error(std::string("Renderer::Retrieve: glMapBufferRange failed") + what + ": " +
+                GlErrorName(error));
+  }
+  return pixels;
+}
+
+// The noise stream of one camera and frame: its seed, its name and the frame index.
+uint32_t NoiseKey(uint64_t seed, const std::string& camera, int64_t frame_index);
+
+// One camera's source view as drawn: projection, focal length (for levels of detail), the
+// view's orientation in the camera, and the camera's +z in the view's OpenGL eye frame.
+struct ViewSetup {
+  Eigen::Matrix4d projection;
+  double focal = 0.0;
+  Eigen::Matrix3d R_CV = Eigen::Matrix3d::Identity();
+  Eigen::Vector3f depth_axis{0.0f, 0.0f, -1.0f};
+};
+
+class GlRenderer final : public Renderer {
+ public:
+  GlRenderer(const scene::Scene& scene, const RendererOptions& options,
+             const std::vector<std::string>& camera_names);
+  ~GlRenderer() override;
+
+  std::vector<Frame> Render(const scene::SceneState& state, int64_t frame_index) override;
+  void Submit(const scene::SceneState& state, int64_t frame_index) override;
+  std::vector<Frame> Retrieve() override;
+  int InFlight() const override { return in_flight_; }
+  const std::vector<std::string>& camera_names() const override { return camera_names_; }
+  std::string DeviceDescription() const override { return description_; }
+  const RenderStats& stats() const override { return stats_; }
+
+ private:
+  // A submitted state whose pixels are on their way.
+  struct Pending {
+    scene::SceneState state;
+    int64_t frame_index = 0;
+    std::vector<geometry::Pose> X_WC;  // per camera
+    GLsync fence = nullptr;
+  };
+
+  // How one camera renders.
+  struct CameraSetup {
+    std::vector<ViewSetup> views;
+    std::unique_ptr<EffectTarget> effects;  // null: the plain path (CameraTarget only)
+    bool distorted = false;                 // the frames carry the lens's distortion
+    bool noise = false;
+    bool blur = false;  // blur configured (it renders sub-frames only when something moves)
+  };
+
+  MeshProgram& GetMeshProgram(int variant);
+  void BuildGroundProgram();
+  void AddItem(const scene::Model& model, const Eigen::Vector3d& scale, int object, int part);
+  void UpdatePoses(const scene::SceneState& state);
+  // The colour pass and the truth pass (internal_draw.cc) draw the same items in the same
+  // order at the same levels of detail, through one visitor.
+  void DrawScene(const ViewSetup& view, double near, const geometry::Pose& X_WV);
+  void DrawTruth(const ViewSetup& view, double near, const geometry::Pose& X_WV);
+  template <class Visit>
+  void ForEachVisibleItem(const ViewSetup& view, double near, const Eigen::Isometry3d& X_EW,
+                          Visit&& visit);
+  const GpuLod& LodOf(const GpuMesh& mesh, double px_per_model_unit) const;
+  static void DrawLod(const GpuMesh& mesh, const GpuLod& lod, bool* culling);
+  void DrawGround(GLint mvp, GLint mv, const Eigen::Matrix4d& P, const Eigen::Isometry3d& X_EW);
+  // Readback (internal_readback.cc): the frame's metadata, and truth (internal_truth.cc).
+  void Describe(int camera, const Pending& pending, ImageMetadata* meta) const;
+  void DrawEffects(int camera, const scene::SceneState& state, int64_t frame_index,
+                   const geometry::Pose& X_WC, int slot);
+  bool MovesDuringExposure(int camera, const scene::SceneState& state,
+                           const std::vector<scene::SceneState>& sub_states) const;
+  // Eye frame from world, and the pixels per model unit at an item's nearest point.
+  static Eigen::Isometry3d EyeFromWorld(const geometry::Pose& X_WV);
+  void SortItems(const Eigen::Isometry3d& X_EW);
+  double PixelsPerModelUnit(const DrawItem& item, double depth, double focal, double near) const;
+  void FillTruth(int camera, const Pending& pending, int slot, Frame* frame);
+  uint32_t ItemId(const DrawItem& item) const;
+  void SetLights(const LightUniforms& uniforms, const Eigen::Isometry3d& X_EW) const;
+  std::shared_ptr<Image> NewImage(int camera);
+
+  EglContext context_;  // first: destroyed last
+  scene::Scene scene_;
+  RendererOptions options_;
+  std::vector<const scene::CameraSpec*> cameras_;
+  std::vector<std::string> camera_names_;
+  std::vector<Eigen::Matrix4d> projections_;
+  std::unique_ptr<GpuResources> resources_;
+  std::vector<std::unique_ptr<CameraTarget>> targets_;  // plain path, per camera (or null)
+  std::vector<CameraSetup> setups_;                     // per camera
+  std::unique_ptr<EffectPrograms> effect_programs_;
+  bool truth_ = false;  // ids and depth rendered
+  std::map<int, MeshProgram> mesh_programs_;
+  GroundProgram ground_;
+  GLuint ground_vao_ = 0;
+  bool draw_ground_ = false;
+  bool draw_robot_ = false;
+  std::vector<DrawItem> items_;
+  std::vector<Eigen::Isometry3d> item_poses_;  // X_WO (X_WLink X_LinkPart) per item, this state
+  std::vector<std::pair<double, int>> order_;  // per view: depth, item
+  Eigen::Vector3f ambient_ = Eigen::Vector3f::Zero();
+  std::vector<const scene::Light*> directional_lights_;
+  std::vector<const scene::Light*> point_lights_;
+  std::array<Pending, CameraTarget::kSlots> pending_;
+  std::vector<std::vector<std::shared_ptr<Image>>> image_pools_;  // per camera
+  int64_t camera_pass_ = 0;                                       // counts DrawScene calls
+  int oldest_ = 0;
+  int in_flight_ = 0;
+  int samples_ = 0;
+  std::string description_;
+  RenderStats stats_;
+};
+
+}  // namespace saccade::render::gl

@@ -1,0 +1,116 @@
+// Retrieve: waits for the oldest submitted state's fence and reads every camera's pixels back
+// from its pixel buffer objects into a pooled image, with the frame's metadata.
+#include <fmt/format.h>
+
+#include <atomic>
+#include <cstring>
+
+#include "render/gl/internal_gl_renderer_impl.h"
+#include "render/gl/internal_pixels.h"
+#include "saccade/core/error.h"
+
+namespace saccade::render::gl {
+
+std::shared_ptr<Image> GlRenderer::NewImage(int camera) {
+  const geometry::Intrinsics& K = cameras_[camera]->model.intrinsics();
+  std::vector<std::shared_ptr<Image>>& pool = image_pools_[camera];
+  for (std::shared_ptr<Image>& image : pool) {
+    // Only the pool holds it: the caller has let go of every frame that shared it.
+    if (image.use_count() == 1) {
+      std::atomic_thread_fence(std::memory_order_acquire);  // after the last reader's release
+      return image;
+    }
+  }
+  auto image = std::make_shared<Image>(K.width(), K.height(), PixelFormat::kRgb8);
+  if (pool.size() < kPooledImagesPerCamera) pool.push_back(image);
+  return image;
+}
+
+std::vector<Frame> GlRenderer::Retrieve() {
+  if (in_flight_ == 0) {
+    throw Error("Renderer::Retrieve: no state is in flight; Submit one first");
+  }
+  context_.MakeCurrent();
+  const Clock::time_point start = Clock::now();
+  const int slot = oldest_;
+  Pending& pending = pending_[slot];
+  GLenum status = GL_TIMEOUT_EXPIRED;
+  while (status == GL_TIMEOUT_EXPIRED) {
+    status = glClientWaitSync(pending.fence, GL_SYNC_FLUSH_COMMANDS_BIT,
+                              GLuint64{1'000'000'000});  // 1 s, then again
+  }
+  glDeleteSync(pending.fence);
+  pending.fence = nullptr;
+  oldest_ = (oldest_ + 1) % CameraTarget::kSlots;
+  --in_flight_;
+  if (status == GL_WAIT_FAILED) {
+    throw Error("Renderer::Retrieve: glClientWaitSync failed: " + GlErrorName(glGetError()));
+  }
+
+  std::vector<Frame> frames;
+  frames.reserve(cameras_.size());
+  for (std::size_t i = 0; i < cameras_.size(); ++i) {
+    const CameraSetup& setup = setups_[i];
+    std::shared_ptr<Image> image = NewImage(static_cast<int>(i));
+    Describe(static_cast<int>(i), pending, &image->metadata());
+    const std::size_t pixel_count =
+        static_cast<std::size_t>(image->width()) * static_cast<std::size_t>(image->height());
+    // One path for every camera: the effect target's colour buffers when effects run, else
+    // the plain target; a tightly packed RGB row is copied as it is.
+    const uint8_t* pixels = setup.effects ? MapOrThrow(setup.effects->color_buffers(), slot, "")
+                                          : MapOrThrow(*targets_[i], slot, "");
+    const int row_bytes = setup.effects ? 4 * image->width() : targets_[i]->row_bytes();
+    if (row_bytes == static_cast<int>(image->stride())) {
+      std::memcpy(image->data(), pixels, image->size_bytes());
+    } else {
+      RgbaToRgb(pixels, image->data(), pixel_count);
+    }
+    if (setup.effects) {
+      setup.effects->color_buffers().Unmap();
+    } else {
+      targets_[i]->Unmap();
+    }
+    Frame frame{std::move(image), nullptr, nullptr, {}};
+    if (truth_) FillTruth(static_cast<int>(i), pending, slot, &frame);
+    frames.push_back(std::move(frame));
+  }
+  ++stats_.frames;
+  const Clock::time_point end = Clock::now();
+  stats_.readback_ms += Milliseconds(start, end);
+  stats_.total_ms += Milliseconds(start, end);
+  return frames;
+}
+
+void GlRenderer::Describe(int camera_index, const Pending& pending, ImageMetadata* out) const {
+  const scene::CameraSpec& camera = *cameras_[camera_index];
+  const CameraSetup& setup = setups_[camera_index];
+  const std::size_t i = static_cast<std::size_t>(camera_index);
+  ImageMetadata& meta = *out;
+  meta.camera = camera.name;
+  meta.time = pending.state.time;
+  meta.frame_index = pending.frame_index;
+  const Eigen::Matrix3d K = camera.model.intrinsics().Matrix();
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) meta.K[3 * r + c] = K(r, c);
+  }
+  // The metadata describes the image as rendered: the lens's distortion, or a pinhole when
+  // distortion is off (or the lens has none).
+  if (setup.distorted) {
+    meta.distortion_model = geometry::ToString(camera.model.distortion().model());
+    meta.distortion = camera.model.distortion().coefficients();
+  } else {
+    meta.distortion_model = geometry::ToString(geometry::DistortionModel::kNone);
+    meta.distortion.clear();
+  }
+  const Eigen::Matrix4d X_WC = pending.X_WC[i].matrix();
+  for (int r = 0; r < 4; ++r) {
+    for (int c = 0; c < 4; ++c) meta.X_WC[4 * r + c] = X_WC(r, c);
+  }
+  meta.has_joints = camera.mount != scene::CameraMount::kWorld;
+  meta.joints = meta.has_joints
+                    ? std::array<double, 4>{pending.state.joints.pan, pending.state.joints.tilt,
+                                            pending.state.joints.left, pending.state.joints.right}
+                    : std::array<double, 4>{};
+}
+
+}  // namespace saccade::render::gl
