@@ -173,9 +173,10 @@ std::string Entry::AsNonEmptyString() const {
 
 std::vector<double> Entry::AsDoubles(int size, const char* names) const {
   const std::string expected =
-      fmt::format("expected {} numbers{}{}", size, *names != '\0' ? " " : "", names);
+      size < 0 ? std::string("expected a list of numbers")
+               : fmt::format("expected {} numbers{}{}", size, *names != '\0' ? " " : "", names);
   if (!node_.IsSequence()) Fail(expected + ", got " + Describe());
-  if (static_cast<int>(node_.size()) != size) {
+  if (size >= 0 && static_cast<int>(node_.size()) != size) {
     Fail(fmt::format("{}, got {}", expected, node_.size()));
   }
   std::vector<double> values;

@@ -57,7 +57,8 @@ class Entry {
   bool AsBool() const;
   std::string AsString() const;  ///< a scalar
   std::string AsNonEmptyString() const;
-  /// `size` finite numbers; `names` says what they are in the message ("[x, y, z]").
+  /// `size` finite numbers (any number of them when `size` < 0); `names` says what they are
+  /// in the message ("[x, y, z]").
   std::vector<double> AsDoubles(int size, const char* names = "") const;
   std::array<double, 3> AsVector3(const char* names = "[x, y, z]") const;
   /// A colour: [r, g, b] (alpha 1) or, when `allow_alpha`, [r, g, b, a]; each in [0, 1].

@@ -12,6 +12,7 @@
 #include <utility>
 #include <vector>
 
+#include "core/internal_yaml.h"
 #include "saccade/core/error.h"
 
 namespace saccade::head {
@@ -22,128 +23,8 @@ constexpr double kRadToDeg = 180.0 / std::numbers::pi;
 // X_WB's rotation must be orthonormal to this (a pose built from rpy is, to ~1e-16).
 constexpr double kRotationTolerance = 1e-9;
 
-// ---------------------------------------------------------------------------------------
 // A YAML node with its key path and file, so that every error names file, line and key.
-class Entry {
- public:
-  Entry(YAML::Node node, std::string path, const std::string* file)
-      : node_(std::move(node)), path_(std::move(path)), file_(file) {}
-
-  const YAML::Node& node() const { return node_; }
-  const std::string& path() const { return path_; }
-  int line() const { return node_.Mark().is_null() ? 0 : node_.Mark().line + 1; }
-
-  [[noreturn]] void Fail(const std::string& what) const {
-    throw FileError(*file_, line(), path_, what);
-  }
-
-  // What the node is, for "expected X, got Y" messages.
-  std::string Describe() const {
-    switch (node_.Type()) {
-      case YAML::NodeType::Null:
-        return "nothing (null)";
-      case YAML::NodeType::Scalar:
-        return "'" + node_.Scalar() + "'";
-      case YAML::NodeType::Sequence:
-        return fmt::format("a list of {} entries", node_.size());
-      case YAML::NodeType::Map:
-        return "a map";
-      default:
-        return "nothing";
-    }
-  }
-
-  // A map whose keys must all be in `allowed` (no unknown keys, no duplicates).
-  void ExpectMap(std::initializer_list<const char*> allowed) const {
-    if (!node_.IsMap()) Fail("expected a map, got " + Describe());
-    std::set<std::string> seen;
-    for (auto it = node_.begin(); it != node_.end(); ++it) {
-      const std::string key = it->first.Scalar();
-      const std::string key_path = Join(key);
-      const int key_line = it->first.Mark().line + 1;
-      bool known = false;
-      std::string expected;
-      for (const char* name : allowed) {
-        known = known || key == name;
-        expected += (expected.empty() ? "" : ", ") + std::string(name);
-      }
-      if (!known) {
-        throw FileError(*file_, key_line, key_path,
-                        "unknown key '" + key + "'; expected one of: " + expected);
-      }
-      if (!seen.insert(key).second) {
-        throw FileError(*file_, key_line, key_path, "duplicate key '" + key + "'");
-      }
-    }
-  }
-
-  bool Has(const char* key) const { return node_.IsMap() && node_[key].IsDefined(); }
-
-  Entry Get(const char* key) const {
-    if (!Has(key)) Fail(std::string("missing key '") + key + "'");
-    return Entry(node_[key], Join(key), file_);
-  }
-  std::optional<Entry> Find(const char* key) const {
-    if (!Has(key)) return std::nullopt;
-    return Entry(node_[key], Join(key), file_);
-  }
-
-  double AsDouble() const {
-    if (!node_.IsScalar()) Fail("expected a number, got " + Describe());
-    double value = 0.0;
-    try {
-      value = node_.as<double>();
-    } catch (const YAML::Exception&) {
-      Fail("expected a number, got " + Describe());
-    }
-    if (!std::isfinite(value)) Fail("expected a finite number, got " + Describe());
-    return value;
-  }
-  double AsPositive() const {
-    const double value = AsDouble();
-    if (!(value > 0.0)) Fail(fmt::format("expected a positive number, got {}", value));
-    return value;
-  }
-  int AsPositiveInt() const {
-    if (!node_.IsScalar()) Fail("expected a positive integer, got " + Describe());
-    long long value = 0;
-    try {
-      value = node_.as<long long>();
-    } catch (const YAML::Exception&) {
-      Fail("expected a positive integer, got " + Describe());
-    }
-    if (value <= 0 || value > 1'000'000) {
-      Fail("expected a positive integer (at most 1000000), got " + Describe());
-    }
-    return static_cast<int>(value);
-  }
-  std::string AsString() const {
-    if (!node_.IsScalar()) Fail("expected a string, got " + Describe());
-    return node_.Scalar();
-  }
-  // A list of finite numbers; `size` < 0 accepts any length.
-  std::vector<double> AsDoubles(int size) const {
-    if (!node_.IsSequence()) {
-      Fail(size < 0 ? "expected a list of numbers, got " + Describe()
-                    : fmt::format("expected a list of {} numbers, got {}", size, Describe()));
-    }
-    if (size >= 0 && static_cast<int>(node_.size()) != size) {
-      Fail(fmt::format("expected a list of {} numbers, got {}", size, Describe()));
-    }
-    std::vector<double> values;
-    for (std::size_t i = 0; i < node_.size(); ++i) {
-      values.push_back(Entry(node_[i], fmt::format("{}[{}]", path_, i), file_).AsDouble());
-    }
-    return values;
-  }
-
- private:
-  std::string Join(const std::string& key) const { return path_.empty() ? key : path_ + "." + key; }
-
-  YAML::Node node_;
-  std::string path_;
-  const std::string* file_;
-};
+using saccade::internal::Entry;
 
 // An angle given either as `<key>_deg` (degrees) or `<key>` (radians): exactly one of them.
 std::optional<Entry> FindAngleEntry(const Entry& parent, const std::string& key, bool* degrees) {
@@ -241,8 +122,8 @@ geometry::Pose ReadPose(const Entry& e) {
 geometry::CameraModel ReadCamera(const Entry& e) {
   e.ExpectMap({"width", "height", "focal_length_mm", "pixel_size_um", "fx", "fy", "cx", "cy",
                "skew", "distortion"});
-  const int width = e.Get("width").AsPositiveInt();
-  const int height = e.Get("height").AsPositiveInt();
+  const int width = static_cast<int>(e.Get("width").AsInteger(1, 1000000));
+  const int height = static_cast<int>(e.Get("height").AsInteger(1, 1000000));
   double fx = 0.0;
   double fy = 0.0;
   const bool physical = e.Has("focal_length_mm") || e.Has("pixel_size_um");

@@ -259,11 +259,11 @@ TEST(HeadDescriptionTest, MissingKeyNamesTheParentAndTheKey) {
 TEST(HeadDescriptionTest, WrongTypesSayWhatWasExpectedAndGot) {
   const std::string scalar = Replace(kValid, "limits_deg: [-45, 45]", "limits_deg: abc");
   ExpectFileError(scalar, LineOf(scalar, "abc"), "joints.tilt.limits_deg",
-                  "expected a list of 2 numbers, got 'abc'");
+                  "expected 2 numbers, got 'abc'");
 
   const std::string three = Replace(kValid, "limits_deg: [-45, 45]", "limits_deg: [-45, 0, 45]");
   ExpectFileError(three, LineOf(three, "[-45, 0, 45]"), "joints.tilt.limits_deg",
-                  "expected a list of 2 numbers, got a list of 3 entries");
+                  "expected 2 numbers, got 3");
 
   const std::string word = Replace(kValid, "half_baseline: 0.1", "half_baseline: wide");
   ExpectFileError(word, LineOf(word, "wide"), "geometry.half_baseline",
@@ -276,7 +276,7 @@ TEST(HeadDescriptionTest, WrongTypesSayWhatWasExpectedAndGot) {
 
   const std::string fraction = Replace(kValid, "width: 1024", "width: 1024.5");
   ExpectFileError(fraction, LineOf(fraction, "1024.5"), "cameras.left.width",
-                  "expected a positive integer, got '1024.5'");
+                  "expected an integer in [1, 1000000], got '1024.5'");
 
   const std::string map =
       Replace(kValid, "pose:\n  position: [0.0, 0.0, 1.2]\n  rpy_deg: [0, 0, 0]\n", "pose: 3\n");
@@ -317,7 +317,7 @@ TEST(HeadDescriptionTest, EmptyRangesAndNonPositiveLimitsAreRejected) {
                   "expected a positive number");
   const std::string width = Replace(kValid, "width: 1024", "width: -1024");
   ExpectFileError(width, LineOf(width, "-1024"), "cameras.left.width",
-                  "expected a positive integer");
+                  "expected an integer in [1, 1000000]");
 }
 
 TEST(HeadDescriptionTest, ConflictingAndUnknownAlternativesAreRejected) {

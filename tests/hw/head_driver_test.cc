@@ -138,7 +138,11 @@ TEST(HeadDriverTest, EmergencyStopHoldsAndRejectsUntilCleared) {
   driver.Command(Pan(-90 * kDeg));
   Sleep(0.05);
   driver.EmergencyStop();
-  const HeadStatus stopped = ReadUntil(driver, [](const HeadStatus& s) { return !s.moving; });
+  // Stopped: every joint at rest, not merely slower than HeadStatus::moving's threshold (a
+  // joint still braking below it moves on, by up to a few tenths of a milliradian).
+  const HeadStatus stopped = ReadUntil(driver, [](const HeadStatus& s) {
+    return s.velocities == head::JointState{0, 0, 0, 0};
+  });
   EXPECT_TRUE(stopped.emergency_stopped);
   EXPECT_FALSE(stopped.ready());
   EXPECT_GT(stopped.positions.pan, -85 * kDeg);
