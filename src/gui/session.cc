@@ -59,13 +59,12 @@ double AxisErrorDeg(const geometry::Pose& X_WC, const Eigen::Vector3d& p_W) {
 
 GuiSession::GuiSession(runtime::Pipeline& pipeline, const scene::Scene& scene,
                        const std::string& scene_name, const GuiOptions& options)
-    : scene_(scene), options_(options) {
-  paused_ = options.paused;
-  speed_ = options.speed;
+    : scene_(scene), options_(options), control_(options.paused) {
   perception_ = options.perception;
   if (!(options.speed >= 0.05 && options.speed <= 10.0)) {
     throw InvalidArgument(fmt::format("--speed must be in [0.05, 10], got {}", options.speed));
   }
+  control_.SetSpeed(options.speed);
   if (options.port < 0 || options.port > 65535) {
     throw InvalidArgument(fmt::format("--port must be in [0, 65535], got {}", options.port));
   }
@@ -290,12 +289,11 @@ json GuiSession::Handle(const json& command, int64_t client) {
     return {{"effects", {{"distortion", d}, {"noise", n}, {"motion_blur", b}}}};
   }
   if (type == "pause") {
-    paused_ = true;
+    control_.Pause();
     return {{"paused", true}};
   }
   if (type == "resume") {
-    steps_to_run_ = 0;
-    paused_ = false;
+    control_.Resume();
     return {{"paused", false}};
   }
   if (type == "step") {
@@ -308,8 +306,10 @@ json GuiSession::Handle(const json& command, int64_t client) {
       }
       count = command["count"].get<int>();
     }
-    if (!paused_) throw CommandError("step: pause first (steps are for a paused simulation)");
-    steps_to_run_ += count;
+    if (!control_.paused()) {
+      throw CommandError("step: pause first (steps are for a paused simulation)");
+    }
+    control_.Step(count);
     return {{"steps", count}};
   }
   if (type == "speed") {
@@ -320,7 +320,7 @@ json GuiSession::Handle(const json& command, int64_t client) {
       throw CommandError("speed: factor must be in [0.05, 10] (simulated s per wall s), got " +
                          (command.contains("factor") ? command["factor"].dump() : "nothing"));
     }
-    speed_ = factor;
+    control_.SetSpeed(factor);
     return {{"speed", factor}};
   }
   if (type == "stop" || type == "estop" || type == "clear") {
@@ -352,8 +352,8 @@ json GuiSession::StateJson(const runtime::StepContext& context, const Latest& la
   json state = {{"type", "state"},
                 {"step", context.step},
                 {"time", t},
-                {"paused", paused_.load()},
-                {"speed", speed_.load()},
+                {"paused", control_.paused()},
+                {"speed", control_.speed()},
                 {"perception", perception_.load()},
                 {"manual", !perception_.load()}};
   if (rendered_) {
@@ -456,14 +456,13 @@ void GuiSession::AfterStep(const runtime::StepContext& context, const Latest& la
     encode_cv_.notify_one();
   }
 
-  // Pause and single steps: wait here, applying commands, until resumed or a step is asked.
+  // Pause, single steps and the pace (runtime/run_control.h), applying commands meanwhile.
   int64_t waited = 0;
-  while (paused_ && !stop) {
-    if (steps_to_run_ > 0) {
-      --steps_to_run_;
-      break;
+  control_.WaitBeforeNext(context, stop, [&](bool paused) {
+    if (!paused) {
+      ApplyQueued();
+      return;
     }
-    std::this_thread::sleep_for(std::chrono::milliseconds(20));
     bool pending = false;
     {
       std::lock_guard lock(queue_mutex_);
@@ -474,26 +473,7 @@ void GuiSession::AfterStep(const runtime::StepContext& context, const Latest& la
       ApplyQueued();
       server_->PublishState(StateJson(context, latest));
     }
-    anchor_wall_ = -1.0;  // the clock restarts from here
-  }
-  // The pace: at most `speed` simulated seconds per wall second.
-  const double now = WallNow();
-  const double speed = speed_;
-  if (anchor_wall_ < 0.0 || std::abs(speed - anchor_speed_) > 1e-12) {
-    anchor_wall_ = now;
-    anchor_sim_ = context.time;
-    anchor_speed_ = speed;
-  }
-  double due = anchor_wall_ + (context.time + context.dt - anchor_sim_) / speed;
-  if (due < now - 0.5) {  // far behind (llvmpipe): do not try to catch up later
-    anchor_wall_ = now;
-    anchor_sim_ = context.time + context.dt;
-    due = now;
-  }
-  while (!stop && WallNow() < due && !paused_) {
-    std::this_thread::sleep_for(std::chrono::duration<double>(std::min(0.02, due - WallNow())));
-    ApplyQueued();
-  }
+  });
   last_return_wall_ = WallNow();
 }
 

@@ -25,6 +25,7 @@
 #include "saccade/gui/overlay.h"
 #include "saccade/render/renderer.h"
 #include "saccade/runtime/pipeline.h"
+#include "saccade/runtime/run_control.h"
 #include "saccade/scene/scene.h"
 #include "saccade/server/gui_server.h"
 
@@ -74,6 +75,7 @@ class GuiSession {
 
   const scene::Scene& scene_;
   GuiOptions options_;
+  runtime::RunControl control_;  // pause, steps, speed (set by commands, obeyed in AfterStep)
   std::unique_ptr<server::GuiServer> server_;
 
   // The components the GUI drives (nullptr when the pipeline has none).
@@ -88,9 +90,6 @@ class GuiSession {
   std::vector<std::function<void()>> queue_;
 
   // Simulation-thread state, mirrored in atomics for the handler's checks and replies.
-  std::atomic<bool> paused_{false};
-  std::atomic<int> steps_to_run_{0};
-  std::atomic<double> speed_{1.0};
   std::atomic<double> sim_time_{0.0};
   std::atomic<bool> perception_{true};
   std::mutex effects_mutex_;
@@ -100,9 +99,6 @@ class GuiSession {
   head::JointState targets_;  // the latest targets, for partial joint commands (joints_mutex_)
 
   // Pacing and timing (simulation thread).
-  double anchor_wall_ = -1.0;  // s, steady clock, at anchor_sim_
-  double anchor_sim_ = 0.0;
-  double anchor_speed_ = 0.0;
   double last_return_wall_ = -1.0;
   double last_step_ms_ = 0.0;
   std::vector<double> step_walls_;  // recent AfterStep times, for steps per second
