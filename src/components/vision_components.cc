@@ -42,13 +42,9 @@ UndistortComponent::UndistortComponent() {
 
 Image UndistortComponent::Apply(const Image& image) {
   // The maps are made once per camera; a camera whose model changes gets new ones.
-  const ImageMetadata& meta = image.metadata();
-  if (!undistorter_ || meta.K != K_ || meta.distortion != distortion_ ||
-      image.width() != undistorter_->camera().intrinsics().width() ||
-      image.height() != undistorter_->camera().intrinsics().height()) {
-    undistorter_ = std::make_unique<vision::Undistorter>(vision::CameraModelOf(image), options_);
-    K_ = meta.K;
-    distortion_ = meta.distortion;
+  const geometry::CameraModel camera = vision::CameraModelOf(image);
+  if (!undistorter_ || !(undistorter_->camera() == camera)) {
+    undistorter_ = std::make_unique<vision::Undistorter>(camera, options_);
   }
   return undistorter_->Apply(image);
 }

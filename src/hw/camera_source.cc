@@ -15,6 +15,7 @@
 #include "saccade/core/error.h"
 #include "saccade/geometry/calibration_io.h"
 #include "saccade/geometry/distortion.h"
+#include "saccade/geometry/image_camera.h"
 #include "saccade/geometry/intrinsics.h"
 #include "saccade/hw/hw_error.h"
 
@@ -320,12 +321,10 @@ class OpenedSource final : public CameraSource {
     meta.camera = name();
     meta.frame_index = index;
     meta.time = FrameTime(index);
-    const Eigen::Matrix3d K = model().intrinsics().Matrix();
-    for (int r = 0; r < 3; ++r) {
-      for (int c = 0; c < 3; ++c) meta.K[static_cast<size_t>(3 * r + c)] = K(r, c);
+    if (!shared_model_ || !(*shared_model_ == model())) {
+      shared_model_ = std::make_shared<const geometry::CameraModel>(model());
     }
-    meta.distortion_model = geometry::ToString(model().distortion().model());
-    meta.distortion = model().distortion().coefficients();
+    geometry::SetCameraModel(meta, shared_model_);
     meta.X_WC = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
     meta.has_joints = false;
     meta.joints = {};
@@ -338,6 +337,8 @@ class OpenedSource final : public CameraSource {
   int first_;
   int every_;
   std::string calibration_;
+  // The frames' camera model, shared by every frame until the model changes (FillMetadata).
+  mutable std::shared_ptr<const geometry::CameraModel> shared_model_;
 
   int64_t next_index_ = 0;
   bool ended_ = false;

@@ -14,6 +14,7 @@
 #include "saccade/core/image_io.h"
 #include "saccade/core/log.h"
 #include "saccade/geometry/calibration_io.h"
+#include "saccade/geometry/image_camera.h"
 #include "saccade/head/json.h"
 
 namespace saccade::render {
@@ -137,17 +138,31 @@ std::string IdsFile(const std::string& camera, int64_t index) {
   return fmt::format("{}/ids/{:06d}.png", camera, index);
 }
 
+/// The camera model a frame was rendered with (it carries it: geometry/image_camera.h).
+const geometry::CameraModel& RenderedModel(const ImageMetadata& m) {
+  const geometry::CameraModel* model = geometry::FindCameraModel(m);
+  if (model == nullptr) {
+    throw Error("render: internal error: camera " + m.camera + "'s frame carries no camera model");
+  }
+  return *model;
+}
+
 /// One line of frames.jsonl: a frame index, its time and every camera's image and metadata.
 json FrameJson(int64_t index, double time, const std::vector<Frame>& frames,
                const TruthRequest& truth, bool scene_has_objects) {
   json cameras = json::object();
   for (const auto& frame : frames) {
     const ImageMetadata& m = frame.color->metadata();
+    const geometry::CameraModel& model = RenderedModel(m);
+    // Row by row, as the file has always said it.
+    const Eigen::Matrix<double, 3, 3, Eigen::RowMajor> K = model.intrinsics().Matrix();
     json entry = {{"file", fmt::format("{}/{:06d}.png", m.camera, index)},
                   {"width", frame.color->width()},
                   {"height", frame.color->height()},
-                  {"K", MatrixJson(m.K.data(), 3, 3)},
-                  {"distortion", {{"model", m.distortion_model}, {"coefficients", m.distortion}}},
+                  {"K", MatrixJson(K.data(), 3, 3)},
+                  {"distortion",
+                   {{"model", geometry::ToString(model.distortion().model())},
+                    {"coefficients", model.distortion().coefficients()}}},
                   {"X_WC", MatrixJson(m.X_WC.data(), 4, 4)}};
     if (m.has_joints) {
       entry["joints"] =
@@ -213,22 +228,6 @@ void PrepareOutput(const fs::path& out, const std::vector<std::string>& cameras,
   }
 }
 
-/// The camera model a frame was rendered with: the camera's K and the distortion its metadata
-/// says was rendered ("none" when RendererOptions::distortion was off or the lens has none).
-geometry::CameraModel RenderedModel(const scene::CameraSpec& camera, const ImageMetadata& m) {
-  geometry::DistortionModel model = geometry::DistortionModel::kNone;
-  if (m.distortion_model == geometry::ToString(geometry::DistortionModel::kRadialTangential)) {
-    model = geometry::DistortionModel::kRadialTangential;
-  } else if (m.distortion_model == geometry::ToString(geometry::DistortionModel::kFisheye)) {
-    model = geometry::DistortionModel::kFisheye;
-  } else if (m.distortion_model != geometry::ToString(geometry::DistortionModel::kNone)) {
-    throw Error(fmt::format("render: internal error: camera {}'s frame says distortion '{}'",
-                            camera.name, m.distortion_model));
-  }
-  return geometry::CameraModel(camera.model.intrinsics(),
-                               geometry::Distortion::FromCoefficients(model, m.distortion));
-}
-
 /// DIR/<camera>.yaml for every camera and DIR/stereo.yaml for a head's eyes, describing the
 /// images as rendered (the first frames' metadata): K, and the lens distortion whenever it
 /// was rendered.
@@ -241,7 +240,7 @@ void WriteCalibrations(const scene::Scene& scene, const scene::SceneState& state
     if (camera == nullptr) {
       throw Error("render: internal error: a frame of unknown camera '" + m.camera + "'");
     }
-    const geometry::CameraModel model = RenderedModel(*camera, m);
+    const geometry::CameraModel& model = RenderedModel(m);
     if (distortion_on && !camera->model.distortion().IsIdentity() &&
         model.distortion().model() == geometry::DistortionModel::kNone) {
       // Only a renderer without lens effects does this; the files then say what the images are.

@@ -1,34 +1,31 @@
 #include "saccade/vision/image_camera.h"
 
+#include <fmt/format.h>
+
 #include <Eigen/Core>
 #include <string>
 
 #include "saccade/core/error.h"
 #include "saccade/geometry/distortion.h"
+#include "saccade/geometry/image_camera.h"
 #include "saccade/geometry/intrinsics.h"
 
 namespace saccade::vision {
 
 geometry::CameraModel CameraModelOf(const Image& image) {
   const ImageMetadata& m = image.metadata();
-  const Eigen::Matrix3d K =
-      Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(m.K.data());
-  const geometry::Intrinsics intrinsics =
-      geometry::Intrinsics::FromMatrix(K, image.width(), image.height());
-  const std::string& model = m.distortion_model;
-  geometry::Distortion distortion;
-  if (model == "radtan") {
-    distortion = geometry::Distortion::RadialTangential(m.distortion);
-  } else if (model == "fisheye") {
-    distortion = geometry::Distortion::Fisheye(m.distortion);
-  } else if (model == "none" || model.empty()) {
-    distortion =
-        geometry::Distortion::FromCoefficients(geometry::DistortionModel::kNone, m.distortion);
-  } else {
-    throw InvalidArgument("CameraModelOf: image of camera '" + m.camera + "': distortion model '" +
-                          model + "', expected none, radtan or fisheye");
+  const geometry::CameraModel* model = geometry::FindCameraModel(m);
+  if (model == nullptr) {
+    throw InvalidArgument("CameraModelOf: image of camera '" + m.camera +
+                          "' carries no camera model");
   }
-  return geometry::CameraModel(intrinsics, distortion);
+  const geometry::Intrinsics& k = model->intrinsics();
+  if (k.width() != image.width() || k.height() != image.height()) {
+    throw InvalidArgument(
+        fmt::format("CameraModelOf: image of camera '{}' is {}x{}, its camera model {}x{}",
+                    m.camera, image.width(), image.height(), k.width(), k.height()));
+  }
+  return *model;
 }
 
 geometry::Pose CameraPoseOf(const Image& image) {

@@ -8,6 +8,7 @@
 #include "internal_cv.h"
 #include "saccade/core/error.h"
 #include "saccade/geometry/distortion.h"
+#include "saccade/geometry/image_camera.h"
 
 namespace saccade::vision {
 
@@ -25,7 +26,9 @@ bool Undistorter::Options::IsValid(std::string* error) const {
 Undistorter::Undistorter(const geometry::CameraModel& camera) : Undistorter(camera, Options()) {}
 
 Undistorter::Undistorter(const geometry::CameraModel& camera, const Options& options)
-    : camera_(camera), options_(options) {
+    : camera_(camera),
+      pinhole_(std::make_shared<const geometry::CameraModel>(camera.intrinsics())),
+      options_(options) {
   std::string error;
   if (!options.IsValid(&error)) throw InvalidArgument(error);
   const auto& in = camera.intrinsics();
@@ -60,8 +63,7 @@ Image Undistorter::Apply(const Image& image) const {
   cv::remap(src, dst, map_x_, map_y_, options_.bilinear ? cv::INTER_LINEAR : cv::INTER_NEAREST,
             cv::BORDER_CONSTANT, cv::Scalar::all(options_.border_value));
   out.metadata() = image.metadata();
-  out.metadata().distortion_model = "none";
-  out.metadata().distortion.clear();
+  geometry::SetCameraModel(out.metadata(), pinhole_);
   return out;
 }
 

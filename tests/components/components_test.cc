@@ -9,6 +9,7 @@
 #include <optional>
 #include <string>
 
+#include "image_camera_helpers.h"
 #include "saccade/components/face_truth.h"
 #include "saccade/components/messages.h"
 #include "saccade/components/register.h"
@@ -238,7 +239,7 @@ TEST(PreprocessingComponents, GiveWhatTheVisionClassesGive) {
   const std::string bench = std::string(SACCADE_SOURCE_DIR) + "/scenes/bench.yaml";
   const head::JointState still{0.0, 0.0, 0.0, 0.0};
   const auto image = RenderOne(bench, "left", still, still);
-  ASSERT_EQ(image->metadata().distortion_model, "radtan");
+  ASSERT_EQ(testing_helpers::DistortionName(image->metadata()), "radtan");
   const auto run = [&](const std::string& type, const json& params) {
     auto c = Make(type, params);
     auto out = Capture<runtime::ImageMessage>(*c, "image");
@@ -263,7 +264,7 @@ TEST(PreprocessingComponents, GiveWhatTheVisionClassesGive) {
   const auto undistorted = run("vision.undistort", json::object());
   EXPECT_TRUE(
       equal(*undistorted, vision::Undistorter(vision::CameraModelOf(*image)).Apply(*image)));
-  EXPECT_EQ(undistorted->metadata().distortion_model, "none");
+  EXPECT_EQ(testing_helpers::DistortionName(undistorted->metadata()), "none");
   EXPECT_EQ(undistorted->metadata().frame_index, image->metadata().frame_index);
 }
 

@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "image_camera_helpers.h"
 #include "saccade/components/face_truth.h"
 #include "saccade/components/messages.h"
 #include "saccade/components/register.h"
@@ -115,10 +116,10 @@ components:
     EXPECT_EQ(left.width(), 640);
     EXPECT_EQ(left.height(), 480);
     // K and distortion from intrinsics.yml: M1 D1 and M2 D2.
-    EXPECT_DOUBLE_EQ(left.metadata().K[2], 3.3568643204394891e+02);
-    EXPECT_DOUBLE_EQ(right.metadata().K[2], 3.3455744527912015e+02);
-    EXPECT_DOUBLE_EQ(left.metadata().distortion[0], 2.9589439552724328e-01);
-    EXPECT_DOUBLE_EQ(right.metadata().distortion[0], -1.6916358306948096e-01);
+    EXPECT_DOUBLE_EQ(testing_helpers::KAt(left.metadata(), 2), 3.3568643204394891e+02);
+    EXPECT_DOUBLE_EQ(testing_helpers::KAt(right.metadata(), 2), 3.3455744527912015e+02);
+    EXPECT_DOUBLE_EQ(testing_helpers::Coefficients(left.metadata())[0], 2.9589439552724328e-01);
+    EXPECT_DOUBLE_EQ(testing_helpers::Coefficients(right.metadata())[0], -1.6916358306948096e-01);
     // X_WC: the head's forward kinematics at the joints the image was taken at.
     ASSERT_TRUE(left.metadata().has_joints);
     const auto& q = left.metadata().joints;

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "hw/camera_test_files.h"
+#include "image_camera_helpers.h"
 #include "saccade/core/error.h"
 #include "saccade/geometry/calibration_io.h"
 #include "saccade/hw/hw_error.h"
@@ -161,9 +162,10 @@ TEST_F(CameraSourceTest, ListTakesEveryOtherEntryOfStereoCalibXmlWithIntrinsicsY
       EXPECT_EQ(meta.camera, spec.name);
       EXPECT_EQ(meta.frame_index, static_cast<int64_t>(i));
       EXPECT_EQ(meta.time, static_cast<double>(i) / 15.0);
-      for (int k = 0; k < 9; ++k) EXPECT_EQ(meta.K[k], K.at<double>(k / 3, k % 3)) << "K " << k;
-      EXPECT_EQ(meta.distortion_model, "radtan");
-      EXPECT_EQ(meta.distortion, expected_distortion);
+      for (int k = 0; k < 9; ++k)
+        EXPECT_EQ(testing_helpers::KAt(meta, k), K.at<double>(k / 3, k % 3)) << "K " << k;
+      EXPECT_EQ(testing_helpers::DistortionName(meta), "radtan");
+      EXPECT_EQ(testing_helpers::Coefficients(meta), expected_distortion);
       ExpectIdentityPose(meta);
     }
     EXPECT_EQ(source->Grab(), nullptr) << "13 frames, then the end";
@@ -368,8 +370,8 @@ TEST_F(CameraSourceTest, OneCameraCalibrationFileGivesTheModel) {
   EXPECT_EQ(source->model(), geometry::ReadCameraCalibration(spec.calibration).model);
   const auto image = source->Grab();
   ASSERT_NE(image, nullptr);
-  EXPECT_EQ(image->metadata().K[0], 5.3591573396163199e+02);
-  EXPECT_EQ(image->metadata().distortion[4], 2.3839153080878486e-01);
+  EXPECT_EQ(testing_helpers::KAt(image->metadata(), 0), 5.3591573396163199e+02);
+  EXPECT_EQ(testing_helpers::Coefficients(image->metadata())[4], 2.3839153080878486e-01);
 }
 
 TEST_F(CameraSourceTest, CalibrationSizeMismatchNamesCameraSizesAndFile) {

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "hw/camera_test_files.h"
+#include "image_camera_helpers.h"
 #include "saccade/core/error.h"
 #include "saccade/geometry/intrinsics.h"
 #include "saccade/hw/hw_error.h"
@@ -230,8 +231,8 @@ TEST_F(StereoSourceTest, PlaysOpenCvStereoSampleAsThirteenPairs) {
     EXPECT_EQ(left.time, i / 10.0);
     EXPECT_EQ(right.time, i / 10.0);
     for (int k = 0; k < 9; ++k) {
-      EXPECT_EQ(left.K[k], M1.at<double>(k / 3, k % 3));
-      EXPECT_EQ(right.K[k], M2.at<double>(k / 3, k % 3));
+      EXPECT_EQ(testing_helpers::KAt(left, k), M1.at<double>(k / 3, k % 3));
+      EXPECT_EQ(testing_helpers::KAt(right, k), M2.at<double>(k / 3, k % 3));
     }
   }
   EXPECT_FALSE(stereo->Grab().has_value());
@@ -315,12 +316,13 @@ std::vector<cv::Point2f> Corners(const Image& image) {
 }
 
 cv::Mat KOf(const ImageMetadata& meta) {
-  return cv::Mat(3, 3, CV_64F, const_cast<double*>(meta.K.data())).clone();
+  cv::Mat K(3, 3, CV_64F);
+  for (int k = 0; k < 9; ++k) K.at<double>(k / 3, k % 3) = testing_helpers::KAt(meta, k);
+  return K;
 }
 cv::Mat DistortionOf(const ImageMetadata& meta) {
-  return cv::Mat(1, static_cast<int>(meta.distortion.size()), CV_64F,
-                 const_cast<double*>(meta.distortion.data()))
-      .clone();
+  const std::vector<double> d = testing_helpers::Coefficients(meta);
+  return cv::Mat(1, static_cast<int>(d.size()), CV_64F, const_cast<double*>(d.data())).clone();
 }
 
 // The pixel RMS of reprojecting each view's corners through its own pose (solvePnP) with the

@@ -49,6 +49,7 @@
 #include <string>
 #include <vector>
 
+#include "image_camera_helpers.h"
 #include "saccade/core/image.h"
 #include "saccade/core/image_io.h"
 #include "saccade/geometry/camera_model.h"
@@ -413,7 +414,7 @@ Observations Observe(const std::vector<TestCamera>& cameras,
     for (std::size_t k = 0; k < X_WO.size(); ++k) {
       const Image& image = *obs.images[k][c];
       const std::string name = test + "_" + camera.name + "_view" + std::to_string(k);
-      EXPECT_EQ(image.metadata().distortion_model,
+      EXPECT_EQ(testing_helpers::DistortionName(image.metadata()),
                 geometry::ToString(camera.model.distortion().model()))
           << name << ": the frame is not rendered with the camera's lens";
       std::vector<Vector3d> p_C;

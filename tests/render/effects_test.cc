@@ -17,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include "image_camera_helpers.h"
 #include "saccade/core/image.h"
 #include "saccade/core/image_io.h"
 #include "saccade/geometry/camera_model.h"
@@ -522,9 +523,9 @@ TEST(TruthTest, DistortionOffRendersThePinholeAndSaysSo) {
   pinhole.distortion = false;
   const Frame distorted = RenderOnce(world)[0];
   const Frame plain = RenderOnce(world, pinhole)[0];
-  EXPECT_EQ(distorted.color->metadata().distortion_model, "radtan");
-  EXPECT_EQ(plain.color->metadata().distortion_model, "none");
-  EXPECT_TRUE(plain.color->metadata().distortion.empty());
+  EXPECT_EQ(testing_helpers::DistortionName(distorted.color->metadata()), "radtan");
+  EXPECT_EQ(testing_helpers::DistortionName(plain.color->metadata()), "none");
+  EXPECT_TRUE(testing_helpers::Coefficients(plain.color->metadata()).empty());
   EXPECT_FALSE(SamePixels(*distorted.color, *plain.color));
   EXPECT_FALSE(distorted.depth);  // not asked for
   EXPECT_TRUE(distorted.objects.empty());

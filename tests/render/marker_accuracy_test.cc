@@ -50,6 +50,7 @@
 #include <string>
 #include <vector>
 
+#include "image_camera_helpers.h"
 #include "saccade/core/image.h"
 #include "saccade/core/image_io.h"
 #include "saccade/geometry/camera_model.h"
@@ -323,7 +324,8 @@ TEST_P(MarkerAccuracyTest, CentroidsMatchOpenCvProjection) {
   const Image& image = *frames[0].color;
   ASSERT_EQ(image.width(), K.width());
   ASSERT_EQ(image.height(), K.height());
-  EXPECT_EQ(image.metadata().distortion_model, geometry::ToString(model.distortion().model()));
+  EXPECT_EQ(testing_helpers::DistortionName(image.metadata()),
+            geometry::ToString(model.distortion().model()));
 
   // Intensity-weighted centroids in windows about OpenCV's pixels; every lit pixel must fall in
   // some window, and every window's border must be dark (the marker lies wholly inside).

@@ -16,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "image_camera_helpers.h"
 #include "saccade/core/error.h"
 #include "saccade/core/image.h"
 #include "saccade/geometry/camera_model.h"
@@ -382,16 +383,17 @@ TEST(RendererTest, SubmitAndRetrieveReturnFramesInOrderWithTheirMetadata) {
       const Eigen::Matrix4d X_WC = world.CameraPose(camera, states[i]).matrix();
       for (int k = 0; k < 16; ++k) EXPECT_EQ(meta.X_WC[k], X_WC(k / 4, k % 4)) << k;
       const Eigen::Matrix3d K = camera.model.intrinsics().Matrix();
-      for (int k = 0; k < 9; ++k) EXPECT_EQ(meta.K[k], K(k / 3, k % 3)) << k;
+      for (int k = 0; k < 9; ++k) EXPECT_EQ(testing_helpers::KAt(meta, k), K(k / 3, k % 3)) << k;
       // The metadata describes the lens as rendered: camera 2's radtan distortion, the
       // eyes' pinholes.
-      EXPECT_EQ(meta.distortion_model, geometry::ToString(camera.model.distortion().IsIdentity()
-                                                              ? geometry::DistortionModel::kNone
-                                                              : camera.model.distortion().model()));
+      EXPECT_EQ(testing_helpers::DistortionName(meta),
+                geometry::ToString(camera.model.distortion().IsIdentity()
+                                       ? geometry::DistortionModel::kNone
+                                       : camera.model.distortion().model()));
       if (!camera.model.distortion().IsIdentity()) {
-        EXPECT_EQ(meta.distortion, camera.model.distortion().coefficients());
+        EXPECT_EQ(testing_helpers::Coefficients(meta), camera.model.distortion().coefficients());
       } else {
-        EXPECT_TRUE(meta.distortion.empty());
+        EXPECT_TRUE(testing_helpers::Coefficients(meta).empty());
       }
       const bool eye = camera.mount != scene::CameraMount::kWorld;
       EXPECT_EQ(meta.has_joints, eye);

@@ -80,8 +80,6 @@ class UndistortComponent : public ImageFilterComponent {
  private:
   vision::Undistorter::Options options_;
   std::unique_ptr<vision::Undistorter> undistorter_;  // made for the latest camera seen
-  std::array<double, 9> K_{};
-  std::vector<double> distortion_;
 };
 
 class MedianComponent : public ImageFilterComponent {

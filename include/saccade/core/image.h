@@ -8,6 +8,8 @@
 #include <cstdint>
 #include <memory>
 #include <string>
+#include <typeindex>
+#include <utility>
 #include <vector>
 
 namespace saccade {
@@ -26,19 +28,52 @@ int BytesPerPixel(PixelFormat format);
 /// "gray8", "rgb8", ...
 const char* ToString(PixelFormat format);
 
-/// What a frame is and where it came from (DESIGN.md): plain numbers, no geometry types, so
-/// that every layer can carry it. Frames are named as in DESIGN.md: X_WC is the camera's
-/// optical frame in the world.
+/// Values of other layers' types that a frame carries, one per type, found by type (no
+/// string round trip): geometry's camera model (geometry/image_camera.h). They are immutable
+/// and shared: copying the metadata copies pointers.
+class TypedValues {
+ public:
+  template <typename T>
+  void Set(std::shared_ptr<const T> value) {
+    for (auto& [type, held] : values_) {
+      if (type == std::type_index(typeid(T))) {
+        held = std::move(value);
+        return;
+      }
+    }
+    values_.emplace_back(std::type_index(typeid(T)), std::move(value));
+  }
+  /// nullptr when the frame carries no T.
+  template <typename T>
+  const T* Get() const {
+    for (const auto& [type, held] : values_) {
+      if (type == std::type_index(typeid(T))) return static_cast<const T*>(held.get());
+    }
+    return nullptr;
+  }
+  template <typename T>
+  std::shared_ptr<const T> Share() const {
+    for (const auto& [type, held] : values_) {
+      if (type == std::type_index(typeid(T))) return std::static_pointer_cast<const T>(held);
+    }
+    return nullptr;
+  }
+
+ private:
+  std::vector<std::pair<std::type_index, std::shared_ptr<const void>>> values_;
+};
+
+/// What a frame is and where it came from (DESIGN.md). Frames are named as in DESIGN.md: X_WC
+/// is the camera's optical frame in the world. The camera model (K and the lens distortion of
+/// the image as it is) is geometry's type, in `typed` (geometry/image_camera.h).
 struct ImageMetadata {
-  std::string camera;       ///< camera name ("left", "right", ...)
-  double time = 0.0;        ///< simulation (or capture) time, seconds
-  int64_t frame_index = 0;  ///< 0, 1, 2, ... per camera
-  std::array<double, 9> K{};           ///< row-major 3x3 camera matrix, pixels
-  std::string distortion_model;        ///< "none", "radtan" or "fisheye"
-  std::vector<double> distortion;      ///< OpenCV order
-  std::array<double, 16> X_WC{};       ///< row-major 4x4 pose of the optical frame in W
-  bool has_joints = false;             ///< whether the camera rides on a head
-  std::array<double, 4> joints{};      ///< pan, tilt, left, right (rad) at capture
+  std::string camera;              ///< camera name ("left", "right", ...)
+  double time = 0.0;               ///< simulation (or capture) time, seconds
+  int64_t frame_index = 0;         ///< 0, 1, 2, ... per camera
+  TypedValues typed;               ///< the camera model
+  std::array<double, 16> X_WC{};   ///< row-major 4x4 pose of the optical frame in W
+  bool has_joints = false;         ///< whether the camera rides on a head
+  std::array<double, 4> joints{};  ///< pan, tilt, left, right (rad) at capture
 };
 
 /// A borrowed, read-only image: pointer, size, format, row stride. Cheap to copy.
@@ -83,7 +118,9 @@ class Image {
   const uint8_t* data() const { return pixels_.data(); }
   std::size_t size_bytes() const { return pixels_.size(); }
   uint8_t* row(int y) { return pixels_.data() + static_cast<std::size_t>(y) * stride(); }
-  const uint8_t* row(int y) const { return pixels_.data() + static_cast<std::size_t>(y) * stride(); }
+  const uint8_t* row(int y) const {
+    return pixels_.data() + static_cast<std::size_t>(y) * stride();
+  }
   ImageMetadata& metadata() { return metadata_; }
   const ImageMetadata& metadata() const { return metadata_; }
   ImageView view() const { return {data(), width_, height_, format_, stride(), &metadata_}; }

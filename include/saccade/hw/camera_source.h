@@ -29,10 +29,9 @@
 //
 // Frames are PixelFormat::kRgb8 (converted from BGR, BGRA, gray, 16-bit) with their
 // ImageMetadata filled as the simulated cameras fill it: camera = the source's name,
-// frame_index 0, 1, 2, ... as delivered, time (below), K and distortion from the calibration
-// (distortion_model "radtan", "fisheye" or "none"; coefficients in OpenCV's order, radtan
-// always 8: k1 k2 p1 p2 k3 k4 k5 k6), X_WC the identity and has_joints false (a component that
-// knows the head fills both).
+// frame_index 0, 1, 2, ... as delivered, time (below), the calibration's camera model
+// (geometry/image_camera.h: K and the distortion, coefficients in OpenCV's order), X_WC the
+// identity and has_joints false (a component that knows the head fills both).
 //
 // Time stamps, in seconds:
 // - devices (v4l2, gstreamer, iidc): the std::chrono::steady_clock time at which the frame was

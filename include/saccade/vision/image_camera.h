@@ -7,9 +7,8 @@
 
 namespace saccade::vision {
 
-/// The camera model of `image`: K and distortion from its metadata, size from the image.
-/// Throws InvalidArgument naming the camera when K is not a valid camera matrix or the
-/// distortion model or coefficients are not ones geometry::Distortion accepts.
+/// The camera model `image` carries (geometry/image_camera.h). Throws InvalidArgument naming
+/// the camera when it carries none or one of another image size.
 geometry::CameraModel CameraModelOf(const Image& image);
 
 /// X_WC of `image`'s optical frame (metres), from its metadata; the bottom row is not checked.

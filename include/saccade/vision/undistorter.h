@@ -2,6 +2,7 @@
 // Undistortion (seed Fig. 2, pre-processing): the image a pinhole camera with the same K
 // would have taken. The remap tables are computed once per camera (cv::initUndistortRectifyMap
 // or cv::fisheye::initUndistortRectifyMap with K as the new camera matrix) and reused.
+#include <memory>
 #include <opencv2/core.hpp>
 #include <string>
 
@@ -37,6 +38,7 @@ class Undistorter {
 
  private:
   geometry::CameraModel camera_;
+  std::shared_ptr<const geometry::CameraModel> pinhole_;  // the output's: K, no distortion
   Options options_;
   cv::Mat map_x_;  // CV_32FC1
   cv::Mat map_y_;

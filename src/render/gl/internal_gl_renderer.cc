@@ -103,6 +103,9 @@ GlRenderer::GlRenderer(const scene::Scene& scene, const RendererOptions& options
         options_.distortion ? camera->model : geometry::CameraModel(K);
     geometry::LensMap lens = geometry::MakeLensMap(model);
     setup.distorted = lens.kind != geometry::LensMap::Kind::kIdentity;
+    // The frames' camera model: the image as rendered (a pinhole of K without distortion).
+    setup.rendered = std::make_shared<const geometry::CameraModel>(
+        setup.distorted ? camera->model : geometry::CameraModel(K));
     setup.noise = options_.noise && camera->sensor.HasNoise();
     setup.blur = options_.motion_blur && camera->sensor.HasBlur();
     for (const geometry::SourceView& source : lens.views) {

@@ -176,6 +176,7 @@ class GlRenderer final : public Renderer {
     std::vector<ViewSetup> views;
     std::unique_ptr<EffectTarget> effects;  // null: the plain path (CameraTarget only)
     bool distorted = false;                 // the frames carry the lens's distortion
+    std::shared_ptr<const geometry::CameraModel> rendered;  // every frame's camera model
     bool noise = false;
     bool blur = false;  // blur configured (it renders sub-frames only when something moves)
   };

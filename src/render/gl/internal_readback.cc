@@ -8,6 +8,7 @@
 #include "render/gl/internal_gl_renderer_impl.h"
 #include "render/gl/internal_pixels.h"
 #include "saccade/core/error.h"
+#include "saccade/geometry/image_camera.h"
 
 namespace saccade::render::gl {
 
@@ -89,19 +90,9 @@ void GlRenderer::Describe(int camera_index, const Pending& pending, ImageMetadat
   meta.camera = camera.name;
   meta.time = pending.state.time;
   meta.frame_index = pending.frame_index;
-  const Eigen::Matrix3d K = camera.model.intrinsics().Matrix();
-  for (int r = 0; r < 3; ++r) {
-    for (int c = 0; c < 3; ++c) meta.K[3 * r + c] = K(r, c);
-  }
-  // The metadata describes the image as rendered: the lens's distortion, or a pinhole when
-  // distortion is off (or the lens has none).
-  if (setup.distorted) {
-    meta.distortion_model = geometry::ToString(camera.model.distortion().model());
-    meta.distortion = camera.model.distortion().coefficients();
-  } else {
-    meta.distortion_model = geometry::ToString(geometry::DistortionModel::kNone);
-    meta.distortion.clear();
-  }
+  // The image as rendered: the lens's distortion, or a pinhole when distortion is off (or the
+  // lens has none).
+  geometry::SetCameraModel(meta, setup.rendered);
   const Eigen::Matrix4d X_WC = pending.X_WC[i].matrix();
   for (int r = 0; r < 4; ++r) {
     for (int c = 0; c < 4; ++c) meta.X_WC[4 * r + c] = X_WC(r, c);
