@@ -1,0 +1,39 @@
+#pragma once
+// vision.camshift -- one eye's CamShift track of the selected face (vision/camshift_tracker.h),
+//   seeded by its detection box, re-seeded when a detection of the same target lies farther
+//   than reseed_fraction of its width from the track, re-detected when lost.
+//   inputs: image (runtime.image, required), selection (vision.selection, required)
+//   outputs: track (vision.track)
+// Parameters: declared in the constructor (docs/components.md lists them).
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "saccade/components/messages.h"
+#include "saccade/runtime/component.h"
+#include "saccade/vision/camshift_tracker.h"
+
+namespace saccade::components {
+
+class CamShiftComponent : public runtime::Component {
+ public:
+  CamShiftComponent();
+  void Step(const runtime::StepContext& context) override;
+
+ protected:
+  void Configured() override;
+
+ private:
+  std::string eye_;
+  runtime::Input<runtime::ImageMessage>& image_;
+  runtime::Input<SelectionMessage>& selection_;
+  runtime::Output<TrackMessage>& track_;
+  bool left_ = true;
+  double reseed_fraction_ = 0.5;
+  vision::CamShiftTracker::Options options_;
+  std::unique_ptr<vision::CamShiftTracker> tracker_;
+  int64_t target_id_ = -1;
+};
+
+}  // namespace saccade::components

@@ -1,0 +1,48 @@
+#pragma once
+// sim.cameras -- renders the scene's cameras (seed: cameraCapture through the FBO), one image
+//   output per camera of its `cameras` parameter.
+//   inputs:  joints (head.joints, optional): the head's state at this step's time; connect
+//            it from sim.head with delay 1. Without it, the scene's initial joints.
+//   outputs: <camera> (runtime.image) per camera, shared; frame index = step.
+// Parameters: declared in the constructor (docs/components.md lists them).
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "saccade/components/messages.h"
+#include "saccade/components/roles.h"
+#include "saccade/render/renderer.h"
+#include "saccade/runtime/component.h"
+#include "saccade/scene/scene.h"
+
+namespace saccade::components {
+
+class SimCameras : public runtime::Component, public EyeCamerasRole {
+ public:
+  SimCameras();
+  void Start() override;
+  void Step(const runtime::StepContext& context) override;
+  void Stop() override;
+
+  const scene::Scene& scene() const override { return *scene_; }
+  /// Switches the scene's effects (the GUI's toggles); the next Step renders with them (it
+  /// makes a new renderer). Call from the thread that runs the pipeline.
+  void SetEffects(bool distortion, bool noise, bool motion_blur) override;
+  const render::RendererOptions& options() const { return options_; }
+  const render::RendererOptions* rendered() const override { return &options_; }
+
+ protected:
+  void Configured() override;
+
+ private:
+  std::string scene_param_;
+  runtime::Input<JointStateMessage>& joints_;
+  std::vector<runtime::Output<runtime::ImageMessage>*> outputs_;
+  std::shared_ptr<const scene::Scene> scene_;
+  render::RendererOptions options_;
+  std::unique_ptr<render::Renderer> renderer_;
+  bool options_changed_ = false;
+};
+
+}  // namespace saccade::components

@@ -1,0 +1,82 @@
+#include "saccade/components/camshift_component.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include "components/internal_frames.h"
+#include "components/internal_scene.h"
+#include "saccade/core/error.h"
+#include "saccade/head/kinematics.h"
+#include "saccade/vision/image_camera.h"
+
+namespace saccade::components {
+
+using internal::Centre;
+using internal::FrameOf;
+
+CamShiftComponent::CamShiftComponent()
+    : image_(AddInput<runtime::ImageMessage>("image", /*required=*/true)),
+      selection_(AddInput<SelectionMessage>("selection", /*required=*/true)),
+      track_(AddOutput<TrackMessage>("track")) {
+  DeclareParam("eye", &eye_, "the eye whose image and box it tracks")
+      .Choices({"left", "right"})
+      .Required();
+  DeclareParam("min_mass_ratio", &options_.min_mass_ratio,
+               "the track is lost when the window's hue mass falls below this share of the seed's")
+      .Range(0.0, 0.999);
+  DeclareParam("reseed_fraction", &reseed_fraction_,
+               "re-seed when a detection lies farther than this share of its width from the track")
+      .Range(0.0, 100.0);
+}
+
+void CamShiftComponent::Configured() {
+  left_ = eye_ == "left";
+  tracker_ = std::make_unique<vision::CamShiftTracker>(options_);
+}
+
+void CamShiftComponent::Step(const runtime::StepContext&) {
+  if (!image_.fresh() || !image_.value().image) return;
+  const std::shared_ptr<const Image>& image = image_.value().image;
+  TrackMessage out;
+  out.image = image;
+  const SelectionMessage* selection = selection_.get();
+  if (selection == nullptr || !selection->valid) {
+    target_id_ = -1;
+    out.reason = "no target";
+    track_.Emit(out);
+    return;
+  }
+  const cv::Rect box = left_ ? selection->left_box : selection->right_box;
+  const bool detected =
+      selection->boxes_fresh && selection->frame_index == image->metadata().frame_index;
+  const bool same_target = selection->target_id == target_id_ && tracker_->tracking();
+  if (same_target) {
+    const vision::TrackState state = tracker_->Update(*image);
+    // A detection of the target far from the track means the track drifted: start again.
+    const bool drifted = detected && !state.lost() &&
+                         cv::norm(state.Center() - Centre(box)) > reseed_fraction_ * box.width;
+    if ((state.lost() || drifted) && detected) {
+      out.reseeded = tracker_->Start(*image, box);
+    } else if (state.lost()) {
+      out.reason = state.reason;
+    }
+  } else if (detected) {
+    out.reseeded = tracker_->Start(*image, box);
+    if (!out.reseeded) out.reason = "the detection holds no usable colour";
+  } else {
+    out.reason = "waiting for a detection of the target";
+  }
+  out.target_id = selection->target_id;
+  target_id_ = tracker_->tracking() ? selection->target_id : -1;
+  out.tracking = tracker_->tracking();
+  if (out.tracking) {
+    out.window = tracker_->state().window;
+    out.center = tracker_->state().Center();
+  }
+  track_.Emit(out);
+}
+
+}  // namespace saccade::components

@@ -1,0 +1,78 @@
+#include "saccade/components/sim_cameras.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include "components/internal_scene.h"
+#include "saccade/core/error.h"
+
+namespace saccade::components {
+
+SimCameras::SimCameras() : joints_(AddInput<JointStateMessage>("joints")) {
+  options_.cameras = {"left", "right"};
+  DeclareParam("scene", &scene_param_, internal::kSceneParamDoc).Path();
+  DeclareParam("cameras", &options_.cameras,
+               "the scene's cameras to render, one image output each, named as the camera");
+  DeclareParam("distortion", &options_.distortion, "the calibrations' lens distortion");
+  DeclareParam("noise", &options_.noise, "sensor noise, seeded per camera and frame");
+  DeclareParam("motion_blur", &options_.motion_blur, "blur over each camera's exposure");
+  DeclareParam("msaa", &options_.msaa_samples, "multisample anti-aliasing: 0, 2, 4 or 8 samples")
+      .Range(0, 8);
+  DeclareParam("lod_max_error_px", &options_.lod_max_error_px,
+               "level of detail: the largest screen error of a simplified model")
+      .Range(0.0, 1e6)
+      .Unit("px");
+}
+
+void SimCameras::Configured() {
+  const internal::SceneRef scene = internal::SceneOf(*this, scene_param_);
+  const std::string& path = scene.path;
+  std::string error;
+  if (!options_.IsValid(&error)) throw InvalidArgument(error);
+  scene_ = scene.scene;
+  for (const std::string& camera : options_.cameras) {
+    if (scene_->FindCamera(camera) == nullptr) {
+      throw InvalidArgument("parameter 'cameras': scene '" + path + "' has no camera '" + camera +
+                            "'");
+    }
+    outputs_.push_back(&AddOutput<runtime::ImageMessage>(camera));
+  }
+}
+
+void SimCameras::Start() { renderer_ = render::MakeRenderer(*scene_, options_); }
+
+void SimCameras::SetEffects(bool distortion, bool noise, bool motion_blur) {
+  if (options_.distortion == distortion && options_.noise == noise &&
+      options_.motion_blur == motion_blur) {
+    return;
+  }
+  options_.distortion = distortion;
+  options_.noise = noise;
+  options_.motion_blur = motion_blur;
+  options_changed_ = true;
+}
+
+void SimCameras::Step(const runtime::StepContext& context) {
+  if (options_changed_ && renderer_) {
+    renderer_.reset();  // one GL context at a time
+    renderer_ = render::MakeRenderer(*scene_, options_);
+    options_changed_ = false;
+  }
+  scene::SceneState state = scene_->InitialState();
+  state.time = context.time;
+  if (const JointStateMessage* joints = joints_.get()) {
+    state.joints = joints->positions;
+    state.joint_velocities = joints->velocities;
+  }
+  std::vector<render::Frame> frames = renderer_->Render(state, context.step);
+  for (std::size_t i = 0; i < frames.size() && i < outputs_.size(); ++i) {
+    outputs_[i]->Emit(runtime::ImageMessage{frames[i].color});
+  }
+}
+
+void SimCameras::Stop() { renderer_.reset(); }
+
+}  // namespace saccade::components
