@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
-# Builds the scene-file fuzzer (fuzz/scene_fuzzer.cc) with clang, libFuzzer, AddressSanitizer
-# and UndefinedBehaviorSanitizer against the project's own sources, then fuzzes for SECONDS
-# (default 60) starting from a copy of fuzz/corpus/scene (the committed seeds never grow).
+# Builds the fuzzers with clang, libFuzzer, AddressSanitizer and UndefinedBehaviorSanitizer
+# against the project's own sources, then fuzzes for SECONDS in all (default 60):
+#   scene_fuzzer      scene YAML (fuzz/scene_fuzzer.cc), three quarters of the time, from a
+#                     copy of fuzz/corpus/scene (the committed seeds never grow);
+#   dynamixel_fuzzer  bytes from a servo bus in any split (fuzz/dynamixel_fuzzer.cc), the rest.
 # Exits non-zero when the fuzzer finds a crash, a sanitizer report, a leak or a hang; the
 # reproducer is left in build-fuzz/ (crash-*, leak-*, timeout-*). Reproduce one with
 #   build-fuzz/scene_fuzzer build-fuzz/crash-<hash>
@@ -30,7 +32,9 @@ flags=(-std=c++20 -O1 -g -fno-omit-frame-pointer
 libs=($(pkg-config --libs yaml-cpp assimp libpng fmt) -lstb -lpthread)
 
 # Compile each source once, again only when it or any header changed since.
-sources=(src/core/*.cc src/geometry/*.cc src/head/*.cc src/scene/*.cc fuzz/scene_fuzzer.cc)
+scene_sources=(src/core/*.cc src/geometry/*.cc src/head/*.cc src/scene/*.cc fuzz/scene_fuzzer.cc)
+dxl_sources=(src/core/*.cc src/hw/dynamixel_protocol.cc fuzz/dynamixel_fuzzer.cc)
+sources=("${scene_sources[@]}" src/hw/dynamixel_protocol.cc fuzz/dynamixel_fuzzer.cc)
 newest_header="$(find include src -name '*.h' -printf '%T@ %p\n' | sort -n | tail -1 | cut -d' ' -f2)"
 objects=()
 stale=()
@@ -54,20 +58,37 @@ if ((${#stale[@]} > 0)); then
   printf '%s\n' "${stale[@]}" | xargs -P 2 -I{} sh -c \
     '$CXX_FUZZ $FLAGS -c "$1" -o "$OUT/obj/$(echo "$1" | tr / _).o"' _ {}
 fi
-"$cxx" -fsanitize=fuzzer,address,undefined "${objects[@]}" "${libs[@]}" -o "$out/scene_fuzzer"
+objects_of() {
+  for source in "$@"; do echo "$out/obj/$(echo "$source" | tr '/' '_').o"; done
+}
+"$cxx" -fsanitize=fuzzer,address,undefined $(objects_of "${scene_sources[@]}") "${libs[@]}" \
+  -o "$out/scene_fuzzer"
+"$cxx" -fsanitize=fuzzer,address,undefined $(objects_of "${dxl_sources[@]}") "${libs[@]}" \
+  -o "$out/dynamixel_fuzzer"
+dxl_seconds=$((seconds / 4))
+scene_seconds=$((seconds - dxl_seconds))
 
 # Fuzz a copy of the seeds: new inputs go to the copy, never into the repository.
 corpus="$(mktemp -d "${TMPDIR:-/tmp}/saccade-scene-corpus.XXXXXX")"
 trap 'rm -rf "$corpus"' EXIT
 cp fuzz/corpus/scene/* "$corpus/"
-echo "fuzz: ${seconds}s over $(ls "$corpus" | wc -l) seeds"
+echo "fuzz: scene files, ${scene_seconds}s over $(ls "$corpus" | wc -l) seeds"
 status=0
 SACCADE_FUZZ_BASE_DIR="$root/scenes" "$out/scene_fuzzer" \
-  -max_total_time="$seconds" -timeout=10 -rss_limit_mb=4096 -max_len=4096 \
+  -max_total_time="$scene_seconds" -timeout=10 -rss_limit_mb=4096 -max_len=4096 \
   -dict=fuzz/scene.dict -artifact_prefix="$out/" -print_final_stats=1 \
   "$corpus" || status=$?
 if ((status != 0)); then
-  echo "fuzz: FAILED (status $status); reproducer in $out/" >&2
+  echo "fuzz: scene files FAILED (status $status); reproducer in $out/" >&2
+  exit "$status"
+fi
+echo "fuzz: servo bus bytes, ${dxl_seconds}s"
+dxl_corpus="$(mktemp -d "${TMPDIR:-/tmp}/saccade-dxl-corpus.XXXXXX")"
+trap 'rm -rf "$corpus" "$dxl_corpus"' EXIT
+"$out/dynamixel_fuzzer" -max_total_time="$dxl_seconds" -timeout=10 -rss_limit_mb=4096 \
+  -max_len=1024 -artifact_prefix="$out/" -print_final_stats=1 "$dxl_corpus" || status=$?
+if ((status != 0)); then
+  echo "fuzz: servo bus bytes FAILED (status $status); reproducer in $out/" >&2
   exit "$status"
 fi
 echo "fuzz: no crash in ${seconds}s"
