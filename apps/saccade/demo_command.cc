@@ -271,6 +271,10 @@ int RunDemo(Options o) {
       {"steps", summary.steps},
       {"sim_time_s", summary.sim_time + dt},
       {"wall_s", summary.wall_seconds},
+      // Simulated seconds per wall second (1: as fast as the cameras deliver), and steps per
+      // wall second: what keeps the loop from camera rate (issue 14).
+      {"real_time_factor", (summary.sim_time + dt) / std::max(summary.wall_seconds, 1e-9)},
+      {"steps_per_second", summary.steps / std::max(summary.wall_seconds, 1e-9)},
       {"faces", faces_total},
       {"faces_fixated", faces_fixated},
       {"fixations", fixations_json},
@@ -309,6 +313,8 @@ int RunDemo(Options o) {
       fmt::print("\n{} faces fixated in {:.2f} s ({} steps, {:.1f} s wall)\n", faces_fixated,
                  summary.sim_time + dt, summary.steps, summary.wall_seconds);
     }
+    fmt::print("{:.1f} steps per second, real-time factor {:.2f} (simulated s per wall s)\n",
+               report["steps_per_second"].get<double>(), report["real_time_factor"].get<double>());
     if (pair_counts) fmt::print("cameras: {}\n", cameras->Describe());
     if (head_status) {
       const HeadStatusMessage& h = *head_status;
