@@ -42,18 +42,11 @@ namespace saccade::app {
 namespace {
 
 namespace fs = std::filesystem;
-using components::CandidatesMessage;
-using components::FacesMessage;
 using components::Fixation;
 using components::FixationJson;
 using components::HeadStatusMessage;
-using components::JointStateMessage;
 using components::Latest;
-using components::SelectionMessage;
 using components::Tap;
-using components::TargetMessage;
-using components::TrackMessage;
-using gui::Annotate;
 using gui::Compose;
 using gui::GuiOptions;
 using gui::GuiSession;

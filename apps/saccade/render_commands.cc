@@ -9,10 +9,7 @@
 #include <cmath>
 #include <csignal>
 #include <cstdio>
-#include <cstring>
 #include <filesystem>
-#include <fstream>
-#include <future>
 #include <iostream>
 #include <memory>
 #include <optional>

@@ -9,6 +9,7 @@
 #include <memory>
 #include <string>
 #include <typeindex>
+#include <typeinfo>
 #include <utility>
 #include <vector>
 
@@ -48,13 +49,6 @@ class TypedValues {
   const T* Get() const {
     for (const auto& [type, held] : values_) {
       if (type == std::type_index(typeid(T))) return static_cast<const T*>(held.get());
-    }
-    return nullptr;
-  }
-  template <typename T>
-  std::shared_ptr<const T> Share() const {
-    for (const auto& [type, held] : values_) {
-      if (type == std::type_index(typeid(T))) return std::static_pointer_cast<const T>(held);
     }
     return nullptr;
   }
