@@ -4,15 +4,11 @@
 // user chose and turns saccade::Error into "saccade: error: ..." with status 1.
 
 #include <CLI/CLI.hpp>
-#include <Eigen/Core>
 #include <functional>
-#include <nlohmann/json.hpp>
 #include <string>
+#include <vector>
 
-#include "saccade/geometry/json.h"
-#include "saccade/geometry/pose.h"
 #include "saccade/head/head_description.h"
-#include "saccade/head/json.h"
 
 namespace saccade::app {
 
@@ -27,7 +23,6 @@ Runner AddBenchCommand(CLI::App& app);
 Runner AddGuiCommand(CLI::App& app);
 
 // Shared helpers.
-inline constexpr double kRadToDeg = 180.0 / M_PI;
 inline constexpr double kDegToRad = M_PI / 180.0;
 
 /// A file shipped with saccade (robots/popeye.yaml, scenes/...): from the working directory if
@@ -35,9 +30,6 @@ inline constexpr double kDegToRad = M_PI / 180.0;
 /// data (share/saccade).
 std::string ShippedFile(const std::string& relative);
 
-/// {"position": [...], "rotation": [[...]x3], "quaternion_wxyz": [...]}: a pose for people
-/// (the 4x4 matrix is ToJson's form, geometry/json.h).
-nlohmann::json PoseJson(const geometry::Pose& X);
 /// Joint angles from 4 command-line values, radians or degrees.
 head::JointState JointsFromArgs(const std::vector<double>& values, bool degrees);
 

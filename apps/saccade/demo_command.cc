@@ -4,31 +4,22 @@
 
 #include <fmt/format.h>
 
-#include <algorithm>
 #include <atomic>
-#include <chrono>
 #include <cmath>
 #include <csignal>
-#include <cstdlib>
 #include <filesystem>
-#include <fstream>
-#include <iostream>
-#include <map>
 #include <memory>
-#include <opencv2/imgcodecs.hpp>
-#include <opencv2/imgproc.hpp>
-#include <opencv2/videoio.hpp>
 #include <optional>
 #include <string>
 #include <vector>
 
 #include "commands.h"
+#include "saccade/components/demo_report.h"
 #include "saccade/components/fixation_scoring.h"
 #include "saccade/components/messages.h"
 #include "saccade/components/register.h"
 #include "saccade/components/roles.h"
 #include "saccade/core/error.h"
-#include "saccade/core/streaming_stats.h"
 #include "saccade/gui/overlay.h"
 #include "saccade/gui/recording.h"
 #include "saccade/gui/session.h"
@@ -36,19 +27,12 @@
 #include "saccade/runtime/pipeline.h"
 #include "saccade/runtime/scheduler.h"
 #include "saccade/scene/scene.h"
-#include "saccade/vision/image_camera.h"
 
 namespace saccade::app {
 namespace {
 
 namespace fs = std::filesystem;
-using components::Fixation;
-using components::FixationJson;
 using components::HeadStatusMessage;
-using components::Latest;
-using components::Tap;
-using gui::Compose;
-using gui::GuiOptions;
 using gui::GuiSession;
 using gui::Recorder;
 using nlohmann::json;
@@ -69,7 +53,7 @@ struct Options {
   bool list = false;
   bool markdown = false;
   bool gui = false;
-  GuiOptions gui_options;
+  gui::GuiOptions gui_options;
 };
 
 /// One attended target, from its selection to the end of its dwell.
@@ -77,28 +61,16 @@ int RunDemo(Options o) {
   components::RegisterComponents();
   if (o.list) {
     const auto reference = runtime::DescribeComponents(runtime::ComponentRegistry::Global());
-    if (o.json) {
-      fmt::print("{}\n", runtime::ComponentsJson(reference).dump(2));
-    } else {
-      fmt::print("{}", o.markdown ? runtime::ComponentsMarkdown(reference)
+    fmt::print("{}", o.json       ? runtime::ComponentsJson(reference).dump(2) + "\n"
+                     : o.markdown ? runtime::ComponentsMarkdown(reference)
                                   : runtime::ComponentsText(reference));
-    }
     return 0;
   }
   if (!(o.duration > 0.0) || !std::isfinite(o.duration)) {
     throw InvalidArgument(fmt::format("demo: --duration must be > 0 s, got {}", o.duration));
   }
   runtime::PipelineSpec spec = runtime::LoadPipelineFile(o.pipeline, o.hardware);
-  if (!o.scene.empty()) {
-    // --scene replaces the pipeline's scene and every component's own `scene` parameter
-    // (absolute: the pipeline file's folder is not the user's).
-    const std::string scene = fs::absolute(o.scene).lexically_normal().string();
-    if (!fs::exists(scene)) throw InvalidArgument("demo: --scene " + o.scene + ": no such file");
-    spec.resources["scene"] = runtime::ResourceSpec{scene, "--scene", 0};
-    for (runtime::ComponentSpec& c : spec.components) {
-      if (c.params.is_object() && c.params.contains("scene")) c.params["scene"] = scene;
-    }
-  }
+  if (!o.scene.empty()) runtime::ReplaceScene(spec, o.scene, "--scene");
   if (o.keep_going) spec.on_error = runtime::OnError::kContinue;
   const double dt = spec.clock.step;
   if (o.realtime) {
@@ -106,14 +78,9 @@ int RunDemo(Options o) {
     spec.clock.rate_hz = 1.0 / dt;
   }
   runtime::Pipeline pipeline = runtime::Pipeline::Build(spec);
-  if (o.gui && o.gui_options.token.empty() && !o.gui_options.no_token) {
-    if (const char* token = std::getenv("SACCADE_GUI_TOKEN")) o.gui_options.token = token;
-  }
 
-  // Where the cameras and the fixation controller run, and the scene the cameras render:
-  // simulated cameras give ground truth; real ones (hw.cameras) give none.
-  // The robot by its roles (components/roles.h). The loop's latency runs from the cameras to
-  // the component that commands the head (the source of the head's `command` input).
+  // The robot by its roles (components/roles.h). Simulated cameras give ground truth; real
+  // ones (hw.cameras) give none.
   std::string cameras_name, head_name;
   const components::EyeCamerasRole* cameras =
       pipeline.FindRole<components::EyeCamerasRole>(&cameras_name);
@@ -122,32 +89,26 @@ int RunDemo(Options o) {
                           " has no eye cameras (a sim.cameras or hw.cameras component)");
   }
   pipeline.FindRole<components::HeadRole>(&head_name);
-  std::optional<std::size_t> cameras_index, fixation_index;
-  std::string commander;
-  for (const runtime::ComponentSpec& c : spec.components) {
-    if (c.name != head_name) continue;
-    for (const runtime::ConnectionSpec& input : c.inputs) {
-      if (input.to_input == "command") commander = input.from_component;
-    }
-  }
-  for (std::size_t i = 0; i < spec.components.size(); ++i) {
-    if (spec.components[i].name == cameras_name) cameras_index = i;
-    if (!commander.empty() && spec.components[i].name == commander) fixation_index = i;
-  }
+  components::CaptureToCommand latency(spec, cameras_name, head_name);
+  components::LoopFigures figures(pipeline);
   const bool truth = cameras->rendered() != nullptr;
   // Real cameras: the scene only carries the robot; its pictures are not what they see.
   const scene::Scene& scene = cameras->scene();
   components::FixationScorer scorer(scene, truth);
   const int faces_total = scorer.faces_total();
   if (!truth && !o.json) {
-    fmt::print("real cameras ({}): no ground truth; fixations are reported as triangulated\n",
-               spec.components[*cameras_index].type);
+    for (const runtime::ComponentSpec& c : spec.components) {
+      if (c.name == cameras_name) {
+        fmt::print("real cameras ({}): no ground truth; fixations are reported as triangulated\n",
+                   c.type);
+      }
+    }
   }
 
-  Latest latest;
+  components::Latest latest;
   components::TapLoopOutputs(pipeline, &latest);
   std::optional<HeadStatusMessage> head_status;
-  Tap<HeadStatusMessage>(pipeline, [&](const HeadStatusMessage& m) {
+  components::Tap<HeadStatusMessage>(pipeline, [&](const HeadStatusMessage& m) {
     if (!o.json && m.fault != (head_status ? head_status->fault : "") && !m.fault.empty()) {
       fmt::print("t = {:6.2f} s  head FAULT: {}\n", m.time, m.fault);
     }
@@ -167,8 +128,6 @@ int RunDemo(Options o) {
   std::unique_ptr<Recorder> recorder;
   if (!o.record.empty()) recorder = std::make_unique<Recorder>(o.record, 1.0 / dt, o.force);
 
-  StreamingStats loop_latency_ms;  // constant memory however long the run
-
   runtime::RunOptions run;
   // With the GUI the loop runs until Ctrl-C (or SIGTERM).
   run.steps = o.gui ? 0 : static_cast<int64_t>(std::ceil(o.duration / dt - 1e-9));
@@ -177,45 +136,23 @@ int RunDemo(Options o) {
   run.on_error = [&](const runtime::StepError& error) {
     fmt::print(stderr, "saccade: error: {}\n", error.ToString());
   };
-  run.step_timing = [&](const runtime::StepContext&, const std::vector<double>& seconds,
-                        double overhead) {
-    if (!cameras_index || !fixation_index || seconds.size() <= *fixation_index) return;
-    // From the end of the capture to the motor command: every stage in between, and the
-    // loop's own time in this step.
-    double total = overhead;
-    for (std::size_t i = *cameras_index + 1; i <= *fixation_index; ++i) total += seconds[i];
-    loop_latency_ms.Add(1e3 * total);
+  run.step_timing = [&](const runtime::StepContext&, const runtime::StepTiming& timing) {
+    latency.Add(timing);
   };
   run.after_step = [&](const runtime::StepContext& context) {
     const double t = context.time;
+    figures.AfterStep(t, latest);
     const components::FixationScorer::Step scored = scorer.Update(context.step, t, latest);
     const bool fixated_now = scored.fixated_now;
     const std::string& status = scored.status;
-    const std::vector<Fixation>& fixations = scorer.fixations();
+    const std::vector<components::Fixation>& fixations = scorer.fixations();
 
-    if (fixated_now) {
-      const Fixation& f = fixations.back();
-      if (!o.json) {
-        if (f.is_face && !f.has_truth) {
-          fmt::print(
-              "t = {:6.2f} s  fixated {:<16} at {:.2f} m  (triangulated; no ground truth)  "
-              "took {:.2f} s  ({})\n",
-              t, f.object, f.distance_m, *f.fixated_at - f.selected_at, f.source);
-        } else if (f.is_face) {
-          fmt::print(
-              "t = {:6.2f} s  fixated {:<16} at {:.2f} m  3D error {:5.1f} mm  eye axis error "
-              "L {:.3f} deg R {:.3f} deg  took {:.2f} s  ({})\n",
-              t, f.object, f.distance_m, 1e3 * f.error_3d_m, f.left_error_deg, f.right_error_deg,
-              *f.fixated_at - f.selected_at, f.source);
-        } else {
-          fmt::print("t = {:6.2f} s  fixated {} (not a face)  took {:.2f} s\n", t, f.object,
-                     *f.fixated_at - f.selected_at);
-        }
-        std::fflush(stdout);
-      }
+    if (fixated_now && !o.json) {
+      fmt::print("{}", components::FixationText(fixations.back(), t));
+      std::fflush(stdout);
     }
     if (recorder) {
-      const cv::Mat frame = Compose(latest, t, status);
+      const cv::Mat frame = gui::Compose(latest, t, status);
       recorder->Write(context.step, frame);
       if (fixated_now) {
         recorder->WriteFixation(static_cast<int>(fixations.size()), fixations.back().object, frame);
@@ -240,108 +177,37 @@ int RunDemo(Options o) {
   const bool nothing_ran = summary.steps == 0 && !summary.errors.empty();
 
   // ---- the report ----
-  const int faces_fixated = scorer.faces_fixated();
-  const json decoys = scorer.DecoysJson();
-  json stages = json::array();
-  for (const runtime::ComponentTiming& c : summary.components) {
-    stages.push_back({{"name", c.name},
-                      {"median_ms", c.median_ms},
-                      {"p95_ms", c.p95_ms},
-                      {"mean_ms", c.mean_ms},
-                      {"max_ms", c.max_ms}});
-  }
-  struct {
-    double median, p95;
-  } const latency{loop_latency_ms.Quantile(0.5), loop_latency_ms.Quantile(0.95)};
-  json fixations_json = json::array();
-  for (const Fixation& f : scorer.fixations()) fixations_json.push_back(FixationJson(f));
-  json errors = json::array();
-  for (const runtime::StepError& e : summary.errors) errors.push_back(e.ToString());
-  const std::optional<components::CameraPairCounts> pair_counts = cameras->pair_counts();
-  json report = {
-      {"pipeline", o.pipeline},
-      {"scene", o.scene.empty() ? json(nullptr) : json(o.scene)},
-      {"steps", summary.steps},
-      {"sim_time_s", summary.sim_time + dt},
-      {"wall_s", summary.wall_seconds},
-      // Simulated seconds per wall second (1: as fast as the cameras deliver), and steps per
-      // wall second: what keeps the loop from camera rate (issue 14).
-      {"real_time_factor", (summary.sim_time + dt) / std::max(summary.wall_seconds, 1e-9)},
-      {"steps_per_second", summary.steps / std::max(summary.wall_seconds, 1e-9)},
-      {"faces", faces_total},
-      {"faces_fixated", faces_fixated},
-      {"fixations", fixations_json},
-      {"decoys", decoys},
-      {"latency_ms",
-       {{"capture_to_command", {{"median", latency.median}, {"p95", latency.p95}}},
-        {"stages", stages}}},
-      {"overhead_share", summary.overhead_share},
-      {"overhead_ms", {{"median", summary.overhead_median_ms}, {"p95", summary.overhead_p95_ms}}},
-      {"errors", errors},
-      {"hardware", spec.hardware_file.empty() ? json(nullptr) : json(spec.hardware_file)},
-      {"ground_truth", truth},
-      {"cameras", pair_counts ? json({{"pairs", pair_counts->pairs},
-                                      {"dropped_left", pair_counts->dropped_left},
-                                      {"dropped_right", pair_counts->dropped_right}})
-                              : json(nullptr)},
-      {"head", head_status ? runtime::MessageTraits<HeadStatusMessage>::ToJson(*head_status)
-                           : json(nullptr)},
-      {"interrupted", g_stop.load() && faces_fixated < faces_total}};
+  components::DemoReport report;
+  report.pipeline = o.pipeline;
+  report.scene = o.scene;
+  report.hardware_file = spec.hardware_file;
+  report.dt = dt;
+  report.summary = summary;
+  report.scorer = &scorer;
+  report.truth = truth;
+  report.capture_to_command_ms = latency.milliseconds();
+  report.detection_age_ms = figures.detection_age_ms();
+  report.exposure_samples = figures.exposure_samples();
+  report.pair_counts = cameras->pair_counts();
+  if (report.pair_counts) report.cameras_description = cameras->Describe();
+  report.head = head_status;
+  report.interrupted = g_stop.load() && scorer.faces_fixated() < faces_total;
+  json report_json = report.Json();
   if (recorder) {
-    report["record"] = {{"folder", o.record},
-                        {"frames", recorder->frames()},
-                        {"video", (fs::path(o.record) / "demo.avi").string()}};
-    recorder->WriteSummary(report);
+    report_json["record"] = {{"folder", o.record},
+                             {"frames", recorder->frames()},
+                             {"video", (fs::path(o.record) / "demo.avi").string()}};
+    recorder->WriteSummary(report_json);
     recorder.reset();  // closes the video
   }
-
   if (o.json) {
-    fmt::print("{}\n", report.dump(2));
+    fmt::print("{}\n", report_json.dump(2));
   } else if (!nothing_ran) {
-    if (truth) {
-      fmt::print(
-          "\n{} of {} faces fixated in {:.2f} s of simulated time ({} steps, {:.1f} s wall)\n",
-          faces_fixated, faces_total, summary.sim_time + dt, summary.steps, summary.wall_seconds);
-    } else {
-      fmt::print("\n{} faces fixated in {:.2f} s ({} steps, {:.1f} s wall)\n", faces_fixated,
-                 summary.sim_time + dt, summary.steps, summary.wall_seconds);
-    }
-    fmt::print("{:.1f} steps per second, real-time factor {:.2f} (simulated s per wall s)\n",
-               report["steps_per_second"].get<double>(), report["real_time_factor"].get<double>());
-    if (pair_counts) fmt::print("cameras: {}\n", cameras->Describe());
-    if (head_status) {
-      const HeadStatusMessage& h = *head_status;
-      fmt::print(
-          "head: {}{}: {} commands, {} rejected, {} clamped or limited, {} watchdog stops{}{}\n",
-          h.driver, h.mirror ? " (mirroring the virtual head)" : "", h.commands,
-          h.rejected_commands, h.limited_commands, h.watchdog_trips,
-          h.emergency_stopped ? ", EMERGENCY STOP" : "",
-          h.fault.empty() ? "" : ", FAULT: " + h.fault);
-    }
-    for (const json& d : decoys) {
-      fmt::print("decoy {}: {} ({} detections on it rejected{})\n", d["name"].get<std::string>(),
-                 d["fixated"].get<bool>() ? "FIXATED (not rejected)" : "rejected, never fixated",
-                 d["rejected_detections"].get<int>(),
-                 d["by_reason"].empty() ? "" : ": " + d["by_reason"].dump());
-    }
-    fmt::print("\nlatency per stage (ms, wall clock on this machine):\n");
-    fmt::print("  {:<14} {:>8} {:>8} {:>8}\n", "stage", "median", "p95", "max");
-    for (const runtime::ComponentTiming& c : summary.components) {
-      fmt::print("  {:<14} {:>8.2f} {:>8.2f} {:>8.2f}\n", c.name, c.median_ms, c.p95_ms, c.max_ms);
-    }
-    fmt::print("  capture -> motor command: median {:.2f} ms, p95 {:.2f} ms\n", latency.median,
-               latency.p95);
-    fmt::print(
-        "  outside the components (messaging, scheduling): {:.4f} ms/step median, "
-        "{:.3f} % of the loop\n",
-        summary.overhead_median_ms, 100.0 * summary.overhead_share);
-    if (!o.record.empty()) {
-      fmt::print("\nrecorded to {}: frames/, demo.avi, summary.json, fixation_*.png\n", o.record);
-    }
+    fmt::print("{}", report.Text(o.record));
   }
   if (gui) fmt::print("{}\n", gui->Describe());
   if (!summary.errors.empty() && summary.stopped_on_error) return 1;
-  if (faces_fixated == 0 && !o.gui) {
+  if (scorer.faces_fixated() == 0 && !o.gui) {
     fmt::print(stderr, "saccade: demo: no face was fixated\n");
     return 3;
   }

@@ -1,14 +1,11 @@
 // render and bench: headless stereo capture to files, and the frames-per-second benchmark.
 
 #include <fmt/format.h>
-#include <unistd.h>
 
 #include <algorithm>
 #include <atomic>
 #include <chrono>
-#include <cmath>
 #include <csignal>
-#include <cstdio>
 #include <filesystem>
 #include <iostream>
 #include <memory>
@@ -18,9 +15,7 @@
 
 #include "commands.h"
 #include "saccade/core/error.h"
-#include "saccade/core/image_io.h"
-#include "saccade/geometry/json.h"
-#include "saccade/head/json.h"
+#include "saccade/core/progress.h"
 #include "saccade/render/benchmark.h"
 #include "saccade/render/dataset.h"
 #include "saccade/render/renderer.h"
@@ -39,27 +34,6 @@ namespace fs = std::filesystem;
 
 std::atomic<bool> g_interrupted{false};
 extern "C" void OnInterrupt(int) { g_interrupted = true; }
-
-/// Progress on a terminal: "[#####.....]  12/100 frames  25.3 fps", redrawn in place.
-class ProgressBar {
- public:
-  explicit ProgressBar(int total) : total_(total), enabled_(::isatty(STDERR_FILENO) != 0) {}
-  void Update(int done, double fps) const {
-    if (!enabled_) return;
-    constexpr int kWidth = 30;
-    const int filled = total_ > 0 ? done * kWidth / total_ : kWidth;
-    std::fprintf(stderr, "\r[%s%s] %d/%d frames  %.1f fps", std::string(filled, '#').c_str(),
-                 std::string(kWidth - filled, '.').c_str(), done, total_, fps);
-    std::fflush(stderr);
-  }
-  void Finish() const {
-    if (enabled_) std::fprintf(stderr, "\n");
-  }
-
- private:
-  int total_;
-  bool enabled_;
-};
 
 struct RenderOptions {
   std::string scene;
@@ -105,22 +79,9 @@ int RunRender(const RenderOptions& o) {
 
   const ProgressBar progress(o.frames);
   const auto start = std::chrono::steady_clock::now();
-  int written = 0;
-  auto state_at = [&](int i) {
-    scene::SceneState state = initial;
-    state.time = i / o.fps;
-    return state;
-  };
-  // Two states in flight: frame i + 1 is drawn while frame i is read back and encoded.
-  renderer->Submit(state_at(0), 0);
-  for (int i = 0; i < o.frames && !g_interrupted; ++i) {
-    if (i + 1 < o.frames) renderer->Submit(state_at(i + 1), i + 1);
-    writer.Write(i, state_at(i).time, initial, renderer->Retrieve());
-    ++written;
-    const double seconds =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    progress.Update(written, written / std::max(seconds, 1e-9));
-  }
+  const int written =
+      render::RenderDataset(*renderer, writer, initial, o.frames, o.fps, g_interrupted,
+                            [&](int done, double fps) { progress.Update(done, fps); });
   progress.Finish();
   std::signal(SIGINT, previous_int);
   std::signal(SIGTERM, previous_term);
@@ -172,80 +133,14 @@ int RunBench(const BenchOptions& o) {
                            o.warmup, progress);
     }
   }
-  const double off_ms =
-      !runs.empty() && runs.front().result ? runs.front().result->ms_per_frame() : 0.0;
-  const auto& cameras = main.cameras;
-  const auto* first = scene.FindCamera(cameras.front());
+  render::BenchReport report{o.scene, o.renderer, o.frames, o.warmup, 0, 0, main, runs};
+  const auto* first = scene.FindCamera(main.cameras.front());
+  report.width = first->model.intrinsics().width();
+  report.height = first->model.intrinsics().height();
   if (o.json) {
-    json effects = json::array();
-    for (const EffectRun& run : runs) {
-      json entry = {{"name", run.name},
-                    {"configured", run.unconfigured.empty()},
-                    {"head_pan_rad_per_s", run.moving ? kBenchPanRate : 0.0}};
-      if (run.result) {
-        entry["frames_per_second"] = run.result->fps();
-        entry["ms_per_frame"] = run.result->ms_per_frame();
-        entry["extra_ms"] = run.result->ms_per_frame() - off_ms;
-      } else {
-        entry["frames_per_second"] = entry["ms_per_frame"] = entry["extra_ms"] = nullptr;
-        entry["note"] = run.unconfigured;
-      }
-      effects.push_back(entry);
-    }
-    json out = {{"scene", o.scene},
-                {"device", main.device},
-                {"cameras", cameras},
-                {"width", first->model.intrinsics().width()},
-                {"height", first->model.intrinsics().height()},
-                {"msaa", o.renderer.msaa_samples},
-                {"lod_max_error_px", o.renderer.lod_max_error_px},
-                {"distortion", o.renderer.distortion},
-                {"noise", o.renderer.noise},
-                {"motion_blur", o.renderer.motion_blur},
-                {"frames", o.frames},
-                {"seconds", main.seconds},
-                {"frames_per_second", main.fps()},
-                {"megapixels_per_second", main.pixels / main.seconds / 1e6},
-                {"ms_per_frame",
-                 {{"total", main.ms_per_frame()},
-                  {"scene_update", main.update_ms},
-                  {"draw", main.draw_ms},
-                  {"effects", main.effects_ms},
-                  {"readback", main.readback_ms}}},
-                {"effects", effects}};
-    std::cout << out.dump(2) << "\n";
-    return 0;
-  }
-  const auto on_off = [](bool on) { return on ? "on" : "off"; };
-  fmt::print("scene    {}\ndevice   {}\n", o.scene, main.device);
-  fmt::print(
-      "cameras  {} x {}x{}, msaa {}, lod max error {} px; distortion {}, noise {}, motion blur "
-      "{}\n",
-      cameras.size(), first->model.intrinsics().width(), first->model.intrinsics().height(),
-      o.renderer.msaa_samples, o.renderer.lod_max_error_px, on_off(o.renderer.distortion),
-      on_off(o.renderer.noise), on_off(o.renderer.motion_blur));
-  fmt::print(
-      "{} frames ({} cameras each, pixels in CPU memory, head still) in {:.3f} s: {:.1f} "
-      "frames/s, {:.1f} Mpixel/s\n",
-      o.frames, cameras.size(), main.seconds, main.fps(), main.pixels / main.seconds / 1e6);
-  fmt::print(
-      "per frame: {:.2f} ms total; stages (CPU wall time, overlapping with the GPU):\n"
-      "  scene update {:.2f} ms, draw {:.2f} ms, effects {:.2f} ms, readback {:.2f} ms\n",
-      main.ms_per_frame(), main.update_ms, main.draw_ms, main.effects_ms, main.readback_ms);
-  if (runs.empty()) return 0;
-  fmt::print("\ncost of each effect ({} frames after {} warm-up each; effects off otherwise):\n",
-             o.frames, o.warmup);
-  fmt::print("  {:<26} {:>9} {:>10} {:>10}\n", "run", "frames/s", "ms/frame", "extra ms");
-  for (const EffectRun& run : runs) {
-    if (!run.result) {
-      fmt::print("  {:<26} not run: {}\n", run.label, run.unconfigured);
-    } else if (&run == &runs.front()) {
-      fmt::print("  {:<26} {:>9.1f} {:>10.2f} {:>10}\n", run.label, run.result->fps(),
-                 run.result->ms_per_frame(), "-");
-    } else {
-      fmt::print("  {:<26} {:>9.1f} {:>10.2f} {:>+10.2f}\n", run.label, run.result->fps(),
-                 run.result->ms_per_frame(), run.result->ms_per_frame() - off_ms);
-    }
+    std::cout << report.Json().dump(2) << "\n";
+  } else {
+    fmt::print("{}", report.Text());
   }
   return 0;
 }

@@ -39,6 +39,8 @@ AttentionComponent::AttentionComponent()
   DeclareParam("radius_m", &ior_options_.radius_m, "size of a fixated or suppressed place")
       .Range(1e-6, 1e6)
       .Unit("m");
+  DeclareParam("follow_objects", &ior_options_.follow,
+               "suppressed places and the dwell follow the faces as they move");
   DeclareParam("suppression_time_s", &ior_options_.suppression_time_s,
                "how long a fixated place stays suppressed")
       .Range(1e-6, 1e9)

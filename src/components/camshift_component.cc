@@ -27,6 +27,9 @@ CamShiftComponent::CamShiftComponent()
   DeclareParam("min_mass_ratio", &options_.min_mass_ratio,
                "the track is lost when the window's hue mass falls below this share of the seed's")
       .Range(0.0, 0.999);
+  DeclareParam("history_frames", &history_frames_,
+               "images kept for detections that arrive late: one older than this is not used")
+      .Range(1, 64);
   DeclareParam("reseed_fraction", &reseed_fraction_,
                "re-seed when a detection lies farther than this share of its width from the track")
       .Range(0.0, 100.0);
@@ -37,9 +40,23 @@ void CamShiftComponent::Configured() {
   tracker_ = std::make_unique<vision::CamShiftTracker>(options_);
 }
 
+bool CamShiftComponent::StartAndCatchUp(std::size_t from, const cv::Rect& box) {
+  if (!tracker_->Start(*recent_[from].image, box)) return false;
+  recent_[from].centre = tracker_->state().Center();
+  for (std::size_t k = from + 1; k < recent_.size(); ++k) {
+    const vision::TrackState state = tracker_->Update(*recent_[k].image);
+    if (state.lost()) return false;
+    recent_[k].centre = state.Center();
+  }
+  return true;
+}
+
 void CamShiftComponent::Step(const runtime::StepContext&) {
   if (!image_.fresh() || !image_.value().image) return;
   const std::shared_ptr<const Image>& image = image_.value().image;
+  recent_.push_back({image, std::nullopt});
+  while (recent_.size() > static_cast<std::size_t>(history_frames_)) recent_.pop_front();
+  const std::size_t now = recent_.size() - 1;
   TrackMessage out;
   out.image = image;
   const SelectionMessage* selection = selection_.get();
@@ -50,21 +67,31 @@ void CamShiftComponent::Step(const runtime::StepContext&) {
     return;
   }
   const cv::Rect box = left_ ? selection->left_box : selection->right_box;
-  const bool detected =
-      selection->boxes_fresh && selection->frame_index == image->metadata().frame_index;
+  // The image the selection's boxes were found in: this one, or a recent one (a detection
+  // that arrived late).
+  std::optional<std::size_t> found;
+  if (selection->boxes_fresh) {
+    for (std::size_t k = 0; k < recent_.size(); ++k) {
+      if (recent_[k].image->metadata().frame_index == selection->frame_index) found = k;
+    }
+  }
+  const bool detected = found.has_value();
   const bool same_target = selection->target_id == target_id_ && tracker_->tracking();
   if (same_target) {
     const vision::TrackState state = tracker_->Update(*image);
-    // A detection of the target far from the track means the track drifted: start again.
-    const bool drifted = detected && !state.lost() &&
-                         cv::norm(state.Center() - Centre(box)) > reseed_fraction_ * box.width;
+    if (!state.lost()) recent_[now].centre = state.Center();
+    // A detection of the target far from where the track was in its image means the track
+    // drifted: start again.
+    const std::optional<cv::Point2d>& then = detected ? recent_[*found].centre : std::nullopt;
+    const bool drifted = detected && !state.lost() && then &&
+                         cv::norm(*then - Centre(box)) > reseed_fraction_ * box.width;
     if ((state.lost() || drifted) && detected) {
-      out.reseeded = tracker_->Start(*image, box);
+      out.reseeded = StartAndCatchUp(*found, box);
     } else if (state.lost()) {
       out.reason = state.reason;
     }
   } else if (detected) {
-    out.reseeded = tracker_->Start(*image, box);
+    out.reseeded = StartAndCatchUp(*found, box);
     if (!out.reseeded) out.reason = "the detection holds no usable colour";
   } else {
     out.reason = "waiting for a detection of the target";

@@ -9,6 +9,7 @@
 #include "components/internal_scene.h"
 #include "saccade/core/error.h"
 #include "saccade/core/log.h"
+#include "saccade/geometry/image_camera.h"
 #include "saccade/head/kinematics.h"
 #include "saccade/hw/dynamixel_head.h"
 namespace saccade::components {
@@ -61,10 +62,7 @@ hw::CameraSourceSpec ReadSource(const nlohmann::json& json, const std::string& n
 
 void SetPose(Image& image, const geometry::Pose& X_WC, const head::JointState& joints) {
   ImageMetadata& meta = image.metadata();
-  const Eigen::Matrix4d m = X_WC.matrix();
-  for (int r = 0; r < 4; ++r) {
-    for (int c = 0; c < 4; ++c) meta.X_WC[static_cast<std::size_t>(4 * r + c)] = m(r, c);
-  }
+  geometry::SetCameraPose(meta, X_WC);
   meta.has_joints = true;
   meta.joints = {joints.pan, joints.tilt, joints.left, joints.right};
 }

@@ -24,6 +24,9 @@ StereoFacesComponent::StereoFacesComponent()
   // A human face's width as the cascade boxes it (the library accepts any width).
   options_.min_width_m = 0.08;
   options_.max_width_m = 0.4;
+  options_.refine_disparity = true;
+  DeclareParam("refine_disparity", &options_.refine_disparity,
+               "match each pair's left face patch in the right image (sub-pixel) for its depth");
   DeclareParam("max_reprojection_px", &options_.max_reprojection_px,
                "largest reprojection error of a left/right pair")
       .Range(1e-6, 1e6)

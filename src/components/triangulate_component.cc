@@ -52,18 +52,36 @@ void TriangulateComponent::Step(const runtime::StepContext& context) {
   const bool tracks_usable = l != nullptr && r != nullptr && l->tracking && r->tracking &&
                              l->target_id == selection->target_id &&
                              r->target_id == selection->target_id && l->image && r->image &&
-                             FrameOf(l->image) == FrameOf(r->image) &&
-                             FrameOf(l->image) == selection->frame_index;
-  if (tracks_usable && (prefer_tracks_ || !selection->boxes_fresh)) {
-    const auto match =
-        associator_.Triangulate(*l->image, vision::StereoObservation::FromBox(l->window), *r->image,
-                                vision::StereoObservation::FromBox(r->window));
-    if (match && match->reprojection_px <= max_reprojection_px_ && match->depth_m > 0.0) {
-      out.p_W = match->p_W;
-      out.source = "tracks";
-      out.reprojection_px = match->reprojection_px;
-      out.gap_m = match->gap_m;
+                             FrameOf(l->image) == FrameOf(r->image);
+  std::optional<vision::StereoMatch> tracked;
+  if (tracks_usable) {
+    tracked = associator_.Triangulate(*l->image, vision::StereoObservation::FromBox(l->window),
+                                      *r->image, vision::StereoObservation::FromBox(r->window));
+    if (!tracked || !(tracked->reprojection_px <= max_reprojection_px_) ||
+        !(tracked->depth_m > 0.0)) {
+      tracked.reset();
+    } else {
+      track_points_.emplace_back(FrameOf(l->image), tracked->p_W);
+      while (track_points_.size() > 64) track_points_.pop_front();
     }
+  }
+  // A detection of the target: its offset from the tracks' point in its own frame.
+  if (selection->boxes_fresh) {
+    offset_target_ = -1;
+    for (const auto& [frame, p_W] : track_points_) {
+      if (frame != selection->frame_index) continue;
+      offset_ = selection->p_W - p_W;
+      offset_target_ = selection->target_id;
+    }
+  }
+  const bool detection_now =
+      selection->boxes_fresh && (!tracked || selection->frame_index == FrameOf(l->image));
+  if (tracked && (prefer_tracks_ || !detection_now)) {
+    out.p_W = tracked->p_W;
+    if (!prefer_tracks_ && offset_target_ == selection->target_id) out.p_W += offset_;
+    out.source = "tracks";
+    out.reprojection_px = tracked->reprojection_px;
+    out.gap_m = tracked->gap_m;
   }
   target_.Emit(out);
 }

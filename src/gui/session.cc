@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <map>
@@ -88,6 +89,10 @@ GuiSession::GuiSession(runtime::Pipeline& pipeline, const scene::Scene& scene,
   server_options.address = options.listen;
   server_options.port = static_cast<uint16_t>(options.port);
   server_options.token = options.token;
+  // --token, else $SACCADE_GUI_TOKEN (but not with --no-token).
+  if (server_options.token.empty() && !options.no_token) {
+    if (const char* token = std::getenv("SACCADE_GUI_TOKEN")) server_options.token = token;
+  }
   server_options.allowed_hosts = options.allowed_hosts;
   if (options.no_token) {
     if (!options.token.empty()) throw InvalidArgument("gui: --no-token and --token contradict");

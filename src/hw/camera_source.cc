@@ -325,7 +325,9 @@ class OpenedSource final : public CameraSource {
       shared_model_ = std::make_shared<const geometry::CameraModel>(model());
     }
     geometry::SetCameraModel(meta, shared_model_);
-    meta.X_WC = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+    // A camera alone: its optical frame is the world's (a head's cameras get their pose
+    // from its kinematics, components/hw_cameras.cc).
+    geometry::SetCameraPose(meta, geometry::Pose::Identity());
     meta.has_joints = false;
     meta.joints = {};
   }

@@ -1,5 +1,7 @@
 #include "saccade/render/benchmark.h"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <chrono>
 
@@ -85,6 +87,89 @@ std::vector<EffectRun> EffectRuns(const scene::Scene& scene, const RendererOptio
   add("truth", "truth depth+ids+boxes", truth, false, "");
   add("all", "everything, pan 2 rad/s", all, true, "");
   return runs;
+}
+
+namespace {
+double OffMs(const std::vector<EffectRun>& runs) {
+  return !runs.empty() && runs.front().result ? runs.front().result->ms_per_frame() : 0.0;
+}
+}  // namespace
+
+nlohmann::json BenchReport::Json() const {
+  using nlohmann::json;
+  const double off_ms = OffMs(runs);
+  json effects = json::array();
+  for (const EffectRun& run : runs) {
+    json entry = {{"name", run.name},
+                  {"configured", run.unconfigured.empty()},
+                  {"head_pan_rad_per_s", run.moving ? kBenchPanRate : 0.0}};
+    if (run.result) {
+      entry["frames_per_second"] = run.result->fps();
+      entry["ms_per_frame"] = run.result->ms_per_frame();
+      entry["extra_ms"] = run.result->ms_per_frame() - off_ms;
+    } else {
+      entry["frames_per_second"] = entry["ms_per_frame"] = entry["extra_ms"] = nullptr;
+      entry["note"] = run.unconfigured;
+    }
+    effects.push_back(entry);
+  }
+  return {{"scene", scene_path},
+          {"device", main.device},
+          {"cameras", main.cameras},
+          {"width", width},
+          {"height", height},
+          {"msaa", options.msaa_samples},
+          {"lod_max_error_px", options.lod_max_error_px},
+          {"distortion", options.distortion},
+          {"noise", options.noise},
+          {"motion_blur", options.motion_blur},
+          {"frames", frames},
+          {"seconds", main.seconds},
+          {"frames_per_second", main.fps()},
+          {"megapixels_per_second", main.pixels / main.seconds / 1e6},
+          {"ms_per_frame",
+           {{"total", main.ms_per_frame()},
+            {"scene_update", main.update_ms},
+            {"draw", main.draw_ms},
+            {"effects", main.effects_ms},
+            {"readback", main.readback_ms}}},
+          {"effects", effects}};
+}
+
+std::string BenchReport::Text() const {
+  const auto on_off = [](bool on) { return on ? "on" : "off"; };
+  std::string out = fmt::format("scene    {}\ndevice   {}\n", scene_path, main.device);
+  out += fmt::format(
+      "cameras  {} x {}x{}, msaa {}, lod max error {} px; distortion {}, noise {}, motion blur "
+      "{}\n",
+      main.cameras.size(), width, height, options.msaa_samples, options.lod_max_error_px,
+      on_off(options.distortion), on_off(options.noise), on_off(options.motion_blur));
+  out += fmt::format(
+      "{} frames ({} cameras each, pixels in CPU memory, head still) in {:.3f} s: {:.1f} "
+      "frames/s, {:.1f} Mpixel/s\n",
+      frames, main.cameras.size(), main.seconds, main.fps(), main.pixels / main.seconds / 1e6);
+  out += fmt::format(
+      "per frame: {:.2f} ms total; stages (CPU wall time, overlapping with the GPU):\n"
+      "  scene update {:.2f} ms, draw {:.2f} ms, effects {:.2f} ms, readback {:.2f} ms\n",
+      main.ms_per_frame(), main.update_ms, main.draw_ms, main.effects_ms, main.readback_ms);
+  if (runs.empty()) return out;
+  const double off_ms = OffMs(runs);
+  out += fmt::format(
+      "\ncost of each effect ({} frames after {} warm-up each; effects off otherwise):\n", frames,
+      warmup);
+  out += fmt::format("  {:<26} {:>9} {:>10} {:>10}\n", "run", "frames/s", "ms/frame", "extra ms");
+  for (const EffectRun& run : runs) {
+    if (!run.result) {
+      out += fmt::format("  {:<26} not run: {}\n", run.label, run.unconfigured);
+    } else if (&run == &runs.front()) {
+      out += fmt::format("  {:<26} {:>9.1f} {:>10.2f} {:>10}\n", run.label, run.result->fps(),
+                         run.result->ms_per_frame(), "-");
+    } else {
+      out += fmt::format("  {:<26} {:>9.1f} {:>10.2f} {:>+10.2f}\n", run.label, run.result->fps(),
+                         run.result->ms_per_frame(), run.result->ms_per_frame() - off_ms);
+    }
+  }
+  return out;
 }
 
 }  // namespace saccade::render

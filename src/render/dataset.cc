@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstring>
 #include <future>
@@ -163,7 +164,8 @@ json FrameJson(int64_t index, double time, const std::vector<Frame>& frames,
                   {"distortion",
                    {{"model", geometry::ToString(model.distortion().model())},
                     {"coefficients", model.distortion().coefficients()}}},
-                  {"X_WC", MatrixJson(m.X_WC.data(), 4, 4)}};
+                  {"X_WC", MatrixJson(geometry::FindCameraPose(m)->matrix())},
+                  {"exposure_samples", m.exposure_samples}};
     if (m.has_joints) {
       entry["joints"] =
           ToJson(head::JointState{m.joints[0], m.joints[1], m.joints[2], m.joints[3]});
@@ -374,6 +376,28 @@ void DatasetWriter::Write(int64_t index, double time, const scene::SceneState& s
   // The index line comes last: a frame listed in frames.jsonl has all its images.
   index_ << line.dump() << "\n" << std::flush;
   ++written_;
+}
+
+int RenderDataset(Renderer& renderer, DatasetWriter& writer, const scene::SceneState& initial,
+                  int frames, double fps, const std::atomic<bool>& stop,
+                  const std::function<void(int done, double fps)>& progress) {
+  const auto start = std::chrono::steady_clock::now();
+  const auto state_at = [&](int i) {
+    scene::SceneState state = initial;
+    state.time = i / fps;
+    return state;
+  };
+  int written = 0;
+  renderer.Submit(state_at(0), 0);
+  for (int i = 0; i < frames && !stop; ++i) {
+    if (i + 1 < frames) renderer.Submit(state_at(i + 1), i + 1);
+    writer.Write(i, state_at(i).time, initial, renderer.Retrieve());
+    ++written;
+    const double seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    if (progress) progress(written, written / std::max(seconds, 1e-9));
+  }
+  return written;
 }
 
 }  // namespace saccade::render

@@ -248,13 +248,16 @@ PipelineSpec ParsePipeline(const std::string& text, const std::string& source,
                            const std::string& hardware) {
   const YAML::Node root_node = saccade::internal::ParseYaml(text, source);
   const Entry root(root_node, "", &source, 1);
-  root.ExpectMap({"clock", "seed", "on_error", "scene", "hardware", "components"},
-                 "a pipeline {clock, seed, on_error, scene, hardware, components}");
+  root.ExpectMap({"clock", "seed", "threads", "on_error", "scene", "hardware", "components"},
+                 "a pipeline {clock, seed, threads, on_error, scene, hardware, components}");
   PipelineSpec spec;
   spec.file = source;
   if (auto scene = ParseScene(root, source)) spec.resources["scene"] = std::move(*scene);
   if (const auto clock = root.Find("clock")) spec.clock = ParseClock(*clock);
   if (const auto seed = root.Find("seed")) spec.seed = seed->AsUint64();
+  if (const auto threads = root.Find("threads")) {
+    spec.threads = static_cast<int>(threads->AsInteger(0, kMaxThreads));
+  }
   if (const auto on_error = root.Find("on_error")) {
     const std::string value = on_error->AsString();
     if (value == "stop") {
@@ -351,6 +354,16 @@ PipelineSpec LoadPipelineFile(const std::string& path, const std::string& hardwa
   std::ostringstream text;
   text << in.rdbuf();
   return ParsePipeline(text.str(), path, hardware);
+}
+
+void ReplaceScene(PipelineSpec& spec, const std::string& path, const std::string& origin) {
+  namespace fs = std::filesystem;
+  const std::string scene = fs::absolute(path).lexically_normal().string();
+  if (!fs::exists(scene)) throw InvalidArgument(origin + " " + path + ": no such file");
+  spec.resources["scene"] = ResourceSpec{scene, origin, 0};
+  for (ComponentSpec& c : spec.components) {
+    if (c.params.is_object() && c.params.contains("scene")) c.params["scene"] = scene;
+  }
 }
 
 uint64_t ComponentSeed(uint64_t pipeline_seed, const std::string& component_name) {

@@ -6,10 +6,13 @@
 #include <chrono>
 #include <cmath>
 #include <exception>
+#include <map>
 #include <thread>
 #include <utility>
 
+#include "runtime/internal_thread_pool.h"
 #include "saccade/core/streaming_stats.h"
+#include "saccade/runtime/port.h"
 
 namespace saccade::runtime {
 namespace {
@@ -39,6 +42,34 @@ std::string What(const std::exception_ptr& error) {
   } catch (...) {
     return "unknown exception";
   }
+}
+
+// The components in levels: a component's level is one past the highest level of the
+// components it reads without a delay; each level in execution order.
+std::vector<std::vector<std::size_t>> Levels(const Pipeline& pipeline) {
+  const auto& components = pipeline.components();
+  const PipelineSpec& spec = pipeline.spec();
+  std::map<std::string, std::size_t> index;
+  for (std::size_t i = 0; i < components.size(); ++i) index[components[i]->name()] = i;
+  std::vector<int> level(components.size(), 0);
+  int deepest = 0;
+  for (const ComponentSpec& c : spec.components) {
+    const auto self = index.find(c.name);
+    if (self == index.end()) continue;
+    int l = 0;
+    for (const ConnectionSpec& input : c.inputs) {
+      const auto from = index.find(input.from_component);
+      if (input.delay != 0 || from == index.end() || from->second >= self->second) continue;
+      l = std::max(l, level[from->second] + 1);
+    }
+    level[self->second] = l;
+    deepest = std::max(deepest, l);
+  }
+  std::vector<std::vector<std::size_t>> levels(static_cast<std::size_t>(deepest) + 1);
+  for (std::size_t i = 0; i < components.size(); ++i) {
+    levels[static_cast<std::size_t>(level[i])].push_back(i);
+  }
+  return levels;
 }
 
 }  // namespace
@@ -87,7 +118,21 @@ RunSummary RunPipeline(Pipeline& pipeline, const RunOptions& options) {
   // Constant memory however long the run (core/streaming_stats.h).
   std::vector<StreamingStats> step_seconds(n);
   StreamingStats overhead_seconds;
-  std::vector<double> step_own;  // this step's component times, for options.step_timing
+  StepTiming timing;  // this step's, for options.step_timing
+  timing.own.assign(n, 0.0);
+  timing.finished.assign(n, 0.0);
+  std::vector<std::exception_ptr> failures(n);
+  std::vector<char> stepped(n, 0);
+  std::vector<DeferredEmits> held(n);  // each component's deliveries in a parallel level
+  const std::vector<std::vector<std::size_t>> levels = Levels(pipeline);
+  std::vector<std::vector<bool>> affine;
+  for (const auto& level : levels) {
+    std::vector<bool> flags;
+    for (const std::size_t i : level) flags.push_back(components[i]->thread_affine());
+    affine.push_back(std::move(flags));
+  }
+  const int hardware = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  internal::ThreadPool pool(spec.threads > 0 ? spec.threads : std::min(hardware, kMaxThreads));
   std::vector<int64_t> error_counts(n, 0);
   const auto report = [&](StepError error) {
     if (options.on_error) options.on_error(error);
@@ -125,45 +170,83 @@ RunSummary RunPipeline(Pipeline& pipeline, const RunOptions& options) {
       // Simulated time is a product, not a running sum: no drift, the same on every run.
       context.time = realtime ? Seconds(tick_start - loop_start) : static_cast<double>(k) * dt;
       context.dt = dt;
+      context.realtime = realtime;
 
       pipeline.DeliverDelayed();
-      double component_seconds = 0.0;
-      step_own.clear();
+      double component_seconds = 0.0;  // per level, the longest own time (the sum if serial)
+      std::fill(timing.own.begin(), timing.own.end(), 0.0);
+      std::fill(timing.finished.begin(), timing.finished.end(), 0.0);
       bool stop_now = false;
-      for (std::size_t i = 0; i < n; ++i) {
-        Component& component = *components[i];
-        if (!component.enabled()) {
+      for (const std::vector<std::size_t>& level : levels) {
+        // Each component of the level: enabled ones stepped (at the same time when the
+        // level has several and the pool threads), their deliveries held back meanwhile.
+        const bool parallel = level.size() > 1 && pool.threads() > 1;
+        pool.Run(
+            level.size(),
+            [&](std::size_t j) {
+              const std::size_t i = level[j];
+              Component& component = *components[i];
+              failures[i] = nullptr;
+              stepped[i] = 0;
+              // One after the other, a failure with on_error: stop ends the step there.
+              if (!component.enabled() || (!parallel && stop_now)) return;
+              stepped[i] = 1;
+              StepContext own_context = context;
+              own_context.seed = component.seed();
+              DeferredEmits*& deferred = DeferredEmits::Current();
+              if (parallel) {
+                deferred = &held[i];
+              } else {
+                pipeline.TakeDeliverySeconds();
+              }
+              const Clock::time_point start = Clock::now();
+              try {
+                component.Step(own_context);
+              } catch (...) {
+                failures[i] = std::current_exception();
+                if (!parallel && spec.on_error == OnError::kStop) stop_now = true;
+              }
+              // Serial: deliveries made while it emitted are the bus's time, not its own.
+              timing.own[i] = std::max(0.0, Seconds(Clock::now() - start) -
+                                                (parallel ? 0.0 : pipeline.TakeDeliverySeconds()));
+              deferred = nullptr;
+            },
+            affine[&level - levels.data()]);
+        // In execution order: the held deliveries, then the bookkeeping.
+        double longest = 0.0;
+        for (const std::size_t i : level) {
+          Component& component = *components[i];
+          if (!stepped[i]) {
+            if (!component.enabled()) {
+              for (const auto& input : component.inputs()) input->MarkSeen();
+            }
+            continue;
+          }
+          if (parallel) held[i].Deliver();
+          timing.finished[i] = Seconds(Clock::now() - tick_start);
           for (const auto& input : component.inputs()) input->MarkSeen();
-          step_own.push_back(0.0);
-          continue;
+          step_seconds[i].Add(timing.own[i]);
+          // One after the other the level takes the sum of its times, at once the longest.
+          longest = parallel ? std::max(longest, timing.own[i]) : longest + timing.own[i];
+          if (failures[i]) {
+            report({component.name(), "step", k, What(failures[i])});
+            ++error_counts[i];
+            if (spec.on_error == OnError::kStop) stop_now = true;
+          }
         }
-        context.seed = component.seed();
         pipeline.TakeDeliverySeconds();
-        const Clock::time_point start = Clock::now();
-        try {
-          component.Step(context);
-        } catch (...) {
-          report({component.name(), "step", k, What(std::current_exception())});
-          ++error_counts[i];
-          stop_now = spec.on_error == OnError::kStop;
-        }
-        // Deliveries made while the component emitted are the bus's time, not the component's.
-        const double own =
-            std::max(0.0, Seconds(Clock::now() - start) - pipeline.TakeDeliverySeconds());
-        for (const auto& input : component.inputs()) input->MarkSeen();
-        step_seconds[i].Add(own);
-        step_own.push_back(own);
-        component_seconds += own;
+        component_seconds += longest;
         if (stop_now) break;
       }
       const double loop = Seconds(Clock::now() - tick_start);
       const double overhead = std::max(0.0, loop - component_seconds);
+      timing.overhead = overhead;
       overhead_seconds.Add(overhead);
       total_component += component_seconds;
       total_overhead += overhead;
       summary.steps = k + 1;
       summary.sim_time = context.time;
-      if (options.step_timing) options.step_timing(context, step_own, overhead);
+      if (options.step_timing) options.step_timing(context, timing);
       if (options.after_step) options.after_step(context);
       if (stop_now) {
         summary.stopped_on_error = true;

@@ -37,6 +37,8 @@ bool FaceDetector::Options::IsValid(std::string* error) const {
     what = "scale_factor " + std::to_string(scale_factor) + ", expected 1 < scale_factor <= 4";
   } else if (min_neighbors < 0) {
     what = "min_neighbors " + std::to_string(min_neighbors) + ", expected >= 0";
+  } else if (pyramid_level < 0 || pyramid_level > 4) {
+    what = "pyramid_level " + std::to_string(pyramid_level) + ", expected 0 .. 4";
   } else if (min_size_px < 1) {
     what = "min_size_px " + std::to_string(min_size_px) + ", expected >= 1";
   } else if (max_size_px != 0 && max_size_px < min_size_px) {
@@ -67,19 +69,77 @@ FaceDetector::FaceDetector(const Options& options) : options_(options) {
 }
 
 std::vector<FaceDetection> FaceDetector::Detect(const Image& image) {
-  cv::Mat gray = internal::ToGray(image, "FaceDetector::Detect");
+  const cv::Mat gray = internal::ToGray(image, "FaceDetector::Detect");
+  return DetectIn(gray, {cv::Rect(0, 0, gray.cols, gray.rows)});
+}
+
+std::vector<FaceDetection> FaceDetector::Detect(const Image& image,
+                                                const std::vector<cv::Rect>& regions) {
+  return DetectIn(internal::ToGray(image, "FaceDetector::Detect"), regions);
+}
+
+std::vector<FaceDetection> FaceDetector::DetectIn(const cv::Mat& gray_image,
+                                                  const std::vector<cv::Rect>& regions) {
+  cv::Mat gray = gray_image;
   if (options_.equalize_histogram) {
     cv::Mat equalized;
     cv::equalizeHist(gray, equalized);
     gray = equalized;
   }
+  // The level searched, and the factor from its pixels to the image's.
+  cv::Mat level = gray;
+  for (int k = 0; k < options_.pyramid_level; ++k) {
+    cv::Mat down;
+    cv::pyrDown(level, down);
+    level = down;
+  }
+  const double scale = static_cast<double>(gray.cols) / level.cols;
+  const auto reduced = [scale](int px) {
+    return std::max(1, static_cast<int>(std::lround(px / scale)));
+  };
+  const cv::Size min_size(reduced(options_.min_size_px), reduced(options_.min_size_px));
+  const cv::Size max_size = options_.max_size_px > 0 ? cv::Size(reduced(options_.max_size_px),
+                                                                reduced(options_.max_size_px))
+                                                     : cv::Size();
+  const cv::Rect level_rect(0, 0, level.cols, level.rows);
   std::vector<cv::Rect> boxes;
   std::vector<int> neighbors;
-  const cv::Size min_size(options_.min_size_px, options_.min_size_px);
-  const cv::Size max_size =
-      options_.max_size_px > 0 ? cv::Size(options_.max_size_px, options_.max_size_px) : cv::Size();
-  face_.detectMultiScale(gray, boxes, neighbors, options_.scale_factor, options_.min_neighbors, 0,
-                         min_size, max_size);
+  for (const cv::Rect& region : regions) {
+    const cv::Rect r(static_cast<int>(std::floor(region.x / scale)),
+                     static_cast<int>(std::floor(region.y / scale)),
+                     static_cast<int>(std::ceil(region.width / scale)),
+                     static_cast<int>(std::ceil(region.height / scale)));
+    const cv::Rect roi = r & level_rect;
+    if (roi.width < min_size.width || roi.height < min_size.height) continue;
+    const std::size_t earlier = boxes.size();  // found in the regions before this one
+    std::vector<cv::Rect> found;
+    std::vector<int> hits;
+    face_.detectMultiScale(level(roi), found, hits, options_.scale_factor, options_.min_neighbors,
+                           0, min_size, max_size);
+    for (std::size_t i = 0; i < found.size(); ++i) {
+      // Back to the image's pixels: the box's corners scaled, rounded outwards.
+      const cv::Rect f = found[i] + roi.tl();
+      const int x0 = static_cast<int>(std::floor(f.x * scale));
+      const int y0 = static_cast<int>(std::floor(f.y * scale));
+      const int x1 = static_cast<int>(std::ceil((f.x + f.width) * scale));
+      const int y1 = static_cast<int>(std::ceil((f.y + f.height) * scale));
+      const cv::Rect box =
+          cv::Rect(x0, y0, x1 - x0, y1 - y0) & cv::Rect(0, 0, gray.cols, gray.rows);
+      const int n = i < hits.size() ? hits[i] : 0;
+      // A face found in two overlapping regions counts once (the box with more hits).
+      bool merged = false;
+      for (std::size_t j = 0; j < earlier; ++j) {
+        const double overlap =
+            static_cast<double>((boxes[j] & box).area()) / std::min(boxes[j].area(), box.area());
+        if (overlap > 0.5) {
+          if (n > neighbors[j]) boxes[j] = box, neighbors[j] = n;
+          merged = true;
+          break;
+        }
+      }
+      if (!merged) boxes.push_back(box), neighbors.push_back(n);
+    }
+  }
   std::vector<FaceDetection> out(boxes.size());
   const cv::Rect image_rect(0, 0, gray.cols, gray.rows);
   for (std::size_t i = 0; i < boxes.size(); ++i) {

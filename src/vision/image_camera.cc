@@ -29,12 +29,12 @@ geometry::CameraModel CameraModelOf(const Image& image) {
 }
 
 geometry::Pose CameraPoseOf(const Image& image) {
-  const Eigen::Matrix4d X =
-      Eigen::Map<const Eigen::Matrix<double, 4, 4, Eigen::RowMajor>>(image.metadata().X_WC.data());
-  geometry::Pose pose = geometry::Pose::Identity();
-  pose.linear() = X.topLeftCorner<3, 3>();
-  pose.translation() = X.topRightCorner<3, 1>();
-  return pose;
+  const geometry::Pose* X_WC = geometry::FindCameraPose(image.metadata());
+  if (X_WC == nullptr) {
+    throw InvalidArgument("CameraPoseOf: image of camera '" + image.metadata().camera +
+                          "' carries no camera pose");
+  }
+  return *X_WC;
 }
 
 }  // namespace saccade::vision

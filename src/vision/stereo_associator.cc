@@ -3,7 +3,9 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <opencv2/imgproc.hpp>
 
+#include "internal_cv.h"
 #include "saccade/core/error.h"
 #include "saccade/geometry/camera_model.h"
 #include "saccade/geometry/triangulation.h"
@@ -34,6 +36,51 @@ bool StereoAssociator::Options::IsValid(std::string* error) const {
   if (error) *error = "StereoAssociator::Options: " + what;
   return false;
 }
+
+namespace {
+
+// Where the patch of `gray_l` around `l` (side about 0.6 of the face's width) matches
+// `gray_r` best near `r`: the right image point that sees what `l` sees, to a fraction of a
+// pixel. std::nullopt when a patch leaves its image or the match is weak (NCC < 0.7).
+std::optional<cv::Point2d> MatchInRight(const cv::Mat& gray_l, const cv::Mat& gray_r,
+                                        const StereoObservation& l, const StereoObservation& r) {
+  const double width = std::max(l.width_px, 12.0);
+  const int half = std::max(4, static_cast<int>(std::lround(0.3 * width)));
+  const cv::Point cl(static_cast<int>(std::lround(l.center.x)),
+                     static_cast<int>(std::lround(l.center.y)));
+  const cv::Rect patch(cl.x - half, cl.y - half, 2 * half + 1, 2 * half + 1);
+  if ((patch & cv::Rect(0, 0, gray_l.cols, gray_l.rows)) != patch) return std::nullopt;
+  // Along the (nearly horizontal) epipolar line a quarter of the width each way; across it a
+  // tenth.
+  const int sx = std::max(3, static_cast<int>(std::lround(0.25 * width)));
+  const int sy = std::max(2, static_cast<int>(std::lround(0.1 * width)));
+  const cv::Rect search(static_cast<int>(std::lround(r.center.x)) - half - sx,
+                        static_cast<int>(std::lround(r.center.y)) - half - sy, patch.width + 2 * sx,
+                        patch.height + 2 * sy);
+  if ((search & cv::Rect(0, 0, gray_r.cols, gray_r.rows)) != search) return std::nullopt;
+  cv::Mat score;
+  cv::matchTemplate(gray_r(search), gray_l(patch), score, cv::TM_CCOEFF_NORMED);
+  double best = 0.0;
+  cv::Point at;
+  cv::minMaxLoc(score, nullptr, &best, nullptr, &at);
+  if (!(best >= 0.7) || at.x == 0 || at.y == 0 || at.x == score.cols - 1 ||
+      at.y == score.rows - 1) {
+    return std::nullopt;  // weak, or the best lies on the search's edge
+  }
+  // A parabola through the peak and its two neighbours, along each axis.
+  const auto vertex = [](float a, float b, float c) {
+    const double curvature = static_cast<double>(a) - 2.0 * b + c;
+    return curvature < 0.0 ? 0.5 * (a - c) / curvature : 0.0;
+  };
+  const double dx = vertex(score.at<float>(at.y, at.x - 1), score.at<float>(at.y, at.x),
+                           score.at<float>(at.y, at.x + 1));
+  const double dy = vertex(score.at<float>(at.y - 1, at.x), score.at<float>(at.y, at.x),
+                           score.at<float>(at.y + 1, at.x));
+  return cv::Point2d(search.x + at.x + dx + half + (l.center.x - cl.x),
+                     search.y + at.y + dy + half + (l.center.y - cl.y));
+}
+
+}  // namespace
 
 StereoAssociator::StereoAssociator() : StereoAssociator(Options()) {}
 
@@ -100,10 +147,29 @@ std::vector<StereoMatch> StereoAssociator::Associate(
   });
   std::vector<bool> used_l(left_observations.size()), used_r(right_observations.size());
   std::vector<StereoMatch> out;
+  cv::Mat gray_l, gray_r;
   for (const StereoMatch& m : candidates) {
     if (used_l[m.left] || used_r[m.right]) continue;
     used_l[m.left] = used_r[m.right] = true;
     out.push_back(m);
+    if (!options_.refine_disparity) continue;
+    if (gray_l.empty()) {
+      gray_l = internal::ToGray(left, "StereoAssociator::Associate");
+      gray_r = internal::ToGray(right, "StereoAssociator::Associate");
+    }
+    const StereoObservation& l = left_observations[m.left];
+    StereoObservation r = right_observations[m.right];
+    const std::optional<cv::Point2d> matched = MatchInRight(gray_l, gray_r, l, r);
+    if (!matched) continue;
+    r.center = *matched;
+    std::optional<StereoMatch> refined = Triangulate(left, l, right, r);
+    if (refined && refined->reprojection_px <= options_.max_reprojection_px &&
+        refined->depth_m >= options_.min_depth_m && refined->depth_m <= options_.max_depth_m) {
+      refined->left = m.left;
+      refined->right = m.right;
+      refined->width_m = m.width_m;
+      out.back() = *refined;
+    }
   }
   std::sort(out.begin(), out.end(),
             [](const StereoMatch& a, const StereoMatch& b) { return a.distance_m < b.distance_m; });

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <map>
 #include <memory>
 #include <string>
@@ -53,14 +54,18 @@ struct Visit {
 struct LoopRun {
   std::vector<Visit> visits;             // in the order attention chose them
   std::vector<head::JointState> joints;  // per step
+  std::vector<double> face_ages_s;       // per faces message: step time less the image's time
   runtime::RunSummary summary;
 };
 
 /// Runs the demo pipeline on `scene_file` for at most `seconds` of simulated time.
-LoopRun RunLoop(const std::string& scene_file, double seconds, bool stop_when_all_done = true) {
+/// `change` edits the pipeline first (threads, parameters).
+LoopRun RunLoop(const std::string& scene_file, double seconds, bool stop_when_all_done = true,
+                const std::function<void(runtime::PipelineSpec&)>& change = {}) {
   RegisterComponents();
   runtime::PipelineSpec spec = runtime::LoadPipelineFile(kSource + "/pipelines/demo.yaml");
   spec.resources["scene"] = runtime::ResourceSpec{scene_file, "closed_loop_test", 0};
+  if (change) change(spec);
   runtime::Pipeline pipeline = runtime::Pipeline::Build(spec);
   // The scene every component of the pipeline works in (loaded once, by the pipeline).
   const std::shared_ptr<const scene::Scene> scene =
@@ -71,6 +76,7 @@ LoopRun RunLoop(const std::string& scene_file, double seconds, bool stop_when_al
   std::map<std::string, std::shared_ptr<const Image>> images;
   std::optional<SelectionMessage> selection;
   std::optional<TargetMessage> target;
+  std::vector<double> face_times;  // this step's faces messages: their images' times
   for (const auto& c : pipeline.components()) {
     for (const auto& o : c->outputs()) {
       if (auto* i = dynamic_cast<runtime::Output<runtime::ImageMessage>*>(o.get())) {
@@ -80,6 +86,9 @@ LoopRun RunLoop(const std::string& scene_file, double seconds, bool stop_when_al
         s->signal().Connect([&](const SelectionMessage& m) { selection = m; });
       } else if (auto* t = dynamic_cast<runtime::Output<TargetMessage>*>(o.get())) {
         t->signal().Connect([&](const TargetMessage& m) { target = m; });
+      } else if (auto* f = dynamic_cast<runtime::Output<FacesMessage>*>(o.get())) {
+        f->signal().Connect(
+            [&](const FacesMessage& m) { face_times.push_back(m.image->metadata().time); });
       } else if (auto* j = dynamic_cast<runtime::Output<JointStateMessage>*>(o.get())) {
         j->signal().Connect([&](const JointStateMessage& m) { out.joints.push_back(m.positions); });
       }
@@ -90,6 +99,8 @@ LoopRun RunLoop(const std::string& scene_file, double seconds, bool stop_when_al
   options.steps = static_cast<int64_t>(seconds / spec.clock.step);
   options.stop = &stop;
   options.after_step = [&](const runtime::StepContext& context) {
+    for (const double t : face_times) out.face_ages_s.push_back(context.time - t);
+    face_times.clear();
     if (!selection) return;
     int done = 0, faces = 0;
     for (const PictureFace& p : pictures) {
@@ -219,6 +230,35 @@ TEST(ClosedLoop, IsDeterministic) {
   for (std::size_t i = 0; i < a.joints.size(); ++i) EXPECT_EQ(a.joints[i], b.joints[i]) << i;
   // And the head did move (a saccade towards the first face).
   EXPECT_NE(a.joints.front(), a.joints.back());
+  // The two eyes' detectors and trackers on two threads: the same run again.
+  const LoopRun serial =
+      RunLoop(scene, 1.6, false, [](runtime::PipelineSpec& spec) { spec.threads = 1; });
+  const LoopRun parallel =
+      RunLoop(scene, 1.6, false, [](runtime::PipelineSpec& spec) { spec.threads = 2; });
+  EXPECT_EQ(serial.joints, a.joints);
+  EXPECT_EQ(parallel.joints, a.joints);
+}
+
+// Detection on threads of its own, its faces due two steps after their image: on the
+// simulated clock every faces message is exactly two steps old, the run repeats bit for bit,
+// and the loop still finds and fixates the nearest portrait.
+TEST(ClosedLoop, AsynchronousDetectionKeepsItsModelledLatencyAndRepeats) {
+  const std::string scene = kSource + "/scenes/portraits.yaml";
+  const auto late = [](runtime::PipelineSpec& spec) {
+    for (runtime::ComponentSpec& c : spec.components) {
+      if (c.type == "vision.face_detector") c.params["latency_steps"] = 2;
+    }
+  };
+  const LoopRun a = RunLoop(scene, 1.6, false, late);
+  const LoopRun b = RunLoop(scene, 1.6, false, late);
+  EXPECT_TRUE(a.summary.errors.empty());
+  ASSERT_GT(a.face_ages_s.size(), 20u);
+  for (const double age : a.face_ages_s) EXPECT_NEAR(age, 0.08, 1e-9);
+  EXPECT_EQ(a.joints, b.joints);
+  ASSERT_FALSE(a.visits.empty());
+  EXPECT_EQ(a.visits.front().object, "astronaut_near");
+  EXPECT_GE(a.visits.front().fixated_at, 0.0);
+  EXPECT_LT(a.visits.front().error_3d_m, Max3dErrorM(a.visits.front().distance_m));
 }
 
 }  // namespace

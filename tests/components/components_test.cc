@@ -411,8 +411,8 @@ TEST(ComponentParams, UnknownMissingAndOutOfRangeParametersAreNamed) {
     return std::string("accepted");
   };
   EXPECT_EQ(message("vision.face_detector", {{"min_neighbours", 3}}),
-            "unknown parameter 'min_neighbours' (known: max_size_px, min_neighbors, min_size_px, "
-            "reject_cats, require_eyes, scale_factor)");
+            "unknown parameter 'min_neighbours' (known: cascade, latency_steps, max_size_px, "
+            "min_neighbors, min_size_px, pyramid_level, reject_cats, require_eyes, scale_factor)");
   EXPECT_EQ(message("vision.camshift", json::object()),
             "parameter 'eye' is required: one of left, right (the eye whose image and box it "
             "tracks)");

@@ -15,6 +15,7 @@
 #include <numbers>
 #include <optional>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "image_camera_helpers.h"
@@ -286,6 +287,7 @@ robot:
   const std::vector<Frame> sharp_frames = reference->Render(still, 0);
   for (int i = 0; i < 2; ++i) {
     EXPECT_TRUE(SamePixels(*still_frames[i].color, *sharp_frames[i].color)) << i;
+    EXPECT_EQ(still_frames[i].color->metadata().exposure_samples, 1) << i;
   }
   // A saccade: pan at 5 rad/s (about 290 deg/s) over 10 ms moves the image by ~0.05 rad,
   // ~60 px at f = 1290 px. The blurred image differs from the sharp one of the same instant,
@@ -313,6 +315,26 @@ robot:
     // but spreads it): a step of height h smeared over n pixels keeps h^2 / n of it. Over
     // ~60 px, far less than half remains.
     EXPECT_LT(gradient(b), 0.5 * gradient(s)) << Keep(b, "saccade");
+    EXPECT_EQ(b.metadata().exposure_samples, 8) << i;  // the scene's limit
+  }
+
+  // Blur takes what the motion needs: a pan that moves the image centre by a third of a
+  // pixel over the exposure is drawn as one instant (the sharp image); one that moves it by
+  // 4 px takes at least 4 sub-frames (no ghost step over a pixel) but not the limit.
+  const double f = world.FindCamera("left")->model.intrinsics().fx();
+  const double exposure = 0.01;
+  for (const auto& [centre_px, least, most] : {std::tuple{0.33, 1, 1}, std::tuple{4.0, 4, 7}}) {
+    SCOPED_TRACE("image motion at the centre " + std::to_string(centre_px) + " px");
+    scene::SceneState panning = still;
+    panning.joint_velocities.pan = centre_px / (f * exposure);
+    const std::vector<Frame> got = renderer->Render(panning, 2);
+    const std::vector<Frame> instant = reference->Render(panning, 2);
+    for (int i = 0; i < 2; ++i) {
+      const int n = got[i].color->metadata().exposure_samples;
+      EXPECT_GE(n, least) << i;
+      EXPECT_LE(n, most) << i;
+      EXPECT_EQ(SamePixels(*got[i].color, *instant[i].color), n == 1) << i;
+    }
   }
 }
 
@@ -359,8 +381,7 @@ std::optional<WorldRay> PixelRay(const scene::Scene& world, const Frame& frame, 
   const scene::CameraSpec& camera = world.cameras()[0];
   const std::optional<Vector3d> ray = camera.model.Unproject(Vector2d(u, v));
   if (!ray) return std::nullopt;
-  Eigen::Matrix4d X_WC;
-  for (int k = 0; k < 16; ++k) X_WC(k / 4, k % 4) = frame.color->metadata().X_WC[k];
+  const Eigen::Matrix4d X_WC = geometry::FindCameraPose(frame.color->metadata())->matrix();
   return WorldRay{X_WC.block<3, 1>(0, 3), X_WC.block<3, 3>(0, 0) * *ray};
 }
 
@@ -387,8 +408,7 @@ void CheckTruth(const scene::Scene& world, const TruthScene& t, const std::strin
   ASSERT_EQ(frame.ids->format(), PixelFormat::kUint32);
   const int w = frame.color->width(), h = frame.color->height();
 
-  Eigen::Matrix4d X_WC;
-  for (int k = 0; k < 16; ++k) X_WC(k / 4, k % 4) = frame.color->metadata().X_WC[k];
+  const Eigen::Matrix4d X_WC = geometry::FindCameraPose(frame.color->metadata())->matrix();
   const Eigen::Matrix3d R_CW = X_WC.block<3, 3>(0, 0).transpose();
   const Vector3d p_WC = X_WC.block<3, 1>(0, 3);
   const double yaw = t.plate_yaw_deg * std::numbers::pi / 180.0;

@@ -381,7 +381,10 @@ TEST(RendererTest, SubmitAndRetrieveReturnFramesInOrderWithTheirMetadata) {
       EXPECT_EQ(meta.frame_index, 10 + i);
       EXPECT_EQ(meta.time, states[i].time);
       const Eigen::Matrix4d X_WC = world.CameraPose(camera, states[i]).matrix();
-      for (int k = 0; k < 16; ++k) EXPECT_EQ(meta.X_WC[k], X_WC(k / 4, k % 4)) << k;
+      const geometry::Pose* carried = geometry::FindCameraPose(meta);
+      ASSERT_NE(carried, nullptr);
+      for (int k = 0; k < 16; ++k)
+        EXPECT_EQ(carried->matrix()(k / 4, k % 4), X_WC(k / 4, k % 4)) << k;
       const Eigen::Matrix3d K = camera.model.intrinsics().Matrix();
       for (int k = 0; k < 9; ++k) EXPECT_EQ(testing_helpers::KAt(meta, k), K(k / 3, k % 3)) << k;
       // The metadata describes the lens as rendered: camera 2's radtan distortion, the

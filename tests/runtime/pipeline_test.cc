@@ -303,6 +303,8 @@ TEST(PipelineLoaderTest, ShapeErrorsNameLineAndKey) {
        "expected stop or continue, got 'ignore'"},
       {"seed: -3\ncomponents: [{name: a, type: test.source}]\n", 1, "seed",
        "expected an integer in [0, "},
+      {"threads: 65\ncomponents: [{name: a, type: test.source}]\n", 1, "threads",
+       "expected an integer in [0, 64]"},
       {"components:\n  - name: a.b\n    type: test.source\n", 2, "components[0].name", "no dots"},
       {"components:\n  - name: a\n    kind: test.source\n", 3, "components[0].kind",
        "unknown key 'kind'"},

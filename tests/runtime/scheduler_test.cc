@@ -3,11 +3,14 @@
 
 #include "saccade/runtime/scheduler.h"
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include <atomic>
 #include <chrono>
 #include <string>
+#include <thread>
+#include <utility>
 #include <vector>
 
 #include "runtime/test_components.h"
@@ -56,9 +59,9 @@ components:
   ASSERT_NE(source, nullptr);
   RunOptions options;
   std::vector<double> source_seconds;
-  options.step_timing = [&](const StepContext&, const std::vector<double>& seconds, double) {
-    ASSERT_EQ(seconds.size(), 2u);
-    source_seconds.push_back(seconds[0]);
+  options.step_timing = [&](const StepContext&, const StepTiming& timing) {
+    ASSERT_EQ(timing.own.size(), 2u);
+    source_seconds.push_back(timing.own[0]);
   };
   options.after_step = [&](const StepContext& context) {
     source->SetEnabled(context.step < 1 || context.step >= 3);
@@ -164,7 +167,10 @@ TEST(SchedulerTest, SimulatedRunsAreDeterministicPerSeed) {
   EXPECT_NE(a[0], a[100]);
 }
 
+// One thread: the three components are one level (none reads another) and run one after the
+// other, so the failing step ends at the failing component.
 constexpr const char* kThrowing = R"(clock: {mode: simulated, step: 1, steps: 6}
+threads: 1
 on_error: ON_ERROR
 components:
   - {name: before, type: test.thrower}
@@ -204,6 +210,78 @@ TEST(SchedulerTest, ThrowingComponentStopsTheRunCleanly) {
   }
   EXPECT_EQ(summary.components[1].errors, 1);
   EXPECT_NE(summary.BriefReport().find("stopped on error"), std::string::npos);
+}
+
+TEST(SchedulerTest, ThrowingComponentInAParallelLevelStopsAfterTheLevel) {
+  // Two threads: the components of the failing one's level ran beside it; the run stops after.
+  std::string text = WithOnError("stop");
+  text.replace(text.find("threads: 1"), 10, "threads: 2");
+  Pipeline pipeline = Load(text);
+  const RunSummary summary = RunPipeline(pipeline);
+  EXPECT_TRUE(summary.stopped_on_error);
+  EXPECT_EQ(summary.steps, 3);
+  ASSERT_EQ(summary.errors.size(), 1u);
+  EXPECT_EQ(summary.errors[0].component, "camera");
+  EXPECT_EQ(pipeline.Find<Thrower>("after")->steps, 3);
+  EXPECT_EQ(pipeline.Find<Thrower>("after")->stops, 1);
+}
+
+// Two random streams, each through a relay to a recorder: levels {a, b}, {ra, rb}, {rec_a,
+// rec_b}, each level's two at the same time when there are threads.
+std::vector<std::vector<double>> TwoBranchRun(int threads) {
+  Pipeline pipeline = Load(fmt::format(R"(clock: {{mode: simulated, step: 1, steps: 50}}
+seed: 3
+threads: {}
+components:
+  - {{name: a, type: test.random}}
+  - {{name: b, type: test.random}}
+  - {{name: ra, type: test.relay, inputs: {{in: a.out}}}}
+  - {{name: rb, type: test.relay, inputs: {{in: b.out}}}}
+  - {{name: rec_a, type: test.recorder, inputs: {{in: ra.out}}}}
+  - {{name: rec_b, type: test.recorder, inputs: {{in: rb.out}}}}
+)",
+                                       threads));
+  RunPipeline(pipeline);
+  std::vector<std::vector<double>> out;
+  for (const char* name : {"rec_a", "rec_b"}) {
+    std::vector<double> values;
+    for (const Record& r : pipeline.Find<Recorder>(name)->records) {
+      EXPECT_TRUE(r.fresh) << name << " step " << r.step;  // delivered within the step
+      values.push_back(r.value);
+    }
+    out.push_back(values);
+  }
+  return out;
+}
+
+TEST(SchedulerTest, ParallelLevelsGiveTheSerialRunBitForBit) {
+  const auto serial = TwoBranchRun(1);
+  ASSERT_EQ(serial[0].size(), 50u);
+  EXPECT_NE(serial[0], serial[1]);
+  EXPECT_EQ(TwoBranchRun(2), serial);
+  EXPECT_EQ(TwoBranchRun(4), serial);
+}
+
+TEST(SchedulerTest, ALevelRunsAtTheSameTimeOnThreadsAndOneAfterTheOtherOnOne) {
+  // Two components that wait for each other inside Step: with two threads they meet at every
+  // step; the thread-affine one always runs on the thread that runs the pipeline.
+  const auto run = [](int threads, const std::string& group, int timeout_ms) {
+    Pipeline pipeline = Load(fmt::format(R"(clock: {{mode: simulated, step: 1, steps: 4}}
+threads: {0}
+components:
+  - {{name: left, type: test.rendezvous, params: {{group: {1}, timeout_ms: {2}, affine: true}}}}
+  - {{name: right, type: test.rendezvous, params: {{group: {1}, timeout_ms: {2}}}}}
+)",
+                                         threads, group, timeout_ms));
+    RunPipeline(pipeline);
+    return std::pair{pipeline.Find<testing::Rendezvous>("left")->met,
+                     pipeline.Find<testing::Rendezvous>("left")->threads};
+  };
+  const auto [met, threads] = run(2, "parallel", 10000);
+  EXPECT_EQ(met, std::vector<bool>(4, true));
+  EXPECT_EQ(threads, std::vector<std::thread::id>(4, std::this_thread::get_id()));
+  // One thread: the first waits alone (a short timeout), and they never meet.
+  EXPECT_EQ(run(1, "serial", 20).first, std::vector<bool>(4, false));
 }
 
 TEST(SchedulerTest, ThrowingComponentWithContinueCountsErrors) {

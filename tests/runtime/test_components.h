@@ -3,11 +3,16 @@
 
 #include <gtest/gtest.h>
 
+#include <chrono>
+#include <condition_variable>
 #include <cstdint>
+#include <map>
 #include <memory>
+#include <mutex>
 #include <random>
 #include <stdexcept>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "saccade/core/image.h"
@@ -129,6 +134,52 @@ class Thrower : public Component {
   bool every_ = false;
 };
 
+/// Waits in Step (up to timeout_ms, default 10 s) until `parties` Rendezvous components of its
+/// `group` are inside their Step at the same time; records per step whether they met, and on which
+/// thread it ran. With params.affine it asks to run on the pipeline's thread.
+class Rendezvous : public Component {
+ public:
+  Rendezvous() : out_(AddOutput<Value>("out")) {}
+  void Configure(const nlohmann::json& params) override {
+    parties_ = params.value("parties", 2);
+    timeout_ms_ = params.value("timeout_ms", 10000);
+    affine_ = params.value("affine", false);
+    group_ = &Group(params.value("group", std::string("g")));
+  }
+  bool thread_affine() const override { return affine_; }
+  void Step(const StepContext& context) override {
+    threads.push_back(std::this_thread::get_id());
+    std::unique_lock<std::mutex> lock(group_->mutex);
+    const int64_t round = context.step;
+    if (++group_->arrived[round] == parties_) group_->met.notify_all();
+    met.push_back(group_->met.wait_for(lock, std::chrono::milliseconds(timeout_ms_),
+                                       [&] { return group_->arrived[round] >= parties_; }));
+    out_.Emit(Value{static_cast<double>(context.step)});
+  }
+  std::vector<bool> met;
+  std::vector<std::thread::id> threads;
+
+ private:
+  struct State {
+    std::mutex mutex;
+    std::condition_variable met;
+    std::map<int64_t, int> arrived;
+  };
+  static State& Group(const std::string& name) {
+    static std::mutex guard;
+    static std::map<std::string, std::unique_ptr<State>> groups;
+    std::lock_guard<std::mutex> lock(guard);
+    auto& state = groups[name];
+    if (!state) state = std::make_unique<State>();
+    return *state;
+  }
+  Output<Value>& out_;
+  int parties_ = 2;
+  int timeout_ms_ = 10000;
+  bool affine_ = false;
+  State* group_ = nullptr;
+};
+
 inline ComponentRegistry MakeTestRegistry() {
   ComponentRegistry registry;
   registry.Register<Source>("test.source", "emits start + step");
@@ -138,6 +189,7 @@ inline ComponentRegistry MakeTestRegistry() {
   registry.Register<RequiredSink>("test.required_sink");
   registry.Register<ImageSink>("test.image_sink");
   registry.Register<Thrower>("test.thrower");
+  registry.Register<Rendezvous>("test.rendezvous");
   return registry;
 }
 

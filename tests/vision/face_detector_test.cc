@@ -49,6 +49,49 @@ TEST(FaceDetector, FindsTheAstronautInBothEyesInsideHerPicture) {
   }
 }
 
+// Cheaper searches find the same face: on pyramid level 1 (a quarter of the pixels; boxes in
+// the image's pixels) and, at full size, inside a region around it; an empty region list
+// searches nothing, a region elsewhere finds nothing on her.
+TEST(FaceDetector, AReducedLevelAndARegionFindTheSameFace) {
+  const StereoFrame frame = RenderFixating(FaceCentreWorld("astronaut"));
+  FaceDetector full;
+  FaceDetector::Options reduced_options;
+  reduced_options.pyramid_level = 1;
+  FaceDetector reduced(reduced_options);
+  for (const auto& [image, truth, eye] : {std::tuple{&frame.left, &frame.left_truth, "left"},
+                                          std::tuple{&frame.right, &frame.right_truth, "right"}}) {
+    SCOPED_TRACE(eye);
+    const cv::Rect picture = TruthBox(*truth, "astronaut");
+    const auto accepted_on_her = [&](const std::vector<FaceDetection>& faces) {
+      std::vector<cv::Rect> boxes;
+      for (const FaceDetection& face : faces) {
+        if (!face.rejected && Overlap(face.box, picture) == 1.0) boxes.push_back(face.box);
+      }
+      return boxes;
+    };
+    const std::vector<cv::Rect> reference = accepted_on_her(full.Detect(*image));
+    ASSERT_EQ(reference.size(), 1u);
+    const cv::Point2d centre = (reference[0].tl() + reference[0].br()) * 0.5;
+    const auto near_reference = [&](const cv::Rect& box, double px) {
+      const cv::Point2d c = (box.tl() + box.br()) * 0.5;
+      return cv::norm(c - centre) <= px && std::abs(box.width - reference[0].width) <= 2 * px;
+    };
+    const std::vector<cv::Rect> halved = accepted_on_her(reduced.Detect(*image));
+    ASSERT_EQ(halved.size(), 1u);
+    EXPECT_TRUE(near_reference(halved[0], 8.0)) << halved[0] << " vs " << reference[0];
+    const cv::Rect around(reference[0].x - reference[0].width / 2,
+                          reference[0].y - reference[0].height / 2, 2 * reference[0].width,
+                          2 * reference[0].height);
+    const std::vector<cv::Rect> inside = accepted_on_her(full.Detect(*image, {around}));
+    ASSERT_EQ(inside.size(), 1u);
+    EXPECT_TRUE(near_reference(inside[0], 4.0)) << inside[0] << " vs " << reference[0];
+    EXPECT_TRUE(full.Detect(*image, {}).empty());
+    const cv::Rect elsewhere(0, 0, 200, 200);
+    ASSERT_EQ((elsewhere & picture).area(), 0);
+    EXPECT_TRUE(accepted_on_her(full.Detect(*image, {elsewhere})).empty());
+  }
+}
+
 // Measured: with the head on the astronaut, the cat's picture is cut by the right image's edge,
 // and alt2 fires on it (a 72 px box straddling its left border); with the head on the cat,
 // alt2 at min_neighbors 2 fires at its left border. Every such candidate must be rejected.

@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <limits>
 #include <optional>
 #include <string>
@@ -45,6 +46,39 @@ TEST(InhibitionOfReturn, VisitsEveryTargetInTurnClosestFirst) {
   // 0 .. 1 s the astronaut (closest), 1 .. 2 s the cat, 2 .. 3 s the far face; then all three
   // are suppressed (nothing selected) until the astronaut's suppression ends at 11 s.
   EXPECT_EQ(Visits(ior, 3.5), (std::vector<std::size_t>{1, 0, 2}));
+}
+
+// Two faces walking across the view at 0.1 m/s (0.4 m over the run, more than radius_m): the
+// nearer (0) is fixated for a second, pursued and let go, then the farther (1). Does attention
+// come back to the first once it has left the place where it was let go?
+std::vector<std::size_t> MovingVisits(bool follow) {
+  InhibitionOfReturn::Options options;
+  options.fixation_time_s = 1.0;
+  options.suppression_time_s = 60.0;
+  options.radius_m = 0.15;
+  options.follow = follow;
+  InhibitionOfReturn ior(options);
+  std::vector<std::size_t> visits;
+  std::optional<Vector3d> fixation;
+  for (int i = 0; i < 120; ++i) {  // 4 s
+    const double t = i / 30.0;
+    const std::vector<Vector3d> seen = {Vector3d(2.0, -0.6 + 0.1 * t, 1.2),
+                                        Vector3d(3.0, 0.6 - 0.1 * t, 1.2)};
+    const std::optional<std::size_t> pick = ior.Select(t, seen, kViewer, fixation);
+    if (pick && (visits.empty() || visits.back() != *pick)) visits.push_back(*pick);
+    fixation = pick ? std::optional<Vector3d>(seen[*pick]) : std::nullopt;
+  }
+  return visits;
+}
+
+TEST(InhibitionOfReturn, SuppressionFollowsAMovingFace) {
+  // Following: each face once; then both stay suppressed wherever they go.
+  EXPECT_EQ(MovingVisits(true), (std::vector<std::size_t>{0, 1}));
+  // Places only: the first face walks out of its suppressed place and is picked again.
+  const std::vector<std::size_t> places = MovingVisits(false);
+  ASSERT_GE(places.size(), 3u) << ::testing::PrintToString(places);
+  EXPECT_EQ(places[0], 0u);
+  EXPECT_GE(std::count(places.begin(), places.end(), 0u), 2) << ::testing::PrintToString(places);
 }
 
 TEST(InhibitionOfReturn, SuppressionEndsAfterItsTime) {

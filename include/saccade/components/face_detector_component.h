@@ -1,7 +1,16 @@
 #pragma once
-// vision.face_detector -- Haar faces with the cat and eye checks (vision/face_detector.h).
-//   inputs: image (runtime.image, required); outputs: faces (vision.faces), every new image.
+// vision.face_detector -- Haar or LBP faces with the cat and eye checks
+// (vision/face_detector.h).
+//   inputs: image (runtime.image, required); outputs: faces (vision.faces), with the image
+//   they were found in (its time is their capture time).
 // Parameters: declared in the constructor (docs/components.md lists them).
+//
+// Detect slowly, track fast: with latency_steps N > 0 the detector works on a thread of its
+// own, on the newest image it can take, while the loop goes on; its faces are emitted N steps
+// after that image arrived (simulated clock: exactly N, so that a run repeats bit for bit) or
+// as soon as they are ready (real time), and it then takes the newest image again. Tracking
+// and triangulation use the image the faces carry, so late faces are placed where they were.
+#include <future>
 #include <memory>
 #include <optional>
 #include <string>
@@ -17,14 +26,23 @@ class FaceDetectorComponent : public runtime::Component {
  public:
   FaceDetectorComponent();
   void Step(const runtime::StepContext& context) override;
+  void Stop() override;
 
  protected:
   void Configured() override;
 
  private:
+  FacesMessage Detect(std::shared_ptr<const Image> image);
+
   vision::FaceDetector::Options options_;
+  std::string cascade_ = "haar";
   bool reject_cats_ = true;
   bool require_eyes_ = true;
+  int latency_steps_ = 0;
+  // The detection in flight (latency_steps > 0) and the step its faces are due.
+  std::future<FacesMessage> running_;
+  int64_t due_step_ = 0;
+  std::shared_ptr<const Image> last_;  // the image detected last
   runtime::Input<runtime::ImageMessage>& image_;
   runtime::Output<FacesMessage>& faces_;
   std::unique_ptr<vision::FaceDetector> detector_;

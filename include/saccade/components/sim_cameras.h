@@ -24,6 +24,7 @@ class SimCameras : public runtime::Component, public EyeCamerasRole {
   void Start() override;
   void Step(const runtime::StepContext& context) override;
   void Stop() override;
+  bool thread_affine() const override { return true; }  // the renderer's GL context
 
   const scene::Scene& scene() const override { return *scene_; }
   /// Switches the scene's effects (the GUI's toggles); the next Step renders with them (it

@@ -30,8 +30,8 @@ int BytesPerPixel(PixelFormat format);
 const char* ToString(PixelFormat format);
 
 /// Values of other layers' types that a frame carries, one per type, found by type (no
-/// string round trip): geometry's camera model (geometry/image_camera.h). They are immutable
-/// and shared: copying the metadata copies pointers.
+/// string round trip): geometry's camera model and pose (geometry/image_camera.h). They are
+/// immutable and shared: copying the metadata copies pointers.
 class TypedValues {
  public:
   template <typename T>
@@ -57,15 +57,15 @@ class TypedValues {
   std::vector<std::pair<std::type_index, std::shared_ptr<const void>>> values_;
 };
 
-/// What a frame is and where it came from (DESIGN.md). Frames are named as in DESIGN.md: X_WC
-/// is the camera's optical frame in the world. The camera model (K and the lens distortion of
-/// the image as it is) is geometry's type, in `typed` (geometry/image_camera.h).
+/// What a frame is and where it came from (DESIGN.md). The camera model (K and the lens
+/// distortion of the image as it is) and the camera's pose X_WC (its optical frame in the
+/// world) are geometry's types, in `typed` (geometry/image_camera.h).
 struct ImageMetadata {
   std::string camera;              ///< camera name ("left", "right", ...)
   double time = 0.0;               ///< simulation (or capture) time, seconds
   int64_t frame_index = 0;         ///< 0, 1, 2, ... per camera
-  TypedValues typed;               ///< the camera model
-  std::array<double, 16> X_WC{};   ///< row-major 4x4 pose of the optical frame in W
+  TypedValues typed;               ///< the camera model and pose
+  int exposure_samples = 1;        ///< sub-frames the exposure was drawn in (motion blur)
   bool has_joints = false;         ///< whether the camera rides on a head
   std::array<double, 4> joints{};  ///< pan, tilt, left, right (rad) at capture
 };

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cstdint>
 #include <functional>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
 #include <vector>
@@ -51,5 +52,19 @@ struct EffectRun {
 /// The runs of the effect table, all on `base`'s other options (MSAA, LOD, cameras).
 std::vector<EffectRun> EffectRuns(const scene::Scene& scene, const RendererOptions& base,
                                   const std::vector<std::string>& cameras);
+
+/// A finished `saccade bench`: the first figure (the options as given, the head still) and
+/// the effect table, as JSON for scripts (docs/cli.md) and as text for people.
+struct BenchReport {
+  std::string scene_path;
+  RendererOptions options;  ///< the first figure's
+  int frames = 0, warmup = 0;
+  int width = 0, height = 0;  ///< the first camera's image
+  Measurement main;
+  std::vector<EffectRun> runs;  ///< empty: --no-effect-table
+
+  nlohmann::json Json() const;
+  std::string Text() const;
+};
 
 }  // namespace saccade::render

@@ -5,9 +5,11 @@
 // one line per frame with every camera's file, K, distortion, X_WC, joints and object truth.
 // A frame is listed in frames.jsonl only once all its images are written: a run that is
 // killed leaves whole frames.
+#include <atomic>
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -60,5 +62,13 @@ class DatasetWriter {
   std::ofstream index_;
   int64_t written_ = 0;
 };
+
+/// Renders `frames` frames at times i / fps from `initial` into `writer`, two in flight
+/// (frame i + 1 is drawn while frame i is read back and written); stops after the frame in
+/// hand once `stop` is set. `progress(done, frames per second)` after each frame. Returns
+/// the number of whole frames written.
+int RenderDataset(Renderer& renderer, DatasetWriter& writer, const scene::SceneState& initial,
+                  int frames, double fps, const std::atomic<bool>& stop,
+                  const std::function<void(int done, double fps)>& progress = {});
 
 }  // namespace saccade::render

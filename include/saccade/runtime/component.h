@@ -34,6 +34,9 @@ struct StepContext {
   double time = 0.0;  ///< s: step * dt when simulated, wall time since start in real time
   double dt = 0.0;    ///< s: the nominal step (1 / rate_hz in real time)
   uint64_t seed = 0;  ///< this component's seed: f(pipeline seed, component name), constant
+  /// The wall clock runs the loop (clock mode realtime): work may finish when it does. When
+  /// false, a component that models a latency must keep to it, for runs to be repeatable.
+  bool realtime = false;
 };
 
 /// A component's method without its types: name, message types, and a JSON call.
@@ -107,6 +110,10 @@ class Component {
   virtual void Step(const StepContext& context) = 0;
   /// Releases resources; called once after the last Step (also after an error).
   virtual void Stop() {}
+  /// Whether Step must run on the thread that runs the pipeline (it owns an OpenGL context,
+  /// say). Other components may be stepped on the scheduler's threads, beside the components
+  /// of their level (scheduler.h); they must not share mutable state with those.
+  virtual bool thread_affine() const { return false; }
 
   /// A disabled component is not stepped (the scheduler skips it and marks its inputs seen),
   /// so it emits nothing: the GUI switches the perception part of a loop off this way. Set

@@ -4,6 +4,7 @@
 //
 //   clock: {mode: simulated, step: 0.04, steps: 500}   # or {mode: realtime, rate_hz: 25}
 //   seed: 1                                            # default 0
+//   threads: 2                                         # default 0: one per core (below)
 //   on_error: stop                                     # or continue; default stop
 //   components:                                        # execution order
 //     - name: cameras                                  # letters, digits, '_' or '-'
@@ -44,6 +45,10 @@
 // A connection from a later (or the same) component is a cycle unless it has `delay: 1`;
 // connections from earlier components are delivered at once. Every error is a FileError
 // naming file, line and key.
+//
+// Parallel steps (scheduler.h): components that do not depend on each other within a step
+// (the two eyes' detectors, say) run at the same time on `threads` threads; the run is the
+// same, bit for bit, as with `threads: 1`.
 
 #include <cstdint>
 #include <map>
@@ -102,10 +107,16 @@ struct ResourceSpec {
 };
 
 /// A parsed (not yet built) pipeline file.
+inline constexpr int kMaxThreads = 64;
+
 struct PipelineSpec {
   std::string file;  ///< for messages
   ClockSpec clock;
   uint64_t seed = 0;
+  /// Threads that step the components of a level (those that do not depend on each other in
+  /// one step) at the same time; 1: one after the other; 0: one per core, at most kMaxThreads.
+  /// The results are the same, bit for bit, whatever the number.
+  int threads = 0;
   OnError on_error = OnError::kStop;
   std::vector<ComponentSpec> components;
   std::string hardware_file;  ///< the hardware file used ("" when none)
@@ -120,6 +131,11 @@ PipelineSpec ParsePipeline(const std::string& text, const std::string& source,
                            const std::string& hardware = "");
 /// Reads and parses a pipeline file (and its hardware file). Throws FileError.
 PipelineSpec LoadPipelineFile(const std::string& path, const std::string& hardware = "");
+
+/// Replaces the pipeline's scene resource and every component's own `scene` parameter with
+/// `path` (made absolute: the pipeline file's folder is not the caller's); `origin` names
+/// where it came from in messages ("--scene"). Throws InvalidArgument when it does not exist.
+void ReplaceScene(PipelineSpec& spec, const std::string& path, const std::string& origin);
 
 /// The seed handed to a component: a fixed mix of the pipeline seed and the component's
 /// name (the same on every platform and run).

@@ -11,12 +11,36 @@
 #include <optional>
 #include <string>
 #include <utility>
+#include <vector>
 
 #include "saccade/core/error.h"
 #include "saccade/runtime/bus.h"
 #include "saccade/runtime/message.h"
 
 namespace saccade::runtime {
+
+/// Emissions held back while the components of one step's level run at the same time
+/// (scheduler.cc): on a thread that has one installed, Output::Emit queues the delivery
+/// instead of making it, and the scheduler delivers every component's queue after the level,
+/// in execution order. So a parallel step delivers what the serial one does, in the same
+/// order, bit for bit.
+class DeferredEmits {
+ public:
+  /// This thread's queue; nullptr (deliver at once) unless the scheduler installed one.
+  static DeferredEmits*& Current() {
+    thread_local DeferredEmits* current = nullptr;
+    return current;
+  }
+  void Add(std::function<void()> deliver) { pending_.push_back(std::move(deliver)); }
+  /// Makes the held deliveries, in the order they were emitted.
+  void Deliver() {
+    for (const auto& deliver : pending_) deliver();
+    pending_.clear();
+  }
+
+ private:
+  std::vector<std::function<void()>> pending_;
+};
 
 /// A port's name and message type, without the type.
 class PortBase {
@@ -85,7 +109,13 @@ class Output final : public OutputBase {
       : OutputBase(name, MessageName<T>()), signal_(std::move(name)) {}
 
   /// Sends `message` to every connected input (by reference; see Signal::Emit).
-  void Emit(const T& message) const { signal_.Emit(message); }
+  void Emit(const T& message) const {
+    if (DeferredEmits* deferred = DeferredEmits::Current()) {
+      deferred->Add([this, message] { signal_.Emit(message); });
+      return;
+    }
+    signal_.Emit(message);
+  }
   Signal<T>& signal() { return signal_; }
 
   ConnectionId ConnectJson(std::function<void(const nlohmann::json&)> slot) override {

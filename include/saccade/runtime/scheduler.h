@@ -1,6 +1,13 @@
 #pragma once
 // Runs a pipeline: Start every component, Step them in order each tick, Stop them.
 //
+// Each step runs in levels: a component's level is one past the highest of those it reads
+// without a delay, so the components of one level do not depend on each other in the step
+// (the two eyes' detectors). With more than one thread (PipelineSpec::threads) a level's
+// components run at the same time; what they emit is held back and delivered after the level,
+// in execution order (port.h's DeferredEmits), so the run is the same, bit for bit, as the
+// serial one. A thread-affine component (Component::thread_affine) runs on the calling thread.
+//
 // Simulated clock: time = step * clock.step, no waiting; the same pipeline and seed give
 // the same run, bit for bit. Real time: one tick every 1 / rate_hz seconds of wall clock
 // (the loop sleeps until the next tick; a tick that ends after the next one was due is an
@@ -64,6 +71,19 @@ struct RunSummary {
   std::string FullReport() const;
 };
 
+/// One step's timing, per component in execution order (seconds).
+struct StepTiming {
+  /// Each component's own time in the step (0: disabled, or not stepped after an error).
+  std::vector<double> own;
+  /// When each finished, its messages delivered, from the step's start (0: not stepped). With
+  /// parallel levels, the end-to-end latency between two components is the difference.
+  std::vector<double> finished;
+  /// The loop's time outside the components' own work: the step's wall time less, per level,
+  /// the longest own time in it (its sum when the level ran one after the other): delivery,
+  /// scheduling.
+  double overhead = 0.0;
+};
+
 struct RunOptions {
   /// Overrides the pipeline's clock.steps when >= 0 (0: until `stop`).
   int64_t steps = -1;
@@ -73,13 +93,9 @@ struct RunOptions {
   std::function<void(const StepError&)> on_error;
   /// Called after each step with its context (progress, recording); may be empty.
   std::function<void(const StepContext&)> after_step;
-  /// Called after each step (before after_step) with each component's own time in that step
-  /// (seconds, in execution order; a component not stepped, after an error, is absent; a
-  /// disabled one counts 0) and
-  /// the loop's overhead in it (seconds). For per-step latencies; may be empty.
-  std::function<void(const StepContext&, const std::vector<double>& component_seconds,
-                     double overhead_seconds)>
-      step_timing;
+  /// Called after each step (before after_step) with its timing (StepTiming). For per-step
+  /// latencies; may be empty.
+  std::function<void(const StepContext&, const StepTiming&)> step_timing;
 };
 
 /// Runs `pipeline` once. Component failures are reported in the summary, not thrown;

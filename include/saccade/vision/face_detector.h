@@ -1,5 +1,6 @@
 #pragma once
-// Face detection with OpenCV's Haar cascades (opencv-data), as the seed's perception stage,
+// Face detection with OpenCV's Haar or LBP cascades (opencv-data), as the seed's perception
+// stage, on the image or a reduced level of its pyramid (cheaper by about 4x a level),
 // with a rejection of what only looks like a human face: Haar face cascades also fire on
 // the cat (scenes/portraits.yaml's chelsea) and on other textures. Each candidate the face
 // cascade finds is checked by OpenCV's cat-face cascade run around its box (a hit rejects it:
@@ -25,7 +26,13 @@ struct FaceDetection {
   }
 };
 
-/// Haar-cascade face detector with a cat/eye rejection. Not thread-safe (OpenCV's
+/// The face cascades opencv-data ships.
+inline constexpr const char* kHaarFaceCascade =
+    "/usr/share/opencv4/haarcascades/haarcascade_frontalface_alt2.xml";
+inline constexpr const char* kLbpFaceCascade =
+    "/usr/share/opencv4/lbpcascades/lbpcascade_frontalface_improved.xml";
+
+/// Cascade face detector with a cat/eye rejection. Not thread-safe (OpenCV's
 /// CascadeClassifier keeps state); use one per thread.
 class FaceDetector {
  public:
@@ -35,7 +42,11 @@ class FaceDetector {
     /// ~30 merged hits and no false positive that survives the eye check; `default` finds her
     /// with ~40 hits but adds a 113 px false box beside her face (rejected by the eye check);
     /// `alt` ~25 hits.
-    std::string cascade_path = "/usr/share/opencv4/haarcascades/haarcascade_frontalface_alt2.xml";
+    std::string cascade_path = kHaarFaceCascade;
+    /// Search the face cascade on pyramid level k (the image halved k times, cv::pyrDown);
+    /// boxes come back in the image's pixels, and the cat and eye checks run on the image
+    /// itself. 0 .. 4; sizes (min_size_px, max_size_px) stay in the image's pixels.
+    int pyramid_level = 0;
     double scale_factor = 1.1;  ///< between pyramid levels: > 1 and <= 4
     int min_neighbors = 3;      ///< hits needed to keep a box: >= 0
     int min_size_px = 30;       ///< smallest face side, pixels: >= 1
@@ -66,10 +77,15 @@ class FaceDetector {
   /// Candidates in an rgb8, rgba8 or gray8 image, largest first, rejected ones included and
   /// flagged. Throws InvalidArgument for another format (a wiring error).
   std::vector<FaceDetection> Detect(const Image& image);
+  /// The same, searching faces only inside `regions` (image pixels, clipped to it); an empty
+  /// list searches nothing. Boxes found in overlapping regions are merged.
+  std::vector<FaceDetection> Detect(const Image& image, const std::vector<cv::Rect>& regions);
 
   const Options& options() const { return options_; }
 
  private:
+  std::vector<FaceDetection> DetectIn(const cv::Mat& gray, const std::vector<cv::Rect>& regions);
+
   Options options_;
   cv::CascadeClassifier face_;
   cv::CascadeClassifier cat_;

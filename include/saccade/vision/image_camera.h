@@ -11,7 +11,8 @@ namespace saccade::vision {
 /// the camera when it carries none or one of another image size.
 geometry::CameraModel CameraModelOf(const Image& image);
 
-/// X_WC of `image`'s optical frame (metres), from its metadata; the bottom row is not checked.
+/// X_WC of `image`'s optical frame (metres), from its metadata; InvalidArgument when the
+/// image carries none.
 geometry::Pose CameraPoseOf(const Image& image);
 
 }  // namespace saccade::vision

@@ -2,7 +2,11 @@
 // Inhibition of return (seed section 7.2): once the head has fixated a place for
 // `fixation_time_s`, that place (a ball of `radius_m` about where it was fixated) is
 // suppressed for `suppression_time_s`, so that the next target selection skips it and the
-// head moves on to the next closest face: a run visits every portrait in turn.
+// head moves on to the next closest face: a run visits every portrait in turn. With
+// `follow` (the default, after the seed's reference [15]) a suppressed place moves with the
+// object in it: at each step it moves to the nearest candidate within radius_m (each candidate
+// carries one suppression at most), and a dwell goes on while the fixation moves by less than
+// radius_m a step, so a face that moves is visited once.
 #include <Eigen/Core>
 #include <optional>
 #include <span>
@@ -18,6 +22,7 @@ class InhibitionOfReturn {
     double fixation_time_s = 2.0;      ///< dwell before a place is suppressed, s: > 0
     double radius_m = 0.15;            ///< size of a fixated / suppressed place, m: > 0
     double suppression_time_s = 10.0;  ///< how long it stays suppressed, s: > 0
+    bool follow = true;                ///< suppressions and the dwell follow moving objects
     bool IsValid(std::string* error) const;
   };
 

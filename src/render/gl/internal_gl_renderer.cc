@@ -2,8 +2,10 @@
 
 #include <fmt/format.h>
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <atomic>
+#include <cmath>
 #include <optional>
 #include <utility>
 
@@ -132,7 +134,10 @@ GlRenderer::GlRenderer(const scene::Scene& scene, const RendererOptions& options
     }
     setups_.push_back(std::move(setup));
   }
-  for (Pending& pending : pending_) pending.X_WC.resize(cameras_.size());
+  for (Pending& pending : pending_) {
+    pending.X_WC.resize(cameras_.size());
+    pending.exposure_samples.assign(cameras_.size(), 1);
+  }
   image_pools_.resize(cameras_.size());
 
   // Fixed state. The projection negates y (flip_rows), which mirrors the winding of every
@@ -340,6 +345,7 @@ void GlRenderer::Submit(const scene::SceneState& state, int64_t frame_index) {
   UpdatePoses(state);
   for (std::size_t i = 0; i < cameras_.size(); ++i) {
     pending.X_WC[i] = scene_.CameraPose(*cameras_[i], state);
+    pending.exposure_samples[i] = 1;
   }
   const Clock::time_point posed = Clock::now();
 
@@ -370,24 +376,78 @@ void GlRenderer::Submit(const scene::SceneState& state, int64_t frame_index) {
   stats_.total_ms += Milliseconds(start, end);
 }
 
-bool GlRenderer::MovesDuringExposure(int camera, const scene::SceneState& state,
-                                     const std::vector<scene::SceneState>& sub_states) const {
-  const geometry::Pose X_WC = scene_.CameraPose(*cameras_[camera], state);
-  const head::JointState& v = state.joint_velocities;
-  const bool joints_move = v.pan != 0.0 || v.tilt != 0.0 || v.left != 0.0 || v.right != 0.0;
-  if (joints_move && draw_robot_) return true;
-  for (const scene::SceneState& sub : sub_states) {
-    if (!scene_.CameraPose(*cameras_[camera], sub).isApprox(X_WC, 0.0)) return true;
-    for (const DrawItem& item : items_) {
-      if (item.object < 0) continue;
-      const scene::Object& object = scene_.objects()[item.object];
-      if (object.motion.IsStatic()) continue;
-      if (!(object.motion.PoseAt(sub.time).matrix() == object.motion.PoseAt(state.time).matrix())) {
-        return true;
-      }
-    }
+geometry::Pose GlRenderer::ItemPose(const DrawItem& item, const scene::SceneState& state,
+                                    const std::optional<head::HeadFrames>& frames) const {
+  if (item.object >= 0) return scene_.ObjectPose(scene_.objects()[item.object], state);
+  const scene::RobotPart& part = scene_.robot()->parts[item.part];
+  return LinkPose(*frames, part.link) * part.X_LinkPart;
+}
+
+double GlRenderer::ImageMotionPx(int camera, const scene::SceneState& s0,
+                                 const scene::SceneState& s1) const {
+  const scene::CameraSpec& spec = *cameras_[camera];
+  const geometry::Intrinsics& k = spec.model.intrinsics();
+  const double near = spec.clip.near;
+  const double left = k.cx() / k.fx(), right = (k.width() - k.cx()) / k.fx();
+  const double top = k.cy() / k.fy(), bottom = (k.height() - k.cy()) / k.fy();
+  const double tx = std::max(left, right), ty = std::max(top, bottom);
+  const double f = std::max(k.fx(), k.fy());
+  // The camera turning by an angle moves a ray at angle a from its axis by f (1 + tan^2 a)
+  // pixels per radian, most at the image's corners; a point shifting by d at depth z moves by
+  // at most f (1 + tan a) d / z pixels.
+  const double turn_gain = f * (1.0 + tx * tx + ty * ty);
+  const double shift_gain = f * (1.0 + std::max(tx, ty));
+  const auto angle = [](const Eigen::Matrix3d& R) {
+    return Eigen::AngleAxisd(R).angle();  // in [0, pi]
+  };
+  const geometry::Pose X_WC0 = scene_.CameraPose(spec, s0);
+  const geometry::Pose X_WC1 = scene_.CameraPose(spec, s1);
+  // The camera's turn moves everything alike; its shift moves the ground most nearby (at
+  // its height) and each item by its own depth, as do the items' own motions.
+  const double turn = angle(X_WC0.linear().transpose() * X_WC1.linear());
+  const Eigen::Vector3d camera_shift = X_WC1.translation() - X_WC0.translation();
+  double px = turn_gain * turn +
+              shift_gain * camera_shift.norm() / std::max(std::abs(X_WC0.translation().z()), near);
+  std::optional<head::HeadFrames> frames0, frames1;
+  if (draw_robot_) {
+    frames0 = head::ForwardKinematics(scene_.robot()->head, s0.joints);
+    frames1 = head::ForwardKinematics(scene_.robot()->head, s1.joints);
   }
-  return false;
+  // Whether a sphere (centre in the camera frame, radius) lies wholly outside the view.
+  const auto outside = [&](const Eigen::Vector3d& c, double r) {
+    const auto beyond = [&](double lateral, double tan_half) {  // past one side plane
+      return (lateral - tan_half * c.z()) / std::sqrt(1.0 + tan_half * tan_half) > r;
+    };
+    return c.z() + r < near || beyond(c.x(), right) || beyond(-c.x(), left) ||
+           beyond(c.y(), bottom) || beyond(-c.y(), top);
+  };
+  const geometry::Pose X_CW0 = X_WC0.inverse(), X_CW1 = X_WC1.inverse();
+  for (const DrawItem& item : items_) {
+    const geometry::Pose X_WO0 = ItemPose(item, s0, frames0);
+    const geometry::Pose X_WO1 = ItemPose(item, s1, frames1);
+    const Eigen::Vector3d centre = item.center_model.cwiseProduct(item.scale);
+    const Eigen::Vector3d c0 = X_WO0 * centre, c1 = X_WO1 * centre;  // world
+    // Out of view at both ends of the exposure (a robot part behind the eye, say): its motion
+    // is not seen.
+    if (outside(X_CW0 * c0, item.radius_model) && outside(X_CW1 * c1, item.radius_model)) {
+      continue;
+    }
+    // A point of the item's bounding sphere moves by its centre's motion plus at most its
+    // turn times the radius, seen at the sphere's nearest depth. Two bounds, the smaller
+    // kept: in the camera's frame (an item that moves with the camera, a part of the head,
+    // hardly moves), and in the world's, the camera's turn apart (a still item does not).
+    const double r = item.radius_model;
+    const double depth = std::max((X_CW0 * c0).z() - r, near);
+    const double relative_turn =
+        angle((X_CW0.linear() * X_WO0.linear()).transpose() * (X_CW1.linear() * X_WO1.linear()));
+    const double in_camera =
+        shift_gain * ((X_CW1 * c1 - X_CW0 * c0).norm() + relative_turn * r) / depth;
+    const double item_turn = angle(X_WO0.linear().transpose() * X_WO1.linear());
+    const double in_world =
+        turn_gain * turn + shift_gain * (((c1 - c0) - camera_shift).norm() + item_turn * r) / depth;
+    px = std::max(px, std::min(in_camera, in_world));
+  }
+  return px;
 }
 
 void GlRenderer::DrawEffects(int camera, const scene::SceneState& state, int64_t frame_index,
@@ -403,22 +463,30 @@ void GlRenderer::DrawEffects(int camera, const scene::SceneState& state, int64_t
   };
 
   // Motion blur: sub-frames at the midpoints of n equal slices of the exposure, centred on the
-  // frame's time, the joints moving at their velocities; only when something moves.
+  // frame's time, the joints moving at their velocities. n is what the image motion over the
+  // exposure needs for no step between sub-frames to exceed a pixel (1 when nothing moves:
+  // one instant), up to the scene's blur_samples.
+  const auto at = [&state](double dt) {
+    scene::SceneState sub = state;
+    sub.time += dt;
+    sub.joints.pan += state.joint_velocities.pan * dt;
+    sub.joints.tilt += state.joint_velocities.tilt * dt;
+    sub.joints.left += state.joint_velocities.left * dt;
+    sub.joints.right += state.joint_velocities.right * dt;
+    return sub;
+  };
   std::vector<scene::SceneState> sub_states;
+  int n = 1;
   if (setup.blur) {
-    const int n = spec.sensor.blur_samples;
-    for (int k = 0; k < n; ++k) {
-      const double dt = spec.sensor.exposure * ((k + 0.5) / n - 0.5);
-      scene::SceneState sub = state;
-      sub.time += dt;
-      sub.joints.pan += state.joint_velocities.pan * dt;
-      sub.joints.tilt += state.joint_velocities.tilt * dt;
-      sub.joints.left += state.joint_velocities.left * dt;
-      sub.joints.right += state.joint_velocities.right * dt;
-      sub_states.push_back(sub);
+    const double exposure = spec.sensor.exposure;
+    const double motion_px = ImageMotionPx(camera, at(-0.5 * exposure), at(0.5 * exposure));
+    n = static_cast<int>(
+        std::clamp(std::ceil(motion_px), 1.0, static_cast<double>(spec.sensor.blur_samples)));
+    if (n > 1) {
+      for (int k = 0; k < n; ++k) sub_states.push_back(at(exposure * ((k + 0.5) / n - 0.5)));
     }
-    if (!MovesDuringExposure(camera, state, sub_states)) sub_states.clear();
   }
+  pending_[slot].exposure_samples[camera] = n;
   const int views = static_cast<int>(setup.views.size());
   if (sub_states.empty()) {
     for (int v = 0; v < views; ++v) {

@@ -167,7 +167,8 @@ class GlRenderer final : public Renderer {
   struct Pending {
     scene::SceneState state;
     int64_t frame_index = 0;
-    std::vector<geometry::Pose> X_WC;  // per camera
+    std::vector<geometry::Pose> X_WC;   // per camera
+    std::vector<int> exposure_samples;  // per camera: sub-frames drawn (1: an instant)
     GLsync fence = nullptr;
   };
 
@@ -178,7 +179,7 @@ class GlRenderer final : public Renderer {
     bool distorted = false;                 // the frames carry the lens's distortion
     std::shared_ptr<const geometry::CameraModel> rendered;  // every frame's camera model
     bool noise = false;
-    bool blur = false;  // blur configured (it renders sub-frames only when something moves)
+    bool blur = false;  // blur configured (sub-frames as many as the image motion needs)
   };
 
   MeshProgram& GetMeshProgram(int variant);
@@ -199,8 +200,11 @@ class GlRenderer final : public Renderer {
   void Describe(int camera, const Pending& pending, ImageMetadata* meta) const;
   void DrawEffects(int camera, const scene::SceneState& state, int64_t frame_index,
                    const geometry::Pose& X_WC, int slot);
-  bool MovesDuringExposure(int camera, const scene::SceneState& state,
-                           const std::vector<scene::SceneState>& sub_states) const;
+  // How far, at most, anything the camera sees moves on its image between s0 and s1
+  // (pixels, a bound through the pinhole of K): motion blur draws that many sub-frames.
+  double ImageMotionPx(int camera, const scene::SceneState& s0, const scene::SceneState& s1) const;
+  geometry::Pose ItemPose(const DrawItem& item, const scene::SceneState& state,
+                          const std::optional<head::HeadFrames>& frames) const;
   // Eye frame from world, and the pixels per model unit at an item's nearest point.
   static Eigen::Isometry3d EyeFromWorld(const geometry::Pose& X_WV);
   void SortItems(const Eigen::Isometry3d& X_EW);

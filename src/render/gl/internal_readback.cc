@@ -93,10 +93,8 @@ void GlRenderer::Describe(int camera_index, const Pending& pending, ImageMetadat
   // The image as rendered: the lens's distortion, or a pinhole when distortion is off (or the
   // lens has none).
   geometry::SetCameraModel(meta, setup.rendered);
-  const Eigen::Matrix4d X_WC = pending.X_WC[i].matrix();
-  for (int r = 0; r < 4; ++r) {
-    for (int c = 0; c < 4; ++c) meta.X_WC[4 * r + c] = X_WC(r, c);
-  }
+  geometry::SetCameraPose(meta, pending.X_WC[i]);
+  meta.exposure_samples = pending.exposure_samples[i];
   meta.has_joints = camera.mount != scene::CameraMount::kWorld;
   meta.joints = meta.has_joints
                     ? std::array<double, 4>{pending.state.joints.pan, pending.state.joints.tilt,
