@@ -172,21 +172,17 @@ json PublishScene(const scene::Scene& scene, const std::string& scene_name, cons
                                                                      : "checker";
   json cameras = json::array();
   for (const scene::CameraSpec& c : scene.cameras()) {
-    const geometry::Intrinsics& k = c.model.intrinsics();
     const char* eye = c.mount == scene::CameraMount::kLeftEye    ? "left"
                       : c.mount == scene::CameraMount::kRightEye ? "right"
                                                                  : "world";
-    cameras.push_back(
-        {{"name", c.name},
-         {"eye", eye},
-         {"width", k.width()},
-         {"height", k.height()},
-         {"K", {k.fx(), k.skew(), k.cx(), 0.0, k.fy(), k.cy(), 0.0, 0.0, 1.0}},
-         {"model", c.model.distortion().model() == geometry::DistortionModel::kFisheye ? "fisheye"
-                                                                                       : "radtan"},
-         {"X_WC", MatrixJson(c.X_WC)},
-         {"near", c.clip.near},
-         {"far", c.clip.far}});
+    // The camera model's codec (geometry/json.h): width, height, K, distortion.
+    json camera = ToJson(c.model);
+    camera["name"] = c.name;
+    camera["eye"] = eye;
+    camera["X_WC"] = MatrixJson(c.X_WC);
+    camera["near"] = c.clip.near;
+    camera["far"] = c.clip.far;
+    cameras.push_back(camera);
   }
   return {{"protocol", server::kProtocolName},
           {"version", server::kProtocolVersion},

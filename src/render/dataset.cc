@@ -16,6 +16,7 @@
 #include "saccade/core/log.h"
 #include "saccade/geometry/calibration_io.h"
 #include "saccade/geometry/image_camera.h"
+#include "saccade/geometry/json.h"
 #include "saccade/head/json.h"
 
 namespace saccade::render {
@@ -23,16 +24,6 @@ namespace {
 
 using nlohmann::json;
 namespace fs = std::filesystem;
-
-json MatrixJson(const double* m, int rows, int cols) {
-  json out = json::array();
-  for (int r = 0; r < rows; ++r) {
-    json row = json::array();
-    for (int c = 0; c < cols; ++c) row.push_back(m[r * cols + c]);
-    out.push_back(row);
-  }
-  return out;
-}
 
 json MatrixJson(const Eigen::Matrix4d& m) {
   json out = json::array();
@@ -154,18 +145,11 @@ json FrameJson(int64_t index, double time, const std::vector<Frame>& frames,
   json cameras = json::object();
   for (const auto& frame : frames) {
     const ImageMetadata& m = frame.color->metadata();
-    const geometry::CameraModel& model = RenderedModel(m);
-    // Row by row, as the file has always said it.
-    const Eigen::Matrix<double, 3, 3, Eigen::RowMajor> K = model.intrinsics().Matrix();
-    json entry = {{"file", fmt::format("{}/{:06d}.png", m.camera, index)},
-                  {"width", frame.color->width()},
-                  {"height", frame.color->height()},
-                  {"K", MatrixJson(K.data(), 3, 3)},
-                  {"distortion",
-                   {{"model", geometry::ToString(model.distortion().model())},
-                    {"coefficients", model.distortion().coefficients()}}},
-                  {"X_WC", MatrixJson(geometry::FindCameraPose(m)->matrix())},
-                  {"exposure_samples", m.exposure_samples}};
+    // The camera model's codec (geometry/json.h): width, height, K, distortion.
+    json entry = ToJson(RenderedModel(m));
+    entry["file"] = fmt::format("{}/{:06d}.png", m.camera, index);
+    entry["X_WC"] = MatrixJson(geometry::FindCameraPose(m)->matrix());
+    entry["exposure_samples"] = m.exposure_samples;
     if (m.has_joints) {
       entry["joints"] =
           ToJson(head::JointState{m.joints[0], m.joints[1], m.joints[2], m.joints[3]});

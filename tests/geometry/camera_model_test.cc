@@ -15,6 +15,8 @@
 #include <string>
 #include <vector>
 
+#include "saccade/geometry/json.h"
+
 namespace saccade::geometry {
 namespace {
 
@@ -429,6 +431,33 @@ TEST(CameraModelContains, UsesThePixelEdges) {
   EXPECT_FALSE(camera.Contains({-0.51, 100}));
   EXPECT_FALSE(camera.Contains({100, -0.51}));
   EXPECT_FALSE(camera.Contains({std::nan(""), 100}));
+}
+
+// The camera model's one JSON form (frames.jsonl, the GUI's scene document) carries it
+// whole: K row by row as OpenCV's camera matrix, the distortion's model and coefficients; it
+// reads back to the same model, and a bad one names the field and what was expected.
+TEST(CameraModelJson, RoundTripsAndNamesWhatIsWrong) {
+  const CameraModel model(
+      Intrinsics(640, 480, 500.5, 501.25, 319.5, 239.25, 0.5),
+      Distortion::RadialTangential(std::vector<double>{-0.2, 0.1, 1e-3, -2e-3, 0.01}));
+  const nlohmann::json j = ToJson(model);
+  EXPECT_EQ(j["K"], nlohmann::json::parse("[[500.5, 0.5, 319.5], [0, 501.25, 239.25], [0, 0, 1]]"));
+  EXPECT_EQ(j["distortion"]["model"], "radtan");
+  const CameraModel back = JsonCodec<CameraModel>::Decode(j, {"camera", ""});
+  EXPECT_TRUE(back == model);
+  nlohmann::json bad = j;
+  bad["distortion"]["model"] = "pinhole";
+  try {
+    JsonCodec<CameraModel>::Decode(bad, {"scene", "camera"});
+    ADD_FAILURE() << "accepted a model named pinhole";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("scene: field 'camera': expected {width, height, K"),
+              std::string::npos)
+        << e.what();
+  }
+  bad = j;
+  bad["K"][1][1] = -1.0;  // a negative focal length: the intrinsics refuse it
+  EXPECT_THROW(JsonCodec<CameraModel>::Decode(bad, {"camera", ""}), Error);
 }
 
 }  // namespace

@@ -67,7 +67,7 @@ class CameraRig {
 
   // The point of pixel (u, v) at depth z in the camera frame (x right, y down, z forward).
   point(u, v, z) {
-    const [fx, s, cx, , fy, cy] = this.camera.K;
+    const [[fx, s, cx], [, fy, cy]] = this.camera.K;
     const y = (v - cy) / fy;
     const x = (u - cx - s * y) / fx;
     return new THREE.Vector3(x * z, y * z, z);
