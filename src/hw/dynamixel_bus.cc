@@ -90,6 +90,22 @@ void DynamixelBus::Send(const Packet& packet) {
   ++stats_.instructions;
 }
 
+bool DynamixelBus::FeedUntil(std::chrono::steady_clock::time_point deadline) {
+  const auto left = deadline - std::chrono::steady_clock::now();
+  if (left <= std::chrono::steady_clock::duration::zero()) return false;
+  uint8_t buffer[512];
+  const size_t n = port_.Read(
+      buffer, sizeof(buffer),
+      std::chrono::duration_cast<std::chrono::microseconds>(left) + std::chrono::microseconds(1));
+  if (n > 0) parser_.Feed(buffer, n);
+  return true;
+}
+
+void DynamixelBus::CountParserErrors(int64_t crc_before) {
+  stats_.crc_errors += parser_.crc_errors() - crc_before;
+  stats_.discarded_bytes = parser_.discarded_bytes();
+}
+
 DynamixelBus::Outcome DynamixelBus::Collect(const std::vector<uint8_t>& ids, int data_length,
                                             std::vector<StatusReply>* replies,
                                             std::vector<bool>* got, std::string* unexpected,
@@ -103,7 +119,6 @@ DynamixelBus::Outcome DynamixelBus::Collect(const std::vector<uint8_t>& ids, int
   const int64_t crc_before = parser_.crc_errors();
   bool crc_failure = false;  // a status packet failed its CRC, or a servo saw a bad instruction
   bool saw_unexpected = false;
-  uint8_t buffer[512];
 
   while (waiting > 0) {
     // Parse what is buffered before waiting for more.
@@ -153,15 +168,9 @@ DynamixelBus::Outcome DynamixelBus::Collect(const std::vector<uint8_t>& ids, int
     if (waiting == 0) break;
     // One servo awaited and its answer was corrupted: no need to wait for the timeout.
     if (crc_failure && waiting == 1 && ids.size() == 1) break;
-    const auto left = deadline - Clock::now();
-    if (left <= Clock::duration::zero()) break;
-    const size_t n = port_.Read(
-        buffer, sizeof(buffer),
-        std::chrono::duration_cast<std::chrono::microseconds>(left) + std::chrono::microseconds(1));
-    if (n > 0) parser_.Feed(buffer, n);
+    if (!FeedUntil(deadline)) break;
   }
-  stats_.crc_errors += parser_.crc_errors() - crc_before;
-  stats_.discarded_bytes = parser_.discarded_bytes();
+  CountParserErrors(crc_before);
   if (waiting == 0) return Outcome::kOk;
   if (crc_failure) return Outcome::kCrc;
   if (saw_unexpected) return Outcome::kProtocol;
@@ -229,7 +238,6 @@ std::map<uint8_t, uint16_t> DynamixelBus::BroadcastPing(std::chrono::microsecond
   std::map<uint8_t, uint16_t> found;
   const auto deadline = Clock::now() + window;
   const int64_t crc_before = parser_.crc_errors();
-  uint8_t buffer[512];
   while (true) {
     while (auto packet = parser_.Next()) {
       if (!packet->is_status()) continue;
@@ -242,15 +250,9 @@ std::map<uint8_t, uint16_t> DynamixelBus::BroadcastPing(std::chrono::microsecond
       if (packet->error & dxl::status_error::kAlert) ++stats_.alerts;
       found[packet->id] = static_cast<uint16_t>(dxl::GetLE(packet->params.data(), 2));
     }
-    const auto left = deadline - Clock::now();
-    if (left <= Clock::duration::zero()) break;
-    const size_t n = port_.Read(
-        buffer, sizeof(buffer),
-        std::chrono::duration_cast<std::chrono::microseconds>(left) + std::chrono::microseconds(1));
-    if (n > 0) parser_.Feed(buffer, n);
+    if (!FeedUntil(deadline)) break;
   }
-  stats_.crc_errors += parser_.crc_errors() - crc_before;
-  stats_.discarded_bytes = parser_.discarded_bytes();
+  CountParserErrors(crc_before);
   return found;
 }
 

@@ -180,6 +180,10 @@ class DynamixelBus {
                   std::vector<StatusReply>* replies, std::vector<bool>* got,
                   std::string* unexpected, const std::string& what);
   void Send(const dxl::Packet& packet);
+  // Feeds the parser what the port delivers until `deadline` (one read); false once it passed.
+  bool FeedUntil(std::chrono::steady_clock::time_point deadline);
+  // Adds the parser's CRC errors since `crc_before` and its discarded bytes to the statistics.
+  void CountParserErrors(int64_t crc_before);
   std::chrono::microseconds TransferTime(size_t bytes) const;
   std::vector<uint8_t> ReadExact(uint8_t id, uint16_t address, uint16_t length);
 
