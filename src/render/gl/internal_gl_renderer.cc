@@ -384,7 +384,7 @@ geometry::Pose GlRenderer::ItemPose(const DrawItem& item, const scene::SceneStat
 }
 
 double GlRenderer::ImageMotionPx(int camera, const scene::SceneState& s0,
-                                 const scene::SceneState& s1) const {
+                                 const scene::SceneState& s1, double* camera_px) const {
   const scene::CameraSpec& spec = *cameras_[camera];
   const geometry::Intrinsics& k = spec.model.intrinsics();
   const double near = spec.clip.near;
@@ -408,6 +408,7 @@ double GlRenderer::ImageMotionPx(int camera, const scene::SceneState& s0,
   const Eigen::Vector3d camera_shift = X_WC1.translation() - X_WC0.translation();
   double px = turn_gain * turn +
               shift_gain * camera_shift.norm() / std::max(std::abs(X_WC0.translation().z()), near);
+  if (camera_px != nullptr) *camera_px = px;
   std::optional<head::HeadFrames> frames0, frames1;
   if (draw_robot_) {
     frames0 = head::ForwardKinematics(scene_.robot()->head, s0.joints);
@@ -450,6 +451,78 @@ double GlRenderer::ImageMotionPx(int camera, const scene::SceneState& s0,
   return px;
 }
 
+std::vector<std::optional<GlRenderer::Region>> GlRenderer::MovingRegions(
+    int camera, const std::vector<scene::SceneState>& subs, std::size_t whole,
+    const std::function<geometry::Pose(const geometry::Pose&, int)>& view_pose) const {
+  const CameraSetup& setup = setups_[camera];
+  const scene::CameraSpec& spec = *cameras_[camera];
+  const int views = static_cast<int>(setup.views.size());
+  const geometry::Pose X_WC = scene_.CameraPose(spec, subs[whole]);
+  std::vector<std::optional<head::HeadFrames>> frames(subs.size());
+  if (draw_robot_) {
+    for (std::size_t k = 0; k < subs.size(); ++k) {
+      frames[k] = head::ForwardKinematics(scene_.robot()->head, subs[k].joints);
+    }
+  }
+  // The bounding spheres of the items that move, at every sub-frame (world frame).
+  std::vector<std::pair<Eigen::Vector3d, double>> spheres;
+  for (const DrawItem& item : items_) {
+    const Eigen::Vector3d centre = item.center_model.cwiseProduct(item.scale);
+    std::vector<geometry::Pose> poses;
+    for (std::size_t k = 0; k < subs.size(); ++k)
+      poses.push_back(ItemPose(item, subs[k], frames[k]));
+    const bool moves = std::any_of(poses.begin(), poses.end(), [&](const geometry::Pose& X) {
+      return X.matrix() != poses.front().matrix();
+    });
+    if (!moves) continue;
+    for (const geometry::Pose& X_WO : poses) spheres.emplace_back(X_WO * centre, item.radius_model);
+  }
+  std::vector<std::optional<Region>> regions(views);
+  for (int v = 0; v < views; ++v) {
+    const geometry::Intrinsics& k = setup.effects->lens().views[v].intrinsics;
+    const Eigen::Isometry3d X_EW = EyeFromWorld(view_pose(X_WC, v));
+    const Eigen::Matrix4d& P = setup.views[v].projection;
+    double x0 = 1e300, y0 = 1e300, x1 = -1e300, y1 = -1e300;
+    bool all = false;
+    // The corners of the cube around each sphere, projected as the rasteriser does: their
+    // hull holds the sphere's image while every corner lies in front of the eye.
+    for (const auto& [c_W, r] : spheres) {
+      const Eigen::Vector3d c_E = X_EW * c_W;
+      for (int corner = 0; corner < 8 && !all; ++corner) {
+        const Eigen::Vector4d p(c_E.x() + ((corner & 1) ? r : -r),
+                                c_E.y() + ((corner & 2) ? r : -r),
+                                c_E.z() + ((corner & 4) ? r : -r), 1.0);
+        const Eigen::Vector4d clip = P * p;
+        if (clip.w() <= 1e-9) {
+          all = true;
+          break;
+        }
+        const double x = 0.5 * (clip.x() / clip.w() + 1.0) * k.width();
+        const double y = 0.5 * (clip.y() / clip.w() + 1.0) * k.height();
+        x0 = std::min(x0, x);
+        x1 = std::max(x1, x);
+        y0 = std::min(y0, y);
+        y1 = std::max(y1, y);
+      }
+      if (all) break;
+    }
+    if (all) continue;
+    // Margin: two pixels for rasterisation and multisampling, one for the camera's own motion
+    // (under a pixel over the exposure); empty when nothing moves in the view.
+    constexpr double kMarginPx = 3.0;
+    const int left =
+        static_cast<int>(std::clamp(std::floor(x0 - kMarginPx), 0.0, double(k.width())));
+    const int right =
+        static_cast<int>(std::clamp(std::ceil(x1 + kMarginPx), 0.0, double(k.width())));
+    const int bottom =
+        static_cast<int>(std::clamp(std::floor(y0 - kMarginPx), 0.0, double(k.height())));
+    const int top =
+        static_cast<int>(std::clamp(std::ceil(y1 + kMarginPx), 0.0, double(k.height())));
+    regions[v] = Region{left, bottom, std::max(0, right - left), std::max(0, top - bottom)};
+  }
+  return regions;
+}
+
 void GlRenderer::DrawEffects(int camera, const scene::SceneState& state, int64_t frame_index,
                              const geometry::Pose& X_WC, int slot) {
   const CameraSetup& setup = setups_[camera];
@@ -477,9 +550,12 @@ void GlRenderer::DrawEffects(int camera, const scene::SceneState& state, int64_t
   };
   std::vector<scene::SceneState> sub_states;
   int n = 1;
+  double camera_px = 0.0;    // the camera's own share of the image motion
+  bool accumulated = false;  // the final pass reads the accumulation
   if (setup.blur) {
     const double exposure = spec.sensor.exposure;
-    const double motion_px = ImageMotionPx(camera, at(-0.5 * exposure), at(0.5 * exposure));
+    const double motion_px =
+        ImageMotionPx(camera, at(-0.5 * exposure), at(0.5 * exposure), &camera_px);
     n = static_cast<int>(
         std::clamp(std::ceil(motion_px), 1.0, static_cast<double>(spec.sensor.blur_samples)));
     if (n > 1) {
@@ -496,19 +572,47 @@ void GlRenderer::DrawEffects(int camera, const scene::SceneState& state, int64_t
       effects.FinishView(v);
     }
   } else {
-    effects.ClearAccumulation();
-    const float weight = 1.0f / static_cast<float>(sub_states.size());
-    for (const scene::SceneState& sub : sub_states) {
-      UpdatePoses(sub);
-      const geometry::Pose X_WCk = scene_.CameraPose(spec, sub);
+    // The camera still (under a pixel over the exposure: as for blur itself, a sub-pixel step
+    // is no ghost), the sub-frame nearest the frame's time is drawn whole and the others only
+    // where they can differ from it (MovingRegions: the moving items' sweep), the whole one
+    // standing for all of them elsewhere: a still head watching a small moving ball redraws
+    // the ball's box, not the image, per sub-frame. A moving camera redraws everything.
+    const std::size_t n = sub_states.size(), whole = n / 2;
+    const bool still = camera_px < 1.0;
+    std::vector<std::optional<Region>> regions(views);
+    if (still) regions = MovingRegions(camera, sub_states, whole, view_pose);
+    const auto scissor = [](const Region& r) {
+      glEnable(GL_SCISSOR_TEST);
+      glScissor(r[0], r[1], r[2], r[3]);
+    };
+    const float weight = 1.0f / static_cast<float>(n);
+    using Mode = EffectTarget::Accumulation;
+    for (std::size_t i = 0; i < n; ++i) {
+      const std::size_t k = i == 0 ? whole : (i <= whole ? i - 1 : i);  // whole one first
+      UpdatePoses(sub_states[k]);
+      const geometry::Pose X_WCk = scene_.CameraPose(spec, sub_states[k]);
       for (int v = 0; v < views; ++v) {
+        const std::optional<Region>& region = regions[v];
+        if (i > 0 && region) scissor(*region);
         effects.BindViewForDrawing(v);
         glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
         DrawScene(setup.views[v], near, view_pose(X_WCk, v));
         effects.FinishView(v);
-        effects.Accumulate(*effect_programs_, v, weight);
+        if (region) scissor(*region);
+        effects.Accumulate(*effect_programs_, v, weight, i == 0 ? Mode::kReplace : Mode::kAdd);
+        glDisable(GL_SCISSOR_TEST);
       }
     }
+    // Still camera: the blurred regions go back into the source views, which hold the whole
+    // sub-frame elsewhere, and the final pass reads those (8 bits, as without blur).
+    if (still) {
+      for (int v = 0; v < views; ++v) {
+        if (regions[v]) scissor(*regions[v]);
+        effects.WriteBack(*effect_programs_, v);
+        glDisable(GL_SCISSOR_TEST);
+      }
+    }
+    accumulated = !still;
     UpdatePoses(state);
   }
   if (effects.has_truth()) {
@@ -521,7 +625,7 @@ void GlRenderer::DrawEffects(int camera, const scene::SceneState& state, int64_t
   noise.read_sigma_dn = static_cast<float>(spec.sensor.read_noise_dn);
   noise.gain_dn_per_e = static_cast<float>(spec.sensor.gain_dn_per_e);
   noise.key = NoiseKey(spec.sensor.seed, spec.name, frame_index);
-  effects.Finish(*effect_programs_, !sub_states.empty(), setup.noise ? &noise : nullptr, slot);
+  effects.Finish(*effect_programs_, accumulated, setup.noise ? &noise : nullptr, slot);
 }
 
 std::vector<Frame> GlRenderer::Render(const scene::SceneState& state, int64_t frame_index) {

@@ -10,8 +10,10 @@
 #include <array>
 #include <chrono>
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -202,7 +204,17 @@ class GlRenderer final : public Renderer {
                    const geometry::Pose& X_WC, int slot);
   // How far, at most, anything the camera sees moves on its image between s0 and s1
   // (pixels, a bound through the pinhole of K): motion blur draws that many sub-frames.
-  double ImageMotionPx(int camera, const scene::SceneState& s0, const scene::SceneState& s1) const;
+  // `camera_px`, when given, gets the camera's own share (its turn and shift).
+  double ImageMotionPx(int camera, const scene::SceneState& s0, const scene::SceneState& s1,
+                       double* camera_px = nullptr) const;
+  // Motion blur's sub-frames with the camera still: per view of the camera, the window
+  // rectangle (x, y, width, height) outside which every sub-frame equals sub-frame `whole`
+  // (the items that move do not reach there), or nullopt for all of the view (a moving item
+  // reaches behind the eye).
+  using Region = std::array<int, 4>;
+  std::vector<std::optional<Region>> MovingRegions(
+      int camera, const std::vector<scene::SceneState>& subs, std::size_t whole,
+      const std::function<geometry::Pose(const geometry::Pose&, int)>& view_pose) const;
   geometry::Pose ItemPose(const DrawItem& item, const scene::SceneState& state,
                           const std::optional<head::HeadFrames>& frames) const;
   // Eye frame from world, and the pixels per model unit at an item's nearest point.
