@@ -20,6 +20,7 @@ using internal::FrameOf;
 
 FaceDetectorComponent::FaceDetectorComponent()
     : image_(AddInput<runtime::ImageMessage>("image", /*required=*/true)),
+      track_(AddInput<TrackMessage>("track")),
       faces_(AddOutput<FacesMessage>("faces")) {
   DeclareParam("cascade", &cascade_,
                "the face cascade: haar (alt2) or lbp (frontalface_improved; on "
@@ -34,6 +35,13 @@ FaceDetectorComponent::FaceDetectorComponent()
                "0: detect within the step; N: detect on a thread of its own, the faces emitted N "
                "steps after their image (simulated clock; real time: once ready)")
       .Range(0, 100);
+  DeclareParam("track_region_scale", &track_region_scale_,
+               "with a track input: search a box this many times the track's window around "
+               "it; 0: always the whole image")
+      .Range(0.0, 100.0);
+  DeclareParam("full_scan_every", &full_scan_every_,
+               "with a track region: search the whole image every N-th detection")
+      .Range(1, 1000000);
   DeclareParam("min_neighbors", &options_.min_neighbors, "overlapping hits needed to keep a box")
       .Range(0, 1000);
   DeclareParam("scale_factor", &options_.scale_factor, "size step between pyramid levels")
@@ -56,10 +64,28 @@ void FaceDetectorComponent::Configured() {
   detector_ = std::make_unique<vision::FaceDetector>(options);
 }
 
-FacesMessage FaceDetectorComponent::Detect(std::shared_ptr<const Image> image) {
+std::optional<cv::Rect> FaceDetectorComponent::NextRegion(const Image& image) {
+  const int64_t n = detections_++;
+  if (!(track_region_scale_ > 0.0) || !track_.has_value() || n % full_scan_every_ == 0) {
+    return std::nullopt;
+  }
+  const TrackMessage& track = track_.value();
+  if (!track.tracking || track.window.area() <= 0) return std::nullopt;
+  const double w = track_region_scale_ * track.window.width;
+  const double h = track_region_scale_ * track.window.height;
+  const cv::Rect region(static_cast<int>(std::floor(track.center.x - 0.5 * w)),
+                        static_cast<int>(std::floor(track.center.y - 0.5 * h)),
+                        static_cast<int>(std::ceil(w)), static_cast<int>(std::ceil(h)));
+  return region & cv::Rect(0, 0, image.width(), image.height());
+}
+
+FacesMessage FaceDetectorComponent::Detect(std::shared_ptr<const Image> image,
+                                           std::optional<cv::Rect> region) {
   FacesMessage out;
   out.image = std::move(image);
-  for (const vision::FaceDetection& d : detector_->Detect(*out.image)) {
+  const std::vector<vision::FaceDetection> found =
+      region ? detector_->Detect(*out.image, {*region}) : detector_->Detect(*out.image);
+  for (const vision::FaceDetection& d : found) {
     out.faces.push_back({d.box, d.neighbors, d.rejected, d.reason});
   }
   return out;
@@ -67,7 +93,10 @@ FacesMessage FaceDetectorComponent::Detect(std::shared_ptr<const Image> image) {
 
 void FaceDetectorComponent::Step(const runtime::StepContext& context) {
   if (latency_steps_ == 0) {
-    if (image_.fresh() && image_.value().image) faces_.Emit(Detect(image_.value().image));
+    if (image_.fresh() && image_.value().image) {
+      const std::shared_ptr<const Image>& image = image_.value().image;
+      faces_.Emit(Detect(image, NextRegion(*image)));
+    }
     return;
   }
   if (running_.valid()) {
@@ -83,7 +112,9 @@ void FaceDetectorComponent::Step(const runtime::StepContext& context) {
   if (!image_.fresh() && image == last_) return;
   last_ = image;
   due_step_ = context.step + latency_steps_;
-  running_ = std::async(std::launch::async, [this, image] { return Detect(image); });
+  const std::optional<cv::Rect> region = NextRegion(*image);
+  running_ =
+      std::async(std::launch::async, [this, image, region] { return Detect(image, region); });
 }
 
 void FaceDetectorComponent::Stop() {
