@@ -84,28 +84,40 @@ RemapTable MakeRemapTable(const geometry::LensMap& lens) {
 
 std::vector<float> GaussianTable() {
   // Quantile i of the standard normal at probability (i + 1/2) / n, by bisection on erfc (to
-  // float precision: 40 halvings of [-9, 9]), then scaled to unit variance (the n quantiles
+  // float precision: 40 halvings of [-9, 0]), then scaled to unit variance (the n quantiles
   // miss the tails beyond 4.5 sigma: their variance is 0.9997).
-  constexpr int kSide = 256;
-  constexpr int n = kSide * kSide;
-  std::vector<float> table(n);
+  constexpr int n = kGaussianTableSide * kGaussianTableSide;
+  std::vector<double> z(n);
   double sum2 = 0.0;
-  std::vector<double> z(n / 2);
   for (int i = 0; i < n / 2; ++i) {
-    const double p = (i + 0.5) / n;  // lower half; the upper half by symmetry
+    const double p = (i + 0.5) / n;  // the lower half; the upper half by symmetry
     double lo = -9.0, hi = 0.0;
     for (int k = 0; k < 40; ++k) {
       const double mid = 0.5 * (lo + hi);
       (0.5 * std::erfc(-mid / std::sqrt(2.0)) < p ? lo : hi) = mid;
     }
     z[i] = 0.5 * (lo + hi);
+    z[n - 1 - i] = -z[i];
     sum2 += 2.0 * z[i] * z[i];
   }
   const double scale = 1.0 / std::sqrt(sum2 / n);
-  // Order does not matter (indices are hashed); symmetric pairs keep the mean exactly 0.
-  for (int i = 0; i < n / 2; ++i) {
-    table[2 * i] = static_cast<float>(z[i] * scale);
-    table[2 * i + 1] = static_cast<float>(-z[i] * scale);
+  // Three channels, each the quantiles in its own order (Fisher-Yates with SplitMix64, fixed
+  // seeds), so that the three deviates of one entry are independent.
+  std::vector<float> table(3 * static_cast<std::size_t>(n));
+  for (int c = 0; c < 3; ++c) {
+    std::vector<int> order(n);
+    for (int i = 0; i < n; ++i) order[i] = i;
+    uint64_t state = 0x5eed0000u + static_cast<uint64_t>(c);
+    for (int i = n - 1; i > 0; --i) {
+      state += 0x9e3779b97f4a7c15ull;
+      uint64_t x = state;
+      x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ull;
+      x = (x ^ (x >> 27)) * 0x94d049bb133111ebull;
+      x ^= x >> 31;
+      std::swap(order[i], order[static_cast<int>(x % static_cast<uint64_t>(i + 1))]);
+    }
+    for (int i = 0; i < n; ++i)
+      table[3 * static_cast<std::size_t>(i) + c] = static_cast<float>(z[order[i]] * scale);
   }
   return table;
 }
@@ -193,7 +205,8 @@ EffectPrograms::EffectPrograms() {
   truth_.id = Uniform(truth_.program, "u_id");
   glUseProgram(0);
   const std::vector<float> gauss = GaussianTable();
-  gauss_ = MakeTexture2d(GL_R32F, GL_RED, GL_FLOAT, 256, 256, gauss.data());
+  gauss_ = MakeTexture2d(GL_RGB32F, GL_RGB, GL_FLOAT, kGaussianTableSide, kGaussianTableSide,
+                         gauss.data());
   CheckGlError("MakeRenderer: building the effect programs");
 }
 

@@ -47,8 +47,10 @@ struct RemapTable {
 };
 RemapTable MakeRemapTable(const geometry::LensMap& lens);
 
-/// 2^16 standard normal deviates, the quantiles at (i + 1/2) / 2^16 scaled to unit variance,
-/// in pairs of opposite sign (mean exactly 0): the sensor noise's table (kFinalFragmentSource).
+/// The sensor noise's table (kFinalFragmentSource): kGaussianTableSide^2 entries of three
+/// standard normal deviates (RGB), each channel the quantiles at (i + 1/2) / 2^16 scaled to
+/// unit variance (mean exactly 0) in an order of its own.
+inline constexpr int kGaussianTableSide = 256;
 std::vector<float> GaussianTable();
 
 /// Programs and the empty vertex array shared by every camera's effect passes.
@@ -77,7 +79,7 @@ class EffectPrograms {
   GLuint accumulate() const { return accumulate_; }
   GLint accumulate_layer() const { return accumulate_layer_; }
   GLint accumulate_weight() const { return accumulate_weight_; }
-  /// GaussianTable() as a 256 x 256 R32F texture.
+  /// GaussianTable() as a kGaussianTableSide^2 RGB32F texture.
   GLuint gauss() const { return gauss_; }
   /// Draws the full-screen triangle (program and framebuffer bound by the caller).
   void DrawFullscreen() const;

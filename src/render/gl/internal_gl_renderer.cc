@@ -17,7 +17,22 @@
 #include "saccade/geometry/lens_map.h"
 
 namespace saccade::render::gl {
+
 namespace {
+
+// The clip-space transform that maps a window rectangle (x, y, width, height) of a
+// width x height view onto the whole of normalised device coordinates: its frustum is the
+// rectangle's part of the view's.
+Eigen::Matrix4d RegionFrustum(const std::array<int, 4>& r, int width, int height) {
+  const double x0 = 2.0 * r[0] / width - 1.0, x1 = 2.0 * (r[0] + r[2]) / width - 1.0;
+  const double y0 = 2.0 * r[1] / height - 1.0, y1 = 2.0 * (r[1] + r[3]) / height - 1.0;
+  Eigen::Matrix4d S = Eigen::Matrix4d::Identity();
+  S(0, 0) = 2.0 / std::max(x1 - x0, 1e-9);
+  S(0, 3) = -(x0 + x1) / std::max(x1 - x0, 1e-9);
+  S(1, 1) = 2.0 / std::max(y1 - y0, 1e-9);
+  S(1, 3) = -(y0 + y1) / std::max(y1 - y0, 1e-9);
+  return S;
+}
 
 // SplitMix64's finaliser (S. Vigna): a bijective 64-bit mix.
 uint64_t Mix64(uint64_t x) {
@@ -593,10 +608,18 @@ void GlRenderer::DrawEffects(int camera, const scene::SceneState& state, int64_t
       const geometry::Pose X_WCk = scene_.CameraPose(spec, sub_states[k]);
       for (int v = 0; v < views; ++v) {
         const std::optional<Region>& region = regions[v];
-        if (i > 0 && region) scissor(*region);
+        const bool part = i > 0 && region;
+        if (part) scissor(*region);
         effects.BindViewForDrawing(v);
         glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
-        DrawScene(setup.views[v], near, view_pose(X_WCk, v));
+        if (part) {
+          // Only the items that reach the region: the frustum of its rectangle.
+          const geometry::Intrinsics& size = effects.lens().views[v].intrinsics;
+          const Eigen::Matrix4d cull = RegionFrustum(*region, size.width(), size.height());
+          DrawScene(setup.views[v], near, view_pose(X_WCk, v), &cull);
+        } else {
+          DrawScene(setup.views[v], near, view_pose(X_WCk, v));
+        }
         effects.FinishView(v);
         if (region) scissor(*region);
         effects.Accumulate(*effect_programs_, v, weight, i == 0 ? Mode::kReplace : Mode::kAdd);

@@ -190,11 +190,13 @@ class GlRenderer final : public Renderer {
   void UpdatePoses(const scene::SceneState& state);
   // The colour pass and the truth pass (internal_draw.cc) draw the same items in the same
   // order at the same levels of detail, through one visitor.
-  void DrawScene(const ViewSetup& view, double near, const geometry::Pose& X_WV);
+  // `cull`: draw only the items inside the frustum of cull * mvp too (a part of the view).
+  void DrawScene(const ViewSetup& view, double near, const geometry::Pose& X_WV,
+                 const Eigen::Matrix4d* cull = nullptr);
   void DrawTruth(const ViewSetup& view, double near, const geometry::Pose& X_WV);
   template <class Visit>
   void ForEachVisibleItem(const ViewSetup& view, double near, const Eigen::Isometry3d& X_EW,
-                          Visit&& visit);
+                          Visit&& visit, const Eigen::Matrix4d* cull = nullptr);
   const GpuLod& LodOf(const GpuMesh& mesh, double px_per_model_unit) const;
   static void DrawLod(const GpuMesh& mesh, const GpuLod& lod, bool* culling);
   void DrawGround(GLint mvp, GLint mv, const Eigen::Matrix4d& P, const Eigen::Isometry3d& X_EW);
