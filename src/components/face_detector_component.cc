@@ -42,6 +42,10 @@ FaceDetectorComponent::FaceDetectorComponent()
   DeclareParam("full_scan_every", &full_scan_every_,
                "with a track region: search the whole image every N-th detection")
       .Range(1, 1000000);
+  DeclareParam("region_pyramid_level", &region_pyramid_level_,
+               "the pyramid level of the search around the track (the whole image's is "
+               "pyramid_level)")
+      .Range(0, 4);
   DeclareParam("min_neighbors", &options_.min_neighbors, "overlapping hits needed to keep a box")
       .Range(0, 1000);
   DeclareParam("scale_factor", &options_.scale_factor, "size step between pyramid levels")
@@ -62,29 +66,46 @@ void FaceDetectorComponent::Configured() {
   if (!reject_cats_) options.cat_cascade_path = "";
   if (!require_eyes_) options.eye_cascade_path = "";
   detector_ = std::make_unique<vision::FaceDetector>(options);
+  options.pyramid_level = region_pyramid_level_;
+  region_detector_ = std::make_unique<vision::FaceDetector>(options);
 }
 
-std::optional<cv::Rect> FaceDetectorComponent::NextRegion(const Image& image) {
+FaceDetectorComponent::Search FaceDetectorComponent::NextSearch(const Image& image) {
+  Search search;
   const int64_t n = detections_++;
-  if (!(track_region_scale_ > 0.0) || !track_.has_value() || n % full_scan_every_ == 0) {
-    return std::nullopt;
-  }
+  if (!(track_region_scale_ > 0.0) || !track_.has_value()) return search;
   const TrackMessage& track = track_.value();
-  if (!track.tracking || track.window.area() <= 0) return std::nullopt;
+  if (!track.tracking || track.window.area() <= 0) return search;
   const double w = track_region_scale_ * track.window.width;
   const double h = track_region_scale_ * track.window.height;
   const cv::Rect region(static_cast<int>(std::floor(track.center.x - 0.5 * w)),
                         static_cast<int>(std::floor(track.center.y - 0.5 * h)),
                         static_cast<int>(std::ceil(w)), static_cast<int>(std::ceil(h)));
-  return region & cv::Rect(0, 0, image.width(), image.height());
+  search.region = region & cv::Rect(0, 0, image.width(), image.height());
+  search.whole = n % full_scan_every_ == 0;
+  return search;
 }
 
 FacesMessage FaceDetectorComponent::Detect(std::shared_ptr<const Image> image,
-                                           std::optional<cv::Rect> region) {
+                                           const Search& search) {
   FacesMessage out;
   out.image = std::move(image);
-  const std::vector<vision::FaceDetection> found =
-      region ? detector_->Detect(*out.image, {*region}) : detector_->Detect(*out.image);
+  std::vector<vision::FaceDetection> found;
+  if (search.whole) found = detector_->Detect(*out.image);
+  if (search.region) {
+    // The tracked face from the region, at the region's pyramid level: it replaces the whole
+    // image's boxes that overlap it.
+    const std::vector<vision::FaceDetection> near =
+        region_detector_->Detect(*out.image, {*search.region});
+    std::erase_if(found, [&near](const vision::FaceDetection& d) {
+      return std::any_of(near.begin(), near.end(), [&d](const vision::FaceDetection& r) {
+        return (d.box & r.box).area() > 0.5 * std::min(d.box.area(), r.box.area());
+      });
+    });
+    found.insert(found.end(), near.begin(), near.end());
+    std::stable_sort(found.begin(), found.end(),
+                     [](const auto& a, const auto& b) { return a.box.area() > b.box.area(); });
+  }
   for (const vision::FaceDetection& d : found) {
     out.faces.push_back({d.box, d.neighbors, d.rejected, d.reason});
   }
@@ -95,7 +116,7 @@ void FaceDetectorComponent::Step(const runtime::StepContext& context) {
   if (latency_steps_ == 0) {
     if (image_.fresh() && image_.value().image) {
       const std::shared_ptr<const Image>& image = image_.value().image;
-      faces_.Emit(Detect(image, NextRegion(*image)));
+      faces_.Emit(Detect(image, NextSearch(*image)));
     }
     return;
   }
@@ -112,9 +133,9 @@ void FaceDetectorComponent::Step(const runtime::StepContext& context) {
   if (!image_.fresh() && image == last_) return;
   last_ = image;
   due_step_ = context.step + latency_steps_;
-  const std::optional<cv::Rect> region = NextRegion(*image);
+  const Search search = NextSearch(*image);
   running_ =
-      std::async(std::launch::async, [this, image, region] { return Detect(image, region); });
+      std::async(std::launch::async, [this, image, search] { return Detect(image, search); });
 }
 
 void FaceDetectorComponent::Stop() {

@@ -26,9 +26,9 @@ SimCameras::SimCameras() : joints_(AddInput<JointStateMessage>("joints")) {
       .Range(0.0, 1e6)
       .Unit("px");
   DeclareParam("pipelined", &pipelined_,
-               "render the next frame while the loop works on this one (one step older): on, "
-               "off, or auto (on with the real-time clock)")
-      .Choices({"auto", "on", "off"});
+               "render the next frame while the loop works on this one (one step older): always, "
+               "never, or auto (with the real-time clock)")
+      .Choices({"auto", "always", "never"});
 }
 
 void SimCameras::Configured() {
@@ -71,7 +71,7 @@ void SimCameras::Step(const runtime::StepContext& context) {
     state.joints = joints->positions;
     state.joint_velocities = joints->velocities;
   }
-  const bool pipelined = pipelined_ == "on" || (pipelined_ == "auto" && context.realtime);
+  const bool pipelined = pipelined_ == "always" || (pipelined_ == "auto" && context.realtime);
   std::vector<render::Frame> frames;
   if (pipelined) {
     if (renderer_->InFlight() > 0) frames = renderer_->Retrieve();

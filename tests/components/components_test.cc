@@ -227,9 +227,9 @@ double Sharpness(const Image& image) {
 // exactly those an unpipelined camera renders for that step (frame index, joints, pixels).
 TEST(SimCameras, PipelinedCaptureEmitsThePreviousStepsFrameUnchanged) {
   auto pipelined =
-      Make("sim.cameras", {{"scene", kScene}, {"cameras", {"left"}}, {"pipelined", "on"}});
+      Make("sim.cameras", {{"scene", kScene}, {"cameras", {"left"}}, {"pipelined", "always"}});
   auto plain =
-      Make("sim.cameras", {{"scene", kScene}, {"cameras", {"left"}}, {"pipelined", "off"}});
+      Make("sim.cameras", {{"scene", kScene}, {"cameras", {"left"}}, {"pipelined", "never"}});
   auto got = Capture<runtime::ImageMessage>(*pipelined, "left");
   auto want = Capture<runtime::ImageMessage>(*plain, "left");
   pipelined->Start();
@@ -499,7 +499,8 @@ TEST(ComponentParams, UnknownMissingAndOutOfRangeParametersAreNamed) {
   };
   EXPECT_EQ(message("vision.face_detector", {{"min_neighbours", 3}}),
             "unknown parameter 'min_neighbours' (known: cascade, full_scan_every, latency_steps, "
-            "max_size_px, min_neighbors, min_size_px, pyramid_level, reject_cats, require_eyes, "
+            "max_size_px, min_neighbors, min_size_px, pyramid_level, region_pyramid_level, "
+            "reject_cats, require_eyes, "
             "scale_factor, track_region_scale)");
   EXPECT_EQ(message("vision.camshift", json::object()),
             "parameter 'eye' is required: one of left, right (the eye whose image and box it "

@@ -4,7 +4,7 @@
 //   inputs:  joints (head.joints, optional): the head's state at this step's time; connect
 //            it from sim.head with delay 1. Without it, the scene's initial joints.
 //   outputs: <camera> (runtime.image) per camera, shared; frame index = step.
-//   Pipelined capture (`pipelined`: on, or auto with the real-time clock): each step submits
+//   Pipelined capture (`pipelined`: always, or auto with the real-time clock): each step submits
 //   this step's state to the renderer and emits the frames of the previous step's, which
 //   rendered while the rest of the loop worked (llvmpipe rasterises on threads of its own, a
 //   GPU on its own); the images are one step older (their capture time says so), and the
@@ -35,7 +35,7 @@ class SimCameras : public runtime::Component, public EyeCamerasRole {
   /// Switches the scene's effects (the GUI's toggles); the next Step renders with them (it
   /// makes a new renderer). Call from the thread that runs the pipeline.
   void SetEffects(bool distortion, bool noise, bool motion_blur) override;
-  void SetPipelined(bool on) override { pipelined_ = on ? "on" : "off"; }
+  void SetPipelined(bool on) override { pipelined_ = on ? "always" : "never"; }
   const render::RendererOptions& options() const { return options_; }
   const render::RendererOptions* rendered() const override { return &options_; }
 

@@ -399,7 +399,8 @@ geometry::Pose GlRenderer::ItemPose(const DrawItem& item, const scene::SceneStat
 }
 
 double GlRenderer::ImageMotionPx(int camera, const scene::SceneState& s0,
-                                 const scene::SceneState& s1, double* camera_px) const {
+                                 const scene::SceneState& s1, double* camera_px,
+                                 std::vector<double>* item_px) const {
   const scene::CameraSpec& spec = *cameras_[camera];
   const geometry::Intrinsics& k = spec.model.intrinsics();
   const double near = spec.clip.near;
@@ -438,7 +439,9 @@ double GlRenderer::ImageMotionPx(int camera, const scene::SceneState& s0,
            beyond(c.y(), bottom) || beyond(-c.y(), top);
   };
   const geometry::Pose X_CW0 = X_WC0.inverse(), X_CW1 = X_WC1.inverse();
-  for (const DrawItem& item : items_) {
+  if (item_px != nullptr) item_px->assign(items_.size(), 0.0);
+  for (std::size_t i = 0; i < items_.size(); ++i) {
+    const DrawItem& item = items_[i];
     const geometry::Pose X_WO0 = ItemPose(item, s0, frames0);
     const geometry::Pose X_WO1 = ItemPose(item, s1, frames1);
     const Eigen::Vector3d centre = item.center_model.cwiseProduct(item.scale);
@@ -461,13 +464,16 @@ double GlRenderer::ImageMotionPx(int camera, const scene::SceneState& s0,
     const double item_turn = angle(X_WO0.linear().transpose() * X_WO1.linear());
     const double in_world =
         turn_gain * turn + shift_gain * (((c1 - c0) - camera_shift).norm() + item_turn * r) / depth;
-    px = std::max(px, std::min(in_camera, in_world));
+    const double item_motion = std::min(in_camera, in_world);
+    if (item_px != nullptr) (*item_px)[i] = item_motion;
+    px = std::max(px, item_motion);
   }
   return px;
 }
 
 std::vector<std::optional<GlRenderer::Region>> GlRenderer::MovingRegions(
     int camera, const std::vector<scene::SceneState>& subs, std::size_t whole,
+    const std::vector<double>& item_px,
     const std::function<geometry::Pose(const geometry::Pose&, int)>& view_pose) const {
   const CameraSetup& setup = setups_[camera];
   const scene::CameraSpec& spec = *cameras_[camera];
@@ -481,7 +487,10 @@ std::vector<std::optional<GlRenderer::Region>> GlRenderer::MovingRegions(
   }
   // The bounding spheres of the items that move, at every sub-frame (world frame).
   std::vector<std::pair<Eigen::Vector3d, double>> spheres;
-  for (const DrawItem& item : items_) {
+  for (std::size_t i = 0; i < items_.size(); ++i) {
+    // Under a pixel over the exposure, an item is as still as the camera (no ghost step).
+    if (item_px[i] < 1.0) continue;
+    const DrawItem& item = items_[i];
     const Eigen::Vector3d centre = item.center_model.cwiseProduct(item.scale);
     std::vector<geometry::Pose> poses;
     for (std::size_t k = 0; k < subs.size(); ++k)
@@ -565,12 +574,13 @@ void GlRenderer::DrawEffects(int camera, const scene::SceneState& state, int64_t
   };
   std::vector<scene::SceneState> sub_states;
   int n = 1;
-  double camera_px = 0.0;    // the camera's own share of the image motion
-  bool accumulated = false;  // the final pass reads the accumulation
+  double camera_px = 0.0;       // the camera's own share of the image motion
+  std::vector<double> item_px;  // and each item's
+  bool accumulated = false;     // the final pass reads the accumulation
   if (setup.blur) {
     const double exposure = spec.sensor.exposure;
     const double motion_px =
-        ImageMotionPx(camera, at(-0.5 * exposure), at(0.5 * exposure), &camera_px);
+        ImageMotionPx(camera, at(-0.5 * exposure), at(0.5 * exposure), &camera_px, &item_px);
     n = static_cast<int>(
         std::clamp(std::ceil(motion_px), 1.0, static_cast<double>(spec.sensor.blur_samples)));
     if (n > 1) {
@@ -595,7 +605,7 @@ void GlRenderer::DrawEffects(int camera, const scene::SceneState& state, int64_t
     const std::size_t n = sub_states.size(), whole = n / 2;
     const bool still = camera_px < 1.0;
     std::vector<std::optional<Region>> regions(views);
-    if (still) regions = MovingRegions(camera, sub_states, whole, view_pose);
+    if (still) regions = MovingRegions(camera, sub_states, whole, item_px, view_pose);
     const auto scissor = [](const Region& r) {
       glEnable(GL_SCISSOR_TEST);
       glScissor(r[0], r[1], r[2], r[3]);

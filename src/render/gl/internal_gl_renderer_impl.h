@@ -206,16 +206,18 @@ class GlRenderer final : public Renderer {
                    const geometry::Pose& X_WC, int slot);
   // How far, at most, anything the camera sees moves on its image between s0 and s1
   // (pixels, a bound through the pinhole of K): motion blur draws that many sub-frames.
-  // `camera_px`, when given, gets the camera's own share (its turn and shift).
+  // `camera_px`, when given, gets the camera's own share (its turn and shift), `item_px` each
+  // item's bound (0 for items out of view).
   double ImageMotionPx(int camera, const scene::SceneState& s0, const scene::SceneState& s1,
-                       double* camera_px = nullptr) const;
+                       double* camera_px = nullptr, std::vector<double>* item_px = nullptr) const;
   // Motion blur's sub-frames with the camera still: per view of the camera, the window
   // rectangle (x, y, width, height) outside which every sub-frame equals sub-frame `whole`
-  // (the items that move do not reach there), or nullopt for all of the view (a moving item
-  // reaches behind the eye).
+  // (the items that move by a pixel or more, by `item_px`, do not reach there), or nullopt for
+  // all of the view (a moving item reaches behind the eye).
   using Region = std::array<int, 4>;
   std::vector<std::optional<Region>> MovingRegions(
       int camera, const std::vector<scene::SceneState>& subs, std::size_t whole,
+      const std::vector<double>& item_px,
       const std::function<geometry::Pose(const geometry::Pose&, int)>& view_pose) const;
   geometry::Pose ItemPose(const DrawItem& item, const scene::SceneState& state,
                           const std::optional<head::HeadFrames>& frames) const;
