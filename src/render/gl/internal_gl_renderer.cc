@@ -17,7 +17,6 @@
 #include "saccade/geometry/lens_map.h"
 
 namespace saccade::render::gl {
-
 namespace {
 
 // The clip-space transform that maps a window rectangle (x, y, width, height) of a
@@ -493,8 +492,9 @@ std::vector<std::optional<GlRenderer::Region>> GlRenderer::MovingRegions(
     const DrawItem& item = items_[i];
     const Eigen::Vector3d centre = item.center_model.cwiseProduct(item.scale);
     std::vector<geometry::Pose> poses;
-    for (std::size_t k = 0; k < subs.size(); ++k)
+    for (std::size_t k = 0; k < subs.size(); ++k) {
       poses.push_back(ItemPose(item, subs[k], frames[k]));
+    }
     const bool moves = std::any_of(poses.begin(), poses.end(), [&](const geometry::Pose& X) {
       return X.matrix() != poses.front().matrix();
     });
@@ -602,7 +602,7 @@ void GlRenderer::DrawEffects(int camera, const scene::SceneState& state, int64_t
     // where they can differ from it (MovingRegions: the moving items' sweep), the whole one
     // standing for all of them elsewhere: a still head watching a small moving ball redraws
     // the ball's box, not the image, per sub-frame. A moving camera redraws everything.
-    const std::size_t n = sub_states.size(), whole = n / 2;
+    const std::size_t count = sub_states.size(), whole = count / 2;
     const bool still = camera_px < 1.0;
     std::vector<std::optional<Region>> regions(views);
     if (still) regions = MovingRegions(camera, sub_states, whole, item_px, view_pose);
@@ -610,9 +610,9 @@ void GlRenderer::DrawEffects(int camera, const scene::SceneState& state, int64_t
       glEnable(GL_SCISSOR_TEST);
       glScissor(r[0], r[1], r[2], r[3]);
     };
-    const float weight = 1.0f / static_cast<float>(n);
+    const float weight = 1.0f / static_cast<float>(count);
     using Mode = EffectTarget::Accumulation;
-    for (std::size_t i = 0; i < n; ++i) {
+    for (std::size_t i = 0; i < count; ++i) {
       const std::size_t k = i == 0 ? whole : (i <= whole ? i - 1 : i);  // whole one first
       UpdatePoses(sub_states[k]);
       const geometry::Pose X_WCk = scene_.CameraPose(spec, sub_states[k]);
