@@ -50,8 +50,9 @@ std::string ResolveTopic(const std::string& name, const std::string& ns) {
   if (name[0] != '/') {
     std::string prefix = ns;
     if (!prefix.empty() && prefix[0] != '/') prefix = "/" + prefix;
+    while (prefix.size() > 1 && prefix.back() == '/') prefix.pop_back();  // "/saccade/" too
     if (prefix.size() > 1) CheckQualified(prefix, ns);
-    while (!prefix.empty() && prefix.back() == '/') prefix.pop_back();
+    if (prefix == "/") prefix.clear();
     full = prefix + "/" + name;
   }
   CheckQualified(full, name);

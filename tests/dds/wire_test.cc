@@ -317,7 +317,7 @@ TEST_F(WireTest, ImageRoundTripKeepsPixelsModelAndPose) {
   EXPECT_EQ(std::memcmp(out.data(), image->data(), out.size_bytes()), 0);
   EXPECT_EQ(out.metadata().camera, "left");
   EXPECT_DOUBLE_EQ(out.metadata().time, 12.345678901);
-  EXPECT_EQ(out.metadata().frame_index, 308);  // round(12.345678901 / 0.04)
+  EXPECT_EQ(out.metadata().frame_index, 309);  // round(12.345678901 s / 0.04 s) = round(308.6)
   const geometry::CameraModel* model = geometry::FindCameraModel(out.metadata());
   ASSERT_NE(model, nullptr);
   EXPECT_EQ(*model, *geometry::FindCameraModel(image->metadata()));  // doubles copied exactly
