@@ -227,9 +227,11 @@ class SimpleWriter final : public Writer {
     writer_ = MakeWriter(*participant_, topic_, options.qos, options.topic);
   }
   void WriteErased(const void* message) override {
+    const M& m = *static_cast<const M*>(message);
+    if (!Publishable(m)) return;
     internal::Holder holder;
     Sample sample{};
-    Fill(*static_cast<const M*>(message), holder, &sample);
+    Fill(m, holder, &sample);
     WriteSample(writer_, &sample, topic(), stats_);
     ++stats_.messages;
   }
@@ -237,6 +239,11 @@ class SimpleWriter final : public Writer {
   const LinkStats& stats() const override { return stats_; }
 
  private:
+  // A target that is not valid (nothing to look at) is not a point: it is not published.
+  static bool Publishable(const TargetMessage& m) { return m.valid && m.p_W.allFinite(); }
+  static bool Publishable(const JointStateMessage&) { return true; }
+  static bool Publishable(const JointCommand&) { return true; }
+
   static void Fill(const JointStateMessage& m, internal::Holder& holder,
                    sensor_msgs_msg_dds__JointState_* out) {
     internal::FillJointState(m.time, m.positions, &m.velocities, holder, out);

@@ -10,7 +10,7 @@
 //                                                          camera's optical frame on /tf
 //   head.joints            sensor_msgs/JointState          names pan, tilt, left, right
 //   head.command           sensor_msgs/JointState          positions, velocities
-//   vision.target          geometry_msgs/PointStamped      frame "world"
+//   vision.target          geometry_msgs/PointStamped      frame "world"; only valid targets
 //
 // Messages carry their capture time as header.stamp (builtin_interfaces/Time: sec, nanosec).
 // Frames are named "world" and "<camera>_optical" (OpenCV's camera frame: x right, y down,
