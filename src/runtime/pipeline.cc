@@ -513,9 +513,13 @@ Pipeline Pipeline::Build(const PipelineSpec& spec, const ComponentRegistry& regi
   }
   const TopicTransport* transport = registry.topic_transport();
   std::vector<std::pair<TopicOutputSpec, std::size_t>> topic_writers;  // and their component
+  // The file's index of each built component (a topic's reader: its consumer's), for messages.
+  std::vector<std::size_t> file_index;
+  for (std::size_t i = 0; i < n; ++i) file_index.push_back(i);
   if (has_topics) {
     PipelineSpec expanded = spec;
     expanded.components.clear();
+    file_index.clear();
     std::vector<std::unique_ptr<Component>> components;
     for (std::size_t i = 0; i < n; ++i) {
       ComponentSpec c = spec.components[i];
@@ -554,6 +558,7 @@ Pipeline Pipeline::Build(const PipelineSpec& spec, const ComponentRegistry& regi
         connection.from_output = "message";
         expanded.components.push_back(std::move(reader));
         components.push_back(std::move(component));
+        file_index.push_back(i);
       }
       for (const TopicOutputSpec& out : c.topic_outputs) {
         if (transport == nullptr) {
@@ -565,6 +570,7 @@ Pipeline Pipeline::Build(const PipelineSpec& spec, const ComponentRegistry& regi
       }
       expanded.components.push_back(std::move(c));
       components.push_back(std::move(pipeline.components_[i]));
+      file_index.push_back(i);
     }
     pipeline.spec_ = std::move(expanded);
     pipeline.components_ = std::move(components);
@@ -590,7 +596,7 @@ Pipeline Pipeline::Build(const PipelineSpec& spec, const ComponentRegistry& regi
     const ComponentSpec& c = built.components[i];
     Component& consumer = *pipeline.components_[i];
     for (const ConnectionSpec& connection : c.inputs) {
-      const std::string key = ComponentKey(i) + ".inputs." + connection.to_input;
+      const std::string key = ComponentKey(file_index[i]) + ".inputs." + connection.to_input;
       const std::string from = connection.from_component + "." + connection.from_output;
       const auto Fail = [&](const std::string& what) {
         throw FileError(file, connection.line, key, what);
@@ -667,7 +673,7 @@ Pipeline Pipeline::Build(const PipelineSpec& spec, const ComponentRegistry& regi
     }
     for (const auto& input : consumer.inputs()) {
       if (input->required() && !input->connected()) {
-        throw FileError(file, c.line, ComponentKey(i) + ".inputs",
+        throw FileError(file, c.line, ComponentKey(file_index[i]) + ".inputs",
                         fmt::format("required input '{}' ({}) of component '{}' ({}) is not "
                                     "connected",
                                     input->name(), input->message_type(), c.name, c.type));
