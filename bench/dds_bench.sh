@@ -30,6 +30,6 @@ wait "$pong" || true
 tail -n 3 /tmp/saccade-ddsperf-ping.txt
 
 echo "== plain Cyclone DDS: 2 x 1024x768 RGB at 30 Hz, ${seconds} s"
-"$build/bin/dds_link_bench" --raw --seconds "$seconds" --domain 193
+"$build/bin/dds_link_bench" --raw --seconds "$seconds" --domain 193 || true  # 1: images lost
 echo "== saccade's writers and readers: 2 x 1024x768 RGB at 30 Hz, ${seconds} s"
-"$build/bin/dds_link_bench" --seconds "$seconds" --domain 194
+"$build/bin/dds_link_bench" --seconds "$seconds" --domain 194 || true
