@@ -289,6 +289,7 @@ class ImageReader final : public Reader {
   std::shared_ptr<const void> TakeErased(double timeout_s) override {
     stats_.lost += LostSince(image_);
     std::shared_ptr<Image> newest;
+    int64_t newest_stamp = 0;  // exact, in ns: the time in seconds does not round-trip
     const auto TakeImages = [&] {
       return TakeAll<sensor_msgs_msg_dds__Image_>(
           image_, [&](const sensor_msgs_msg_dds__Image_& msg) {
@@ -301,6 +302,7 @@ class ImageReader final : public Reader {
             }
             if (newest) ++stats_.lost;  // an older one, never handed over
             newest = std::move(image);
+            newest_stamp = internal::StampNs(msg.header.stamp);
           });
     };
     TakeImages();
@@ -310,7 +312,7 @@ class ImageReader final : public Reader {
       if (!newest) ++stats_.late;
     }
     if (!newest) return nullptr;
-    Complete(*newest);
+    Complete(*newest, newest_stamp);
     return std::make_shared<const ImageMessage>(ImageMessage{std::move(newest)});
   }
   int matched() const override { return SubscriptionMatches(image_); }
@@ -318,9 +320,8 @@ class ImageReader final : public Reader {
 
  private:
   // Camera model, pose and frame index of a received image.
-  void Complete(Image& image) {
+  void Complete(Image& image, int64_t stamp) {
     ImageMetadata& meta = image.metadata();
-    const int64_t stamp = static_cast<int64_t>(std::llround(meta.time * 1e9));
     if (last_stamp_ && stamp < *last_stamp_) {
       ++stats_.restarts;
       received_ = 0;
