@@ -120,5 +120,23 @@ TEST_F(DdsCli, KillingAndRestartingTheRobotResumesTheLoop) {
   EXPECT_GT(std::abs(last_pan - first_pan), kMoved) << Read(dir_ / "second.csv");
 }
 
+TEST_F(DdsCli, RunNamesTheFileLineAndKeyOfABadTopic) {
+  const fs::path file = dir_ / "bad.yaml";
+  std::ofstream(file) << "clock: {mode: simulated, step: 0.04, steps: 1}\n"
+                         "scene: " SACCADE_SOURCE_DIR
+                         "/scenes/portraits.yaml\n"
+                         "components:\n"
+                         "  - name: head\n"
+                         "    type: sim.head\n"
+                         "    inputs: {command: {topic: 'head command'}}\n";
+  const CommandRun run = Saccade("run " + file.string());
+  EXPECT_EQ(run.status, 1) << run.output;
+  EXPECT_THAT(run.output, HasSubstr("bad.yaml:6: components[0].inputs.command: topic 'head "
+                                    "command': character ' ' is not allowed"));
+  const CommandRun domain = Saccade("run " + file.string() + " --dds-domain 999");
+  EXPECT_EQ(domain.status, 1) << domain.output;
+  EXPECT_THAT(domain.output, HasSubstr("transport.domain: expected an integer 0..232, got 999"));
+}
+
 }  // namespace
 }  // namespace saccade::e2e
