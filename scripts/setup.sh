@@ -38,6 +38,9 @@ packages=(
   opencv-doc assimp-testmodels libmujoco-samples
   # OpenCV's trained Haar cascades (faces, eyes, cat faces) for the perception loop
   opencv-data
+  # DDS beyond one process (ROS 2's wire): Cyclone DDS's C library and idlc (cyclonedds-dev),
+  # ddsperf for the transport benchmark (cyclonedds-tools)
+  cyclonedds-dev cyclonedds-tools
 )
 
 # Node.js and npm install the GUI's three.js and the browser tests' playwright-core (web/):
@@ -92,6 +95,15 @@ if ! cmp -s web/package-lock.json web/node_modules/.saccade-installed-lock 2>/de
   echo "setup: installing the GUI's npm packages (web/package-lock.json)"
   (cd web && npm ci --no-audit --no-fund --loglevel=error)
   cp web/package-lock.json web/node_modules/.saccade-installed-lock
+fi
+
+# The DDS tests' independent ROS 2 serializer (Foxglove's, tests/dds/ros2_reference/), exactly
+# as its package-lock.json pins it; again only when the lock file changed.
+ref=tests/dds/ros2_reference
+if ! cmp -s $ref/package-lock.json $ref/node_modules/.saccade-installed-lock 2>/dev/null; then
+  echo "setup: installing the DDS tests' npm packages ($ref/package-lock.json)"
+  (cd $ref && npm ci --no-audit --no-fund --loglevel=error)
+  cp $ref/package-lock.json $ref/node_modules/.saccade-installed-lock
 fi
 
 build_dir="${1:-build}"

@@ -21,6 +21,7 @@ Runner AddDemoCommand(CLI::App& app);
 Runner AddRenderCommand(CLI::App& app);
 Runner AddBenchCommand(CLI::App& app);
 Runner AddGuiCommand(CLI::App& app);
+Runner AddRunCommand(CLI::App& app);
 
 // Shared helpers.
 inline constexpr double kDegToRad = M_PI / 180.0;

@@ -99,8 +99,21 @@ ConnectionSpec ParseConnection(const Entry& e, const std::string& input) {
   connection.to_input = input;
   connection.line = e.line();
   std::optional<Entry> from;
+  if (e.IsMap() && e.Has("topic")) {
+    // A topic of another process: the transport reads the other keys (its options).
+    connection.topic = e.Get("topic").AsNonEmptyString();
+    connection.topic_options = ToJson(e);
+    connection.topic_options.erase("topic");
+    if (const auto it = connection.topic_options.find("delay");
+        it != connection.topic_options.end()) {
+      connection.delay = static_cast<int>(e.Get("delay").AsInteger(0, 1));
+      connection.topic_options.erase(it);
+    }
+    return connection;
+  }
   if (e.IsMap()) {
-    e.ExpectMap({"from", "delay"}, "a connection {from: component.output, delay: 0 | 1}");
+    e.ExpectMap({"from", "delay"},
+                "a connection {from: component.output, delay: 0 | 1} or {topic: NAME, ...}");
     from = e.Get("from");
     if (const auto d = e.Find("delay")) connection.delay = static_cast<int>(d->AsInteger(0, 1));
   } else if (e.IsScalar()) {
@@ -187,7 +200,8 @@ std::map<std::string, ComponentSpec> LoadHardware(const std::string& path,
 }
 
 ComponentSpec ParseComponent(const Entry& e) {
-  e.ExpectMap({"name", "type", "params", "inputs"}, "a component {name, type, params, inputs}");
+  e.ExpectMap({"name", "type", "params", "inputs", "outputs"},
+              "a component {name, type, params, inputs, outputs}");
   ComponentSpec spec;
   spec.line = e.line();
   const Entry name = e.Get("name");
@@ -224,6 +238,39 @@ ComponentSpec ParseComponent(const Entry& e) {
       }
     }
   }
+  if (const auto outputs = e.Find("outputs")) {
+    if (!outputs->IsNull()) {
+      if (!outputs->IsMap()) {
+        outputs->Fail("expected a map output: topic (or {topic: NAME, ...}), got " +
+                      outputs->Describe());
+      }
+      for (auto it = outputs->node().begin(); it != outputs->node().end(); ++it) {
+        const int key_line = KeyLine(it->first, outputs->line());
+        if (!it->first.IsScalar()) {
+          throw FileError(outputs->file(), key_line, outputs->path(), "expected an output name");
+        }
+        TopicOutputSpec out;
+        out.output = it->first.Scalar();
+        out.line = key_line;
+        const Entry value(it->second, outputs->path() + "." + out.output, &outputs->file(),
+                          key_line);
+        if (value.IsMap()) {
+          out.topic = value.Get("topic").AsNonEmptyString();
+          out.topic_options = ToJson(value);
+          out.topic_options.erase("topic");
+        } else {
+          out.topic = value.AsNonEmptyString();
+        }
+        for (const TopicOutputSpec& other : spec.topic_outputs) {
+          if (other.output == out.output && other.topic == out.topic) {
+            throw FileError(outputs->file(), key_line, value.path(),
+                            "output '" + out.output + "' is written to '" + out.topic + "' twice");
+          }
+        }
+        spec.topic_outputs.push_back(std::move(out));
+      }
+    }
+  }
   return spec;
 }
 
@@ -248,10 +295,16 @@ PipelineSpec ParsePipeline(const std::string& text, const std::string& source,
                            const std::string& hardware) {
   const YAML::Node root_node = saccade::internal::ParseYaml(text, source);
   const Entry root(root_node, "", &source, 1);
-  root.ExpectMap({"clock", "seed", "threads", "on_error", "scene", "hardware", "components"},
-                 "a pipeline {clock, seed, threads, on_error, scene, hardware, components}");
+  root.ExpectMap(
+      {"clock", "seed", "threads", "on_error", "scene", "hardware", "transport", "components"},
+      "a pipeline {clock, seed, threads, on_error, scene, hardware, transport, components}");
   PipelineSpec spec;
   spec.file = source;
+  if (const auto transport = root.Find("transport")) {
+    if (!transport->IsMap()) transport->Fail("expected a map, got " + transport->Describe());
+    spec.transport = ToJson(*transport);
+    spec.transport_line = transport->line();
+  }
   if (auto scene = ParseScene(root, source)) spec.resources["scene"] = std::move(*scene);
   if (const auto clock = root.Find("clock")) spec.clock = ParseClock(*clock);
   if (const auto seed = root.Find("seed")) spec.seed = seed->AsUint64();
@@ -450,21 +503,100 @@ Pipeline Pipeline::Build(const PipelineSpec& spec, const ComponentRegistry& regi
     pipeline.components_.push_back(std::move(component));
   }
 
+  // Topic connections (the file comment): a reader component just before each consumer of a
+  // topic, and writers attached to the outputs that name one, through the registered transport.
+  bool has_topics = false;
+  for (const ComponentSpec& c : spec.components) {
+    has_topics = has_topics || !c.topic_outputs.empty() ||
+                 std::any_of(c.inputs.begin(), c.inputs.end(),
+                             [](const ConnectionSpec& x) { return !x.topic.empty(); });
+  }
+  const TopicTransport* transport = registry.topic_transport();
+  std::vector<std::pair<TopicOutputSpec, std::size_t>> topic_writers;  // and their component
+  // The file's index of each built component (a topic's reader: its consumer's), for messages.
+  std::vector<std::size_t> file_index;
+  for (std::size_t i = 0; i < n; ++i) file_index.push_back(i);
+  if (has_topics) {
+    PipelineSpec expanded = spec;
+    expanded.components.clear();
+    file_index.clear();
+    std::vector<std::unique_ptr<Component>> components;
+    for (std::size_t i = 0; i < n; ++i) {
+      ComponentSpec c = spec.components[i];
+      for (std::size_t k = 0; k < c.inputs.size(); ++k) {
+        ConnectionSpec& connection = c.inputs[k];
+        if (connection.topic.empty()) continue;
+        const std::string key = ComponentKey(i) + ".inputs." + connection.to_input;
+        if (transport == nullptr) {
+          throw FileError(file, connection.line, key,
+                          "input '" + connection.to_input + "' reads the topic '" +
+                              connection.topic +
+                              "', but this program has no topic transport (DDS)");
+        }
+        const InputBase* input = pipeline.components_[i]->FindInput(connection.to_input);
+        if (input == nullptr) {
+          throw FileError(
+              file, connection.line, key,
+              fmt::format("component '{}' ({}) has no input '{}'; its inputs: {}", c.name, c.type,
+                          connection.to_input, PortNames(pipeline.components_[i]->inputs())));
+        }
+        ComponentSpec reader;
+        reader.name = c.name + "-" + connection.to_input + "-topic";
+        reader.type = transport->name + " reader of " + connection.topic;
+        reader.line = reader.type_line = reader.params_line = connection.line;
+        TopicEndpoint endpoint{connection.topic, input->message_type(), connection.topic_options,
+                               &spec, c.name + "." + connection.to_input};
+        std::unique_ptr<Component> component;
+        try {
+          component = transport->make_reader(endpoint);
+        } catch (const std::exception& error) {
+          throw FileError(file, connection.line, key, error.what());
+        }
+        component->Initialise(reader.name, ComponentSeed(spec.seed, reader.name), base_dir,
+                              pipeline.resources_);
+        connection.from_component = reader.name;
+        connection.from_output = "message";
+        expanded.components.push_back(std::move(reader));
+        components.push_back(std::move(component));
+        file_index.push_back(i);
+      }
+      for (const TopicOutputSpec& out : c.topic_outputs) {
+        if (transport == nullptr) {
+          throw FileError(file, out.line, ComponentKey(i) + ".outputs." + out.output,
+                          "output '" + out.output + "' writes the topic '" + out.topic +
+                              "', but this program has no topic transport (DDS)");
+        }
+        topic_writers.emplace_back(out, expanded.components.size());
+      }
+      expanded.components.push_back(std::move(c));
+      components.push_back(std::move(pipeline.components_[i]));
+      file_index.push_back(i);
+    }
+    pipeline.spec_ = std::move(expanded);
+    pipeline.components_ = std::move(components);
+  }
+  const PipelineSpec& built = pipeline.spec_;
+  const std::size_t m = built.components.size();
+  if (has_topics) {
+    index.clear();
+    for (std::size_t i = 0; i < m; ++i) index.emplace(built.components[i].name, i);
+  }
+
   // Immediate edges producer -> consumer, to name the components of a cycle.
-  std::vector<std::vector<std::size_t>> readers(n);
-  for (std::size_t i = 0; i < n; ++i) {
-    for (const ConnectionSpec& connection : spec.components[i].inputs) {
+  std::vector<std::vector<std::size_t>> readers(m);
+  for (std::size_t i = 0; i < m; ++i) {
+    for (const ConnectionSpec& connection : built.components[i].inputs) {
       const auto it = index.find(connection.from_component);
       if (it != index.end() && connection.delay == 0) readers[it->second].push_back(i);
     }
   }
 
   double* delivery_seconds = pipeline.delivery_seconds_.get();
-  for (std::size_t i = 0; i < n; ++i) {
-    const ComponentSpec& c = spec.components[i];
+  for (std::size_t i = 0; i < m; ++i) {
+    const ComponentSpec& c = built.components[i];
     Component& consumer = *pipeline.components_[i];
     for (const ConnectionSpec& connection : c.inputs) {
-      const std::string key = ComponentKey(i) + ".inputs." + connection.to_input;
+      const std::string key = ComponentKey(file_index[i]) + ".inputs." + connection.to_input;
       const std::string from = connection.from_component + "." + connection.from_output;
       const auto Fail = [&](const std::string& what) {
         throw FileError(file, connection.line, key, what);
@@ -477,7 +609,7 @@ Pipeline Pipeline::Build(const PipelineSpec& spec, const ComponentRegistry& regi
       const auto it = index.find(connection.from_component);
       if (it == index.end()) {
         std::vector<std::string> names;
-        for (const ComponentSpec& other : spec.components) names.push_back(other.name);
+        for (const ComponentSpec& other : built.components) names.push_back(other.name);
         Fail(fmt::format("unknown component '{}' in '{}'; components: {}",
                          connection.from_component, from, Join(names)));
       }
@@ -486,7 +618,7 @@ Pipeline Pipeline::Build(const PipelineSpec& spec, const ComponentRegistry& regi
       OutputBase* output = producer.FindOutput(connection.from_output);
       if (output == nullptr) {
         Fail(fmt::format("component '{}' ({}) has no output '{}'; its outputs: {}", producer.name(),
-                         spec.components[j].type, connection.from_output,
+                         built.components[j].type, connection.from_output,
                          PortNames(producer.outputs())));
       }
       if (output->message_type() != input->message_type()) {
@@ -496,9 +628,9 @@ Pipeline Pipeline::Build(const PipelineSpec& spec, const ComponentRegistry& regi
       }
       if (j >= i && connection.delay == 0) {
         // The producer runs after (or is) the consumer: find the consumer's path to it.
-        std::vector<std::size_t> parent(n, n);
+        std::vector<std::size_t> parent(m, m);
         std::vector<std::size_t> queue{i};
-        std::vector<bool> seen(n, false);
+        std::vector<bool> seen(m, false);
         seen[i] = true;
         for (std::size_t q = 0; q < queue.size() && !seen[j]; ++q) {
           for (std::size_t next : readers[queue[q]]) {
@@ -513,7 +645,7 @@ Pipeline Pipeline::Build(const PipelineSpec& spec, const ComponentRegistry& regi
           std::string cycle = c.name;
           if (j != i) {
             std::vector<std::string> path;
-            for (std::size_t k = j; k != n; k = parent[k]) path.push_back(spec.components[k].name);
+            for (std::size_t k = j; k != m; k = parent[k]) path.push_back(built.components[k].name);
             std::reverse(path.begin(), path.end());
             cycle.clear();
             for (const std::string& name : path) cycle += name + " -> ";
@@ -541,11 +673,28 @@ Pipeline Pipeline::Build(const PipelineSpec& spec, const ComponentRegistry& regi
     }
     for (const auto& input : consumer.inputs()) {
       if (input->required() && !input->connected()) {
-        throw FileError(file, c.line, ComponentKey(i) + ".inputs",
+        throw FileError(file, c.line, ComponentKey(file_index[i]) + ".inputs",
                         fmt::format("required input '{}' ({}) of component '{}' ({}) is not "
                                     "connected",
                                     input->name(), input->message_type(), c.name, c.type));
       }
+    }
+  }
+  for (const auto& [out, i] : topic_writers) {
+    const std::string key = "components." + built.components[i].name + ".outputs." + out.output;
+    OutputBase* output = pipeline.components_[i]->FindOutput(out.output);
+    if (output == nullptr) {
+      throw FileError(file, out.line, key,
+                      fmt::format("component '{}' ({}) has no output '{}'; its outputs: {}",
+                                  built.components[i].name, built.components[i].type, out.output,
+                                  PortNames(pipeline.components_[i]->outputs())));
+    }
+    try {
+      transport->attach_writer(TopicEndpoint{out.topic, output->message_type(), out.topic_options,
+                                             &spec, built.components[i].name + "." + out.output},
+                               *output);
+    } catch (const std::exception& error) {
+      throw FileError(file, out.line, key, error.what());
     }
   }
   return pipeline;

@@ -214,7 +214,7 @@ TEST(Cli, HugeInputsAreRefusedWithAClearErrorAndExitOne) {
 }
 
 TEST(Cli, EverySubcommandHasHelp) {
-  for (const char* sub : {"fk", "ik", "camera", "demo"}) {
+  for (const char* sub : {"fk", "ik", "camera", "demo", "run"}) {
     const CommandRun help = Saccade(std::string(sub) + " --help");
     EXPECT_EQ(help.status, 0) << sub;
     EXPECT_THAT(help.output, HasSubstr("Usage")) << sub;

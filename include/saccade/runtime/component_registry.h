@@ -5,6 +5,7 @@
 #include <functional>
 #include <map>
 #include <memory>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <utility>
 #include <vector>
@@ -13,6 +14,29 @@
 #include "saccade/runtime/resources.h"
 
 namespace saccade::runtime {
+
+struct PipelineSpec;
+
+/// One end of a topic connection, as the pipeline hands it to the topic transport.
+struct TopicEndpoint {
+  std::string topic;         ///< as the file names it (the transport resolves it)
+  std::string message_type;  ///< MessageTraits<T>::kName of the port
+  nlohmann::json options = nlohmann::json::object();  ///< the connection's other keys
+  const PipelineSpec* pipeline = nullptr;             ///< its clock and `transport:` map
+  std::string where;                                  ///< "component.port" for messages
+};
+
+/// Carries messages between processes on topics (the dds module registers one). Both
+/// functions throw saccade::Error naming what is wrong with the endpoint; the pipeline adds
+/// the file, line and key.
+struct TopicTransport {
+  std::string name;  ///< "dds"
+  /// A component with one output "message" of the endpoint's type, that emits what the
+  /// topic receives each step (configured: the pipeline only names and seeds it).
+  std::function<std::unique_ptr<Component>(const TopicEndpoint& endpoint)> make_reader;
+  /// Writes every message `output` emits to the topic from now on.
+  std::function<void(const TopicEndpoint& endpoint, OutputBase& output)> attach_writer;
+};
 
 /// Makes components by type name ("vision.face_detector"). Modules register theirs.
 class ComponentRegistry {
@@ -45,6 +69,13 @@ class ComponentRegistry {
   bool HasResource(const std::string& kind) const { return resources_.contains(kind); }
   const std::map<std::string, ResourceLoader>& resource_loaders() const { return resources_; }
 
+  /// Sets the transport that pipelines use for topic connections (a later call replaces it).
+  void SetTopicTransport(TopicTransport transport) { topic_transport_ = std::move(transport); }
+  /// nullptr when none is set.
+  const TopicTransport* topic_transport() const {
+    return topic_transport_.make_reader ? &topic_transport_ : nullptr;
+  }
+
   bool Has(const std::string& type) const;
   /// A new component. Throws InvalidArgument naming the known types when `type` is unknown.
   std::unique_ptr<Component> Create(const std::string& type) const;
@@ -60,6 +91,7 @@ class ComponentRegistry {
   };
   std::vector<std::pair<std::string, Entry>> entries_;  // sorted by type
   std::map<std::string, ResourceLoader> resources_;
+  TopicTransport topic_transport_;
 };
 
 }  // namespace saccade::runtime

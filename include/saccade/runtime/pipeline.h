@@ -46,6 +46,26 @@
 // connections from earlier components are delivered at once. Every error is a FileError
 // naming file, line and key.
 //
+// Topics (issue 16, docs/dds.md): a connection may name a topic of another process instead of
+// a component's port, in either direction, so that one pipeline split in two runs as two
+// processes. The transport is registered by the layer that has one
+// (ComponentRegistry::SetTopicTransport; the dds module registers DDS): runtime knows no DDS.
+//
+//   transport: {domain: 7, namespace: /saccade}       # handed to the transport as it is
+//   components:
+//     - name: faces_left
+//       type: vision.face_detector
+//       inputs:
+//         image: {topic: left/image_raw, wait_s: 2}   # read from a topic (options: transport's)
+//     - name: fixation
+//       type: control.fixation
+//       inputs: {target: triangulate.target}
+//       outputs:
+//         command: head/command                        # or {topic: head/command, qos: default}
+//
+// A topic input is read by a component the transport makes, stepped just before its reader
+// (named "<component>-<input>-topic"); a topic output is written as its component emits.
+//
 // Parallel steps (scheduler.h): components that do not depend on each other within a step
 // (the two eyes' detectors, say) run at the same time on `threads` threads; the run is the
 // same, bit for bit, as with `threads: 1`.
@@ -77,13 +97,24 @@ struct ClockSpec {
   int64_t steps = 0;    ///< steps to run; 0: until RunOptions::stop is set (scheduler.h)
 };
 
-/// One input's connection: `to_input` of the component reads `from_component.from_output`.
+/// One input's connection: `to_input` of the component reads `from_component.from_output`,
+/// or, when `topic` is not empty, the topic (the pipeline's topic transport reads it).
 struct ConnectionSpec {
   std::string from_component;
   std::string from_output;
   std::string to_input;
-  int delay = 0;  ///< 0 or 1 step
-  int line = 0;   ///< in the pipeline file
+  int delay = 0;                                            ///< 0 or 1 step
+  int line = 0;                                             ///< in the pipeline file
+  std::string topic;                                        ///< "" for a component's port
+  nlohmann::json topic_options = nlohmann::json::object();  ///< the entry's other keys
+};
+
+/// An output also written to a topic (`outputs: {port: topic}` of a component).
+struct TopicOutputSpec {
+  std::string output;
+  std::string topic;
+  nlohmann::json topic_options = nlohmann::json::object();
+  int line = 0;
 };
 
 struct ComponentSpec {
@@ -91,6 +122,7 @@ struct ComponentSpec {
   std::string type;
   nlohmann::json params = nlohmann::json::object();
   std::vector<ConnectionSpec> inputs;
+  std::vector<TopicOutputSpec> topic_outputs;
   int line = 0;
   int type_line = 0;
   int params_line = 0;
@@ -122,6 +154,9 @@ struct PipelineSpec {
   std::string hardware_file;  ///< the hardware file used ("" when none)
   /// Shared resources by kind ("scene"), from the pipeline file or its hardware file.
   std::map<std::string, ResourceSpec> resources;
+  /// The `transport:` map, handed to the topic transport as it is (empty when absent).
+  nlohmann::json transport = nlohmann::json::object();
+  int transport_line = 0;
 };
 
 /// Parses pipeline YAML; checks its shape (keys, types, ranges, duplicate names), and reads

@@ -1,0 +1,168 @@
+// run: any pipeline file, headless, until its clock's steps are done or Ctrl-C. Topic
+// connections go over DDS (docs/dds.md), so that one pipeline split in two files runs as two
+// processes: `saccade run pipelines/robot.yaml` and `saccade run pipelines/perception.yaml`.
+
+#include <fmt/format.h>
+
+#include <atomic>
+#include <cmath>
+#include <csignal>
+#include <fstream>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "commands.h"
+#include "saccade/components/loop_outputs.h"
+#include "saccade/components/messages.h"
+#include "saccade/components/register.h"
+#include "saccade/core/error.h"
+#include "saccade/dds/transport.h"
+#include "saccade/runtime/pipeline.h"
+#include "saccade/runtime/scheduler.h"
+
+namespace saccade::app {
+namespace {
+
+using nlohmann::json;
+
+std::atomic<bool> g_run_stop{false};
+extern "C" void OnRunInterrupt(int) { g_run_stop = true; }
+
+struct RunCommandOptions {
+  std::string pipeline;
+  std::string hardware;
+  std::string scene;
+  int64_t steps = -1;
+  bool realtime = false;
+  bool json = false;
+  std::string joints_csv;
+  // DDS (the pipeline's `transport:` map; these override it)
+  std::optional<int> domain;
+  std::string ns;
+  std::string config;
+  std::string interface;
+  std::vector<std::string> peers;
+};
+
+int Run(const RunCommandOptions& o) {
+  components::RegisterComponents();
+  dds::RegisterDdsTransport(runtime::ComponentRegistry::Global());
+  runtime::PipelineSpec spec = runtime::LoadPipelineFile(o.pipeline, o.hardware);
+  if (!o.scene.empty()) runtime::ReplaceScene(spec, o.scene, "--scene");
+  if (o.realtime) {
+    spec.clock.rate_hz = 1.0 / spec.clock.step;
+    spec.clock.mode = runtime::ClockMode::kRealtime;
+  }
+  if (o.domain) spec.transport["domain"] = *o.domain;
+  if (!o.ns.empty()) spec.transport["namespace"] = o.ns;
+  if (!o.config.empty()) spec.transport["config"] = o.config;
+  if (!o.interface.empty()) {
+    spec.transport["interface"] = o.interface;
+    if (o.config.empty()) spec.transport["config"] = "network";
+  }
+  if (!o.peers.empty()) spec.transport["peers"] = o.peers;
+  runtime::Pipeline pipeline = runtime::Pipeline::Build(spec);
+
+  // The head's state as the pipeline's components emit it: a fixation is the head coming to
+  // rest after a move (JointStateMessage::arrived turning true).
+  std::unique_ptr<std::ofstream> csv;
+  if (!o.joints_csv.empty()) {
+    csv = std::make_unique<std::ofstream>(o.joints_csv);
+    if (!*csv) throw InvalidArgument("run: cannot write --joints-csv " + o.joints_csv);
+    *csv << "time,pan,tilt,left,right,arrived\n";
+  }
+  json fixations = json::array();
+  bool was_arrived = true;
+  components::Tap<components::JointStateMessage>(
+      pipeline, [&](const components::JointStateMessage& m) {
+        if (csv) {
+          *csv << fmt::format("{:.6f},{:.17g},{:.17g},{:.17g},{:.17g},{}\n", m.time,
+                              m.positions.pan, m.positions.tilt, m.positions.left,
+                              m.positions.right, m.arrived ? 1 : 0);
+        }
+        if (m.arrived && !was_arrived) {
+          fixations.push_back({{"time", m.time},
+                               {"pan", m.positions.pan},
+                               {"tilt", m.positions.tilt},
+                               {"left", m.positions.left},
+                               {"right", m.positions.right}});
+          if (!o.json) {
+            fmt::print(
+                "t = {:6.2f} s  fixation: pan {:+.4f} tilt {:+.4f} left {:+.4f} right "
+                "{:+.4f} rad\n",
+                m.time, m.positions.pan, m.positions.tilt, m.positions.left, m.positions.right);
+            std::fflush(stdout);
+          }
+        }
+        was_arrived = m.arrived;
+      });
+
+  runtime::RunOptions run;
+  run.steps = o.steps;
+  g_run_stop = false;
+  run.stop = &g_run_stop;
+  run.on_error = [&](const runtime::StepError& error) {
+    fmt::print(stderr, "saccade: error: {}\n", error.ToString());
+  };
+  if (o.steps < 0 && spec.clock.steps == 0) run.steps = 0;  // until Ctrl-C
+  auto previous_int = std::signal(SIGINT, OnRunInterrupt);
+  auto previous_term = std::signal(SIGTERM, OnRunInterrupt);
+  const runtime::RunSummary summary = runtime::RunPipeline(pipeline, run);
+  std::signal(SIGINT, previous_int);
+  std::signal(SIGTERM, previous_term);
+  if (csv) csv->flush();
+  if (o.json) {
+    fmt::print("{}\n", json{{"pipeline", o.pipeline},
+                            {"steps", summary.steps},
+                            {"errors", summary.errors_total},
+                            {"fixations", fixations}}
+                           .dump(2));
+  } else {
+    fmt::print("{}: {}\n", o.pipeline, summary.BriefReport());
+  }
+  // Stops the components (the DDS readers report what crossed) before exiting.
+  return !summary.errors.empty() && summary.stopped_on_error ? 1 : 0;
+}
+
+}  // namespace
+
+Runner AddRunCommand(CLI::App& app) {
+  auto o = std::make_shared<RunCommandOptions>();
+  auto* run = app.add_subcommand(
+      "run",
+      "Run any pipeline file headless (runtime/pipeline.h). Connections that name a topic go "
+      "over DDS on ROS 2's wire (docs/dds.md), so that one pipeline split in two files runs as "
+      "two processes, on one machine or two: e.g. `saccade run pipelines/robot.yaml` and "
+      "`saccade run pipelines/perception.yaml`. Prints each fixation (the head coming to rest) "
+      "and the run's summary; the DDS readers log what crossed (messages, lost, late, "
+      "restarts).");
+  run->add_option("pipeline", o->pipeline, "The pipeline file")->required();
+  run->add_option("--hardware", o->hardware, "Hardware file replacing the pipeline's own");
+  run->add_option("--scene", o->scene, "Scene replacing the pipeline's (and its hardware's)");
+  run->add_option("--steps", o->steps,
+                  "Steps to run (default: the file's clock.steps; 0 until "
+                  "Ctrl-C)");
+  run->add_flag("--realtime", o->realtime, "Run at the wall clock's pace (rate 1 / clock.step)");
+  run->add_flag("--json", o->json, "Print the result as JSON: steps, errors, fixations");
+  run->add_option("--joints-csv", o->joints_csv,
+                  "Write every head state the pipeline emits (time, pan, tilt, left, right in "
+                  "rad, arrived) to this CSV file");
+  run->add_option("--dds-domain", o->domain,
+                  "DDS domain id, 0..232 (ROS_DOMAIN_ID; default the "
+                  "file's transport.domain, else 0)");
+  run->add_option("--dds-namespace", o->ns,
+                  "ROS namespace of the relative topic names (e.g. /saccade)");
+  run->add_option("--dds-config", o->config,
+                  "Cyclone DDS configuration: loopback (default: nothing leaves the machine), "
+                  "network (with --dds-interface), env (CYCLONEDDS_URI) or a file.xml");
+  run->add_option("--dds-interface", o->interface,
+                  "Network interface for DDS (e.g. eth0); implies --dds-config network");
+  run->add_option("--dds-peer", o->peers,
+                  "Unicast discovery peer (host or address) for networks without multicast; "
+                  "repeatable");
+  return [o] { return Run(*o); };
+}
+
+}  // namespace saccade::app

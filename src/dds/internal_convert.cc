@@ -1,0 +1,263 @@
+#include "dds/internal_convert.h"
+
+#include <fmt/format.h>
+
+#include <Eigen/Geometry>
+#include <cstring>
+
+#include "saccade/geometry/image_camera.h"
+
+namespace saccade::dds::internal {
+
+builtin_interfaces_msg_dds__Time_ ToStamp(double seconds) {
+  const auto ns = static_cast<int64_t>(std::llround(seconds * 1e9));
+  int64_t sec = ns / 1000000000;
+  int64_t nanosec = ns % 1000000000;
+  if (nanosec < 0) {  // builtin_interfaces/Time: -1.7 s is {sec: -2, nanosec: 3e8}
+    nanosec += 1000000000;
+    sec -= 1;
+  }
+  return {static_cast<int32_t>(sec), static_cast<uint32_t>(nanosec)};
+}
+
+int64_t StampNs(const builtin_interfaces_msg_dds__Time_& stamp) {
+  return static_cast<int64_t>(stamp.sec) * 1000000000 + stamp.nanosec;
+}
+
+double FromStamp(const builtin_interfaces_msg_dds__Time_& stamp) {
+  return static_cast<double>(StampNs(stamp)) * 1e-9;
+}
+
+std::string OpticalFrame(const std::string& camera) { return camera + "_optical"; }
+
+std::string CameraOfFrame(const std::string& frame) {
+  static const std::string kSuffix = "_optical";
+  if (frame.size() > kSuffix.size() &&
+      frame.compare(frame.size() - kSuffix.size(), kSuffix.size(), kSuffix) == 0) {
+    return frame.substr(0, frame.size() - kSuffix.size());
+  }
+  return frame;
+}
+
+std::optional<std::string> RosEncoding(PixelFormat format) {
+  switch (format) {
+    case PixelFormat::kGray8:
+      return "mono8";
+    case PixelFormat::kRgb8:
+      return "rgb8";
+    case PixelFormat::kRgba8:
+      return "rgba8";
+    case PixelFormat::kGray16:
+      return "mono16";
+    case PixelFormat::kFloat32:
+      return "32FC1";
+    case PixelFormat::kUint32:
+      return std::nullopt;
+  }
+  return std::nullopt;
+}
+
+std::optional<PixelFormat> FormatOfEncoding(const std::string& encoding) {
+  if (encoding == "mono8" || encoding == "8UC1") return PixelFormat::kGray8;
+  if (encoding == "rgb8" || encoding == "8UC3") return PixelFormat::kRgb8;
+  if (encoding == "rgba8" || encoding == "8UC4") return PixelFormat::kRgba8;
+  if (encoding == "mono16" || encoding == "16UC1") return PixelFormat::kGray16;
+  if (encoding == "32FC1") return PixelFormat::kFloat32;
+  return std::nullopt;
+}
+
+namespace {
+
+char* Keep(Holder& holder, std::string text) {
+  holder.strings.push_back(std::move(text));
+  return holder.strings.back().data();
+}
+
+std_msgs_msg_dds__Header_ Header(double time, char* frame) { return {ToStamp(time), frame}; }
+
+}  // namespace
+
+bool FillImage(const Image& image, Holder& holder, sensor_msgs_msg_dds__Image_* out) {
+  const std::optional<std::string> encoding = RosEncoding(image.format());
+  if (!encoding) return false;
+  holder.strings.reserve(8);
+  const ImageMetadata& meta = image.metadata();
+  out->header = Header(meta.time, Keep(holder, OpticalFrame(meta.camera)));
+  out->height = static_cast<uint32_t>(image.height());
+  out->width = static_cast<uint32_t>(image.width());
+  out->encoding = Keep(holder, *encoding);
+  out->is_bigendian = 0;  // saccade's 16- and 32-bit pixels are the machine's: little-endian
+  out->step = static_cast<uint32_t>(image.stride());
+  out->data._maximum = out->data._length = static_cast<uint32_t>(image.size_bytes());
+  out->data._buffer = const_cast<uint8_t*>(image.data());  // written, never modified
+  out->data._release = false;
+  return true;
+}
+
+bool FillCameraInfo(const Image& image, Holder& holder, sensor_msgs_msg_dds__CameraInfo_* out) {
+  const geometry::CameraModel* model = geometry::FindCameraModel(image.metadata());
+  if (model == nullptr) return false;
+  holder.strings.reserve(8);
+  const geometry::Intrinsics& k = model->intrinsics();
+  *out = {};
+  out->header = Header(image.metadata().time, Keep(holder, OpticalFrame(image.metadata().camera)));
+  out->height = static_cast<uint32_t>(k.height());
+  out->width = static_cast<uint32_t>(k.width());
+  const geometry::Distortion& distortion = model->distortion();
+  std::vector<double>& d = holder.doubles[0];
+  d.clear();
+  // ROS's models (sensor_msgs/distortion_models.hpp) take OpenCV's coefficient order.
+  if (distortion.model() == geometry::DistortionModel::kFisheye) {
+    out->distortion_model = Keep(holder, "equidistant");
+    d = distortion.coefficients();
+  } else if (distortion.model() == geometry::DistortionModel::kRadialTangential) {
+    const std::vector<double>& c = distortion.coefficients();  // k1 k2 p1 p2 k3 k4 k5 k6
+    const bool rational = c.size() > 5 && (c[5] != 0 || c[6] != 0 || c[7] != 0);
+    out->distortion_model = Keep(holder, rational ? "rational_polynomial" : "plumb_bob");
+    d.assign(c.begin(), c.begin() + (rational ? 8 : 5));
+  } else {
+    out->distortion_model = Keep(holder, "plumb_bob");
+    d.assign(5, 0.0);
+  }
+  out->d._maximum = out->d._length = static_cast<uint32_t>(d.size());
+  out->d._buffer = d.data();
+  out->d._release = false;
+  const double K[9] = {k.fx(), k.skew(), k.cx(), 0, k.fy(), k.cy(), 0, 0, 1};
+  std::memcpy(out->k, K, sizeof(K));
+  const double R[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+  std::memcpy(out->r, R, sizeof(R));
+  // P = [K | 0]: a monocular camera (each eye is its own; the head moves the baseline).
+  const double P[12] = {k.fx(), k.skew(), k.cx(), 0, 0, k.fy(), k.cy(), 0, 0, 0, 1, 0};
+  std::memcpy(out->p, P, sizeof(P));
+  return true;
+}
+
+bool FillCameraTransform(const Image& image, Holder& holder,
+                         geometry_msgs_msg_dds__TransformStamped_* out) {
+  const geometry::Pose* X_WC = geometry::FindCameraPose(image.metadata());
+  if (X_WC == nullptr) return false;
+  holder.strings.reserve(8);
+  out->header = Header(image.metadata().time, Keep(holder, kWorldFrame));
+  out->child_frame_id = Keep(holder, OpticalFrame(image.metadata().camera));
+  const Eigen::Vector3d t = X_WC->translation();
+  const Eigen::Quaterniond q(X_WC->rotation());
+  out->transform.translation = {t.x(), t.y(), t.z()};
+  out->transform.rotation = {q.x(), q.y(), q.z(), q.w()};
+  return true;
+}
+
+std::optional<geometry::CameraModel> CameraModelOf(const sensor_msgs_msg_dds__CameraInfo_& info,
+                                                   std::string* error) {
+  const std::string model = info.distortion_model ? info.distortion_model : "";
+  const std::vector<double> d(info.d._buffer, info.d._buffer + info.d._length);
+  try {
+    const geometry::Intrinsics k(static_cast<int>(info.width), static_cast<int>(info.height),
+                                 info.k[0], info.k[4], info.k[2], info.k[5], info.k[1]);
+    bool zero = true;
+    for (double c : d) zero = zero && c == 0.0;
+    if (d.empty() || zero) return geometry::CameraModel(k);
+    if (model == "equidistant") {
+      return geometry::CameraModel(k, geometry::Distortion::Fisheye(d));
+    }
+    if (model == "plumb_bob" || model == "rational_polynomial") {
+      return geometry::CameraModel(k, geometry::Distortion::RadialTangential(d));
+    }
+    if (error) *error = "unknown distortion model '" + model + "'";
+  } catch (const std::exception& e) {
+    if (error) *error = e.what();
+  }
+  return std::nullopt;
+}
+
+geometry::Pose PoseOf(const geometry_msgs_msg_dds__Transform_& transform) {
+  const auto& r = transform.rotation;
+  const auto& t = transform.translation;
+  const Eigen::Quaterniond q = Eigen::Quaterniond(r.w, r.x, r.y, r.z).normalized();
+  return geometry::MakePose(q.toRotationMatrix(), Eigen::Vector3d(t.x, t.y, t.z));
+}
+
+std::shared_ptr<Image> ImageOf(const sensor_msgs_msg_dds__Image_& msg, std::string* error) {
+  const std::string encoding = msg.encoding ? msg.encoding : "";
+  const std::optional<PixelFormat> format = FormatOfEncoding(encoding);
+  if (!format) {
+    *error = "encoding '" + encoding + "' is not one of mono8, rgb8, rgba8, mono16, 32FC1";
+    return nullptr;
+  }
+  if (msg.is_bigendian && BytesPerPixel(*format) > 1) {
+    *error = "big-endian " + encoding + " images are not supported";
+    return nullptr;
+  }
+  const std::size_t row = static_cast<std::size_t>(msg.width) * BytesPerPixel(*format);
+  if (msg.step < row || static_cast<std::size_t>(msg.data._length) <
+                            static_cast<std::size_t>(msg.step) * msg.height) {
+    *error = fmt::format("{}x{} {} image: step {} and {} bytes of data are too short", msg.width,
+                         msg.height, encoding, msg.step, msg.data._length);
+    return nullptr;
+  }
+  auto image =
+      std::make_shared<Image>(static_cast<int>(msg.width), static_cast<int>(msg.height), *format);
+  if (msg.step == row) {
+    std::memcpy(image->data(), msg.data._buffer, row * msg.height);
+  } else {
+    for (uint32_t y = 0; y < msg.height; ++y) {
+      std::memcpy(image->row(static_cast<int>(y)), msg.data._buffer + std::size_t{y} * msg.step,
+                  row);
+    }
+  }
+  image->metadata().camera = CameraOfFrame(msg.header.frame_id ? msg.header.frame_id : "");
+  image->metadata().time = FromStamp(msg.header.stamp);
+  return image;
+}
+
+void FillJointState(double time, const head::JointState& positions,
+                    const head::JointState* velocities, Holder& holder,
+                    sensor_msgs_msg_dds__JointState_* out) {
+  holder.strings.reserve(8);
+  *out = {};
+  out->header = Header(time, Keep(holder, ""));
+  holder.string_pointers.clear();
+  holder.doubles[0].clear();
+  holder.doubles[1].clear();
+  for (const head::Joint joint : head::kAllJoints) {
+    holder.string_pointers.push_back(const_cast<char*>(head::JointName(joint)));
+    holder.doubles[0].push_back(positions[joint]);
+    if (velocities) holder.doubles[1].push_back((*velocities)[joint]);
+  }
+  out->name = {4, 4, holder.string_pointers.data(), false};
+  out->position = {4, 4, holder.doubles[0].data(), false};
+  const auto nv = static_cast<uint32_t>(holder.doubles[1].size());
+  out->velocity = {nv, nv, nv ? holder.doubles[1].data() : nullptr, false};
+  out->effort = {0, 0, nullptr, false};
+}
+
+bool JointsOf(const sensor_msgs_msg_dds__JointState_& msg, head::JointState* positions,
+              head::JointState* velocities, std::string* error) {
+  const uint32_t n = msg.name._length;
+  if (msg.position._length != n || (msg.velocity._length != 0 && msg.velocity._length != n)) {
+    *error = fmt::format("{} names, {} positions and {} velocities", n, msg.position._length,
+                         msg.velocity._length);
+    return false;
+  }
+  bool seen[4] = {false, false, false, false};
+  *velocities = head::JointState{};
+  for (uint32_t i = 0; i < n; ++i) {
+    const std::string name = msg.name._buffer[i] ? msg.name._buffer[i] : "";
+    for (const head::Joint joint : head::kAllJoints) {
+      if (name == head::JointName(joint)) {
+        (*positions)[joint] = msg.position._buffer[i];
+        if (msg.velocity._length) (*velocities)[joint] = msg.velocity._buffer[i];
+        seen[static_cast<int>(joint)] = true;
+      }
+    }
+  }
+  for (const head::Joint joint : head::kAllJoints) {
+    if (!seen[static_cast<int>(joint)]) {
+      *error = fmt::format("joint '{}' is missing (expected names pan, tilt, left, right)",
+                           head::JointName(joint));
+      return false;
+    }
+  }
+  return true;
+}
+
+}  // namespace saccade::dds::internal

@@ -1,0 +1,73 @@
+#pragma once
+// Conversions between saccade's messages and the ROS 2 types idlc generates (Cyclone's C
+// structs). The writers' side fills structs that borrow the message's memory (pixels and
+// strings are not copied: the struct is only valid while the message and `Holder` live); the
+// readers' side copies out of Cyclone's loaned samples.
+#include <cmath>
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "dds/internal_cyclone.h"
+#include "saccade/components/messages.h"
+#include "saccade/core/image.h"
+#include "saccade/geometry/camera_model.h"
+#include "saccade/geometry/pose.h"
+
+namespace saccade::dds::internal {
+
+/// Seconds to builtin_interfaces/Time (nanosec in [0, 1e9), rounded to the nanosecond).
+builtin_interfaces_msg_dds__Time_ ToStamp(double seconds);
+double FromStamp(const builtin_interfaces_msg_dds__Time_& stamp);
+/// The stamp in nanoseconds, exact (for matching an image with its pose).
+int64_t StampNs(const builtin_interfaces_msg_dds__Time_& stamp);
+
+/// The world frame's name, and a camera's optical frame ("left" -> "left_optical").
+inline constexpr const char* kWorldFrame = "world";
+std::string OpticalFrame(const std::string& camera);
+/// The camera of an optical frame ("left_optical" -> "left"; other names as they are).
+std::string CameraOfFrame(const std::string& frame);
+
+/// sensor_msgs/Image encodings of saccade's pixel formats ("rgb8", "mono8", ...); nullopt for
+/// a format ROS has no encoding for.
+std::optional<std::string> RosEncoding(PixelFormat format);
+std::optional<PixelFormat> FormatOfEncoding(const std::string& encoding);
+
+/// Memory a filled struct borrows (strings that are not the message's own).
+struct Holder {
+  std::vector<std::string> strings;
+  std::vector<char*> string_pointers;
+  std::vector<double> doubles[3];
+};
+
+/// `image` as sensor_msgs/Image, borrowing its pixels and `holder`'s strings. False when its
+/// format has no ROS encoding.
+bool FillImage(const Image& image, Holder& holder, sensor_msgs_msg_dds__Image_* out);
+/// The image's camera model as sensor_msgs/CameraInfo; false when it carries none.
+bool FillCameraInfo(const Image& image, Holder& holder, sensor_msgs_msg_dds__CameraInfo_* out);
+/// The image's pose X_WC as a transform world -> the camera's optical frame; false when none.
+bool FillCameraTransform(const Image& image, Holder& holder,
+                         geometry_msgs_msg_dds__TransformStamped_* out);
+
+/// The camera model of a CameraInfo; nullopt (and `*error` says why) when it is not one
+/// (zero K, unknown distortion model, wrong coefficient count).
+std::optional<geometry::CameraModel> CameraModelOf(const sensor_msgs_msg_dds__CameraInfo_& info,
+                                                   std::string* error);
+/// The transform's pose (rotation from the normalised quaternion).
+geometry::Pose PoseOf(const geometry_msgs_msg_dds__Transform_& transform);
+/// A new image from sensor_msgs/Image (pixels copied, rows re-packed when step is wider);
+/// nullptr (and `*error` says why) for an unknown encoding, big-endian data or a short buffer.
+std::shared_ptr<Image> ImageOf(const sensor_msgs_msg_dds__Image_& msg, std::string* error);
+
+/// The four joints as JointState (names pan, tilt, left, right).
+void FillJointState(double time, const head::JointState& positions,
+                    const head::JointState* velocities, Holder& holder,
+                    sensor_msgs_msg_dds__JointState_* out);
+/// Positions and velocities of a JointState by joint name; false (and `*error` says why) when
+/// a joint is missing or the lengths disagree. Velocities are zero when the message has none.
+bool JointsOf(const sensor_msgs_msg_dds__JointState_& msg, head::JointState* positions,
+              head::JointState* velocities, std::string* error);
+
+}  // namespace saccade::dds::internal

@@ -1,0 +1,587 @@
+#include "saccade/dds/topics.h"
+
+#include <fmt/format.h>
+
+#include <chrono>
+#include <deque>
+#include <map>
+#include <thread>
+
+#include "dds/internal_convert.h"
+#include "dds/internal_cyclone.h"
+#include "saccade/components/messages.h"
+#include "saccade/core/log.h"
+#include "saccade/dds/topic_names.h"
+#include "saccade/geometry/image_camera.h"
+
+namespace saccade::dds {
+
+using components::JointCommand;
+using components::JointStateMessage;
+using components::TargetMessage;
+using runtime::ImageMessage;
+using runtime::MessageName;
+
+namespace {
+
+constexpr int kMaxTake = 32;  // samples taken at once: older ones are skipped (counted lost)
+
+// Cyclone's QoS for `qos` (XCDR1 explicitly: the only representation rmw_cyclonedds reads).
+dds_qos_t* MakeQos(const Qos& qos) {
+  dds_qos_t* q = dds_create_qos();
+  dds_qset_reliability(q,
+                       qos.reliability == Reliability::kReliable ? DDS_RELIABILITY_RELIABLE
+                                                                 : DDS_RELIABILITY_BEST_EFFORT,
+                       DDS_MSECS(100));
+  dds_qset_durability(q, qos.durability == Durability::kVolatile ? DDS_DURABILITY_VOLATILE
+                                                                 : DDS_DURABILITY_TRANSIENT_LOCAL);
+  dds_qset_history(q, DDS_HISTORY_KEEP_LAST, qos.depth);
+  const dds_data_representation_id_t xcdr1 = DDS_DATA_REPRESENTATION_XCDR1;
+  dds_qset_data_representation(q, 1, &xcdr1);
+  return q;
+}
+
+// A Cyclone entity deleted with its owner.
+class Entity {
+ public:
+  Entity() = default;
+  explicit Entity(dds_entity_t handle) : handle_(handle) {}
+  Entity(Entity&& other) noexcept : handle_(std::exchange(other.handle_, 0)) {}
+  Entity& operator=(Entity&& other) noexcept {
+    std::swap(handle_, other.handle_);
+    return *this;
+  }
+  ~Entity() {
+    if (handle_ > 0) dds_delete(handle_);
+  }
+  dds_entity_t get() const { return handle_; }
+
+ private:
+  dds_entity_t handle_ = 0;
+};
+
+Entity MakeTopic(const Participant& participant, const dds_topic_descriptor_t* descriptor,
+                 const std::string& ros_topic) {
+  const std::string name = DdsTopicName(ros_topic);
+  return Entity(internal::Check(
+      dds_create_topic(participant.handle(), descriptor, name.c_str(), nullptr, nullptr),
+      fmt::format("dds: cannot create topic {} ({})", name, descriptor->m_typename)));
+}
+
+Entity MakeWriter(const Participant& participant, const Entity& topic, const Qos& qos,
+                  const std::string& what) {
+  dds_qos_t* q = MakeQos(qos);
+  const dds_entity_t writer = dds_create_writer(participant.handle(), topic.get(), q, nullptr);
+  dds_delete_qos(q);
+  return Entity(internal::Check(writer, "dds: cannot create the writer of " + what));
+}
+
+Entity MakeReader(const Participant& participant, const Entity& topic, const Qos& qos,
+                  const std::string& what) {
+  dds_qos_t* q = MakeQos(qos);
+  const dds_entity_t reader = dds_create_reader(participant.handle(), topic.get(), q, nullptr);
+  dds_delete_qos(q);
+  return Entity(internal::Check(reader, "dds: cannot create the reader of " + what));
+}
+
+int PublicationMatches(const Entity& writer) {
+  dds_publication_matched_status_t status{};
+  if (dds_get_publication_matched_status(writer.get(), &status) < 0) return 0;
+  return static_cast<int>(status.current_count);
+}
+
+int SubscriptionMatches(const Entity& reader) {
+  dds_subscription_matched_status_t status{};
+  if (dds_get_subscription_matched_status(reader.get(), &status) < 0) return 0;
+  return static_cast<int>(status.current_count);
+}
+
+bool WaitUntil(double timeout_s, const std::function<bool()>& done) {
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
+  while (!done()) {
+    if (std::chrono::steady_clock::now() >= deadline) return false;
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  }
+  return true;
+}
+
+// Writes `sample`, logging (not throwing: a per-frame path) when Cyclone refuses.
+void WriteSample(const Entity& writer, const void* sample, const std::string& topic,
+                 LinkStats& stats) {
+  const dds_return_t rc = dds_write(writer.get(), sample);
+  if (rc < 0) {
+    ++stats.lost;
+    log::Log(log::Level::kWarn, "dds: writing {} failed: {}", topic, dds_strretcode(rc));
+  }
+}
+
+// Takes every sample there is from `reader` (loaned), calls `each` on the valid ones in
+// arrival order, returns the count of valid samples.
+template <typename Sample, typename Each>
+int TakeAll(const Entity& reader, Each each) {
+  int valid = 0;
+  for (;;) {
+    void* samples[kMaxTake] = {nullptr};
+    dds_sample_info_t infos[kMaxTake];
+    const dds_return_t n = dds_take(reader.get(), samples, infos, kMaxTake, kMaxTake);
+    if (n <= 0) break;
+    for (dds_return_t i = 0; i < n; ++i) {
+      if (infos[i].valid_data) {
+        each(*static_cast<const Sample*>(samples[i]));
+        ++valid;
+      }
+    }
+    dds_return_loan(reader.get(), samples, n);
+    if (n < kMaxTake) break;
+  }
+  return valid;
+}
+
+// Counts what DDS reports lost (best-effort gaps) since the last call.
+int64_t LostSince(const Entity& reader) {
+  dds_sample_lost_status_t status{};
+  if (dds_get_sample_lost_status(reader.get(), &status) < 0) return 0;
+  return status.total_count_change;
+}
+
+// A waitset on "data available" of one reader.
+class DataWait {
+ public:
+  explicit DataWait(const Entity& reader) {
+    waitset_ = Entity(internal::Check(dds_create_waitset(DDS_CYCLONEDDS_HANDLE), "dds: waitset"));
+    condition_ = Entity(internal::Check(dds_create_readcondition(reader.get(), DDS_ANY_STATE),
+                                        "dds: read condition"));
+    internal::Check(dds_waitset_attach(waitset_.get(), condition_.get(), 0), "dds: attach");
+  }
+  void Wait(double timeout_s) {
+    if (timeout_s <= 0) return;
+    dds_waitset_wait(waitset_.get(), nullptr, 0, static_cast<dds_duration_t>(timeout_s * 1e9));
+  }
+
+ private:
+  Entity waitset_;
+  Entity condition_;
+};
+
+// ---- writers -------------------------------------------------------------------------------
+
+class ImageWriter final : public Writer {
+ public:
+  ImageWriter(std::shared_ptr<Participant> participant, const TopicOptions& options)
+      : Writer(MessageName<ImageMessage>(), options.topic), participant_(std::move(participant)) {
+    const std::string info_topic = SiblingTopic(options.topic, "camera_info");
+    image_topic_ = MakeTopic(*participant_, &sensor_msgs_msg_dds__Image__desc, options.topic);
+    image_ = MakeWriter(*participant_, image_topic_, options.qos, options.topic);
+    info_topic_ = MakeTopic(*participant_, &sensor_msgs_msg_dds__CameraInfo__desc, info_topic);
+    info_ = MakeWriter(*participant_, info_topic_, Qos::Latched(), info_topic);
+    if (!options.tf_topic.empty()) {
+      tf_topic_ = MakeTopic(*participant_, &tf2_msgs_msg_dds__TFMessage__desc, options.tf_topic);
+      // ROS 2's tf QoS: reliable, volatile, keep last 100.
+      tf_ = MakeWriter(*participant_, tf_topic_,
+                       {Reliability::kReliable, Durability::kVolatile, 100}, options.tf_topic);
+    }
+  }
+
+  void WriteErased(const void* message) override {
+    const auto& m = *static_cast<const ImageMessage*>(message);
+    if (!m.image) return;
+    const Image& image = *m.image;
+    internal::Holder holder;
+    // Pose and camera info first, so that a reader has them when the image arrives.
+    if (tf_.get() > 0) {
+      geometry_msgs_msg_dds__TransformStamped_ transform{};
+      if (internal::FillCameraTransform(image, holder, &transform)) {
+        tf2_msgs_msg_dds__TFMessage_ tf{};
+        tf.transforms = {1, 1, &transform, false};
+        WriteSample(tf_, &tf, "/tf", stats_);
+      }
+    }
+    sensor_msgs_msg_dds__CameraInfo_ info{};
+    if (internal::FillCameraInfo(image, holder, &info)) WriteSample(info_, &info, topic(), stats_);
+    sensor_msgs_msg_dds__Image_ msg{};
+    if (!internal::FillImage(image, holder, &msg)) {
+      throw InvalidArgument(fmt::format("dds: {} images have no sensor_msgs/Image encoding ({})",
+                                        ToString(image.format()), topic()));
+    }
+    WriteSample(image_, &msg, topic(), stats_);
+    ++stats_.messages;
+  }
+  int matched() const override { return PublicationMatches(image_); }
+  const LinkStats& stats() const override { return stats_; }
+
+ private:
+  std::shared_ptr<Participant> participant_;
+  Entity image_topic_, info_topic_, tf_topic_;
+  Entity image_, info_, tf_;
+  LinkStats stats_;
+};
+
+// head.joints, head.command and vision.target: one ROS message each.
+template <typename M, typename Sample>
+class SimpleWriter final : public Writer {
+ public:
+  SimpleWriter(std::shared_ptr<Participant> participant, const TopicOptions& options,
+               const dds_topic_descriptor_t* descriptor)
+      : Writer(MessageName<M>(), options.topic), participant_(std::move(participant)) {
+    topic_ = MakeTopic(*participant_, descriptor, options.topic);
+    writer_ = MakeWriter(*participant_, topic_, options.qos, options.topic);
+  }
+  void WriteErased(const void* message) override {
+    const M& m = *static_cast<const M*>(message);
+    if (!Publishable(m)) return;
+    internal::Holder holder;
+    Sample sample{};
+    Fill(m, holder, &sample);
+    WriteSample(writer_, &sample, topic(), stats_);
+    ++stats_.messages;
+  }
+  int matched() const override { return PublicationMatches(writer_); }
+  const LinkStats& stats() const override { return stats_; }
+
+ private:
+  // A target that is not valid (nothing to look at) is not a point: it is not published.
+  static bool Publishable(const TargetMessage& m) { return m.valid && m.p_W.allFinite(); }
+  static bool Publishable(const JointStateMessage&) { return true; }
+  static bool Publishable(const JointCommand&) { return true; }
+
+  static void Fill(const JointStateMessage& m, internal::Holder& holder,
+                   sensor_msgs_msg_dds__JointState_* out) {
+    internal::FillJointState(m.time, m.positions, &m.velocities, holder, out);
+  }
+  static void Fill(const JointCommand& m, internal::Holder& holder,
+                   sensor_msgs_msg_dds__JointState_* out) {
+    internal::FillJointState(m.time, m.positions, &m.velocities, holder, out);
+  }
+  static void Fill(const TargetMessage& m, internal::Holder& holder,
+                   geometry_msgs_msg_dds__PointStamped_* out) {
+    holder.strings.reserve(2);
+    holder.strings.emplace_back(internal::kWorldFrame);
+    out->header = {internal::ToStamp(m.time), holder.strings.back().data()};
+    out->point = {m.p_W.x(), m.p_W.y(), m.p_W.z()};
+  }
+
+  std::shared_ptr<Participant> participant_;
+  Entity topic_, writer_;
+  LinkStats stats_;
+};
+
+// ---- readers -------------------------------------------------------------------------------
+
+class ImageReader final : public Reader {
+ public:
+  ImageReader(std::shared_ptr<Participant> participant, const TopicOptions& options)
+      : Reader(MessageName<ImageMessage>(), options.topic),
+        participant_(std::move(participant)),
+        frame_period_s_(options.frame_period_s) {
+    const std::string info_topic = SiblingTopic(options.topic, "camera_info");
+    image_topic_ = MakeTopic(*participant_, &sensor_msgs_msg_dds__Image__desc, options.topic);
+    image_ = MakeReader(*participant_, image_topic_, options.qos, options.topic);
+    info_topic_ = MakeTopic(*participant_, &sensor_msgs_msg_dds__CameraInfo__desc, info_topic);
+    info_ = MakeReader(*participant_, info_topic_, Qos::Latched(), info_topic);
+    if (!options.tf_topic.empty()) {
+      tf_topic_ = MakeTopic(*participant_, &tf2_msgs_msg_dds__TFMessage__desc, options.tf_topic);
+      tf_ = MakeReader(*participant_, tf_topic_,
+                       {Reliability::kReliable, Durability::kVolatile, 100}, options.tf_topic);
+    }
+    wait_ = std::make_unique<DataWait>(image_);
+  }
+
+  std::shared_ptr<const void> TakeErased(double timeout_s) override {
+    stats_.lost += LostSince(image_);
+    std::shared_ptr<Image> newest;
+    int64_t newest_stamp = 0;  // exact, in ns: the time in seconds does not round-trip
+    const auto TakeImages = [&] {
+      return TakeAll<sensor_msgs_msg_dds__Image_>(
+          image_, [&](const sensor_msgs_msg_dds__Image_& msg) {
+            std::string error;
+            std::shared_ptr<Image> image = internal::ImageOf(msg, &error);
+            if (!image) {
+              ++stats_.lost;
+              log::Log(log::Level::kWarn, "dds: {}: image dropped: {}", topic(), error);
+              return;
+            }
+            if (newest) ++stats_.lost;  // an older one, never handed over
+            newest = std::move(image);
+            newest_stamp = internal::StampNs(msg.header.stamp);
+          });
+    };
+    TakeImages();
+    if (!newest && timeout_s > 0) {
+      wait_->Wait(timeout_s);
+      TakeImages();
+      if (!newest) ++stats_.late;
+    }
+    if (!newest) return nullptr;
+    Complete(*newest, newest_stamp);
+    return std::make_shared<const ImageMessage>(ImageMessage{std::move(newest)});
+  }
+  int matched() const override { return SubscriptionMatches(image_); }
+  const LinkStats& stats() const override { return stats_; }
+
+ private:
+  // Camera model, pose and frame index of a received image.
+  void Complete(Image& image, int64_t stamp) {
+    ImageMetadata& meta = image.metadata();
+    if (last_stamp_ && stamp < *last_stamp_) {
+      ++stats_.restarts;
+      received_ = 0;
+      poses_.clear();
+    }
+    last_stamp_ = stamp;
+    meta.frame_index = frame_period_s_ > 0
+                           ? static_cast<int64_t>(std::llround(meta.time / frame_period_s_))
+                           : received_;
+    ++received_;
+    ++stats_.messages;
+    const std::string frame = internal::OpticalFrame(meta.camera);
+    const auto Poll = [&] {
+      TakeAll<sensor_msgs_msg_dds__CameraInfo_>(
+          info_, [&](const sensor_msgs_msg_dds__CameraInfo_& info) {
+            std::string error;
+            if (auto model = internal::CameraModelOf(info, &error)) {
+              models_[info.header.frame_id ? info.header.frame_id : ""] =
+                  std::make_shared<const geometry::CameraModel>(*model);
+            } else {
+              log::Log(log::Level::kWarn, "dds: camera info of {} ignored: {}", topic(), error);
+            }
+          });
+      if (tf_.get() > 0) {
+        TakeAll<tf2_msgs_msg_dds__TFMessage_>(tf_, [&](const tf2_msgs_msg_dds__TFMessage_& tf) {
+          for (uint32_t i = 0; i < tf.transforms._length; ++i) {
+            const auto& t = tf.transforms._buffer[i];
+            if (!t.child_frame_id) continue;
+            auto& history = poses_[t.child_frame_id];
+            history.emplace_back(internal::StampNs(t.header.stamp), internal::PoseOf(t.transform));
+            if (history.size() > 64) history.pop_front();
+          }
+        });
+      }
+    };
+    const auto Found = [&]() -> bool {
+      if (!models_.contains(frame)) return false;
+      if (tf_.get() <= 0) return true;
+      const auto it = poses_.find(frame);
+      if (it == poses_.end()) return false;
+      for (const auto& [s, pose] : it->second) {
+        if (s == stamp) return true;
+      }
+      return false;
+    };
+    // The pose and info were written before the image; allow them a moment on other sockets.
+    Poll();
+    if (!Found())
+      WaitUntil(0.05, [&] {
+        Poll();
+        return Found();
+      });
+    if (const auto m = models_.find(frame); m != models_.end()) {
+      geometry::SetCameraModel(meta, m->second);
+    } else {
+      ++stats_.incomplete;
+    }
+    if (tf_.get() > 0) {
+      const geometry::Pose* best = nullptr;
+      if (const auto it = poses_.find(frame); it != poses_.end()) {
+        for (const auto& [s, pose] : it->second) {
+          if (s <= stamp) best = &pose;  // the newest at or before the image's time
+        }
+      }
+      if (best) {
+        geometry::SetCameraPose(meta, *best);
+      } else {
+        ++stats_.incomplete;
+      }
+    }
+  }
+
+  std::shared_ptr<Participant> participant_;
+  double frame_period_s_;
+  Entity image_topic_, info_topic_, tf_topic_;
+  Entity image_, info_, tf_;
+  std::unique_ptr<DataWait> wait_;
+  std::map<std::string, std::shared_ptr<const geometry::CameraModel>> models_;
+  std::map<std::string, std::deque<std::pair<int64_t, geometry::Pose>>> poses_;
+  std::optional<int64_t> last_stamp_;
+  int64_t received_ = 0;
+  LinkStats stats_;
+};
+
+template <typename M, typename Sample>
+class SimpleReader final : public Reader {
+ public:
+  SimpleReader(std::shared_ptr<Participant> participant, const TopicOptions& options,
+               const dds_topic_descriptor_t* descriptor)
+      : Reader(MessageName<M>(), options.topic), participant_(std::move(participant)) {
+    topic_ = MakeTopic(*participant_, descriptor, options.topic);
+    reader_ = MakeReader(*participant_, topic_, options.qos, options.topic);
+    wait_ = std::make_unique<DataWait>(reader_);
+  }
+  std::shared_ptr<const void> TakeErased(double timeout_s) override {
+    stats_.lost += LostSince(reader_);
+    std::shared_ptr<M> newest;
+    const auto Take = [&] {
+      TakeAll<Sample>(reader_, [&](const Sample& sample) {
+        std::string error;
+        auto message = std::make_shared<M>();
+        if (!Convert(sample, message.get(), &error)) {
+          ++stats_.lost;
+          log::Log(log::Level::kWarn, "dds: {}: message dropped: {}", topic(), error);
+          return;
+        }
+        if (newest) ++stats_.lost;
+        newest = std::move(message);
+      });
+    };
+    Take();
+    if (!newest && timeout_s > 0) {
+      wait_->Wait(timeout_s);
+      Take();
+      if (!newest) ++stats_.late;
+    }
+    if (!newest) return nullptr;
+    if (last_time_ && newest->time < *last_time_) ++stats_.restarts;
+    last_time_ = newest->time;
+    ++stats_.messages;
+    return newest;
+  }
+  int matched() const override { return SubscriptionMatches(reader_); }
+  const LinkStats& stats() const override { return stats_; }
+
+ private:
+  static bool Convert(const sensor_msgs_msg_dds__JointState_& s, JointStateMessage* m,
+                      std::string* error) {
+    if (!internal::JointsOf(s, &m->positions, &m->velocities, error)) return false;
+    m->time = internal::FromStamp(s.header.stamp);
+    // JointState has no targets: at rest (every velocity within sim.head's 1e-4 tolerance)
+    // the head is where it is heading.
+    m->arrived = true;
+    for (const head::Joint joint : head::kAllJoints) {
+      m->arrived = m->arrived && std::abs(m->velocities[joint]) <= 1e-4;
+    }
+    m->targets = m->positions;
+    return true;
+  }
+  static bool Convert(const sensor_msgs_msg_dds__JointState_& s, JointCommand* m,
+                      std::string* error) {
+    if (!internal::JointsOf(s, &m->positions, &m->velocities, error)) return false;
+    m->time = internal::FromStamp(s.header.stamp);
+    return true;
+  }
+  static bool Convert(const geometry_msgs_msg_dds__PointStamped_& s, TargetMessage* m,
+                      std::string* error) {
+    const std::string frame = s.header.frame_id ? s.header.frame_id : "";
+    if (frame != internal::kWorldFrame) {
+      *error = "point in frame '" + frame + "', expected 'world'";
+      return false;
+    }
+    m->time = internal::FromStamp(s.header.stamp);
+    m->valid = true;
+    m->p_W = Eigen::Vector3d(s.point.x, s.point.y, s.point.z);
+    m->source = "dds";
+    return true;
+  }
+
+  std::shared_ptr<Participant> participant_;
+  Entity topic_, reader_;
+  std::unique_ptr<DataWait> wait_;
+  std::optional<double> last_time_;
+  LinkStats stats_;
+};
+
+void CheckCreate(const std::shared_ptr<Participant>& participant, const TopicOptions& options) {
+  if (!participant) throw InvalidArgument("dds: no participant");
+  DdsTopicName(options.topic);  // throws for a name that is not fully qualified and valid
+  std::string error;
+  if (!options.qos.IsValid(&error)) {
+    throw InvalidArgument("dds: QoS of " + options.topic + ": " + error);
+  }
+  if (!options.tf_topic.empty()) DdsTopicName(options.tf_topic);
+}
+
+std::string SupportedList() {
+  std::string text;
+  for (const std::string& type : SupportedMessageTypes()) {
+    text += (text.empty() ? "" : ", ") + type + " (" + RosTypeOf(type) + ")";
+  }
+  return text;
+}
+
+}  // namespace
+
+std::vector<std::string> SupportedMessageTypes() {
+  return {MessageName<ImageMessage>(), MessageName<JointStateMessage>(),
+          MessageName<JointCommand>(), MessageName<TargetMessage>()};
+}
+
+std::string RosTypeOf(const std::string& message_type) {
+  if (message_type == MessageName<ImageMessage>()) return "sensor_msgs/msg/Image";
+  if (message_type == MessageName<JointStateMessage>()) return "sensor_msgs/msg/JointState";
+  if (message_type == MessageName<JointCommand>()) return "sensor_msgs/msg/JointState";
+  if (message_type == MessageName<TargetMessage>()) return "geometry_msgs/msg/PointStamped";
+  throw InvalidArgument("dds: message type '" + message_type +
+                        "' has no ROS 2 form; DDS topics carry " + SupportedList());
+}
+
+void Writer::CheckType(const char* name) const {
+  if (message_type_ != name) {
+    throw InvalidArgument(
+        fmt::format("dds: the writer of {} sends {}, not {}", topic_, message_type_, name));
+  }
+}
+
+void Reader::CheckType(const char* name) const {
+  if (message_type_ != name) {
+    throw InvalidArgument(
+        fmt::format("dds: the reader of {} gives {}, not {}", topic_, message_type_, name));
+  }
+}
+
+bool Writer::WaitForReaders(int count, double timeout_s) const {
+  return WaitUntil(timeout_s, [&] { return matched() >= count; });
+}
+
+bool Reader::WaitForWriters(int count, double timeout_s) const {
+  return WaitUntil(timeout_s, [&] { return matched() >= count; });
+}
+
+std::unique_ptr<Writer> Writer::Create(std::shared_ptr<Participant> participant,
+                                       const std::string& message_type,
+                                       const TopicOptions& options) {
+  RosTypeOf(message_type);  // throws for an unsupported type
+  CheckCreate(participant, options);
+  if (message_type == MessageName<ImageMessage>()) {
+    return std::make_unique<ImageWriter>(std::move(participant), options);
+  }
+  if (message_type == MessageName<JointStateMessage>()) {
+    return std::make_unique<SimpleWriter<JointStateMessage, sensor_msgs_msg_dds__JointState_>>(
+        std::move(participant), options, &sensor_msgs_msg_dds__JointState__desc);
+  }
+  if (message_type == MessageName<JointCommand>()) {
+    return std::make_unique<SimpleWriter<JointCommand, sensor_msgs_msg_dds__JointState_>>(
+        std::move(participant), options, &sensor_msgs_msg_dds__JointState__desc);
+  }
+  return std::make_unique<SimpleWriter<TargetMessage, geometry_msgs_msg_dds__PointStamped_>>(
+      std::move(participant), options, &geometry_msgs_msg_dds__PointStamped__desc);
+}
+
+std::unique_ptr<Reader> Reader::Create(std::shared_ptr<Participant> participant,
+                                       const std::string& message_type,
+                                       const TopicOptions& options) {
+  RosTypeOf(message_type);
+  CheckCreate(participant, options);
+  if (message_type == MessageName<ImageMessage>()) {
+    return std::make_unique<ImageReader>(std::move(participant), options);
+  }
+  if (message_type == MessageName<JointStateMessage>()) {
+    return std::make_unique<SimpleReader<JointStateMessage, sensor_msgs_msg_dds__JointState_>>(
+        std::move(participant), options, &sensor_msgs_msg_dds__JointState__desc);
+  }
+  if (message_type == MessageName<JointCommand>()) {
+    return std::make_unique<SimpleReader<JointCommand, sensor_msgs_msg_dds__JointState_>>(
+        std::move(participant), options, &sensor_msgs_msg_dds__JointState__desc);
+  }
+  return std::make_unique<SimpleReader<TargetMessage, geometry_msgs_msg_dds__PointStamped_>>(
+      std::move(participant), options, &geometry_msgs_msg_dds__PointStamped__desc);
+}
+
+}  // namespace saccade::dds

@@ -1,0 +1,231 @@
+#include "saccade/dds/transport.h"
+
+#include <fmt/format.h>
+
+#include <map>
+#include <mutex>
+#include <set>
+
+#include "saccade/components/messages.h"
+#include "saccade/core/log.h"
+#include "saccade/dds/topic_names.h"
+#include "saccade/dds/topics.h"
+#include "saccade/runtime/pipeline.h"
+
+namespace saccade::dds {
+namespace {
+
+using components::JointCommand;
+using components::JointStateMessage;
+using components::TargetMessage;
+using runtime::ImageMessage;
+using runtime::MessageName;
+
+void CheckKeys(const nlohmann::json& map, const std::set<std::string>& known,
+               const std::string& where) {
+  for (const auto& [key, value] : map.items()) {
+    if (!known.contains(key)) {
+      std::string list;
+      for (const std::string& k : known) list += (list.empty() ? "" : ", ") + k;
+      throw InvalidArgument(fmt::format("{}: unknown key '{}'; expected {}", where, key, list));
+    }
+  }
+}
+
+double Seconds(const nlohmann::json& map, const char* key, const std::string& where) {
+  const auto it = map.find(key);
+  if (it == map.end()) return 0.0;
+  if (!it->is_number() || it->get<double>() < 0 || it->get<double>() > 3600) {
+    throw InvalidArgument(
+        fmt::format("{}.{}: expected seconds 0..3600, got {}", where, key, it->dump()));
+  }
+  return it->get<double>();
+}
+
+// One participant per domain and configuration in the process: Cyclone allows few per host.
+std::shared_ptr<Participant> SharedParticipant(const DomainOptions& options) {
+  static std::mutex mutex;
+  static std::map<std::string, std::weak_ptr<Participant>> participants;
+  std::lock_guard lock(mutex);
+  std::string key = fmt::format("{}|{}|{}|{}", options.domain_id, options.config, options.interface,
+                                options.multicast);
+  for (const std::string& peer : options.peers) key += "|" + peer;
+  if (auto existing = participants[key].lock()) return existing;
+  auto participant = Participant::Create(options);
+  participants[key] = participant;
+  return participant;
+}
+
+struct Endpoint {
+  std::shared_ptr<Participant> participant;
+  TopicOptions options;
+};
+
+Endpoint Resolve(const runtime::TopicEndpoint& endpoint, const std::set<std::string>& keys) {
+  const std::string where = endpoint.where;
+  CheckKeys(endpoint.options, keys, where);
+  std::string ns;
+  const nlohmann::json transport =
+      endpoint.pipeline ? endpoint.pipeline->transport : nlohmann::json::object();
+  const DomainOptions domain = ParseTransport(transport, &ns);
+  Endpoint out;
+  out.options.topic = ResolveTopic(endpoint.topic, ns);
+  RosTypeOf(endpoint.message_type);  // names the supported types when this one is not
+  out.options.qos = DefaultQos(endpoint.message_type);
+  if (const auto it = endpoint.options.find("qos"); it != endpoint.options.end()) {
+    out.options.qos = ParseQos(*it, where + ".qos");
+  }
+  if (const auto it = endpoint.options.find("tf"); it != endpoint.options.end()) {
+    if (!it->is_string()) throw InvalidArgument(where + ".tf: expected a topic or \"\"");
+    const std::string tf = it->get<std::string>();
+    out.options.tf_topic = tf.empty() ? "" : ResolveTopic(tf, ns);
+  }
+  if (endpoint.pipeline && endpoint.pipeline->clock.mode == runtime::ClockMode::kSimulated) {
+    out.options.frame_period_s = endpoint.pipeline->clock.step;
+  }
+  out.participant = SharedParticipant(domain);
+  return out;
+}
+
+template <runtime::Message M>
+class TopicReaderComponent final : public runtime::Component {
+ public:
+  TopicReaderComponent(std::unique_ptr<Reader> reader, double wait_s, double start_wait_s)
+      : reader_(std::move(reader)),
+        wait_s_(wait_s),
+        start_wait_s_(start_wait_s),
+        output_(AddOutput<M>("message")) {}
+
+  void Start() override {
+    if (start_wait_s_ > 0 && !reader_->WaitForWriters(1, start_wait_s_)) {
+      log::Log(log::Level::kWarn, "dds: {}: no writer after {} s; stepping on without one",
+               reader_->topic(), start_wait_s_);
+    }
+  }
+  void Step(const runtime::StepContext&) override {
+    // Waits only while a writer is there: a sender that went away never blocks the loop.
+    const double wait = wait_s_ > 0 && reader_->matched() > 0 ? wait_s_ : 0.0;
+    if (auto message = reader_->Take<M>(wait)) output_.Emit(*message);
+  }
+  void Stop() override {
+    const LinkStats& s = reader_->stats();
+    log::Info("dds: {} ({}): {} messages, {} lost, {} late, {} restarts{}", reader_->topic(),
+              RosTypeOf(reader_->message_type()), s.messages, s.lost, s.late, s.restarts,
+              s.incomplete ? fmt::format(", {} without camera info or pose", s.incomplete) : "");
+  }
+
+ private:
+  std::unique_ptr<Reader> reader_;
+  double wait_s_;
+  double start_wait_s_;
+  runtime::Output<M>& output_;
+};
+
+template <runtime::Message M>
+void AttachWriter(std::shared_ptr<Writer> writer, double start_wait_s, runtime::OutputBase& port) {
+  auto* typed = dynamic_cast<runtime::Output<M>*>(&port);
+  SACCADE_ASSERT(typed != nullptr, "output of the wrong type");
+  auto first = std::make_shared<bool>(true);
+  typed->signal().Connect([writer, start_wait_s, first](const M& message) {
+    if (*first) {
+      *first = false;
+      if (start_wait_s > 0 && !writer->WaitForReaders(1, start_wait_s)) {
+        log::Log(log::Level::kWarn, "dds: {}: no reader after {} s; writing without one",
+                 writer->topic(), start_wait_s);
+      }
+    }
+    writer->Write(message);
+  });
+}
+
+template <typename F>
+auto Dispatch(const std::string& type, F&& f) {
+  if (type == MessageName<ImageMessage>()) return f(ImageMessage{});
+  if (type == MessageName<JointStateMessage>()) return f(JointStateMessage{});
+  if (type == MessageName<JointCommand>()) return f(JointCommand{});
+  if (type == MessageName<TargetMessage>()) return f(TargetMessage{});
+  RosTypeOf(type);  // throws, naming the supported types
+  SACCADE_ASSERT(false, "unreachable");
+}
+
+}  // namespace
+
+DomainOptions ParseTransport(const nlohmann::json& transport, std::string* ns) {
+  const std::string where = "transport";
+  if (!transport.is_object()) throw InvalidArgument("transport: expected a map");
+  CheckKeys(transport, {"domain", "namespace", "config", "interface", "peers", "multicast"}, where);
+  DomainOptions options;
+  if (const auto it = transport.find("domain"); it != transport.end()) {
+    if (!it->is_number_integer() || it->get<int64_t>() < 0 || it->get<int64_t>() > kMaxDomainId) {
+      throw InvalidArgument(fmt::format("transport.domain: expected an integer 0..{}, got {}",
+                                        kMaxDomainId, it->dump()));
+    }
+    options.domain_id = it->get<int>();
+  }
+  const auto String = [&](const char* key, std::string* out) {
+    if (const auto it = transport.find(key); it != transport.end()) {
+      if (!it->is_string()) {
+        throw InvalidArgument(
+            fmt::format("transport.{}: expected a string, got {}", key, it->dump()));
+      }
+      *out = it->get<std::string>();
+    }
+  };
+  std::string name_space;
+  String("namespace", &name_space);
+  String("config", &options.config);
+  String("interface", &options.interface);
+  if (const auto it = transport.find("peers"); it != transport.end()) {
+    if (!it->is_array()) throw InvalidArgument("transport.peers: expected a list of hosts");
+    for (const auto& peer : *it) {
+      if (!peer.is_string()) throw InvalidArgument("transport.peers: expected host names");
+      options.peers.push_back(peer.get<std::string>());
+    }
+  }
+  if (const auto it = transport.find("multicast"); it != transport.end()) {
+    if (!it->is_boolean()) throw InvalidArgument("transport.multicast: expected true or false");
+    options.multicast = it->get<bool>();
+  }
+  std::string error;
+  if (!options.IsValid(&error)) throw InvalidArgument("transport: " + error);
+  if (!name_space.empty()) ResolveTopic("x", name_space);  // checks the namespace
+  if (ns) *ns = name_space;
+  return options;
+}
+
+Qos DefaultQos(const std::string& message_type) {
+  if (message_type == MessageName<ImageMessage>()) return Qos::Images();
+  if (message_type == MessageName<JointStateMessage>()) return Qos::Latched();
+  return Qos::Default();
+}
+
+void RegisterDdsTransport(runtime::ComponentRegistry& registry) {
+  components::RegisterMessages();
+  runtime::TopicTransport transport;
+  transport.name = "dds";
+  transport.make_reader =
+      [](const runtime::TopicEndpoint& endpoint) -> std::unique_ptr<runtime::Component> {
+    Endpoint e = Resolve(endpoint, {"qos", "wait_s", "start_wait_s", "tf"});
+    const double wait_s = Seconds(endpoint.options, "wait_s", endpoint.where);
+    const double start_wait_s = Seconds(endpoint.options, "start_wait_s", endpoint.where);
+    auto reader = Reader::Create(e.participant, endpoint.message_type, e.options);
+    return Dispatch(endpoint.message_type, [&](auto tag) -> std::unique_ptr<runtime::Component> {
+      using M = decltype(tag);
+      return std::make_unique<TopicReaderComponent<M>>(std::move(reader), wait_s, start_wait_s);
+    });
+  };
+  transport.attach_writer = [](const runtime::TopicEndpoint& endpoint,
+                               runtime::OutputBase& output) {
+    Endpoint e = Resolve(endpoint, {"qos", "start_wait_s", "tf"});
+    const double start_wait_s = Seconds(endpoint.options, "start_wait_s", endpoint.where);
+    std::shared_ptr<Writer> writer =
+        Writer::Create(e.participant, endpoint.message_type, e.options);
+    Dispatch(endpoint.message_type, [&](auto tag) {
+      AttachWriter<decltype(tag)>(writer, start_wait_s, output);
+      return 0;
+    });
+  };
+  registry.SetTopicTransport(std::move(transport));
+}
+
+}  // namespace saccade::dds

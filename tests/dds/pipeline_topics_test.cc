@@ -1,0 +1,146 @@
+// Pipeline connections that name a DDS topic (runtime/pipeline.h, dds/transport.h): a plain
+// ROS 2-typed publisher drives a pipeline's head, and bad topic connections are reported at
+// their file and line.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <optional>
+
+#include "dds_test_util.h"
+#include "saccade/components/loop_outputs.h"
+#include "saccade/components/messages.h"
+#include "saccade/components/register.h"
+#include "saccade/dds/transport.h"
+#include "saccade/runtime/pipeline.h"
+#include "saccade/runtime/scheduler.h"
+
+namespace saccade::dds {
+namespace {
+
+using ::testing::HasSubstr;
+using namespace saccade::dds::testing;
+
+const std::string kScene = SACCADE_SOURCE_DIR "/scenes/portraits.yaml";
+
+std::string HeadPipeline(int domain, const std::string& command_input) {
+  return "clock: {mode: simulated, step: 0.04, steps: 50}\n"
+         "scene: " +
+         kScene +
+         "\n"
+         "transport: {domain: " +
+         std::to_string(domain) +
+         ", namespace: /saccade}\n"
+         "components:\n"
+         "  - name: head\n"
+         "    type: sim.head\n"
+         "    inputs:\n"
+         "      command: " +
+         command_input +
+         "\n"
+         "    outputs: {joints: joint_states}\n";
+}
+
+class PipelineTopics : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    PinLoopback();
+    components::RegisterComponents();
+    RegisterDdsTransport(runtime::ComponentRegistry::Global());
+  }
+};
+
+TEST_F(PipelineTopics, PlainPublisherOfJointStateCommandsMovesTheHead) {
+  constexpr int kDomain = 181;
+  runtime::Pipeline pipeline = runtime::Pipeline::LoadString(
+      HeadPipeline(kDomain, "{topic: head/command, start_wait_s: 10}"), "head.yaml");
+  // The reader of the topic is a component just before the head.
+  ASSERT_EQ(pipeline.components().size(), 2u);
+  EXPECT_EQ(pipeline.components()[0]->name(), "head-command-topic");
+
+  // A plain Cyclone DDS program of the ROS 2 types commands pan 0.2 rad, tilt -0.1 rad.
+  Raw raw(RawParticipant(kDomain));
+  Raw writer(
+      RawWriter(raw.get(), &ref_sensor_msgs_msg_dds__JointState__desc, "rt/saccade/head/command"));
+  Raw joints(RawReader(raw.get(), &ref_sensor_msgs_msg_dds__JointState__desc,
+                       "rt/saccade/joint_states", 100, /*transient_local=*/true));
+  ASSERT_TRUE(WaitWriterMatched(writer.get()));
+  char* names[4] = {const_cast<char*>("pan"), const_cast<char*>("tilt"), const_cast<char*>("left"),
+                    const_cast<char*>("right")};
+  double position[4] = {0.2, -0.1, 0.05, -0.05};
+  ref_sensor_msgs_msg_dds__JointState_ command{};
+  command.header.frame_id = const_cast<char*>("");
+  command.name = {4, 4, names, false};
+  command.position = {4, 4, position, false};
+  ASSERT_EQ(dds_write(writer.get(), &command), DDS_RETCODE_OK);
+
+  std::optional<components::JointStateMessage> last;
+  components::Tap<components::JointStateMessage>(
+      pipeline, [&](const components::JointStateMessage& m) { last = m; });
+  const runtime::RunSummary summary = runtime::RunPipeline(pipeline);
+  ASSERT_EQ(summary.errors_total, 0);
+  ASSERT_TRUE(last.has_value());
+  // 2 s is ample for sim.head's motors to get there (they move at rad/s).
+  constexpr double kArrived = 1e-3;  // rad
+  EXPECT_NEAR(last->positions.pan, 0.2, kArrived);
+  EXPECT_NEAR(last->positions.tilt, -0.1, kArrived);
+  EXPECT_NEAR(last->positions.left, 0.05, kArrived);
+  EXPECT_NEAR(last->positions.right, -0.05, kArrived);
+
+  // And the head's state went out on joint_states, as ROS 2's JointState.
+  ref_sensor_msgs_msg_dds__JointState_ state{};
+  ASSERT_TRUE(TakeSample(joints.get(), &state));
+  EXPECT_EQ(state.name._length, 4u);
+  EXPECT_STREQ(state.name._buffer[0], "pan");
+  dds_sample_free(&state, &ref_sensor_msgs_msg_dds__JointState__desc, DDS_FREE_CONTENTS);
+}
+
+TEST_F(PipelineTopics, BadTopicConnectionsNameFileLineAndKey) {
+  const auto ErrorOf = [](const std::string& text, const runtime::ComponentRegistry& registry =
+                                                       runtime::ComponentRegistry::Global()) {
+    try {
+      runtime::Pipeline::LoadString(text, "head.yaml", registry);
+    } catch (const FileError& e) {
+      return std::string(e.what());
+    }
+    return std::string("(no error)");
+  };
+  EXPECT_THAT(ErrorOf(HeadPipeline(182, "{topic: head/command, qos: fast}")),
+              HasSubstr("head.yaml:8: components[0].inputs.command: head.command.qos: unknown QoS "
+                        "profile 'fast'"));
+  EXPECT_THAT(ErrorOf(HeadPipeline(182, "{topic: 'head command'}")),
+              HasSubstr("head.yaml:8: components[0].inputs.command: topic 'head command': "
+                        "character ' ' is not allowed"));
+  EXPECT_THAT(
+      ErrorOf(HeadPipeline(182, "{topic: head/command, wait: 3}")),
+      HasSubstr("head.command: unknown key 'wait'; expected qos, start_wait_s, tf, wait_s"));
+  EXPECT_THAT(ErrorOf(HeadPipeline(300, "{topic: head/command}")),
+              HasSubstr("transport.domain: expected an integer 0..232, got 300"));
+  // A program without a topic transport says so.
+  runtime::ComponentRegistry plain;
+  components::RegisterComponents(plain);
+  EXPECT_THAT(ErrorOf(HeadPipeline(182, "{topic: head/command}"), plain),
+              HasSubstr("reads the topic 'head/command', but this program has no topic "
+                        "transport (DDS)"));
+}
+
+TEST_F(PipelineTopics, OutputsMustExistAndHaveARosForm) {
+  const std::string base =
+      "clock: {mode: simulated, step: 0.04, steps: 1}\n"
+      "scene: " +
+      kScene +
+      "\n"
+      "transport: {domain: 183}\n"
+      "components:\n"
+      "  - name: head\n"
+      "    type: sim.head\n";
+  try {
+    runtime::Pipeline::LoadString(base + "    outputs: {jionts: joint_states}\n", "h.yaml");
+    FAIL() << "no error";
+  } catch (const FileError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("h.yaml:7: components.head.outputs.jionts: component 'head' "
+                                    "(sim.head) has no output 'jionts'; its outputs: joints"));
+  }
+}
+
+}  // namespace
+}  // namespace saccade::dds

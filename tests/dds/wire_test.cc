@@ -1,0 +1,360 @@
+// saccade's messages on the ROS 2 wire, checked from outside: a plain Cyclone DDS program
+// built from the tests' own IDL of the ROS 2 definitions (tests/dds/idl/, not saccade's
+// headers) receives them, and their serialized bytes equal those of an independent ROS 2
+// serializer (Foxglove's, under Node). Each test has its own DDS domain, on loopback.
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+#include <cmath>
+#include <random>
+
+#include "dds_test_util.h"
+#include "saccade/components/messages.h"
+#include "saccade/core/image.h"
+#include "saccade/dds/participant.h"
+#include "saccade/dds/topics.h"
+#include "saccade/geometry/image_camera.h"
+#include "saccade/geometry/pose.h"
+
+namespace saccade::dds {
+namespace {
+
+using namespace saccade::dds::testing;
+using components::JointCommand;
+using components::JointStateMessage;
+using components::TargetMessage;
+using nlohmann::json;
+using runtime::ImageMessage;
+
+// A random image of `format` with a camera model and pose, as the renderer makes them.
+std::shared_ptr<Image> MakeImage(int width, int height, PixelFormat format, uint32_t seed,
+                                 const geometry::Distortion& distortion) {
+  auto image = std::make_shared<Image>(width, height, format);
+  std::mt19937 random(seed);
+  for (std::size_t i = 0; i < image->size_bytes(); ++i) {
+    image->data()[i] = static_cast<uint8_t>(random());
+  }
+  ImageMetadata& meta = image->metadata();
+  meta.camera = "left";
+  meta.time = 12.345678901;
+  meta.frame_index = 308;
+  geometry::SetCameraModel(
+      meta, std::make_shared<const geometry::CameraModel>(
+                geometry::Intrinsics(width, height, 812.5, 810.25, 0.5 * width + 3.25,
+                                     0.5 * height - 1.5, 0.75),
+                distortion));
+  geometry::SetCameraPose(
+      meta, geometry::MakePose(
+                Eigen::AngleAxisd(0.3, Eigen::Vector3d(0.2, -1.0, 0.4).normalized()).matrix(),
+                Eigen::Vector3d(0.05, 0.1, 1.2)));
+  return image;
+}
+
+geometry::Distortion RationalDistortion() {
+  const double c[8] = {-0.21, 0.07, 0.001, -0.002, 0.01, 0.002, -0.003, 0.004};
+  return geometry::Distortion::RadialTangential(c);
+}
+
+json Stamp(double seconds) {
+  const auto ns = static_cast<int64_t>(std::llround(seconds * 1e9));
+  return {{"sec", ns / 1000000000}, {"nanosec", ns % 1000000000}};
+}
+
+json Header(double seconds, const std::string& frame) {
+  return {{"stamp", Stamp(seconds)}, {"frame_id", frame}};
+}
+
+// The ROS 2 message saccade's documented mapping (topics.h, docs/dds.md) makes of each.
+json ExpectedImage(const Image& image) {
+  std::string base64;
+  {
+    static const char* k = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    const uint8_t* d = image.data();
+    const std::size_t n = image.size_bytes();
+    for (std::size_t i = 0; i < n; i += 3) {
+      const uint32_t v = (uint32_t{d[i]} << 16) | (i + 1 < n ? uint32_t{d[i + 1]} << 8 : 0) |
+                         (i + 2 < n ? uint32_t{d[i + 2]} : 0);
+      base64 += k[(v >> 18) & 63];
+      base64 += k[(v >> 12) & 63];
+      base64 += i + 1 < n ? k[(v >> 6) & 63] : '=';
+      base64 += i + 2 < n ? k[v & 63] : '=';
+    }
+  }
+  const char* encoding = image.format() == PixelFormat::kRgb8 ? "rgb8" : "mono8";
+  return {{"header", Header(image.metadata().time, "left_optical")},
+          {"height", image.height()},
+          {"width", image.width()},
+          {"encoding", encoding},
+          {"is_bigendian", 0},
+          {"step", image.stride()},
+          {"data", {{"base64", base64}}}};
+}
+
+json ExpectedCameraInfo(const Image& image) {
+  const geometry::CameraModel& model = *geometry::FindCameraModel(image.metadata());
+  const geometry::Intrinsics& k = model.intrinsics();
+  const std::vector<double>& c = model.distortion().coefficients();
+  const bool rational = c[5] != 0 || c[6] != 0 || c[7] != 0;
+  return {{"header", Header(image.metadata().time, "left_optical")},
+          {"height", k.height()},
+          {"width", k.width()},
+          {"distortion_model", rational ? "rational_polynomial" : "plumb_bob"},
+          {"d", std::vector<double>(c.begin(), c.begin() + (rational ? 8 : 5))},
+          {"k", {k.fx(), k.skew(), k.cx(), 0.0, k.fy(), k.cy(), 0.0, 0.0, 1.0}},
+          {"r", {1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0}},
+          {"p", {k.fx(), k.skew(), k.cx(), 0.0, 0.0, k.fy(), k.cy(), 0.0, 0.0, 0.0, 1.0, 0.0}},
+          {"binning_x", 0},
+          {"binning_y", 0},
+          {"roi",
+           {{"x_offset", 0}, {"y_offset", 0}, {"height", 0}, {"width", 0}, {"do_rectify", false}}}};
+}
+
+json ExpectedTf(const Image& image) {
+  const geometry::Pose& X_WC = *geometry::FindCameraPose(image.metadata());
+  const Eigen::Quaterniond q(X_WC.rotation());
+  const Eigen::Vector3d t = X_WC.translation();
+  return {{"transforms",
+           {{{"header", Header(image.metadata().time, "world")},
+             {"child_frame_id", "left_optical"},
+             {"transform",
+              {{"translation", {{"x", t.x()}, {"y", t.y()}, {"z", t.z()}}},
+               {"rotation", {{"x", q.x()}, {"y", q.y()}, {"z", q.z()}, {"w", q.w()}}}}}}}}};
+}
+
+json ExpectedJoints(double time, const head::JointState& p, const head::JointState& v) {
+  return {{"header", Header(time, "")},
+          {"name", {"pan", "tilt", "left", "right"}},
+          {"position", {p.pan, p.tilt, p.left, p.right}},
+          {"velocity", {v.pan, v.tilt, v.left, v.right}},
+          {"effort", json::array()}};
+}
+
+// Compares saccade's wire bytes with the reference's. CDR encapsulation: both say CDR_LE
+// (00 01); Cyclone may pad the payload to 4 bytes and say so in the options' last two bits
+// (XTypes 1.3, 7.4.3.5.2), so the payloads must agree up to the reference's length and the
+// rest be that padding, zero.
+void ExpectSameCdr(const std::vector<uint8_t>& ours, const std::string& reference_hex,
+                   const std::string& what) {
+  ASSERT_GE(ours.size(), 4u) << what << ": nothing received";
+  ASSERT_GE(reference_hex.size(), 8u) << what;
+  EXPECT_EQ(ours[0], 0x00) << what << ": encapsulation must be CDR_LE (XCDR1)";
+  EXPECT_EQ(ours[1], 0x01) << what << ": encapsulation must be CDR_LE (XCDR1)";
+  const std::string hex = Hex(ours);
+  const std::size_t payload = reference_hex.size() - 8;
+  ASSERT_GE(hex.size() - 8, payload) << what << ": saccade's bytes are shorter";
+  EXPECT_EQ(hex.substr(8, payload), reference_hex.substr(8)) << what;
+  const std::size_t padding = (hex.size() - 8 - payload) / 2;
+  EXPECT_LT(padding, 4u) << what;
+  EXPECT_EQ(static_cast<std::size_t>(ours[3] & 3), padding) << what << ": padding count";
+  for (std::size_t i = ours.size() - padding; i < ours.size(); ++i) EXPECT_EQ(ours[i], 0) << what;
+}
+
+class WireTest : public ::testing::Test {
+ protected:
+  void SetUp() override { PinLoopback(); }
+};
+
+TEST_F(WireTest, PlainCycloneSubscriberDecodesTheImageBitExactly) {
+  constexpr int kDomain = 161;
+  auto participant = Participant::Create(Domain(kDomain));
+  Raw raw(RawParticipant(kDomain));
+  Raw reader(
+      RawReader(raw.get(), &ref_sensor_msgs_msg_dds__Image__desc, "rt/saccade/left/image_raw"));
+  auto writer =
+      Writer::Create(participant, "runtime.image", Topic("/saccade/left/image_raw", Qos::Images()));
+  ASSERT_TRUE(writer->WaitForReaders(1, 10));
+  const auto image = MakeImage(1024, 768, PixelFormat::kRgb8, 7, RationalDistortion());
+  writer->Write(ImageMessage{image});
+
+  ref_sensor_msgs_msg_dds__Image_ got{};
+  ASSERT_TRUE(TakeSample(reader.get(), &got));
+  EXPECT_EQ(got.width, 1024u);
+  EXPECT_EQ(got.height, 768u);
+  EXPECT_EQ(got.step, 1024u * 3);
+  EXPECT_STREQ(got.encoding, "rgb8");
+  EXPECT_EQ(got.is_bigendian, 0);
+  EXPECT_STREQ(got.header.frame_id, "left_optical");
+  EXPECT_EQ(got.header.stamp.sec, 12);
+  EXPECT_EQ(got.header.stamp.nanosec, 345678901u);
+  ASSERT_EQ(got.data._length, image->size_bytes());
+  EXPECT_EQ(std::memcmp(got.data._buffer, image->data(), image->size_bytes()), 0)
+      << "the pixels differ";
+  dds_sample_free(&got, &ref_sensor_msgs_msg_dds__Image__desc, DDS_FREE_CONTENTS);
+}
+
+TEST_F(WireTest, TypeNamesAreRos2s) {
+  // rmw_cyclonedds matches on these names (no XTypes type information: idlc -t).
+  EXPECT_STREQ(ref_sensor_msgs_msg_dds__Image__desc.m_typename, "sensor_msgs::msg::dds_::Image_");
+  constexpr int kDomain = 162;
+  auto participant = Participant::Create(Domain(kDomain));
+  Raw raw(RawParticipant(kDomain));
+  // A reader of the right topic name and type name matches saccade's writer: the names agree.
+  Raw reader(
+      RawReader(raw.get(), &ref_sensor_msgs_msg_dds__JointState__desc, "rt/saccade/joint_states"));
+  auto writer =
+      Writer::Create(participant, "head.joints", Topic("/saccade/joint_states", Qos::Latched()));
+  EXPECT_TRUE(WaitReaderMatched(reader.get()));
+  EXPECT_EQ(RosTypeOf("head.joints"), "sensor_msgs/msg/JointState");
+}
+
+TEST_F(WireTest, BytesEqualAnIndependentRos2Serializer) {
+  constexpr int kDomain = 163;
+  auto participant = Participant::Create(Domain(kDomain));
+  Raw raw(RawParticipant(kDomain));
+  Raw image_reader(
+      RawReader(raw.get(), &ref_sensor_msgs_msg_dds__Image__desc, "rt/cam/left/image"));
+  Raw info_reader(
+      RawReader(raw.get(), &ref_sensor_msgs_msg_dds__CameraInfo__desc, "rt/cam/left/camera_info"));
+  Raw tf_reader(RawReader(raw.get(), &ref_tf2_msgs_msg_dds__TFMessage__desc, "rt/tf"));
+  Raw joints_reader(
+      RawReader(raw.get(), &ref_sensor_msgs_msg_dds__JointState__desc, "rt/saccade/joint_states"));
+  Raw command_reader(
+      RawReader(raw.get(), &ref_sensor_msgs_msg_dds__JointState__desc, "rt/saccade/head/command"));
+  Raw target_reader(
+      RawReader(raw.get(), &ref_geometry_msgs_msg_dds__PointStamped__desc, "rt/saccade/target"));
+  auto images = Writer::Create(participant, "runtime.image", Topic("/cam/left/image"));
+  auto joints = Writer::Create(participant, "head.joints", Topic("/saccade/joint_states"));
+  auto commands = Writer::Create(participant, "head.command", Topic("/saccade/head/command"));
+  auto targets = Writer::Create(participant, "vision.target", Topic("/saccade/target"));
+  for (dds_entity_t r : {image_reader.get(), info_reader.get(), tf_reader.get(),
+                         joints_reader.get(), command_reader.get(), target_reader.get()}) {
+    ASSERT_TRUE(WaitReaderMatched(r));
+  }
+
+  // Odd sizes, so that strings and sequences leave the payload unaligned.
+  const auto rgb = MakeImage(5, 3, PixelFormat::kRgb8, 1, RationalDistortion());
+  const double plumb[5] = {-0.3, 0.12, 0.0005, -0.0007, 0.02};
+  auto gray =
+      MakeImage(7, 2, PixelFormat::kGray8, 2, geometry::Distortion::RadialTangential(plumb));
+  gray->metadata().time = 0.04 * 3;
+  JointStateMessage state;
+  state.time = 7.04;
+  state.positions = {0.1, -0.2, 0.3125, -0.0625};
+  state.velocities = {1.5, 0, -2.25, 1e-9};
+  JointCommand command;
+  command.time = 7.08;
+  command.positions = {-0.4, 0.25, 0.05, -0.05};
+  command.velocities = {0.0, 0.0, 0.0, 0.0};
+  TargetMessage target;
+  target.time = 7.12;
+  target.valid = true;
+  target.p_W = Eigen::Vector3d(1.25, -0.375, 1.6);
+
+  json inputs = json::array();
+  std::vector<std::vector<uint8_t>> ours;
+  std::vector<std::string> what;
+  for (const auto& image : {rgb, std::shared_ptr<Image>(gray)}) {
+    images->Write(ImageMessage{image});
+    ours.push_back(TakeCdr(tf_reader.get()));
+    inputs.push_back({{"type", "tf2_msgs/TFMessage"}, {"message", ExpectedTf(*image)}});
+    ours.push_back(TakeCdr(info_reader.get()));
+    inputs.push_back({{"type", "sensor_msgs/CameraInfo"}, {"message", ExpectedCameraInfo(*image)}});
+    ours.push_back(TakeCdr(image_reader.get()));
+    inputs.push_back({{"type", "sensor_msgs/Image"}, {"message", ExpectedImage(*image)}});
+    what.insert(what.end(), {"TFMessage", "CameraInfo", "Image"});
+  }
+  joints->Write(state);
+  ours.push_back(TakeCdr(joints_reader.get()));
+  inputs.push_back({{"type", "sensor_msgs/JointState"},
+                    {"message", ExpectedJoints(state.time, state.positions, state.velocities)}});
+  commands->Write(command);
+  ours.push_back(TakeCdr(command_reader.get()));
+  inputs.push_back(
+      {{"type", "sensor_msgs/JointState"},
+       {"message", ExpectedJoints(command.time, command.positions, command.velocities)}});
+  targets->Write(target);
+  ours.push_back(TakeCdr(target_reader.get()));
+  inputs.push_back({{"type", "geometry_msgs/PointStamped"},
+                    {"message",
+                     {{"header", Header(target.time, "world")},
+                      {"point", {{"x", 1.25}, {"y", -0.375}, {"z", 1.6}}}}}});
+  what.insert(what.end(),
+              {"JointState (head.joints)", "JointState (head.command)", "PointStamped"});
+
+  const std::vector<std::string> reference = ReferenceSerialize(inputs);
+  ASSERT_EQ(reference.size(), ours.size());
+  for (std::size_t i = 0; i < ours.size(); ++i) ExpectSameCdr(ours[i], reference[i], what[i]);
+}
+
+TEST_F(WireTest, LateJoiningSubscriberGetsTheNewestJointState) {
+  constexpr int kDomain = 164;
+  auto participant = Participant::Create(Domain(kDomain));
+  auto writer =
+      Writer::Create(participant, "head.joints", Topic("/saccade/joint_states", Qos::Latched()));
+  JointStateMessage state;
+  for (int i = 1; i <= 3; ++i) {
+    state.time = 0.04 * i;
+    state.positions.pan = 0.1 * i;
+    writer->Write(state);
+  }
+  // The subscriber joins after the three states: transient local gives it the newest.
+  Raw raw(RawParticipant(kDomain));
+  Raw reader(RawReader(raw.get(), &ref_sensor_msgs_msg_dds__JointState__desc,
+                       "rt/saccade/joint_states", 10, /*transient_local=*/true));
+  ref_sensor_msgs_msg_dds__JointState_ got{};
+  ASSERT_TRUE(TakeSample(reader.get(), &got));
+  ASSERT_EQ(got.position._length, 4u);
+  EXPECT_EQ(got.position._buffer[0], 0.1 * 3);
+  EXPECT_EQ(got.header.stamp.nanosec, 120000000u);
+  dds_sample_free(&got, &ref_sensor_msgs_msg_dds__JointState__desc, DDS_FREE_CONTENTS);
+  // Only the newest: the history is one deep.
+  EXPECT_FALSE(TakeSample(reader.get(), &got, 0.3));
+}
+
+TEST_F(WireTest, ImageRoundTripKeepsPixelsModelAndPose) {
+  constexpr int kDomain = 165;
+  auto participant = Participant::Create(Domain(kDomain));
+  auto reader = Reader::Create(participant, "runtime.image",
+                               Topic("/saccade/left/image_raw", Qos::Images(), 0.04));
+  auto writer = Writer::Create(participant, "runtime.image", Topic("/saccade/left/image_raw"));
+  ASSERT_TRUE(writer->WaitForReaders(1, 10));
+  const auto image = MakeImage(64, 48, PixelFormat::kRgb8, 3, RationalDistortion());
+  writer->Write(ImageMessage{image});
+  auto got = reader->Take<ImageMessage>(10.0);
+  ASSERT_TRUE(got && got->image);
+  const Image& out = *got->image;
+  ASSERT_EQ(out.size_bytes(), image->size_bytes());
+  EXPECT_EQ(std::memcmp(out.data(), image->data(), out.size_bytes()), 0);
+  EXPECT_EQ(out.metadata().camera, "left");
+  EXPECT_DOUBLE_EQ(out.metadata().time, 12.345678901);
+  EXPECT_EQ(out.metadata().frame_index, 309);  // round(12.345678901 s / 0.04 s) = round(308.6)
+  const geometry::CameraModel* model = geometry::FindCameraModel(out.metadata());
+  ASSERT_NE(model, nullptr);
+  EXPECT_EQ(*model, *geometry::FindCameraModel(image->metadata()));  // doubles copied exactly
+  const geometry::Pose* pose = geometry::FindCameraPose(out.metadata());
+  ASSERT_NE(pose, nullptr);
+  // Through a quaternion: equal to rounding.
+  constexpr double kPoseTolerance = 1e-12;
+  EXPECT_TRUE(pose->isApprox(*geometry::FindCameraPose(image->metadata()), kPoseTolerance));
+  EXPECT_EQ(reader->stats().incomplete, 0);
+  EXPECT_EQ(reader->stats().messages, 1);
+}
+
+TEST_F(WireTest, ReaderCountsLateWaitsAndSkippedMessages) {
+  constexpr int kDomain = 166;
+  auto participant = Participant::Create(Domain(kDomain));
+  auto reader =
+      Reader::Create(participant, "head.command", Topic("/saccade/head/command", Qos::Default()));
+  EXPECT_EQ(reader->Take<JointCommand>(0.05), nullptr);  // nobody writes: late, not blocked
+  EXPECT_EQ(reader->stats().late, 1);
+  auto writer = Writer::Create(participant, "head.command", Topic("/saccade/head/command"));
+  ASSERT_TRUE(writer->WaitForReaders(1, 10));
+  JointCommand command;
+  for (int i = 0; i < 3; ++i) {
+    command.time = i;
+    writer->Write(command);
+  }
+  ASSERT_TRUE(reader->WaitForWriters(1, 1));
+  std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  auto got = reader->Take<JointCommand>(1.0);
+  ASSERT_NE(got, nullptr);
+  EXPECT_EQ(got->time, 2.0);           // the newest
+  EXPECT_EQ(reader->stats().lost, 2);  // the two older ones, skipped
+  command.time = 0.5;                  // the sender restarted
+  writer->Write(command);
+  ASSERT_NE(reader->Take<JointCommand>(1.0), nullptr);
+  EXPECT_EQ(reader->stats().restarts, 1);
+}
+
+}  // namespace
+}  // namespace saccade::dds
