@@ -172,7 +172,7 @@ void GlRenderer::RenderBatch(const std::vector<BatchHead>& heads, uint8_t* out,
     const std::size_t first = static_cast<std::size_t>(column) * rows;
     const int count = static_cast<int>(std::min<std::size_t>(rows, tiles - first));
     glReadPixels(column * width, 0, width, count * height, GL_RGBA, GL_UNSIGNED_BYTE,
-                 reinterpret_cast<const void*>(first * tile_rgba));
+                 reinterpret_cast<void*>(first * tile_rgba));
   }
   const auto* rgba = static_cast<const uint8_t*>(glMapBufferRange(
       GL_PIXEL_PACK_BUFFER, 0, static_cast<GLsizeiptr>(tiles * tile_rgba), GL_MAP_READ_BIT));
