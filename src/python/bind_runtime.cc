@@ -436,14 +436,17 @@ void BindRuntime(py::module_& m) {
 
   m.def(
       "register_component",
-      [](const std::string& type, py::function factory, const std::string& description) {
+      [](const std::string& type, py::function callable, const std::string& description) {
+        // Kept for the life of the process, as the registration: never released after the
+        // interpreter has ended.
+        const py::object* factory = new py::object(std::move(callable));
         runtime::ComponentRegistry::Global().Register(
             type,
             [factory, type]() -> std::unique_ptr<Component> {
               py::gil_scoped_acquire gil;
               py::object impl;
               try {
-                impl = factory();
+                impl = (*factory)();
               } catch (py::error_already_set& error) {
                 throw Error("making a '" + type + "': " + std::string(error.what()));
               }
