@@ -11,6 +11,13 @@ import saccade
 from saccade.envs import AutoresetMode, FixationEnv, VectorFixationEnv
 
 SIZE = 32
+# Env i of a vector env is tile i of a batch: a few edge pixels may differ from a single env's
+# image (render_test.py: BATCH_MAX_DIFFERING), at most this share of pixels by more than 1 DN.
+TILE_MAX_DIFFERING = 5e-3
+
+
+def same_image(a, b):
+    return (np.abs(a.astype(int) - b.astype(int)) > 1).mean() <= TILE_MAX_DIFFERING
 
 
 @pytest.fixture(scope="module")
@@ -125,7 +132,7 @@ def test_vector_env_contract_and_batch_equals_single_envs():
     single = FixationEnv(image_size=SIZE)
     for i in range(n):
         o, info = single.reset(seed=10 + i)
-        assert np.array_equal(o["left"], obs["left"][i]) and np.array_equal(o["right"], obs["right"][i])
+        assert same_image(o["left"], obs["left"][i]) and same_image(o["right"], obs["right"][i])
         assert np.allclose(info["target_W"], infos["target_W"][i])
     actions = venv.action_space.sample()
     obs, rewards, terminations, truncations, infos = venv.step(actions)

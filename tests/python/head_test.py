@@ -29,7 +29,8 @@ def test_ik_then_fk_puts_the_target_on_both_optical_axes(popeye):
         frames = head.forward_kinematics(popeye, result.joints)
         for X in (frames.X_WCamLeft, frames.X_WCamRight):
             ray = target - X[:3, 3]
-            angle = np.arccos(np.clip(X[:3, 2] @ ray / np.linalg.norm(ray), -1, 1))
+            # atan2 of |cross| and dot: arccos loses the angle below sqrt(eps).
+            angle = np.arctan2(np.linalg.norm(np.cross(X[:3, 2], ray)), X[:3, 2] @ ray)
             assert angle < AXIS_TOLERANCE_RAD
         assert np.allclose(frames.p_WFixation, target, atol=1e-6)
 

@@ -66,6 +66,7 @@ def test_python_component_receives_signals_and_drives_a_cpp_component():
         assert pipeline.components == ["brain", "head"]
         assert "test.commander" in saccade.runtime.component_types()
         pipeline.watch("head.joints")
+        assert pipeline.read("brain.seen") is None  # watched from now on, nothing yet
         pipeline.step(40)
         joints = pipeline.read("head.joints")
         # sim.head (C++) moved the pan joint to the Python component's command.

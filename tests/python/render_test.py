@@ -12,10 +12,12 @@ import pytest
 import saccade
 from conftest import path
 
-# Batch and single renders draw the same pinhole image through the same draw calls: equal to
-# the bit. (They differ only where the framebuffers differ in size, which rasterisation rules
-# make irrelevant for llvmpipe; one level of 8-bit rounding is allowed for other devices.)
-BATCH_MAX_DIFF = 1
+# Batch and single renders draw the same pinhole image through the same draw calls. A tile far
+# from the framebuffer's origin has window coordinates with less sub-pixel precision (llvmpipe:
+# fixed point), so a few edge pixels may fall on the other side of a triangle's edge: measured
+# 0.05 % of pixels differ by more than 1 DN at 1024 x 768 (up to 12 such pixels per image).
+BATCH_MAX_DIFFERING = 1e-3  # share of pixels off by more than 1 DN
+BATCH_MAX_MEAN_DIFF = 0.05  # DN
 
 
 @pytest.fixture(scope="module")
@@ -59,11 +61,12 @@ def test_ground_truth_depth_and_ids_agree_with_the_projection(renderer, scene):
     assert isinstance(depth.base, saccade.Image) and isinstance(ids.base, saccade.Image)
     assert depth.shape == ids.shape == frame.color.shape[:2]
     X_WC = scene.camera_pose("left", state)
-    model = scene.cameras[0].model
-    seen = [o for o in frame.objects if o.pixels > 0 and o.name != "robot"]
-    assert seen, "the scene's objects are in view"
+    model = frame.image.camera_model  # the image as rendered (its lens included)
+    # The pictures: their centre lies on their surface, in full view of the left eye.
+    seen = [o for o in frame.objects if o.pixels > 0 and o.name in ("astronaut", "chelsea")]
+    assert len(seen) == 2, "both pictures are in view"
     for truth in seen:
-        # The object's centre, projected through the camera model (pinhole here).
+        # The picture's centre, projected through the camera model.
         p_W = scene.object_pose(truth.name, state)[:3, 3]
         p_C = np.linalg.inv(X_WC) @ np.append(p_W, 1.0)
         u, v = model.project(p_C[:3])
@@ -95,11 +98,14 @@ def test_batch_equals_single_renders_of_each_head(scene):
     states = [saccade.scene.SceneState(0.0, rng.uniform(-0.2, 0.2, 4)) for _ in range(5)]
     batch = single.render_batch([saccade.render.BatchHead(s) for s in states])
     assert batch.shape[:2] == (5, 2) and batch.dtype == np.uint8
+    # The first tile lies where a batch of one puts it: the same pixels, to the bit.
+    assert np.array_equal(single.render_batch([saccade.render.BatchHead(states[0])])[0], batch[0])
     for i, state in enumerate(states):
         frames = single.render(state)
         for c in range(2):
             diff = np.abs(batch[i, c].astype(int) - frames[c].color.astype(int))
-            assert diff.max() <= BATCH_MAX_DIFF, (i, c, diff.max())
+            assert (diff > 1).mean() <= BATCH_MAX_DIFFERING, (i, c, (diff > 1).sum())
+            assert diff.mean() <= BATCH_MAX_MEAN_DIFF, (i, c, diff.mean())
     # Different joints give different images: every head is drawn with its own state.
     assert not np.array_equal(batch[0, 0], batch[1, 0])
 
