@@ -11,6 +11,7 @@
 #include <cstdlib>
 #include <fstream>
 #include <sstream>
+#include <vector>
 
 #include "saccade/head/kinematics.h"
 #include "saccade/render/renderer.h"
@@ -83,7 +84,17 @@ void BM_FixationEnvStep(benchmark::State& bench) {
   bench.counters["steps_per_s"] =
       benchmark::Counter(static_cast<double>(bench.iterations()), benchmark::Counter::kIsRate);
 }
-BENCHMARK(BM_FixationEnvStep)->Unit(benchmark::kMillisecond)->MinTime(2.0)->UseRealTime();
+// The shared machine's load varies from second to second: many short repetitions, and the
+// least disturbed one ("min") is the figure python_env_bench.py compares.
+BENCHMARK(BM_FixationEnvStep)
+    ->Unit(benchmark::kMillisecond)
+    ->MinTime(0.1)
+    ->Repetitions(30)
+    ->ComputeStatistics("min",
+                        [](const std::vector<double>& v) {
+                          return *std::min_element(v.begin(), v.end());
+                        })
+    ->UseRealTime();
 
 }  // namespace
 

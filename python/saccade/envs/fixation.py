@@ -159,6 +159,7 @@ class _Heads:
         self.steps = np.zeros(n, dtype=np.int64)
         self.object_poses: List[List[Optional[np.ndarray]]] = [[None] * self.pool.count for _ in range(n)]
         self.hidden = [[True] * self.pool.count for _ in range(n)]
+        self.batch: List[Any] = [None] * n
         self.target = np.zeros((n, 3))
         self.target_index = np.zeros(n, dtype=np.int64)
         self.axis_error = np.zeros((n, 2))
@@ -220,6 +221,8 @@ class _Heads:
                     f"shown: {sorted(int(k) for k in shown)}")
         self.object_poses[i] = poses
         self.hidden[i] = hidden
+        # Converted to C++ once per episode; each step only sets the state.
+        self.batch[i] = saccade.render.BatchHead(saccade.scene.SceneState(), poses, hidden)
         self.target_index[i] = target
         self.target[i] = poses[target][:3, 3]
         if self.pool.kinds[target] == "mug":
@@ -259,9 +262,10 @@ class _Heads:
         if self.action_mode == "velocity":
             q = q + actions * self.dt
         else:
-            step = np.clip(actions - q, -self.max_velocity * self.dt, self.max_velocity * self.dt)
-            q = q + step
-        self.joints[rows] = np.clip(q, self.joint_min, self.joint_max)
+            reach = self.max_velocity * self.dt
+            q = q + np.minimum(np.maximum(actions - q, -reach), reach)
+        # minimum/maximum: np.clip's checks cost more than the rest of a step.
+        self.joints[rows] = np.minimum(np.maximum(q, self.joint_min), self.joint_max)
         self.steps[rows] += 1
         for i in rows:
             self.update_errors(int(i))
@@ -280,12 +284,11 @@ class _Heads:
         return reward, success, bool(self.steps[i] >= self.max_episode_steps)
 
     def render(self, rows: Sequence[int], out: np.ndarray) -> np.ndarray:
-        heads = [
-            saccade.render.BatchHead(
-                saccade.scene.SceneState(float(self.steps[i]) * self.dt, self.joints[i]),
-                self.object_poses[i], self.hidden[i])
-            for i in rows
-        ]
+        heads = []
+        for i in rows:
+            head = self.batch[i]
+            head.state = saccade.scene.SceneState(float(self.steps[i]) * self.dt, self.joints[i])
+            heads.append(head)
         return self.renderer.render_batch(heads, out=out)
 
     def info(self, i: int) -> Dict[str, Any]:
