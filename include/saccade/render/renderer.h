@@ -18,8 +18,8 @@
 // remap, so it matches the distorted colour image pixel for pixel.
 
 #include <Eigen/Core>
-#include <cstdint>
 #include <cstddef>
+#include <cstdint>
 #include <memory>
 #include <optional>
 #include <string>
