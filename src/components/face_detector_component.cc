@@ -20,6 +20,7 @@ using internal::FrameOf;
 
 FaceDetectorComponent::FaceDetectorComponent()
     : image_(AddInput<runtime::ImageMessage>("image", /*required=*/true)),
+      track_(AddInput<TrackMessage>("track")),
       faces_(AddOutput<FacesMessage>("faces")) {
   DeclareParam("cascade", &cascade_,
                "the face cascade: haar (alt2) or lbp (frontalface_improved; on "
@@ -34,6 +35,17 @@ FaceDetectorComponent::FaceDetectorComponent()
                "0: detect within the step; N: detect on a thread of its own, the faces emitted N "
                "steps after their image (simulated clock; real time: once ready)")
       .Range(0, 100);
+  DeclareParam("track_region_scale", &track_region_scale_,
+               "with a track input: search a box this many times the track's window around "
+               "it; 0: always the whole image")
+      .Range(0.0, 100.0);
+  DeclareParam("full_scan_every", &full_scan_every_,
+               "with a track region: search the whole image every N-th detection")
+      .Range(1, 1000000);
+  DeclareParam("region_pyramid_level", &region_pyramid_level_,
+               "the pyramid level of the search around the track (the whole image's is "
+               "pyramid_level)")
+      .Range(0, 4);
   DeclareParam("min_neighbors", &options_.min_neighbors, "overlapping hits needed to keep a box")
       .Range(0, 1000);
   DeclareParam("scale_factor", &options_.scale_factor, "size step between pyramid levels")
@@ -54,12 +66,47 @@ void FaceDetectorComponent::Configured() {
   if (!reject_cats_) options.cat_cascade_path = "";
   if (!require_eyes_) options.eye_cascade_path = "";
   detector_ = std::make_unique<vision::FaceDetector>(options);
+  options.pyramid_level = region_pyramid_level_;
+  region_detector_ = std::make_unique<vision::FaceDetector>(options);
 }
 
-FacesMessage FaceDetectorComponent::Detect(std::shared_ptr<const Image> image) {
+FaceDetectorComponent::Search FaceDetectorComponent::NextSearch(const Image& image) {
+  Search search;
+  const int64_t n = detections_++;
+  if (!(track_region_scale_ > 0.0) || !track_.has_value()) return search;
+  const TrackMessage& track = track_.value();
+  if (!track.tracking || track.window.area() <= 0) return search;
+  const double w = track_region_scale_ * track.window.width;
+  const double h = track_region_scale_ * track.window.height;
+  const cv::Rect region(static_cast<int>(std::floor(track.center.x - 0.5 * w)),
+                        static_cast<int>(std::floor(track.center.y - 0.5 * h)),
+                        static_cast<int>(std::ceil(w)), static_cast<int>(std::ceil(h)));
+  search.region = region & cv::Rect(0, 0, image.width(), image.height());
+  search.whole = n % full_scan_every_ == 0;
+  return search;
+}
+
+FacesMessage FaceDetectorComponent::Detect(std::shared_ptr<const Image> image,
+                                           const Search& search) {
   FacesMessage out;
   out.image = std::move(image);
-  for (const vision::FaceDetection& d : detector_->Detect(*out.image)) {
+  std::vector<vision::FaceDetection> found;
+  if (search.whole) found = detector_->Detect(*out.image);
+  if (search.region) {
+    // The tracked face from the region, at the region's pyramid level: it replaces the whole
+    // image's boxes that overlap it.
+    const std::vector<vision::FaceDetection> near =
+        region_detector_->Detect(*out.image, {*search.region});
+    std::erase_if(found, [&near](const vision::FaceDetection& d) {
+      return std::any_of(near.begin(), near.end(), [&d](const vision::FaceDetection& r) {
+        return (d.box & r.box).area() > 0.5 * std::min(d.box.area(), r.box.area());
+      });
+    });
+    found.insert(found.end(), near.begin(), near.end());
+    std::stable_sort(found.begin(), found.end(),
+                     [](const auto& a, const auto& b) { return a.box.area() > b.box.area(); });
+  }
+  for (const vision::FaceDetection& d : found) {
     out.faces.push_back({d.box, d.neighbors, d.rejected, d.reason});
   }
   return out;
@@ -67,7 +114,10 @@ FacesMessage FaceDetectorComponent::Detect(std::shared_ptr<const Image> image) {
 
 void FaceDetectorComponent::Step(const runtime::StepContext& context) {
   if (latency_steps_ == 0) {
-    if (image_.fresh() && image_.value().image) faces_.Emit(Detect(image_.value().image));
+    if (image_.fresh() && image_.value().image) {
+      const std::shared_ptr<const Image>& image = image_.value().image;
+      faces_.Emit(Detect(image, NextSearch(*image)));
+    }
     return;
   }
   if (running_.valid()) {
@@ -83,7 +133,9 @@ void FaceDetectorComponent::Step(const runtime::StepContext& context) {
   if (!image_.fresh() && image == last_) return;
   last_ = image;
   due_step_ = context.step + latency_steps_;
-  running_ = std::async(std::launch::async, [this, image] { return Detect(image); });
+  const Search search = NextSearch(*image);
+  running_ =
+      std::async(std::launch::async, [this, image, search] { return Detect(image, search); });
 }
 
 void FaceDetectorComponent::Stop() {

@@ -25,6 +25,10 @@ SimCameras::SimCameras() : joints_(AddInput<JointStateMessage>("joints")) {
                "level of detail: the largest screen error of a simplified model")
       .Range(0.0, 1e6)
       .Unit("px");
+  DeclareParam("pipelined", &pipelined_,
+               "render the next frame while the loop works on this one (one step older): always, "
+               "never, or auto (with the real-time clock)")
+      .Choices({"auto", "always", "never"});
 }
 
 void SimCameras::Configured() {
@@ -67,7 +71,14 @@ void SimCameras::Step(const runtime::StepContext& context) {
     state.joints = joints->positions;
     state.joint_velocities = joints->velocities;
   }
-  std::vector<render::Frame> frames = renderer_->Render(state, context.step);
+  const bool pipelined = pipelined_ == "always" || (pipelined_ == "auto" && context.realtime);
+  std::vector<render::Frame> frames;
+  if (pipelined) {
+    if (renderer_->InFlight() > 0) frames = renderer_->Retrieve();
+    renderer_->Submit(state, context.step);
+  } else {
+    frames = renderer_->Render(state, context.step);
+  }
   for (std::size_t i = 0; i < frames.size() && i < outputs_.size(); ++i) {
     outputs_[i]->Emit(runtime::ImageMessage{frames[i].color});
   }

@@ -80,6 +80,8 @@ GuiSession::GuiSession(runtime::Pipeline& pipeline, const scene::Scene& scene,
     component->SetEnabled(options.perception);
   }
   if (rendered_) effects_ = *cameras_->rendered();
+  // The GUI shows the loop as it goes: the next frame renders while this one is processed.
+  if (cameras_ != nullptr) cameras_->SetPipelined(true);
   Tap<HeadStatusMessage>(pipeline, [this](const HeadStatusMessage& m) {
     head_status_ = runtime::MessageTraits<HeadStatusMessage>::ToJson(m);
   });

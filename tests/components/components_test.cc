@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <memory>
 #include <opencv2/imgproc.hpp>
 #include <optional>
@@ -222,6 +223,92 @@ double Sharpness(const Image& image) {
 
 // The motors' velocities reach the renderer: a saccade in progress blurs the eye's image
 // (scenes/portraits.yaml's eye cameras expose for 8 ms).
+// Pipelined capture: each step submits its state and emits the previous step's frames,
+// exactly those an unpipelined camera renders for that step (frame index, joints, pixels).
+TEST(SimCameras, PipelinedCaptureEmitsThePreviousStepsFrameUnchanged) {
+  auto pipelined =
+      Make("sim.cameras", {{"scene", kScene}, {"cameras", {"left"}}, {"pipelined", "always"}});
+  auto plain =
+      Make("sim.cameras", {{"scene", kScene}, {"cameras", {"left"}}, {"pipelined", "never"}});
+  auto got = Capture<runtime::ImageMessage>(*pipelined, "left");
+  auto want = Capture<runtime::ImageMessage>(*plain, "left");
+  pipelined->Start();
+  plain->Start();
+  std::shared_ptr<const Image> previous;
+  for (int64_t step = 0; step < 4; ++step) {
+    JointStateMessage joints;
+    joints.time = At(step).time;
+    joints.positions = {0.05 * step, -0.02 * step, 0.0, 0.0};
+    In<JointStateMessage>(*pipelined, "joints").Deliver(joints);
+    In<JointStateMessage>(*plain, "joints").Deliver(joints);
+    pipelined->Step(At(step));
+    plain->Step(At(step));
+    if (step == 0) {
+      EXPECT_FALSE(got->has_value());  // nothing rendered before the first step
+    } else {
+      ASSERT_TRUE(got->has_value());
+      const Image& image = *(*got)->image;
+      EXPECT_EQ(image.metadata().frame_index, step - 1);
+      EXPECT_DOUBLE_EQ(image.metadata().time, At(step - 1).time);
+      EXPECT_DOUBLE_EQ(image.metadata().joints[0], 0.05 * (step - 1));
+      ASSERT_EQ(image.size_bytes(), previous->size_bytes());
+      EXPECT_EQ(std::memcmp(image.data(), previous->data(), image.size_bytes()), 0) << step;
+    }
+    previous = (*want)->image;
+  }
+  pipelined->Stop();
+  plain->Stop();
+}
+
+// Detect slowly, track fast: with a track, the detector searches a box around it, and the
+// whole image every full_scan_every-th time.
+TEST(FaceDetectorComponent, SearchesAroundTheTrackAndTheWholeImageEveryNthTime) {
+  const scene::Scene& scene = Scene();
+  const head::IkResult look =
+      head::SolveFixation(scene.robot()->head, FaceCentreAt(scene, Astronaut(), 0.0));
+  ASSERT_TRUE(look.reachable());
+  const std::shared_ptr<const Image> image = RenderOne(kScene, "left", look.joints, {});
+  auto full = Make("vision.face_detector", json::object());
+  auto faces_full = Capture<FacesMessage>(*full, "faces");
+  In<runtime::ImageMessage>(*full, "image").Deliver(runtime::ImageMessage{image});
+  full->Step(At(0));
+  ASSERT_TRUE(faces_full->has_value());
+  std::optional<cv::Rect> face;
+  for (const FacesMessage::Face& f : (*faces_full)->faces) {
+    if (!f.rejected) face = f.box;
+  }
+  ASSERT_TRUE(face);
+  const std::size_t candidates = (*faces_full)->faces.size();
+
+  auto around = Make("vision.face_detector", {{"track_region_scale", 2.0}, {"full_scan_every", 2}});
+  auto faces = Capture<FacesMessage>(*around, "faces");
+  const auto detect = [&](const cv::Rect& window, int64_t step) {
+    TrackMessage track;
+    track.tracking = true;
+    track.window = window;
+    track.center = {window.x + 0.5 * window.width, window.y + 0.5 * window.height};
+    In<TrackMessage>(*around, "track").Deliver(track);
+    In<runtime::ImageMessage>(*around, "image").Deliver(runtime::ImageMessage{image});
+    around->Step(At(step));
+    return (*faces)->faces;
+  };
+  const cv::Rect elsewhere(20, 20, face->width, face->height);    // the sky, top left
+  EXPECT_EQ(detect(elsewhere, 0).size(), candidates);             // 1st: the whole image
+  EXPECT_TRUE(detect(elsewhere, 1).empty());                      // 2nd: around the track
+  EXPECT_EQ(detect(elsewhere, 2).size(), candidates);             // 3rd: the whole image
+  const std::vector<FacesMessage::Face> near = detect(*face, 3);  // 4th: around the face
+  ASSERT_EQ(near.size(), 1u);
+  EXPECT_FALSE(near[0].rejected);
+  // The same cascade on the same pixels: the same face. The box is the mean of the cascade's
+  // overlapping hits, some of which the region's edge cuts off: a few pixels on ~90.
+  const double kBoxTolerancePx = 0.05 * face->width;
+  EXPECT_NEAR(near[0].box.x + 0.5 * near[0].box.width, face->x + 0.5 * face->width,
+              kBoxTolerancePx);
+  EXPECT_NEAR(near[0].box.y + 0.5 * near[0].box.height, face->y + 0.5 * face->height,
+              kBoxTolerancePx);
+  EXPECT_NEAR(near[0].box.width, face->width, kBoxTolerancePx);
+}
+
 TEST(SimCameras, TheHeadsMotionBlursTheEyeImages) {
   const std::string portraits = std::string(SACCADE_SOURCE_DIR) + "/scenes/portraits.yaml";
   const head::JointState still{0.0, 0.0, 0.0, 0.0};
@@ -411,8 +498,10 @@ TEST(ComponentParams, UnknownMissingAndOutOfRangeParametersAreNamed) {
     return std::string("accepted");
   };
   EXPECT_EQ(message("vision.face_detector", {{"min_neighbours", 3}}),
-            "unknown parameter 'min_neighbours' (known: cascade, latency_steps, max_size_px, "
-            "min_neighbors, min_size_px, pyramid_level, reject_cats, require_eyes, scale_factor)");
+            "unknown parameter 'min_neighbours' (known: cascade, full_scan_every, latency_steps, "
+            "max_size_px, min_neighbors, min_size_px, pyramid_level, region_pyramid_level, "
+            "reject_cats, require_eyes, "
+            "scale_factor, track_region_scale)");
   EXPECT_EQ(message("vision.camshift", json::object()),
             "parameter 'eye' is required: one of left, right (the eye whose image and box it "
             "tracks)");

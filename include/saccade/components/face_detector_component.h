@@ -1,8 +1,14 @@
 #pragma once
 // vision.face_detector -- Haar or LBP faces with the cat and eye checks
 // (vision/face_detector.h).
-//   inputs: image (runtime.image, required); outputs: faces (vision.faces), with the image
-//   they were found in (its time is their capture time).
+//   inputs: image (runtime.image, required); track (vision.track, optional: this eye's
+//           CamShift track, connect it with delay 1); outputs: faces (vision.faces), with the
+//           image they were found in (its time is their capture time).
+//
+// While the track input follows a target and `track_region_scale` > 0, the detector searches
+// a box that many times the track's window around it (at `region_pyramid_level`), and the
+// whole image too (at `pyramid_level`) every `full_scan_every`-th detection, so that
+// attention still sees the other faces.
 // Parameters: declared in the constructor (docs/components.md lists them).
 //
 // Detect slowly, track fast: with latency_steps N > 0 the detector works on a thread of its
@@ -32,20 +38,33 @@ class FaceDetectorComponent : public runtime::Component {
   void Configured() override;
 
  private:
-  FacesMessage Detect(std::shared_ptr<const Image> image);
+  // Where a detection searches: the whole image (at pyramid_level), a region around the track
+  // (at region_pyramid_level), or both (the region's faces replace the whole image's there).
+  struct Search {
+    bool whole = true;
+    std::optional<cv::Rect> region;
+  };
+  Search NextSearch(const Image& image);
+  FacesMessage Detect(std::shared_ptr<const Image> image, const Search& search);
 
   vision::FaceDetector::Options options_;
   std::string cascade_ = "haar";
   bool reject_cats_ = true;
   bool require_eyes_ = true;
   int latency_steps_ = 0;
+  double track_region_scale_ = 0.0;
+  int full_scan_every_ = 5;
+  int region_pyramid_level_ = 0;
+  int64_t detections_ = 0;  // started so far
   // The detection in flight (latency_steps > 0) and the step its faces are due.
   std::future<FacesMessage> running_;
   int64_t due_step_ = 0;
   std::shared_ptr<const Image> last_;  // the image detected last
   runtime::Input<runtime::ImageMessage>& image_;
+  runtime::Input<TrackMessage>& track_;
   runtime::Output<FacesMessage>& faces_;
-  std::unique_ptr<vision::FaceDetector> detector_;
+  std::unique_ptr<vision::FaceDetector> detector_;         // the whole image
+  std::unique_ptr<vision::FaceDetector> region_detector_;  // around the track
 };
 
 }  // namespace saccade::components

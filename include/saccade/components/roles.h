@@ -64,6 +64,10 @@ class EyeCamerasRole {
     (void)distortion, (void)noise, (void)motion_blur;
     throw Error("real cameras have no rendered effects to switch");
   }
+  /// Pipelined capture: each step emits the frames rendered during the previous one, which
+  /// overlaps rendering with the rest of the loop (sim.cameras' `pipelined`). Rendered cameras
+  /// only; real ones capture on their own clock anyway. Call before the run starts.
+  virtual void SetPipelined(bool on) { (void)on; }
   /// Pairs delivered and frames dropped, for real cameras; nullopt for rendered ones.
   virtual std::optional<CameraPairCounts> pair_counts() const { return std::nullopt; }
   /// A line for people about the sources ("" for rendered cameras).

@@ -4,6 +4,11 @@
 //   inputs:  joints (head.joints, optional): the head's state at this step's time; connect
 //            it from sim.head with delay 1. Without it, the scene's initial joints.
 //   outputs: <camera> (runtime.image) per camera, shared; frame index = step.
+//   Pipelined capture (`pipelined`: always, or auto with the real-time clock): each step submits
+//   this step's state to the renderer and emits the frames of the previous step's, which
+//   rendered while the rest of the loop worked (llvmpipe rasterises on threads of its own, a
+//   GPU on its own); the images are one step older (their capture time says so), and the
+//   first step emits none.
 // Parameters: declared in the constructor (docs/components.md lists them).
 #include <memory>
 #include <optional>
@@ -30,6 +35,7 @@ class SimCameras : public runtime::Component, public EyeCamerasRole {
   /// Switches the scene's effects (the GUI's toggles); the next Step renders with them (it
   /// makes a new renderer). Call from the thread that runs the pipeline.
   void SetEffects(bool distortion, bool noise, bool motion_blur) override;
+  void SetPipelined(bool on) override { pipelined_ = on ? "always" : "never"; }
   const render::RendererOptions& options() const { return options_; }
   const render::RendererOptions* rendered() const override { return &options_; }
 
@@ -43,6 +49,7 @@ class SimCameras : public runtime::Component, public EyeCamerasRole {
   std::shared_ptr<const scene::Scene> scene_;
   render::RendererOptions options_;
   std::unique_ptr<render::Renderer> renderer_;
+  std::string pipelined_ = "auto";
   bool options_changed_ = false;
 };
 

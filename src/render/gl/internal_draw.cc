@@ -21,17 +21,23 @@ void GlRenderer::SortItems(const Eigen::Isometry3d& X_EW) {
 }
 
 // Calls visit(item, MV, mvp, pixels per model unit) for every item not outside the view's
-// frustum, front to back.
+// frustum (and, with `cull`, not outside the frustum of cull * mvp: a part of the view),
+// front to back.
 template <class Visit>
 void GlRenderer::ForEachVisibleItem(const ViewSetup& view, double near,
-                                    const Eigen::Isometry3d& X_EW, Visit&& visit) {
+                                    const Eigen::Isometry3d& X_EW, Visit&& visit,
+                                    const Eigen::Matrix4d* cull) {
   SortItems(X_EW);
   for (const auto& [depth, index] : order_) {
     const DrawItem& item = items_[index];
     Eigen::Affine3d MV = X_EW * item_poses_[index];
     MV.linear() = MV.linear() * item.scale.asDiagonal();
     const Eigen::Matrix4d mvp = view.projection * MV.matrix();
-    if (!item.model->bounds.isEmpty() && OutsideFrustum(mvp, item.model->bounds)) continue;
+    if (!item.model->bounds.isEmpty() &&
+        (OutsideFrustum(mvp, item.model->bounds) ||
+         (cull != nullptr && OutsideFrustum(*cull * mvp, item.model->bounds)))) {
+      continue;
+    }
     visit(item, MV, mvp, PixelsPerModelUnit(item, depth, view.focal, near));
   }
 }
@@ -60,7 +66,8 @@ void GlRenderer::DrawGround(GLint mvp, GLint mv, const Eigen::Matrix4d& P,
   glDrawArrays(GL_TRIANGLE_STRIP, 0, 4);
 }
 
-void GlRenderer::DrawScene(const ViewSetup& view, double near, const geometry::Pose& X_WV) {
+void GlRenderer::DrawScene(const ViewSetup& view, double near, const geometry::Pose& X_WV,
+                           const Eigen::Matrix4d* cull) {
   ++camera_pass_;
   const Eigen::Isometry3d X_EW = EyeFromWorld(X_WV);
   MeshProgram* program = nullptr;
@@ -113,7 +120,8 @@ void GlRenderer::DrawScene(const ViewSetup& view, double near, const geometry::P
           }
           DrawLod(mesh, lod, &culling);
         }
-      });
+      },
+      cull);
   if (culling) glDisable(GL_CULL_FACE);
 
   if (draw_ground_) {

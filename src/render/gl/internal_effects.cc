@@ -20,6 +20,7 @@ constexpr GLint kMapUnit = 2;
 constexpr GLint kIdsUnit = 3;
 constexpr GLint kZUnit = 4;
 constexpr GLint kFootprintUnit = 5;
+constexpr GLint kGaussUnit = 6;
 
 // The lens remap's samples of a pixel's footprint (kFinalFragmentSource): one per
 // kTapSpacing source pixels of the footprint's side, at most kMaxTaps a side. Up to 1.5 source
@@ -81,6 +82,46 @@ RemapTable MakeRemapTable(const geometry::LensMap& lens) {
   return table;
 }
 
+std::vector<float> GaussianTable() {
+  // Quantile i of the standard normal at probability (i + 1/2) / n, by bisection on erfc (to
+  // float precision: 40 halvings of [-9, 0]), then scaled to unit variance (the n quantiles
+  // miss the tails beyond 4.5 sigma: their variance is 0.9997).
+  constexpr int n = kGaussianTableSide * kGaussianTableSide;
+  std::vector<double> z(n);
+  double sum2 = 0.0;
+  for (int i = 0; i < n / 2; ++i) {
+    const double p = (i + 0.5) / n;  // the lower half; the upper half by symmetry
+    double lo = -9.0, hi = 0.0;
+    for (int k = 0; k < 40; ++k) {
+      const double mid = 0.5 * (lo + hi);
+      (0.5 * std::erfc(-mid / std::sqrt(2.0)) < p ? lo : hi) = mid;
+    }
+    z[i] = 0.5 * (lo + hi);
+    z[n - 1 - i] = -z[i];
+    sum2 += 2.0 * z[i] * z[i];
+  }
+  const double scale = 1.0 / std::sqrt(sum2 / n);
+  // Three channels, each the quantiles in its own order (Fisher-Yates with SplitMix64, fixed
+  // seeds), so that the three deviates of one entry are independent.
+  std::vector<float> table(3 * static_cast<std::size_t>(n));
+  for (int c = 0; c < 3; ++c) {
+    std::vector<int> order(n);
+    for (int i = 0; i < n; ++i) order[i] = i;
+    uint64_t state = 0x5eed0000u + static_cast<uint64_t>(c);
+    for (int i = n - 1; i > 0; --i) {
+      state += 0x9e3779b97f4a7c15ull;
+      uint64_t x = state;
+      x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ull;
+      x = (x ^ (x >> 27)) * 0x94d049bb133111ebull;
+      x ^= x >> 31;
+      std::swap(order[i], order[static_cast<int>(x % static_cast<uint64_t>(i + 1))]);
+    }
+    for (int i = 0; i < n; ++i)
+      table[3 * static_cast<std::size_t>(i) + c] = static_cast<float>(z[order[i]] * scale);
+  }
+  return table;
+}
+
 namespace {
 
 std::string Defines(bool identity, bool noise) {
@@ -123,6 +164,15 @@ GLuint MakeTexture2d(GLenum internal_format, GLenum format, GLenum type, int wid
   return texture;
 }
 
+// The scene views are read by the final pass's bilinear fetches (kFinalFragmentSource), and by
+// texelFetch, which ignores filtering.
+void FilterLinearly(GLuint array) {
+  glBindTexture(GL_TEXTURE_2D_ARRAY, array);
+  glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+  glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+  glBindTexture(GL_TEXTURE_2D_ARRAY, 0);
+}
+
 void CheckComplete(const char* what, int width, int height) {
   const GLenum status = glCheckFramebufferStatus(GL_FRAMEBUFFER);
   if (status != GL_FRAMEBUFFER_COMPLETE) {
@@ -154,11 +204,15 @@ EffectPrograms::EffectPrograms() {
   truth_.depth_axis = Uniform(truth_.program, "u_depth_axis");
   truth_.id = Uniform(truth_.program, "u_id");
   glUseProgram(0);
+  const std::vector<float> gauss = GaussianTable();
+  gauss_ = MakeTexture2d(GL_RGB32F, GL_RGB, GL_FLOAT, kGaussianTableSide, kGaussianTableSide,
+                         gauss.data());
   CheckGlError("MakeRenderer: building the effect programs");
 }
 
 EffectPrograms::~EffectPrograms() {
   glDeleteVertexArrays(1, &vao_);
+  glDeleteTextures(1, &gauss_);
   glDeleteProgram(accumulate_);
   glDeleteProgram(truth_.program);
   for (const auto& [variant, final] : finals_) glDeleteProgram(final.program);
@@ -179,6 +233,7 @@ const EffectPrograms::Final& EffectPrograms::GetFinal(bool identity, bool noise)
   glUniform1i(Uniform(f.program, "u_source"), kSourceUnit);
   glUniform1i(Uniform(f.program, "u_map"), kMapUnit);
   glUniform1i(Uniform(f.program, "u_footprint"), kFootprintUnit);
+  glUniform1i(Uniform(f.program, "u_gauss"), kGaussUnit);
   glUseProgram(0);
   CheckGlError("MakeRenderer: building the final pass");
   return finals_.emplace(variant, f).first->second;
@@ -261,6 +316,7 @@ EffectTarget::EffectTarget(const geometry::LensMap& lens, int samples, bool blur
   }
   const int w = source_width_, h = source_height_;
   source_ = MakeArray(GL_RGBA8, GL_RGBA, GL_UNSIGNED_BYTE, w, h, layers_);
+  FilterLinearly(source_);
   glGenFramebuffers(1, &draw_framebuffer_);
   glBindFramebuffer(GL_FRAMEBUFFER, draw_framebuffer_);
   depth_ = MakeRenderbuffer(GL_DEPTH_COMPONENT32F, w, h, samples_);
@@ -279,6 +335,7 @@ EffectTarget::EffectTarget(const geometry::LensMap& lens, int samples, bool blur
   }
   if (blur_) {
     accumulation_ = MakeArray(GL_RGBA32F, GL_RGBA, GL_FLOAT, w, h, layers_);
+    FilterLinearly(accumulation_);
     glGenFramebuffers(1, &accumulation_framebuffer_);
     glBindFramebuffer(GL_FRAMEBUFFER, accumulation_framebuffer_);
     glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, accumulation_, 0, 0);
@@ -355,28 +412,37 @@ void EffectTarget::FinishView(int view) const {
                     GL_COLOR_BUFFER_BIT, GL_NEAREST);
 }
 
-void EffectTarget::ClearAccumulation() const {
-  glBindFramebuffer(GL_FRAMEBUFFER, accumulation_framebuffer_);
-  const GLfloat zero[4] = {0.0f, 0.0f, 0.0f, 0.0f};
-  for (int layer = 0; layer < layers_; ++layer) {
-    glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, accumulation_, 0, layer);
-    glClearBufferfv(GL_COLOR, 0, zero);
-  }
-}
-
-void EffectTarget::Accumulate(const EffectPrograms& programs, int view, float weight) const {
+void EffectTarget::Accumulate(const EffectPrograms& programs, int view, float weight,
+                              Accumulation mode) const {
   glBindFramebuffer(GL_FRAMEBUFFER, accumulation_framebuffer_);
   glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, accumulation_, 0, view);
   glViewport(0, 0, source_width_, source_height_);
   glDisable(GL_DEPTH_TEST);
-  glEnable(GL_BLEND);
-  glBlendFunc(GL_ONE, GL_ONE);
+  if (mode == Accumulation::kAdd) {
+    glEnable(GL_BLEND);
+    glBlendFunc(GL_ONE, GL_ONE);
+  }
   glUseProgram(programs.accumulate());
   glUniform1i(programs.accumulate_layer(), view);
   glUniform1f(programs.accumulate_weight(), weight);
   BindTexture(kSourceUnit, GL_TEXTURE_2D_ARRAY, source_);
   programs.DrawFullscreen();
   glDisable(GL_BLEND);
+  glEnable(GL_DEPTH_TEST);
+  glActiveTexture(GL_TEXTURE0);
+}
+
+void EffectTarget::WriteBack(const EffectPrograms& programs, int view) const {
+  const GLuint framebuffer = samples_ > 0 ? resolve_framebuffer_ : draw_framebuffer_;
+  glBindFramebuffer(GL_FRAMEBUFFER, framebuffer);
+  glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, source_, 0, view);
+  glViewport(0, 0, source_width_, source_height_);
+  glDisable(GL_DEPTH_TEST);
+  glUseProgram(programs.accumulate());
+  glUniform1i(programs.accumulate_layer(), view);
+  glUniform1f(programs.accumulate_weight(), 1.0f);
+  BindTexture(kSourceUnit, GL_TEXTURE_2D_ARRAY, accumulation_);
+  programs.DrawFullscreen();
   glEnable(GL_DEPTH_TEST);
   glActiveTexture(GL_TEXTURE0);
 }
@@ -411,6 +477,7 @@ void EffectTarget::Finish(EffectPrograms& programs, bool accumulated, const Nois
     glUniform1f(final.read_sigma, noise->read_sigma_dn);
     glUniform1f(final.gain, noise->gain_dn_per_e);
     glUniform1ui(final.key, noise->key);
+    BindTexture(kGaussUnit, GL_TEXTURE_2D, programs.gauss());
   }
   BindTexture(kSourceUnit, GL_TEXTURE_2D_ARRAY, accumulated ? accumulation_ : source_);
   programs.DrawFullscreen();

@@ -5,9 +5,12 @@
 //   pinhole, or cube faces), each into one layer of an RGBA8 texture array (through an MSAA
 //   framebuffer and a resolve when MSAA is on)
 //     -> with motion blur, repeated per sub-frame and summed with weights into an RGBA32F
-//        array (additive blending)
+//        array (additive blending); with the camera still, the sub-frames after the first
+//        only inside the region that the moving items sweep (scissored), the first standing
+//        for all of them elsewhere
 //   -> one final pass at the camera's size: lens remap (per-pixel map; each pixel the mean of
-//      the source over its footprint, RemapTable), sensor noise, quantisation to 8 bits
+//      the source over its footprint, RemapTable, by bilinear texture fetches), sensor noise
+//      (a hashed table of normal deviates, GaussianTable), quantisation to 8 bits
 //      (internal_effect_shaders.h)
 //   -> readback through pixel buffer objects, one per in-flight slot.
 //
@@ -44,6 +47,12 @@ struct RemapTable {
 };
 RemapTable MakeRemapTable(const geometry::LensMap& lens);
 
+/// The sensor noise's table (kFinalFragmentSource): kGaussianTableSide^2 entries of three
+/// standard normal deviates (RGB), each channel the quantiles at (i + 1/2) / 2^16 scaled to
+/// unit variance (mean exactly 0) in an order of its own.
+inline constexpr int kGaussianTableSide = 256;
+std::vector<float> GaussianTable();
+
 /// Programs and the empty vertex array shared by every camera's effect passes.
 class EffectPrograms {
  public:
@@ -70,12 +79,15 @@ class EffectPrograms {
   GLuint accumulate() const { return accumulate_; }
   GLint accumulate_layer() const { return accumulate_layer_; }
   GLint accumulate_weight() const { return accumulate_weight_; }
+  /// GaussianTable() as a kGaussianTableSide^2 RGB32F texture.
+  GLuint gauss() const { return gauss_; }
   /// Draws the full-screen triangle (program and framebuffer bound by the caller).
   void DrawFullscreen() const;
 
  private:
   GLuint vao_ = 0;
   GLuint accumulate_ = 0;
+  GLuint gauss_ = 0;
   GLint accumulate_layer_ = -1, accumulate_weight_ = -1;
   std::map<int, Final> finals_;
   std::map<int, GLuint> truth_remaps_;
@@ -125,9 +137,14 @@ class EffectTarget {
   void BindViewForDrawing(int view) const;
   /// Resolves MSAA into the view's layer (nothing to do without MSAA).
   void FinishView(int view) const;
-  /// Motion blur: zeroes the accumulation array, then adds view layers with weights.
-  void ClearAccumulation() const;
-  void Accumulate(const EffectPrograms& programs, int view, float weight) const;
+  /// Motion blur: writes weight x the view's layer into its accumulation layer, replacing what
+  /// is there (the first sub-frame) or adding to it (the others). Honours the scissor test.
+  enum class Accumulation { kReplace, kAdd };
+  void Accumulate(const EffectPrograms& programs, int view, float weight, Accumulation mode) const;
+  /// Motion blur that redrew only regions: copies the view's accumulation layer into its
+  /// source layer (to 8 bits, as the scene passes draw), honouring the scissor test; the final
+  /// pass then reads the source (Finish with `accumulated` false).
+  void WriteBack(const EffectPrograms& programs, int view) const;
   /// Binds the truth framebuffer of `view`, sets the viewport and clears it (id 0, z 0).
   void BindTruthForDrawing(int view) const;
 

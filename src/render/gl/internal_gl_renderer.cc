@@ -19,6 +19,20 @@
 namespace saccade::render::gl {
 namespace {
 
+// The clip-space transform that maps a window rectangle (x, y, width, height) of a
+// width x height view onto the whole of normalised device coordinates: its frustum is the
+// rectangle's part of the view's.
+Eigen::Matrix4d RegionFrustum(const std::array<int, 4>& r, int width, int height) {
+  const double x0 = 2.0 * r[0] / width - 1.0, x1 = 2.0 * (r[0] + r[2]) / width - 1.0;
+  const double y0 = 2.0 * r[1] / height - 1.0, y1 = 2.0 * (r[1] + r[3]) / height - 1.0;
+  Eigen::Matrix4d S = Eigen::Matrix4d::Identity();
+  S(0, 0) = 2.0 / std::max(x1 - x0, 1e-9);
+  S(0, 3) = -(x0 + x1) / std::max(x1 - x0, 1e-9);
+  S(1, 1) = 2.0 / std::max(y1 - y0, 1e-9);
+  S(1, 3) = -(y0 + y1) / std::max(y1 - y0, 1e-9);
+  return S;
+}
+
 // SplitMix64's finaliser (S. Vigna): a bijective 64-bit mix.
 uint64_t Mix64(uint64_t x) {
   x += 0x9e3779b97f4a7c15ull;
@@ -384,7 +398,8 @@ geometry::Pose GlRenderer::ItemPose(const DrawItem& item, const scene::SceneStat
 }
 
 double GlRenderer::ImageMotionPx(int camera, const scene::SceneState& s0,
-                                 const scene::SceneState& s1) const {
+                                 const scene::SceneState& s1, double* camera_px,
+                                 std::vector<double>* item_px) const {
   const scene::CameraSpec& spec = *cameras_[camera];
   const geometry::Intrinsics& k = spec.model.intrinsics();
   const double near = spec.clip.near;
@@ -408,6 +423,7 @@ double GlRenderer::ImageMotionPx(int camera, const scene::SceneState& s0,
   const Eigen::Vector3d camera_shift = X_WC1.translation() - X_WC0.translation();
   double px = turn_gain * turn +
               shift_gain * camera_shift.norm() / std::max(std::abs(X_WC0.translation().z()), near);
+  if (camera_px != nullptr) *camera_px = px;
   std::optional<head::HeadFrames> frames0, frames1;
   if (draw_robot_) {
     frames0 = head::ForwardKinematics(scene_.robot()->head, s0.joints);
@@ -422,7 +438,9 @@ double GlRenderer::ImageMotionPx(int camera, const scene::SceneState& s0,
            beyond(c.y(), bottom) || beyond(-c.y(), top);
   };
   const geometry::Pose X_CW0 = X_WC0.inverse(), X_CW1 = X_WC1.inverse();
-  for (const DrawItem& item : items_) {
+  if (item_px != nullptr) item_px->assign(items_.size(), 0.0);
+  for (std::size_t i = 0; i < items_.size(); ++i) {
+    const DrawItem& item = items_[i];
     const geometry::Pose X_WO0 = ItemPose(item, s0, frames0);
     const geometry::Pose X_WO1 = ItemPose(item, s1, frames1);
     const Eigen::Vector3d centre = item.center_model.cwiseProduct(item.scale);
@@ -445,9 +463,88 @@ double GlRenderer::ImageMotionPx(int camera, const scene::SceneState& s0,
     const double item_turn = angle(X_WO0.linear().transpose() * X_WO1.linear());
     const double in_world =
         turn_gain * turn + shift_gain * (((c1 - c0) - camera_shift).norm() + item_turn * r) / depth;
-    px = std::max(px, std::min(in_camera, in_world));
+    const double item_motion = std::min(in_camera, in_world);
+    if (item_px != nullptr) (*item_px)[i] = item_motion;
+    px = std::max(px, item_motion);
   }
   return px;
+}
+
+std::vector<std::optional<GlRenderer::Region>> GlRenderer::MovingRegions(
+    int camera, const std::vector<scene::SceneState>& subs, std::size_t whole,
+    const std::vector<double>& item_px,
+    const std::function<geometry::Pose(const geometry::Pose&, int)>& view_pose) const {
+  const CameraSetup& setup = setups_[camera];
+  const scene::CameraSpec& spec = *cameras_[camera];
+  const int views = static_cast<int>(setup.views.size());
+  const geometry::Pose X_WC = scene_.CameraPose(spec, subs[whole]);
+  std::vector<std::optional<head::HeadFrames>> frames(subs.size());
+  if (draw_robot_) {
+    for (std::size_t k = 0; k < subs.size(); ++k) {
+      frames[k] = head::ForwardKinematics(scene_.robot()->head, subs[k].joints);
+    }
+  }
+  // The bounding spheres of the items that move, at every sub-frame (world frame).
+  std::vector<std::pair<Eigen::Vector3d, double>> spheres;
+  for (std::size_t i = 0; i < items_.size(); ++i) {
+    // Under a pixel over the exposure, an item is as still as the camera (no ghost step).
+    if (item_px[i] < 1.0) continue;
+    const DrawItem& item = items_[i];
+    const Eigen::Vector3d centre = item.center_model.cwiseProduct(item.scale);
+    std::vector<geometry::Pose> poses;
+    for (std::size_t k = 0; k < subs.size(); ++k) {
+      poses.push_back(ItemPose(item, subs[k], frames[k]));
+    }
+    const bool moves = std::any_of(poses.begin(), poses.end(), [&](const geometry::Pose& X) {
+      return X.matrix() != poses.front().matrix();
+    });
+    if (!moves) continue;
+    for (const geometry::Pose& X_WO : poses) spheres.emplace_back(X_WO * centre, item.radius_model);
+  }
+  std::vector<std::optional<Region>> regions(views);
+  for (int v = 0; v < views; ++v) {
+    const geometry::Intrinsics& k = setup.effects->lens().views[v].intrinsics;
+    const Eigen::Isometry3d X_EW = EyeFromWorld(view_pose(X_WC, v));
+    const Eigen::Matrix4d& P = setup.views[v].projection;
+    double x0 = 1e300, y0 = 1e300, x1 = -1e300, y1 = -1e300;
+    bool all = false;
+    // The corners of the cube around each sphere, projected as the rasteriser does: their
+    // hull holds the sphere's image while every corner lies in front of the eye.
+    for (const auto& [c_W, r] : spheres) {
+      const Eigen::Vector3d c_E = X_EW * c_W;
+      for (int corner = 0; corner < 8 && !all; ++corner) {
+        const Eigen::Vector4d p(c_E.x() + ((corner & 1) ? r : -r),
+                                c_E.y() + ((corner & 2) ? r : -r),
+                                c_E.z() + ((corner & 4) ? r : -r), 1.0);
+        const Eigen::Vector4d clip = P * p;
+        if (clip.w() <= 1e-9) {
+          all = true;
+          break;
+        }
+        const double x = 0.5 * (clip.x() / clip.w() + 1.0) * k.width();
+        const double y = 0.5 * (clip.y() / clip.w() + 1.0) * k.height();
+        x0 = std::min(x0, x);
+        x1 = std::max(x1, x);
+        y0 = std::min(y0, y);
+        y1 = std::max(y1, y);
+      }
+      if (all) break;
+    }
+    if (all) continue;
+    // Margin: two pixels for rasterisation and multisampling, one for the camera's own motion
+    // (under a pixel over the exposure); empty when nothing moves in the view.
+    constexpr double kMarginPx = 3.0;
+    const int left =
+        static_cast<int>(std::clamp(std::floor(x0 - kMarginPx), 0.0, double(k.width())));
+    const int right =
+        static_cast<int>(std::clamp(std::ceil(x1 + kMarginPx), 0.0, double(k.width())));
+    const int bottom =
+        static_cast<int>(std::clamp(std::floor(y0 - kMarginPx), 0.0, double(k.height())));
+    const int top =
+        static_cast<int>(std::clamp(std::ceil(y1 + kMarginPx), 0.0, double(k.height())));
+    regions[v] = Region{left, bottom, std::max(0, right - left), std::max(0, top - bottom)};
+  }
+  return regions;
 }
 
 void GlRenderer::DrawEffects(int camera, const scene::SceneState& state, int64_t frame_index,
@@ -477,9 +574,13 @@ void GlRenderer::DrawEffects(int camera, const scene::SceneState& state, int64_t
   };
   std::vector<scene::SceneState> sub_states;
   int n = 1;
+  double camera_px = 0.0;       // the camera's own share of the image motion
+  std::vector<double> item_px;  // and each item's
+  bool accumulated = false;     // the final pass reads the accumulation
   if (setup.blur) {
     const double exposure = spec.sensor.exposure;
-    const double motion_px = ImageMotionPx(camera, at(-0.5 * exposure), at(0.5 * exposure));
+    const double motion_px =
+        ImageMotionPx(camera, at(-0.5 * exposure), at(0.5 * exposure), &camera_px, &item_px);
     n = static_cast<int>(
         std::clamp(std::ceil(motion_px), 1.0, static_cast<double>(spec.sensor.blur_samples)));
     if (n > 1) {
@@ -496,19 +597,55 @@ void GlRenderer::DrawEffects(int camera, const scene::SceneState& state, int64_t
       effects.FinishView(v);
     }
   } else {
-    effects.ClearAccumulation();
-    const float weight = 1.0f / static_cast<float>(sub_states.size());
-    for (const scene::SceneState& sub : sub_states) {
-      UpdatePoses(sub);
-      const geometry::Pose X_WCk = scene_.CameraPose(spec, sub);
+    // The camera still (under a pixel over the exposure: as for blur itself, a sub-pixel step
+    // is no ghost), the sub-frame nearest the frame's time is drawn whole and the others only
+    // where they can differ from it (MovingRegions: the moving items' sweep), the whole one
+    // standing for all of them elsewhere: a still head watching a small moving ball redraws
+    // the ball's box, not the image, per sub-frame. A moving camera redraws everything.
+    const std::size_t count = sub_states.size(), whole = count / 2;
+    const bool still = camera_px < 1.0;
+    std::vector<std::optional<Region>> regions(views);
+    if (still) regions = MovingRegions(camera, sub_states, whole, item_px, view_pose);
+    const auto scissor = [](const Region& r) {
+      glEnable(GL_SCISSOR_TEST);
+      glScissor(r[0], r[1], r[2], r[3]);
+    };
+    const float weight = 1.0f / static_cast<float>(count);
+    using Mode = EffectTarget::Accumulation;
+    for (std::size_t i = 0; i < count; ++i) {
+      const std::size_t k = i == 0 ? whole : (i <= whole ? i - 1 : i);  // whole one first
+      UpdatePoses(sub_states[k]);
+      const geometry::Pose X_WCk = scene_.CameraPose(spec, sub_states[k]);
       for (int v = 0; v < views; ++v) {
+        const std::optional<Region>& region = regions[v];
+        const bool part = i > 0 && region;
+        if (part) scissor(*region);
         effects.BindViewForDrawing(v);
         glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
-        DrawScene(setup.views[v], near, view_pose(X_WCk, v));
+        if (part) {
+          // Only the items that reach the region: the frustum of its rectangle.
+          const geometry::Intrinsics& size = effects.lens().views[v].intrinsics;
+          const Eigen::Matrix4d cull = RegionFrustum(*region, size.width(), size.height());
+          DrawScene(setup.views[v], near, view_pose(X_WCk, v), &cull);
+        } else {
+          DrawScene(setup.views[v], near, view_pose(X_WCk, v));
+        }
         effects.FinishView(v);
-        effects.Accumulate(*effect_programs_, v, weight);
+        if (region) scissor(*region);
+        effects.Accumulate(*effect_programs_, v, weight, i == 0 ? Mode::kReplace : Mode::kAdd);
+        glDisable(GL_SCISSOR_TEST);
       }
     }
+    // Still camera: the blurred regions go back into the source views, which hold the whole
+    // sub-frame elsewhere, and the final pass reads those (8 bits, as without blur).
+    if (still) {
+      for (int v = 0; v < views; ++v) {
+        if (regions[v]) scissor(*regions[v]);
+        effects.WriteBack(*effect_programs_, v);
+        glDisable(GL_SCISSOR_TEST);
+      }
+    }
+    accumulated = !still;
     UpdatePoses(state);
   }
   if (effects.has_truth()) {
@@ -521,7 +658,7 @@ void GlRenderer::DrawEffects(int camera, const scene::SceneState& state, int64_t
   noise.read_sigma_dn = static_cast<float>(spec.sensor.read_noise_dn);
   noise.gain_dn_per_e = static_cast<float>(spec.sensor.gain_dn_per_e);
   noise.key = NoiseKey(spec.sensor.seed, spec.name, frame_index);
-  effects.Finish(*effect_programs_, !sub_states.empty(), setup.noise ? &noise : nullptr, slot);
+  effects.Finish(*effect_programs_, accumulated, setup.noise ? &noise : nullptr, slot);
 }
 
 std::vector<Frame> GlRenderer::Render(const scene::SceneState& state, int64_t frame_index) {

@@ -10,8 +10,10 @@
 #include <array>
 #include <chrono>
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -191,11 +193,13 @@ class GlRenderer final : public Renderer {
   void UpdatePoses(const scene::SceneState& state);
   // The colour pass and the truth pass (internal_draw.cc) draw the same items in the same
   // order at the same levels of detail, through one visitor.
-  void DrawScene(const ViewSetup& view, double near, const geometry::Pose& X_WV);
+  // `cull`: draw only the items inside the frustum of cull * mvp too (a part of the view).
+  void DrawScene(const ViewSetup& view, double near, const geometry::Pose& X_WV,
+                 const Eigen::Matrix4d* cull = nullptr);
   void DrawTruth(const ViewSetup& view, double near, const geometry::Pose& X_WV);
   template <class Visit>
   void ForEachVisibleItem(const ViewSetup& view, double near, const Eigen::Isometry3d& X_EW,
-                          Visit&& visit);
+                          Visit&& visit, const Eigen::Matrix4d* cull = nullptr);
   const GpuLod& LodOf(const GpuMesh& mesh, double px_per_model_unit) const;
   static void DrawLod(const GpuMesh& mesh, const GpuLod& lod, bool* culling);
   void DrawGround(GLint mvp, GLint mv, const Eigen::Matrix4d& P, const Eigen::Isometry3d& X_EW);
@@ -205,7 +209,19 @@ class GlRenderer final : public Renderer {
                    const geometry::Pose& X_WC, int slot);
   // How far, at most, anything the camera sees moves on its image between s0 and s1
   // (pixels, a bound through the pinhole of K): motion blur draws that many sub-frames.
-  double ImageMotionPx(int camera, const scene::SceneState& s0, const scene::SceneState& s1) const;
+  // `camera_px`, when given, gets the camera's own share (its turn and shift), `item_px` each
+  // item's bound (0 for items out of view).
+  double ImageMotionPx(int camera, const scene::SceneState& s0, const scene::SceneState& s1,
+                       double* camera_px = nullptr, std::vector<double>* item_px = nullptr) const;
+  // Motion blur's sub-frames with the camera still: per view of the camera, the window
+  // rectangle (x, y, width, height) outside which every sub-frame equals sub-frame `whole`
+  // (the items that move by a pixel or more, by `item_px`, do not reach there), or nullopt for
+  // all of the view (a moving item reaches behind the eye).
+  using Region = std::array<int, 4>;
+  std::vector<std::optional<Region>> MovingRegions(
+      int camera, const std::vector<scene::SceneState>& subs, std::size_t whole,
+      const std::vector<double>& item_px,
+      const std::function<geometry::Pose(const geometry::Pose&, int)>& view_pose) const;
   geometry::Pose ItemPose(const DrawItem& item, const scene::SceneState& state,
                           const std::optional<head::HeadFrames>& frames) const;
   // Eye frame from world, and the pixels per model unit at an item's nearest point.
