@@ -41,6 +41,11 @@ packages=(
   # DDS beyond one process (ROS 2's wire): Cyclone DDS's C library and idlc (cyclonedds-dev),
   # ddsperf for the transport benchmark (cyclonedds-tools)
   cyclonedds-dev cyclonedds-tools
+  # the Python package (docs/python.md): pybind11 bindings for Debian's /usr/bin/python3, numpy
+  # arrays, its tests under pytest
+  pybind11-dev python3-numpy python3-pytest python3-dev
+  # the reference of the Python tests for the camera model (cv2.projectPoints)
+  python3-opencv
 )
 
 # Node.js and npm install the GUI's three.js and the browser tests' playwright-core (web/):

@@ -35,6 +35,11 @@ bool RendererOptions::IsValid(std::string* error) const {
   return message.empty();
 }
 
+void Renderer::RenderBatch(const std::vector<BatchHead>& /*heads*/, uint8_t* /*out*/,
+                           std::size_t /*out_bytes*/) {
+  throw Error("Renderer::RenderBatch: this renderer has no batch path");
+}
+
 std::unique_ptr<Renderer> MakeRenderer(const scene::Scene& scene, const RendererOptions& options) {
   std::string error;
   if (!options.IsValid(&error)) {

@@ -18,8 +18,10 @@
 // remap, so it matches the distorted colour image pixel for pixel.
 
 #include <Eigen/Core>
+#include <cstddef>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -97,6 +99,17 @@ struct Frame {
   std::vector<ObjectTruth> objects;
 };
 
+/// One head of a batch (Renderer::RenderBatch): its state (time, joints) and, optionally, its
+/// own placement of the scene's objects, so that every head of a batch sees its own world.
+struct BatchHead {
+  scene::SceneState state;
+  /// Empty, or one entry per scene object (scene order): a pose X_WO that replaces the
+  /// object's motion for this head; std::nullopt keeps the motion's pose at state.time.
+  std::vector<std::optional<geometry::Pose>> object_poses;
+  /// Empty, or one flag per scene object: true hides the object from this head's cameras.
+  std::vector<bool> hidden;
+};
+
 /// Cumulative time spent per stage, for `saccade bench` (milliseconds, wall clock).
 struct RenderStats {
   int64_t frames = 0;          ///< states rendered (each with every camera)
@@ -124,6 +137,18 @@ class Renderer {
   virtual std::vector<Frame> Retrieve() = 0;
   /// Submitted states not yet retrieved (0, 1 or 2). Submit with 2 in flight throws Error.
   virtual int InFlight() const = 0;
+
+  /// Batch rendering: draws every head of `heads` through every selected camera into one
+  /// framebuffer of tiles and reads them back at once into `out`: heads.size() x cameras x
+  /// height x width x 3 bytes (kRgb8, row 0 at the top), tightly packed, `out_bytes` long.
+  /// Every camera must have the same size. The images are the pinhole images of each camera's
+  /// K (no distortion, noise or blur; no ground truth), lit as the scene says. Not pipelined:
+  /// returns with the pixels in `out`. Throws InvalidArgument when the cameras' sizes differ,
+  /// `out_bytes` is not the size above, a head's object_poses or hidden has neither 0 nor one
+  /// entry per object, or the batch exceeds the device's framebuffer size; Error when the
+  /// backend has no batch path.
+  virtual void RenderBatch(const std::vector<BatchHead>& heads, uint8_t* out,
+                           std::size_t out_bytes);
 
   /// The names of the cameras rendered, in frame order.
   virtual const std::vector<std::string>& camera_names() const = 0;

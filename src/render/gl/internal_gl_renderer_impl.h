@@ -160,6 +160,9 @@ class GlRenderer final : public Renderer {
   void Submit(const scene::SceneState& state, int64_t frame_index) override;
   std::vector<Frame> Retrieve() override;
   int InFlight() const override { return in_flight_; }
+  // Batch rendering (internal_batch.cc).
+  void RenderBatch(const std::vector<BatchHead>& heads, uint8_t* out,
+                   std::size_t out_bytes) override;
   const std::vector<std::string>& camera_names() const override { return camera_names_; }
   std::string DeviceDescription() const override { return description_; }
   const RenderStats& stats() const override { return stats_; }
@@ -260,6 +263,15 @@ class GlRenderer final : public Renderer {
   int samples_ = 0;
   std::string description_;
   RenderStats stats_;
+  // The batch's framebuffer of tiles and its pixel buffer (internal_batch.cc), made on the
+  // first RenderBatch and remade when the batch grows; freed with the context.
+  struct BatchTarget {
+    GLuint framebuffer = 0, color = 0, depth = 0, pixels = 0;
+    int columns = 0, rows = 0;  // tiles
+    std::size_t pixel_bytes = 0;
+  };
+  BatchTarget batch_;
+  std::vector<ViewSetup> batch_views_;  // per camera: the pinhole of its K
 };
 
 }  // namespace saccade::render::gl

@@ -1,0 +1,138 @@
+#!/usr/bin/python3
+"""Benchmarks of the Python package (docs/python.md; figures in bench/baselines/):
+
+1. VectorFixationEnv steps per second with 128 x 128 stereo observations for N = 1, 4, 16,
+   64 heads (one batch render per step), and the cost per stereo observation;
+2. one FixationEnv step through Python against the same step in C++ (build/bin/env_step_bench:
+   the action checked, joints moved, forward kinematics, both eyes drawn through
+   RenderBatch), on the same scene and the same objects.
+
+    PYTHONPATH=build/python /usr/bin/python3 bench/python_env_bench.py [--sizes 1 4 16 64]
+"""
+
+import argparse
+import json
+import math
+import os
+import subprocess
+import tempfile
+import time
+
+import numpy as np
+
+import saccade
+from saccade.envs import FixationEnv, VectorFixationEnv
+
+
+def vector_rate(n: int, size: int, seconds: float):
+    env = VectorFixationEnv(num_envs=n, image_size=size, max_episode_steps=10**9)
+    env.reset(seed=0)
+    actions = np.zeros((n, 4), np.float32)
+    actions[:, 0] = 0.05  # a slow pan: every step draws a new view
+    for _ in range(3):
+        env.step(actions)
+    # Each step timed: the mean, and the median (less sensitive to the shared machine's load).
+    times = []
+    start = time.perf_counter()
+    while time.perf_counter() - start < seconds or len(times) < 5:
+        t0 = time.perf_counter()
+        env.step(actions)
+        times.append(time.perf_counter() - t0)
+    env.close()
+    mean, median = float(np.mean(times)), float(np.median(times))
+    return 1.0 / median, n / median, n / mean
+
+
+def same_layout(env: FixationEnv):
+    # The C++ bench's layout (bench/env_step_bench.cc): the first three objects 2 m ahead.
+    heads = env._heads
+    count = heads.pool.count
+    base = heads.X_WB[:3, 3]
+    poses, hidden = [None] * count, [True] * count
+    for i in range(min(3, count)):
+        X = np.eye(4)
+        X[:3, :3] = [[-1, 0, 0], [0, -1, 0], [0, 0, 1]]
+        X[:3, 3] = base + np.array([2.0, -0.6 + 0.6 * i, 0.0])
+        poses[i], hidden[i] = X, False
+    heads.object_poses[0], heads.hidden[0] = poses, hidden
+    heads.batch[0] = saccade.render.BatchHead(saccade.scene.SceneState(), poses, hidden)
+    heads.target[0] = poses[0][:3, 3]
+    heads.joints[0] = 0.0
+
+
+def python_step_ms(size: int, repetitions: int = 30, seconds: float = 0.1) -> float:
+    # As env_step_bench: the mean of each short repetition, the least disturbed one kept.
+    env = FixationEnv(image_size=size, max_episode_steps=10**9)
+    env.reset(seed=0)
+    same_layout(env)
+    action = np.array([0.1, -0.05, 0.02, -0.02], np.float32)
+    for _ in range(5):
+        env.step(action)
+    best = math.inf
+    for _ in range(repetitions):
+        steps = 0
+        start = time.perf_counter()
+        while time.perf_counter() - start < seconds:
+            env.step(action)
+            steps += 1
+        best = min(best, 1000.0 * (time.perf_counter() - start) / steps)
+    env.close()
+    return best
+
+
+def cpp_step_ms(size: int, binary: str) -> float:
+    env = FixationEnv(image_size=size)
+    with tempfile.NamedTemporaryFile("w", suffix=".yaml", delete=False) as scene:
+        scene.write(env._heads.pool.yaml)
+    env.close()
+    try:
+        result = subprocess.run(
+            [binary, "--benchmark_format=json"], check=True, capture_output=True, text=True,
+            env=dict(os.environ, SACCADE_ENV_SCENE=scene.name))
+    finally:
+        os.unlink(scene.name)
+    report = [b for b in json.loads(result.stdout)["benchmarks"] if b.get("aggregate_name") == "min"][0]
+    return report["real_time"] if report["time_unit"] == "ms" else report["real_time"] / 1e6
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--sizes", type=int, nargs="*", default=[1, 4, 16, 64])
+    parser.add_argument("--image", type=int, default=128)
+    parser.add_argument("--seconds", type=float, default=5.0)
+    parser.add_argument("--rounds", type=int, default=2, help="alternating rounds (the best is kept)")
+    parser.add_argument("--cpp", default=os.path.join(saccade.source_dir(), "build", "bin", "env_step_bench"))
+    args = parser.parse_args()
+
+    renderer = saccade.render.Renderer(FixationEnv(image_size=8)._heads.scene, cameras=["left"])
+    print(f"device: {renderer.device}")
+    print(f"\nVectorFixationEnv, {args.image}x{args.image} stereo, median step, best of "
+          f"{args.rounds} rounds of {args.seconds:.0f} s:")
+    print("| N | vector steps/s | stereo obs/s | ms per stereo obs | vs N = 1 | obs/s (mean step) |")
+    print("|---|---|---|---|---|---|")
+    best = {n: (0.0, 0.0, 0.0) for n in args.sizes}
+    for _ in range(args.rounds):
+        for n in args.sizes:
+            result = vector_rate(n, args.image, args.seconds)
+            if result[1] > best[n][1]:
+                best[n] = result
+    base = 1000.0 / best[args.sizes[0]][1]
+    for n in args.sizes:
+        steps, obs, obs_mean = best[n]
+        print(f"| {n} | {steps:.1f} | {obs:.0f} | {1000.0 / obs:.2f} | {1000.0 / obs / base:.2f} | {obs_mean:.0f} |")
+
+    if os.path.exists(args.cpp):
+        py, cpp = [], []
+        for _ in range(args.rounds):
+            py.append(python_step_ms(args.image))
+            cpp.append(cpp_step_ms(args.image, args.cpp))
+        p, c = min(py), min(cpp)
+        print(f"\nFixationEnv.step, {args.image}x{args.image} stereo, same scene and objects "
+              f"(least disturbed of 30 x 0.1 s, {args.rounds} rounds): Python {p:.3f} ms, C++ {c:.3f} ms, "
+              f"Python overhead {100.0 * (p - c) / c:+.1f} %")
+    else:
+        print(f"\n{args.cpp} not built: no C++ comparison (cmake --build build --target env_step_bench)")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,134 @@
+// saccade.head: the stereo head's description, forward and inverse kinematics (paper
+// appendix A). Joint states are JointState or any sequence pan, tilt, left, right (rad).
+#include <pybind11/eigen.h>
+#include <pybind11/operators.h>
+#include <pybind11/stl.h>
+#include <pybind11/stl/filesystem.h>
+
+#include "python/internal_bindings.h"
+#include "saccade/core/error.h"
+#include "saccade/head/head_description.h"
+#include "saccade/head/kinematics.h"
+
+namespace saccade::python {
+
+void BindHead(py::module_& m) {
+  using namespace head;
+  py::class_<JointState>(m, "JointState", "Joint angles in radians: pan, tilt, left, right.")
+      .def(py::init<>())
+      .def(py::init([](double pan, double tilt, double left, double right) {
+             return JointState{pan, tilt, left, right};
+           }),
+           "pan"_a, "tilt"_a, "left"_a, "right"_a)
+      .def(py::init([](const Eigen::Vector4d& v) {
+             return JointState{v[0], v[1], v[2], v[3]};
+           }),
+           "values"_a, "From a sequence pan, tilt, left, right.")
+      .def_readwrite("pan", &JointState::pan)
+      .def_readwrite("tilt", &JointState::tilt)
+      .def_readwrite("left", &JointState::left)
+      .def_readwrite("right", &JointState::right)
+      .def(
+          "to_array",
+          [](const JointState& j) { return Eigen::Vector4d(j.pan, j.tilt, j.left, j.right); },
+          "numpy array pan, tilt, left, right.")
+      .def(
+          "__array__",
+          [](const JointState& j, py::object /*dtype*/) {
+            return Eigen::Vector4d(j.pan, j.tilt, j.left, j.right);
+          },
+          "dtype"_a = py::none())
+      .def(py::self == py::self)
+      .def("__repr__", [](const JointState& j) {
+        return "JointState(pan=" + std::to_string(j.pan) + ", tilt=" + std::to_string(j.tilt) +
+               ", left=" + std::to_string(j.left) + ", right=" + std::to_string(j.right) + ")";
+      });
+  py::implicitly_convertible<py::list, JointState>();
+  py::implicitly_convertible<py::tuple, JointState>();
+  py::implicitly_convertible<py::array, JointState>();
+
+  py::class_<JointLimits>(m, "JointLimits", "Position (rad), velocity (rad/s), acceleration.")
+      .def_readonly("min", &JointLimits::min)
+      .def_readonly("max", &JointLimits::max)
+      .def_readonly("max_velocity", &JointLimits::max_velocity)
+      .def_readonly("max_acceleration", &JointLimits::max_acceleration);
+  py::class_<HeadGeometry>(m, "HeadGeometry", "Lengths of appendix A, metres.")
+      .def_readonly("B", &HeadGeometry::B)
+      .def_readonly("D", &HeadGeometry::D)
+      .def_readonly("H", &HeadGeometry::H)
+      .def_readonly("delta_l", &HeadGeometry::delta_l)
+      .def_readonly("delta_r", &HeadGeometry::delta_r);
+
+  py::class_<HeadDescription>(m, "HeadDescription",
+                              "A stereo head (robots/popeye.yaml documents the file format).")
+      .def_static("from_yaml_file", &HeadDescription::FromYamlFile, "path"_a,
+                  "Loads a head description; raises FileError with file:line: key.")
+      .def_static("from_yaml_string", &HeadDescription::FromYamlString, "text"_a,
+                  "source"_a = "<string>")
+      .def_property_readonly("name", &HeadDescription::name)
+      .def_property_readonly("geometry", &HeadDescription::geometry)
+      .def(
+          "limits",
+          [](const HeadDescription& h, const std::string& joint) {
+            for (Joint j : kAllJoints) {
+              if (joint == JointName(j)) return h.limits(j);
+            }
+            throw InvalidArgument("HeadDescription.limits: unknown joint '" + joint +
+                                  "'; expected pan, tilt, left or right");
+          },
+          "joint"_a, "The limits of 'pan', 'tilt', 'left' or 'right'.")
+      .def_property_readonly("X_WB",
+                             [](const HeadDescription& h) { return PoseToMatrix(h.X_WB()); })
+      .def_property_readonly("left_camera", &HeadDescription::left_camera)
+      .def_property_readonly("right_camera", &HeadDescription::right_camera)
+      .def("within_limits", &HeadDescription::WithinLimits, "joints"_a)
+      .def("check_limits", &HeadDescription::CheckLimits, "joints"_a,
+           "Raises InvalidArgument naming the first joint outside its limits.");
+
+  py::class_<HeadFrames>(m, "HeadFrames", "Every frame of the head in the world (4x4 poses).")
+      .def_property_readonly("X_WB", [](const HeadFrames& f) { return PoseToMatrix(f.X_WB); })
+      .def_property_readonly("X_WN", [](const HeadFrames& f) { return PoseToMatrix(f.X_WN); })
+      .def_property_readonly(
+          "X_WC", [](const HeadFrames& f) { return PoseToMatrix(f.X_WC); }, "The cyclopean frame.")
+      .def_property_readonly("X_WL", [](const HeadFrames& f) { return PoseToMatrix(f.X_WL); })
+      .def_property_readonly("X_WR", [](const HeadFrames& f) { return PoseToMatrix(f.X_WR); })
+      .def_property_readonly(
+          "X_WCamLeft", [](const HeadFrames& f) { return PoseToMatrix(f.X_WCamLeft); },
+          "The left camera's optical frame (OpenCV axes).")
+      .def_property_readonly("X_WCamRight",
+                             [](const HeadFrames& f) { return PoseToMatrix(f.X_WCamRight); })
+      .def_readonly("p_WFixation", &HeadFrames::p_WFixation,
+                    "Where the optical axes meet, or None.");
+  m.def("forward_kinematics", &ForwardKinematics, "head"_a, "joints"_a,
+        "The head's frames for a joint state (appendix A); never raises.");
+
+  py::class_<IkResult>(m, "IkResult")
+      .def_readonly("joints", &IkResult::joints, "The solution, within the joint limits.")
+      .def_property_readonly("reachability",
+                             [](const IkResult& r) { return ToString(r.reachability); })
+      .def_property_readonly("reachable", &IkResult::reachable)
+      .def_readonly("axis_error", &IkResult::axis_error,
+                    "Largest angle (rad) between an optical axis and its camera's target ray.")
+      .def_readonly("iterations", &IkResult::iterations)
+      .def_readonly("message", &IkResult::message);
+  m.def(
+      "solve_fixation",
+      [](const HeadDescription& head, const Eigen::Vector3d& p_W, const std::string& mode,
+         const JointState& seed) {
+        IkOptions options;
+        if (mode == "independent") {
+          options.mode = VergenceMode::kIndependent;
+        } else if (mode != "symmetric") {
+          throw InvalidArgument("solve_fixation: mode '" + mode +
+                                "'; expected 'symmetric' or 'independent'");
+        }
+        options.seed = seed;
+        return SolveFixation(head, p_W, options);
+      },
+      "head"_a, "p_W"_a, "mode"_a = "symmetric", "seed"_a = JointState{},
+      "Inverse kinematics: the joints that bring p_W (world, metres) onto both optical axes.");
+  m.def("solve_fixation_closed_form", &SolveFixationClosedForm, "head"_a, "p_W"_a,
+        "Closed form of eqs. 10-13 (symmetric vergence, D = H = 0).");
+}
+
+}  // namespace saccade::python

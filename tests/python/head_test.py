@@ -1,0 +1,69 @@
+# tier: unit
+"""saccade.head: the description file, forward and inverse kinematics."""
+
+import numpy as np
+import pytest
+
+import saccade
+from saccade import head
+
+# FK(IK(p)) meets p to this angle: the solver converges to 1e-9 rad (kinematics.h).
+AXIS_TOLERANCE_RAD = 1e-8
+
+
+def test_description_fields(popeye):
+    assert popeye.name
+    limits = popeye.limits("pan")
+    assert limits.min < 0 < limits.max and limits.max_velocity > 0
+    assert popeye.X_WB.shape == (4, 4)
+    assert popeye.left_camera.intrinsics.width > 0
+
+
+def test_ik_then_fk_puts_the_target_on_both_optical_axes(popeye):
+    rng = np.random.default_rng(3)
+    base = popeye.X_WB[:3, 3]
+    for _ in range(20):
+        target = base + np.array([rng.uniform(1.0, 3.0), rng.uniform(-0.8, 0.8), rng.uniform(-0.5, 0.5)])
+        result = head.solve_fixation(popeye, target)
+        assert result.reachable, result.message
+        frames = head.forward_kinematics(popeye, result.joints)
+        for X in (frames.X_WCamLeft, frames.X_WCamRight):
+            ray = target - X[:3, 3]
+            # atan2 of |cross| and dot: arccos loses the angle below sqrt(eps).
+            angle = np.arctan2(np.linalg.norm(np.cross(X[:3, 2], ray)), X[:3, 2] @ ray)
+            assert angle < AXIS_TOLERANCE_RAD
+        assert np.allclose(frames.p_WFixation, target, atol=1e-6)
+
+
+def test_joint_states_from_sequences(popeye):
+    a = head.JointState(0.1, -0.2, 0.05, -0.05)
+    assert np.allclose(np.asarray(a), [0.1, -0.2, 0.05, -0.05])
+    frames_a = head.forward_kinematics(popeye, a)
+    frames_b = head.forward_kinematics(popeye, [0.1, -0.2, 0.05, -0.05])
+    assert np.allclose(frames_a.X_WCamLeft, frames_b.X_WCamLeft)
+
+
+def test_unreachable_target_is_reported_not_raised(popeye):
+    behind = popeye.X_WB[:3, 3] + np.array([-2.0, 0.0, 0.0])
+    result = head.solve_fixation(popeye, behind)
+    assert not result.reachable
+    assert result.reachability in ("behind", "joint limit", "kBehind", "kJointLimit") or result.message
+
+
+def test_check_limits_names_the_joint(popeye):
+    with pytest.raises(saccade.InvalidArgument, match="tilt"):
+        popeye.check_limits(head.JointState(0.0, 3.0, 0.0, 0.0))
+    assert not popeye.within_limits([0.0, 3.0, 0.0, 0.0])
+
+
+def test_bad_description_raises_file_error_with_line():
+    text = "name: x\ngeometry:\n  B: -0.1\n"
+    with pytest.raises(saccade.FileError) as error:
+        head.HeadDescription.from_yaml_string(text, "inline.yaml")
+    assert str(error.value).startswith("inline.yaml:")
+    assert error.value.line >= 1
+
+
+def test_bad_ik_mode_is_refused(popeye):
+    with pytest.raises(saccade.InvalidArgument, match="symmetric"):
+        head.solve_fixation(popeye, np.array([2.0, 0, 1.2]), mode="sideways")
