@@ -4,6 +4,7 @@
 
 #include <charconv>
 #include <cmath>
+#include <fstream>
 #include <limits>
 #include <set>
 #include <utility>
@@ -223,6 +224,35 @@ YAML::Node ParseYaml(const std::string& text, const std::string& source) {
     throw FileError(source, error.mark.is_null() ? 0 : error.mark.line + 1, "",
                     "YAML syntax error: " + error.msg);
   }
+}
+
+std::string ReadConfigFile(const std::filesystem::path& path, const std::string& what) {
+  const std::string name = path.string();
+  std::error_code ec;
+  const auto status = std::filesystem::status(path, ec);
+  if (!std::filesystem::exists(status))
+    throw FileError(name, 0, "", "cannot open the " + what + ": no such file");
+  if (!std::filesystem::is_regular_file(status)) {
+    throw FileError(name, 0, "",
+                    fmt::format("not a regular file (a folder, device or pipe); "
+                                "expected a {}",
+                                what));
+  }
+  const std::uintmax_t size = std::filesystem::file_size(path, ec);
+  if (!ec && size > kMaxConfigFileBytes) {
+    throw FileError(name, 0, "",
+                    fmt::format("the {} is {} bytes, more than the {} a configuration file may "
+                                "have",
+                                what, size, kMaxConfigFileBytes));
+  }
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw FileError(name, 0, "", "cannot open the " + what);
+  std::string text;
+  text.resize(static_cast<std::size_t>(ec ? 0 : size));
+  in.read(text.data(), static_cast<std::streamsize>(text.size()));
+  if (in.bad()) throw FileError(name, 0, "", "cannot read the " + what);
+  text.resize(static_cast<std::size_t>(in.gcount()));
+  return text;
 }
 
 }  // namespace saccade::internal

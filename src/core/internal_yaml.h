@@ -8,6 +8,7 @@
 
 #include <array>
 #include <cstdint>
+#include <filesystem>
 #include <initializer_list>
 #include <optional>
 #include <string>
@@ -75,5 +76,15 @@ class Entry {
 
 /// Parses YAML text; a syntax error throws FileError with the line.
 YAML::Node ParseYaml(const std::string& text, const std::string& source);
+
+/// The largest configuration file (scene, head, pipeline, calibration) read whole: far above
+/// any real one, far below what would exhaust memory.
+inline constexpr std::uintmax_t kMaxConfigFileBytes = std::uintmax_t{64} << 20;
+
+/// The whole text of a configuration file. `what` names it in errors ("head description").
+/// Throws FileError (file, line 0) when it is missing, not a regular file (a folder, a device
+/// such as /dev/zero, a pipe: none of them ends or fits), larger than kMaxConfigFileBytes, or
+/// cannot be read.
+std::string ReadConfigFile(const std::filesystem::path& path, const std::string& what);
 
 }  // namespace saccade::internal

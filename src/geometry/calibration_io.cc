@@ -1,6 +1,7 @@
 #include "saccade/geometry/calibration_io.h"
 
 #include <fcntl.h>
+#include <fmt/format.h>
 #include <unistd.h>
 
 #include <Eigen/LU>
@@ -15,6 +16,7 @@
 #include <system_error>
 #include <vector>
 
+#include "core/internal_yaml.h"
 #include "internal_opencv_storage.h"
 #include "saccade/core/error.h"
 
@@ -53,6 +55,18 @@ std::string ReadFileText(const std::filesystem::path& path) {
   if (!std::filesystem::exists(status)) throw FileError(file, 0, "", "file not found");
   if (std::filesystem::is_directory(status)) {
     throw FileError(file, 0, "", "is a directory, expected a calibration file");
+  }
+  // A device (/dev/zero) or a pipe never ends: read regular files only, of a bounded size.
+  if (!std::filesystem::is_regular_file(status)) {
+    throw FileError(file, 0, "",
+                    "not a regular file (a device or pipe), expected a calibration file");
+  }
+  if (const auto size = std::filesystem::file_size(path, ec);
+      !ec && size > saccade::internal::kMaxConfigFileBytes) {
+    throw FileError(
+        file, 0, "",
+        fmt::format("the file is {} bytes, more than the {} a calibration file may have", size,
+                    saccade::internal::kMaxConfigFileBytes));
   }
   std::ifstream in(path, std::ios::binary);
   if (!in) throw FileError(file, 0, "", "cannot be opened for reading");

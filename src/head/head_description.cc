@@ -347,12 +347,8 @@ HeadDescription::HeadDescription(std::string name, const HeadGeometry& geometry,
 }
 
 HeadDescription HeadDescription::FromYamlFile(const std::filesystem::path& path) {
-  std::ifstream stream(path);
-  if (!stream) throw FileError(path.string(), 0, "", "cannot open the head description file");
-  std::stringstream text;
-  text << stream.rdbuf();
-  if (stream.bad()) throw FileError(path.string(), 0, "", "cannot read the head description file");
-  return FromYamlString(text.str(), path.string());
+  return FromYamlString(saccade::internal::ReadConfigFile(path, "head description file"),
+                        path.string());
 }
 
 HeadDescription HeadDescription::FromYamlString(const std::string& text,

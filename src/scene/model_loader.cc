@@ -17,6 +17,7 @@
 #include <fstream>
 #include <mutex>
 #include <sstream>
+#include <string_view>
 #include <system_error>
 #include <utility>
 
@@ -186,6 +187,40 @@ void CheckPlyHeader(const fs::path& path, const std::string& name) {
   }
 }
 
+// A binary STL's header (80 bytes, then the triangle count as a little-endian uint32, then
+// 50 bytes a triangle) against the model limits and the file's size, so that a 134-byte file
+// claiming 50 million triangles is refused by its count, not by Assimp's guess at its format.
+// Files whose extension is not .stl, and ASCII STL ("solid" and not the binary size), pass.
+void CheckStlHeader(const fs::path& path, const std::string& name) {
+  std::string extension = path.extension().string();
+  for (char& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  if (extension != ".stl") return;
+  std::error_code ec;
+  const auto file_bytes = static_cast<int64_t>(fs::file_size(path, ec));
+  if (ec || file_bytes < 84) return;  // Assimp reports what it cannot read
+  std::ifstream in(path, std::ios::binary);
+  char header[84] = {};
+  if (!in.read(header, sizeof(header))) return;
+  const auto* bytes = reinterpret_cast<const unsigned char*>(header + 80);
+  const int64_t count = int64_t{bytes[0]} | int64_t{bytes[1]} << 8 | int64_t{bytes[2]} << 16 |
+                        int64_t{bytes[3]} << 24;
+  const int64_t binary_bytes = 84 + 50 * count;
+  if (std::string_view(header, 5) == "solid" && binary_bytes != file_bytes) return;  // ASCII
+  const auto fail = [&](const std::string& what) { throw FileError(name, 0, "", what); };
+  if (count > kMaxModelTriangles) {
+    fail(
+        fmt::format("the binary STL header declares {} triangles, more than the {} a model may "
+                    "have (scene/limits.h)",
+                    count, kMaxModelTriangles));
+  }
+  if (binary_bytes > file_bytes) {
+    fail(
+        fmt::format("the binary STL header declares {} triangles, which need {} bytes, but the "
+                    "file holds {} (a truncated file or a lying header)",
+                    count, binary_bytes, file_bytes));
+  }
+}
+
 class ModelReader {
  public:
   ModelReader(const fs::path& path, const std::shared_ptr<const Texture>& texture_override,
@@ -197,6 +232,7 @@ class ModelReader {
     importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE,
                                 aiPrimitiveType_POINT | aiPrimitiveType_LINE);
     CheckPlyHeader(path_, name_);
+    CheckStlHeader(path_, name_);
     std::string reason;
     bool data_loss = false;
     const aiScene* scene = Import(importer, name_, &reason, &data_loss);

@@ -29,6 +29,7 @@
 
 #include "saccade/server/gui_server.h"
 #include "server/internal_access.h"
+#include "server/internal_command.h"
 
 namespace saccade::server::internal_gui {
 
@@ -168,38 +169,6 @@ inline json StatsJson(const ClientStats& s) {
               {"commands", s.commands},
               {"errors", s.errors},
               {"queued_bytes", s.queued_bytes}};
-}
-
-inline std::string JsonTypeName(const json& value) { return value.type_name(); }
-
-// Commands nest a few levels; deeper input is refused before parsing, so that no handler
-// walks (or dumps) it recursively.
-inline constexpr int kMaxNesting = 64;
-
-// The deepest nesting of arrays and objects in JSON text (strings skipped).
-inline int NestingDepth(std::string_view text) {
-  int depth = 0;
-  int deepest = 0;
-  bool in_string = false;
-  bool escaped = false;
-  for (const char c : text) {
-    if (in_string) {
-      if (escaped) {
-        escaped = false;
-      } else if (c == '\\') {
-        escaped = true;
-      } else if (c == '"') {
-        in_string = false;
-      }
-    } else if (c == '"') {
-      in_string = true;
-    } else if (c == '[' || c == '{') {
-      deepest = std::max(deepest, ++depth);
-    } else if (c == ']' || c == '}') {
-      --depth;
-    }
-  }
-  return deepest;
 }
 
 struct Document {

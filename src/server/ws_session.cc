@@ -170,55 +170,14 @@ void WsSession::OnRead(beast::error_code ec) {
 }
 
 void WsSession::HandleCommand(std::string_view text) {
-  if (const int depth = NestingDepth(text); depth > kMaxNesting) {
-    SendError(nullptr, "malformed JSON: nested " + std::to_string(depth) +
-                           " levels deep, at most " + std::to_string(kMaxNesting));
+  ParsedCommand parsed = ParseCommand(text, last_id_);
+  if (!parsed.ok()) {
+    SendError(std::move(parsed.error_id), parsed.error);
     return;
   }
-  json command;
-  try {
-    command = json::parse(text);
-  } catch (const json::exception& e) {
-    SendError(nullptr, std::string("malformed JSON: ") + e.what());
-    return;
-  }
-  if (!command.is_object()) {
-    SendError(nullptr, "a command must be a JSON object, got " + JsonTypeName(command));
-    return;
-  }
-  // The id, when there is a valid one, goes into every error below.
-  json id = nullptr;
-  const auto id_it = command.find("id");
-  const bool id_ok =
-      id_it != command.end() && id_it->is_number_integer() &&
-      !(id_it->is_number_unsigned() &&
-        id_it->get<uint64_t>() > static_cast<uint64_t>(std::numeric_limits<int64_t>::max()));
-  if (id_ok) id = id_it->get<int64_t>();
-  const auto type_it = command.find("type");
-  if (type_it == command.end()) {
-    SendError(id, "missing field 'type' (a string naming the command)");
-    return;
-  }
-  if (!type_it->is_string()) {
-    SendError(id, "field 'type' must be a string, got " + JsonTypeName(*type_it));
-    return;
-  }
-  if (id_it == command.end()) {
-    SendError(nullptr, "missing field 'id' (an integer that grows with each command)");
-    return;
-  }
-  if (!id_ok) {
-    SendError(nullptr, "field 'id' must be an integer (int64), got " +
-                           (id_it->is_number_integer() ? std::string("an out-of-range number")
-                                                       : JsonTypeName(*id_it)));
-    return;
-  }
-  const int64_t id_value = id.get<int64_t>();
-  if (last_id_ && id_value <= *last_id_) {
-    SendError(
-        id, "out of order: id " + std::to_string(id_value) + " after " + std::to_string(*last_id_));
-    return;
-  }
+  const json& command = parsed.command;
+  const json id = parsed.id;
+  const int64_t id_value = parsed.id;
   last_id_ = id_value;
 
   CommandHandler handler;

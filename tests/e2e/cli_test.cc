@@ -182,6 +182,12 @@ TEST(Cli, HugeInputsAreRefusedWithAClearErrorAndExitOne) {
         "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
         "property float z\nelement face 50000000\nproperty list uchar int vertex_indices\n"
         "end_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n");
+  // A binary STL of one triangle whose header says 50 million (80 header bytes, the count as
+  // a little-endian uint32, 50 bytes a triangle).
+  std::string stl(80, ' ');
+  stl += std::string("\x80\xf0\xfa\x02", 4);  // 50000000 = 0x02faf080
+  stl += std::string(50, '\0');
+  write("huge.stl", stl);
   std::string pipeline = "clock: {mode: simulated, step: 0.04, steps: 1}\ncomponents:\n";
   for (int i = 0; i < 10000; ++i) {
     pipeline += "  - {name: c" + std::to_string(i) + ", type: vision.stereo_faces}\n";
@@ -202,6 +208,14 @@ TEST(Cli, HugeInputsAreRefusedWithAClearErrorAndExitOne) {
       {"render --frames 1 --force --out " + (dir / "out").string() + " --scene " +
            write("model.yaml", "objects:\n  - {name: blob, kind: model, file: huge.ply}\n"),
        "huge.ply: the PLY header declares 50000000 faces"},
+      {"render --frames 1 --force --out " + (dir / "out").string() + " --scene " +
+           write("stl.yaml", "objects:\n  - {name: blob, kind: model, file: huge.stl}\n"),
+       "huge.stl: the binary STL header declares 50000000 triangles"},
+      // A device never ends: configuration files are read only when regular, and bounded.
+      {"fk --head /dev/zero --joints 0 0 0 0",
+       "/dev/zero: not a regular file (a folder, device or pipe); expected a head description"},
+      {"camera --calibration /dev/zero",
+       "/dev/zero: not a regular file (a device or pipe), expected a calibration file"},
       {"demo --pipeline " + write("pipeline.yaml", pipeline),
        "pipeline.yaml:3: components: 10000 components, more than the 1000"},
   };

@@ -1003,6 +1003,17 @@ TEST_F(CalibrationIoTest, MissingFileAndDirectoryThrowFileError) {
   }
 }
 
+TEST_F(CalibrationIoTest, ADeviceIsRefusedBeforeReading) {
+  // Issue 18: /dev/zero never ends; reading it whole took all memory.
+  try {
+    ReadCameraCalibration("/dev/zero");
+    ADD_FAILURE() << "no FileError";
+  } catch (const FileError& e) {
+    EXPECT_EQ(e.file(), "/dev/zero");
+    EXPECT_NE(std::string(e.what()).find("not a regular file"), std::string::npos) << e.what();
+  }
+}
+
 TEST_F(CalibrationIoTest, StereoImageSizeMissingEverywhereNamesImageWidth) {
   const fs::path path = WriteText("stereo.yml", kGoodStereo);
   try {

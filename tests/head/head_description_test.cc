@@ -374,6 +374,20 @@ TEST(HeadDescriptionTest, FileErrorsNameThePath) {
   std::filesystem::remove(bad);
 }
 
+TEST(HeadDescriptionTest, ADeviceOrFolderIsRefusedBeforeReading) {
+  // Issue 18: /dev/zero never ends; reading it whole took all memory.
+  for (const char* path : {"/dev/zero", "/tmp"}) {
+    try {
+      HeadDescription::FromYamlFile(path);
+      ADD_FAILURE() << "no FileError for " << path;
+    } catch (const FileError& error) {
+      EXPECT_EQ(error.file(), path);
+      EXPECT_NE(std::string(error.what()).find("not a regular file"), std::string::npos)
+          << error.what();
+    }
+  }
+}
+
 // The validating constructor, for descriptions built in code.
 class HeadDescriptionConstructorTest : public ::testing::Test {
  protected:

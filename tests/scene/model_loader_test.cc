@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
 #include <fstream>
 #include <iterator>
 #include <string>
@@ -199,6 +200,26 @@ TEST_F(ModelLoaderTest, RejectsAPlyHeaderThatClaimsMoreThanAModelMayHaveBeforeRe
   // The honest one loads.
   const auto honest = dir_.Write("one.ply", fmt::format(fmt::runtime(header), 1));
   EXPECT_EQ(Load(OneModel(honest.string())).objects().size(), 1u);
+}
+
+TEST_F(ModelLoaderTest, RejectsABinaryStlHeaderThatClaimsMoreThanAModelMayHave) {
+  // Issue 18: a model of 50 million triangles, as a 134-byte binary STL that says so.
+  const auto stl = [](uint32_t count, int facets) {
+    std::string bytes(80, ' ');
+    for (int i = 0; i < 4; ++i) bytes += static_cast<char>((count >> (8 * i)) & 0xff);
+    std::string facet(50, '\0');  // normal, three corners (floats), attribute bytes
+    const float corners[12] = {0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1, 0};
+    std::memcpy(facet.data(), corners, sizeof(corners));
+    for (int i = 0; i < facets; ++i) bytes += facet;
+    return bytes;
+  };
+  ExpectRejected(dir_.Write("huge.stl", stl(50'000'000, 1)).string(),
+                 {"the binary STL header declares 50000000 triangles, more than the 10000000"});
+  // Within the limit, but more than the file holds.
+  ExpectRejected(dir_.Write("lying.stl", stl(1000, 1)).string(),
+                 {"declares 1000 triangles, which need 50084 bytes, but the file holds 134"});
+  // The honest one loads.
+  EXPECT_EQ(Load(OneModel(dir_.Write("one.stl", stl(1, 1)).string())).objects().size(), 1u);
 }
 
 TEST_F(ModelLoaderTest, RejectsModelsWithoutTriangles) {
