@@ -161,11 +161,9 @@ std::optional<ResourceSpec> ParseScene(const Entry& root, const std::string& fil
 // A hardware file: component name -> its type and params; `scene` its scene, if it names one.
 std::map<std::string, ComponentSpec> LoadHardware(const std::string& path,
                                                   std::optional<ResourceSpec>* scene) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw FileError(path, 0, "", "cannot open the hardware file");
-  std::ostringstream text;
-  text << in.rdbuf();
-  const YAML::Node root_node = saccade::internal::ParseYaml(text.str(), path);
+  // A regular file of bounded size (not /dev/zero, a folder or a pipe).
+  const std::string text = saccade::internal::ReadConfigFile(path, "hardware file");
+  const YAML::Node root_node = saccade::internal::ParseYaml(text, path);
   const Entry root(root_node, "", &path, 1);
   root.ExpectMap({"scene", "components"},
                  "a hardware file {scene, components: {name: {type, params}}}");
@@ -402,11 +400,7 @@ PipelineSpec ParsePipeline(const std::string& text, const std::string& source,
 }
 
 PipelineSpec LoadPipelineFile(const std::string& path, const std::string& hardware) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw FileError(path, 0, "", "cannot open the pipeline file");
-  std::ostringstream text;
-  text << in.rdbuf();
-  return ParsePipeline(text.str(), path, hardware);
+  return ParsePipeline(saccade::internal::ReadConfigFile(path, "pipeline file"), path, hardware);
 }
 
 void ReplaceScene(PipelineSpec& spec, const std::string& path, const std::string& origin) {

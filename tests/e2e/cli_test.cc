@@ -216,6 +216,10 @@ TEST(Cli, HugeInputsAreRefusedWithAClearErrorAndExitOne) {
        "/dev/zero: not a regular file (a folder, device or pipe); expected a head description"},
       {"camera --calibration /dev/zero",
        "/dev/zero: not a regular file (a device or pipe), expected a calibration file"},
+      {"demo --pipeline /dev/zero",
+       "/dev/zero: not a regular file (a folder, device or pipe); expected a pipeline file"},
+      {"demo --hardware /dev/zero",
+       "/dev/zero: not a regular file (a folder, device or pipe); expected a hardware file"},
       {"demo --pipeline " + write("pipeline.yaml", pipeline),
        "pipeline.yaml:3: components: 10000 components, more than the 1000"},
   };
