@@ -1,10 +1,11 @@
 #!/usr/bin/env bash
 # The README's second command: set up, build, and run every test.
-# Warnings are errors (scripts/setup.sh). With CI=true: the scene loader and the Dynamixel
-# packet parser are fuzzed briefly
-# (libFuzzer), and the unit tests run a second time under AddressSanitizer and
-# UndefinedBehaviorSanitizer (build-asan/, which builds the unit tier only). Each phase's wall time is printed as it ends, and all of
-# them at the end, also when a phase fails. Compiles go through ccache (scripts/setup.sh).
+# Warnings are errors (scripts/setup.sh). With CI=true: every libFuzzer target (fuzz/run.sh:
+# scene, pipeline, hardware, head, calibration, GUI command, Dynamixel parser) is fuzzed
+# briefly, and the unit tests run a second time under AddressSanitizer and
+# UndefinedBehaviorSanitizer (build-asan/, which builds the unit tier only). Each phase's wall
+# time is printed as it ends, and all of them at the end, also when a phase fails. Compiles go
+# through ccache (scripts/setup.sh).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 jobs=$(nproc)
@@ -57,7 +58,7 @@ cache_figures
 end
 
 if $ci || [ "${SACCADE_FUZZ:-}" = "1" ]; then
-  begin "fuzzing: scene loader, Dynamixel parser (libFuzzer, ${SACCADE_FUZZ_SECONDS:-60} s)"
+  begin "fuzzing: seven targets (libFuzzer, ${SACCADE_FUZZ_SECONDS:-60} s)"
   bash fuzz/run.sh "${SACCADE_FUZZ_SECONDS:-60}"
   end
 fi
