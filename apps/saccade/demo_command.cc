@@ -130,7 +130,10 @@ int RunDemo(Options o) {
 
   runtime::RunOptions run;
   // With the GUI the loop runs until Ctrl-C (or SIGTERM).
-  run.steps = o.gui ? 0 : static_cast<int64_t>(std::ceil(o.duration / dt - 1e-9));
+  // On the real-time clock --duration is wall seconds: a loop slower than its rate still ends on
+  // time (a step count would run longer).
+  run.steps = o.gui || o.realtime ? 0 : static_cast<int64_t>(std::ceil(o.duration / dt - 1e-9));
+  if (o.realtime && !o.gui) run.seconds = o.duration;
   g_stop = false;
   run.stop = &g_stop;
   run.on_error = [&](const runtime::StepError& error) {
@@ -294,7 +297,7 @@ Runner AddDemoCommand(CLI::App& app) {
                    "recorded_cameras.yaml, emulated_servos.yaml, mirror.yaml, robot.yaml)")
       ->check(CLI::ExistingFile);
   demo->add_option("--duration", o->duration,
-                   "Longest run, simulated seconds; it ends sooner once every face was fixated")
+                   "Longest run, in seconds of the loop's clock (simulated; wall seconds with --realtime); it ends sooner once every face was fixated")
       ->capture_default_str();
   demo->add_option("--record", o->record,
                    "Folder for the annotated frames (frames/*.jpg), a video (demo.avi, MJPEG), "

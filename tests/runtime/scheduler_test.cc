@@ -366,6 +366,43 @@ components:
   for (std::size_t k = 1; k < r.size(); ++k) EXPECT_GT(r[k].time, r[k - 1].time);
 }
 
+TEST(SchedulerTest, SecondsEndTheRunOnItsClockEvenWhenStepsAreSlow) {
+  // Simulated: the steps whose time is under the bound (0, 0.25), whatever clock.steps says.
+  Pipeline simulated = Load(R"(clock: {mode: simulated, step: 0.25, steps: 100}
+components:
+  - {name: source, type: test.source}
+)");
+  RunOptions options;
+  options.seconds = 0.5;
+  EXPECT_EQ(RunPipeline(simulated, options).steps, 2);
+
+  // Real time, each step 30 ms against a 10 ms period: 0.2 s of wall clock hold about 7 steps,
+  // not the 20 that 0.2 s at 100 Hz would count, and no step starts at or after 0.2 s.
+  struct Slow : Component {
+    std::vector<double> times;
+    void Step(const StepContext& context) override {
+      times.push_back(context.time);
+      std::this_thread::sleep_for(std::chrono::milliseconds(30));
+    }
+  };
+  ComponentRegistry registry = MakeTestRegistry();
+  registry.Register<Slow>("test.slow");
+  Pipeline realtime = Pipeline::LoadString(R"(clock: {mode: realtime, rate_hz: 100}
+components:
+  - {name: slow, type: test.slow}
+)",
+                                           "run.yaml", registry);
+  options.seconds = 0.2;
+  options.steps = 0;
+  const RunSummary summary = RunPipeline(realtime, options);
+  const std::vector<double>& times = realtime.Find<Slow>("slow")->times;
+  ASSERT_EQ(static_cast<int64_t>(times.size()), summary.steps);
+  EXPECT_GE(summary.steps, 1);
+  EXPECT_LE(summary.steps, 8);
+  for (const double t : times) EXPECT_LT(t, 0.2);
+  EXPECT_GT(summary.overruns, 0);
+}
+
 TEST(SchedulerTest, StopFlagEndsAnUnboundedRun) {
   Pipeline pipeline = Load(R"(components:
   - {name: source, type: test.source}

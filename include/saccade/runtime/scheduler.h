@@ -87,6 +87,10 @@ struct StepTiming {
 struct RunOptions {
   /// Overrides the pipeline's clock.steps when >= 0 (0: until `stop`).
   int64_t steps = -1;
+  /// When > 0, also ends the run before the first step whose time reaches it (seconds of the
+  /// run's clock: on the real-time clock the wall seconds since the loop began, so a loop slower
+  /// than its rate still ends on time; steps then bounds nothing and may be 0).
+  double seconds = 0.0;
   /// Set (from another thread, a signal handler) to end the run after the current step.
   const std::atomic<bool>* stop = nullptr;
   /// Told of each failure as it happens (e.g. to log it); may be empty.
