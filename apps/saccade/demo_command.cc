@@ -134,6 +134,7 @@ int RunDemo(Options o) {
   // time (a step count would run longer).
   run.steps = o.gui || o.realtime ? 0 : static_cast<int64_t>(std::ceil(o.duration / dt - 1e-9));
   if (o.realtime && !o.gui) run.seconds = o.duration;
+  run.live = o.gui;  // paced by the page: detection on its own thread, frames pipelined
   g_stop = false;
   run.stop = &g_stop;
   run.on_error = [&](const runtime::StepError& error) {
@@ -297,7 +298,8 @@ Runner AddDemoCommand(CLI::App& app) {
                    "recorded_cameras.yaml, emulated_servos.yaml, mirror.yaml, robot.yaml)")
       ->check(CLI::ExistingFile);
   demo->add_option("--duration", o->duration,
-                   "Longest run, in seconds of the loop's clock (simulated; wall seconds with --realtime); it ends sooner once every face was fixated")
+                   "Longest run, in seconds of the loop's clock (simulated; wall seconds with "
+                   "--realtime); it ends sooner once every face was fixated")
       ->capture_default_str();
   demo->add_option("--record", o->record,
                    "Folder for the annotated frames (frames/*.jpg), a video (demo.avi, MJPEG), "

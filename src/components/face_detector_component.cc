@@ -35,6 +35,10 @@ FaceDetectorComponent::FaceDetectorComponent()
                "0: detect within the step; N: detect on a thread of its own, the faces emitted N "
                "steps after their image (simulated clock; real time: once ready)")
       .Range(0, 100);
+  DeclareParam("realtime_thread", &realtime_thread_,
+               "on the real-time clock (saccade demo --realtime, the GUI), detect on a thread of "
+               "its own whatever latency_steps says, the faces emitted once ready, so that the "
+               "loop runs at camera rate; false: within the step");
   DeclareParam("track_region_scale", &track_region_scale_,
                "with a track input: search a box this many times the track's window around "
                "it; 0: always the whole image")
@@ -113,7 +117,8 @@ FacesMessage FaceDetectorComponent::Detect(std::shared_ptr<const Image> image,
 }
 
 void FaceDetectorComponent::Step(const runtime::StepContext& context) {
-  if (latency_steps_ == 0) {
+  const bool own_thread = latency_steps_ > 0 || (context.realtime && realtime_thread_);
+  if (!own_thread) {
     if (image_.fresh() && image_.value().image) {
       const std::shared_ptr<const Image>& image = image_.value().image;
       faces_.Emit(Detect(image, NextSearch(*image)));

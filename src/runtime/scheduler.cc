@@ -106,8 +106,9 @@ RunSummary RunPipeline(Pipeline& pipeline, const RunOptions& options) {
   const PipelineSpec& spec = pipeline.spec();
   const int64_t steps = options.steps >= 0 ? options.steps : spec.clock.steps;
   if (steps == 0 && options.stop == nullptr && !(options.seconds > 0.0)) {
-    throw InvalidArgument("RunPipeline: pipeline '" + spec.file +
-                          "' has no clock.steps and no stop flag or seconds were given: it would never end");
+    throw InvalidArgument(
+        "RunPipeline: pipeline '" + spec.file +
+        "' has no clock.steps and no stop flag or seconds were given: it would never end");
   }
   const bool realtime = spec.clock.mode == ClockMode::kRealtime;
   const double dt = realtime ? 1.0 / spec.clock.rate_hz : spec.clock.step;
@@ -170,7 +171,7 @@ RunSummary RunPipeline(Pipeline& pipeline, const RunOptions& options) {
       // Simulated time is a product, not a running sum: no drift, the same on every run.
       context.time = realtime ? Seconds(tick_start - loop_start) : static_cast<double>(k) * dt;
       context.dt = dt;
-      context.realtime = realtime;
+      context.realtime = realtime || options.live;
       if (options.seconds > 0.0 && context.time >= options.seconds) break;
 
       pipeline.DeliverDelayed();

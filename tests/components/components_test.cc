@@ -3,12 +3,14 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstring>
 #include <memory>
 #include <opencv2/imgproc.hpp>
 #include <optional>
 #include <string>
+#include <thread>
 
 #include "image_camera_helpers.h"
 #include "saccade/components/face_truth.h"
@@ -309,6 +311,48 @@ TEST(FaceDetectorComponent, SearchesAroundTheTrackAndTheWholeImageEveryNthTime) 
   EXPECT_NEAR(near[0].box.width, face->width, kBoxTolerancePx);
 }
 
+// On the real-time clock detection runs on a thread of its own (the loop goes on at camera
+// rate): the step that brings the image emits nothing, a later one emits the faces of that
+// image, the same as a detection within the step. realtime_thread: false detects within it.
+TEST(FaceDetectorComponent, OnTheRealTimeClockDetectsOnAThreadOfItsOwn) {
+  const scene::Scene& scene = Scene();
+  const head::IkResult look =
+      head::SolveFixation(scene.robot()->head, FaceCentreAt(scene, Astronaut(), 0.0));
+  ASSERT_TRUE(look.reachable());
+  const std::shared_ptr<const Image> image = RenderOne(kScene, "left", look.joints, {});
+  const auto realtime = [](int64_t step) {
+    runtime::StepContext context = At(step);
+    context.realtime = true;
+    return context;
+  };
+  auto within = Make("vision.face_detector", {{"realtime_thread", false}});
+  auto want = Capture<FacesMessage>(*within, "faces");
+  In<runtime::ImageMessage>(*within, "image").Deliver(runtime::ImageMessage{image});
+  within->Step(realtime(0));
+  ASSERT_TRUE(want->has_value());  // within the step
+  ASSERT_FALSE((*want)->faces.empty());
+
+  auto threaded = Make("vision.face_detector", json::object());
+  auto got = Capture<FacesMessage>(*threaded, "faces");
+  In<runtime::ImageMessage>(*threaded, "image").Deliver(runtime::ImageMessage{image});
+  threaded->Step(realtime(0));
+  EXPECT_FALSE(got->has_value());  // started, not waited for
+  int64_t step = 1;
+  const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+  while (!got->has_value() && std::chrono::steady_clock::now() < give_up) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    threaded->Step(realtime(step++));  // no new image: only collects
+  }
+  ASSERT_TRUE(got->has_value());
+  EXPECT_EQ((*got)->image, image);  // stamped with the frame it came from
+  ASSERT_EQ((*got)->faces.size(), (*want)->faces.size());
+  for (std::size_t i = 0; i < (*want)->faces.size(); ++i) {
+    EXPECT_EQ((*got)->faces[i].box, (*want)->faces[i].box) << i;
+    EXPECT_EQ((*got)->faces[i].rejected, (*want)->faces[i].rejected) << i;
+  }
+  threaded->Stop();
+}
+
 TEST(SimCameras, TheHeadsMotionBlursTheEyeImages) {
   const std::string portraits = std::string(SACCADE_SOURCE_DIR) + "/scenes/portraits.yaml";
   const head::JointState still{0.0, 0.0, 0.0, 0.0};
@@ -499,7 +543,8 @@ TEST(ComponentParams, UnknownMissingAndOutOfRangeParametersAreNamed) {
   };
   EXPECT_EQ(message("vision.face_detector", {{"min_neighbours", 3}}),
             "unknown parameter 'min_neighbours' (known: cascade, full_scan_every, latency_steps, "
-            "max_size_px, min_neighbors, min_size_px, pyramid_level, region_pyramid_level, "
+            "max_size_px, min_neighbors, min_size_px, pyramid_level, realtime_thread, "
+            "region_pyramid_level, "
             "reject_cats, require_eyes, "
             "scale_factor, track_region_scale)");
   EXPECT_EQ(message("vision.camshift", json::object()),

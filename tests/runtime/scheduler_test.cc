@@ -403,6 +403,35 @@ components:
   EXPECT_GT(summary.overruns, 0);
 }
 
+// A live run (the GUI's, paced from outside) tells components that work may finish when it
+// does, on the simulated clock's times.
+TEST(SchedulerTest, ALiveRunIsRealTimeToComponentsOnSimulatedTimes) {
+  struct Probe : Component {
+    std::vector<std::pair<double, bool>> seen;
+    void Step(const StepContext& context) override {
+      seen.emplace_back(context.time, context.realtime);
+    }
+  };
+  ComponentRegistry registry = MakeTestRegistry();
+  registry.Register<Probe>("test.probe");
+  for (const bool live : {false, true}) {
+    Pipeline pipeline = Pipeline::LoadString(R"(clock: {mode: simulated, step: 0.5, steps: 3}
+components:
+  - {name: probe, type: test.probe}
+)",
+                                             "run.yaml", registry);
+    RunOptions options;
+    options.live = live;
+    RunPipeline(pipeline, options);
+    const auto& seen = pipeline.Find<Probe>("probe")->seen;
+    ASSERT_EQ(seen.size(), 3u);
+    for (std::size_t k = 0; k < seen.size(); ++k) {
+      EXPECT_EQ(seen[k].first, 0.5 * static_cast<double>(k));
+      EXPECT_EQ(seen[k].second, live);
+    }
+  }
+}
+
 TEST(SchedulerTest, StopFlagEndsAnUnboundedRun) {
   Pipeline pipeline = Load(R"(components:
   - {name: source, type: test.source}

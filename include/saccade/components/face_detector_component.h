@@ -52,11 +52,12 @@ class FaceDetectorComponent : public runtime::Component {
   bool reject_cats_ = true;
   bool require_eyes_ = true;
   int latency_steps_ = 0;
+  bool realtime_thread_ = true;
   double track_region_scale_ = 0.0;
   int full_scan_every_ = 5;
   int region_pyramid_level_ = 0;
   int64_t detections_ = 0;  // started so far
-  // The detection in flight (latency_steps > 0) and the step its faces are due.
+  // The detection in flight (on its own thread) and the step its faces are due.
   std::future<FacesMessage> running_;
   int64_t due_step_ = 0;
   std::shared_ptr<const Image> last_;  // the image detected last

@@ -34,8 +34,9 @@ struct StepContext {
   double time = 0.0;  ///< s: step * dt when simulated, wall time since start in real time
   double dt = 0.0;    ///< s: the nominal step (1 / rate_hz in real time)
   uint64_t seed = 0;  ///< this component's seed: f(pipeline seed, component name), constant
-  /// The wall clock runs the loop (clock mode realtime): work may finish when it does. When
-  /// false, a component that models a latency must keep to it, for runs to be repeatable.
+  /// The wall clock runs the loop (clock mode realtime, or a live run paced from outside, as
+  /// the GUI's: RunOptions::live): work may finish when it does. When false, a component that
+  /// models a latency must keep to it, for runs to be repeatable.
   bool realtime = false;
 };
 

@@ -91,6 +91,10 @@ struct RunOptions {
   /// run's clock: on the real-time clock the wall seconds since the loop began, so a loop slower
   /// than its rate still ends on time; steps then bounds nothing and may be 0).
   double seconds = 0.0;
+  /// The loop runs live, paced against the wall clock from outside (the GUI's after_step
+  /// waits): components see StepContext::realtime true -- work may finish when it does, as on
+  /// the real-time clock -- while the time stays the simulated clock's (step * dt).
+  bool live = false;
   /// Set (from another thread, a signal handler) to end the run after the current step.
   const std::atomic<bool>* stop = nullptr;
   /// Told of each failure as it happens (e.g. to log it); may be empty.
