@@ -167,7 +167,7 @@ void GuiSession::Enqueue(std::function<void()> action) {
   queue_.push_back(std::move(action));
 }
 
-void GuiSession::ApplyQueued() {
+int GuiSession::ApplyQueued() {
   std::vector<std::function<void()>> actions;
   {
     std::lock_guard lock(queue_mutex_);
@@ -180,6 +180,7 @@ void GuiSession::ApplyQueued() {
       server_->Broadcast({{"type", "event"}, {"level", "error"}, {"message", error.what()}});
     }
   }
+  return static_cast<int>(actions.size());
 }
 
 void GuiSession::SetPerception(bool enabled) {
@@ -261,7 +262,7 @@ json GuiSession::Handle(const json& command, int64_t client) {
       c.time = sim_time_;
       c.positions = target;
       c.velocities = {0.0, 0.0, 0.0, 0.0};
-      head_->Move(c);
+      commanded_ = head_->Move(c);
     });
     reply["perception"] = false;
     return reply;
@@ -371,8 +372,9 @@ json GuiSession::StateJson(const runtime::StepContext& context, const Latest& la
     state["effects"] = nullptr;
   }
   std::optional<head::HeadFrames> frames;
-  if (latest.joints && scene_.robot()) {
-    const JointStateMessage& j = *latest.joints;
+  const std::optional<JointStateMessage>& joints = commanded_ ? commanded_ : latest.joints;
+  if (joints && scene_.robot()) {
+    const JointStateMessage& j = *joints;
     state["joints"] = {{"positions", ToJson(j.positions)},
                        {"targets", ToJson(j.targets)},
                        {"velocities", ToJson(j.velocities)},
@@ -443,6 +445,7 @@ void GuiSession::AfterStep(const runtime::StepContext& context, const Latest& la
   if (step_walls_.size() > 26) step_walls_.erase(step_walls_.begin());
   sim_time_ = context.time + context.dt;
 
+  commanded_.reset();  // this step's joints are the newest
   ApplyQueued();
   server_->PublishState(StateJson(context, latest));
 
@@ -467,7 +470,8 @@ void GuiSession::AfterStep(const runtime::StepContext& context, const Latest& la
   int64_t waited = 0;
   control_.WaitBeforeNext(context, stop, [&](bool paused) {
     if (!paused) {
-      ApplyQueued();
+      // A hand command while the loop waits for its pace: the page sees its targets at once.
+      if (ApplyQueued() > 0) server_->PublishState(StateJson(context, latest));
       return;
     }
     bool pending = false;

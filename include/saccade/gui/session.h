@@ -67,7 +67,7 @@ class GuiSession {
  private:
   nlohmann::json Handle(const nlohmann::json& command, int64_t client);
   void Enqueue(std::function<void()> action);
-  void ApplyQueued();
+  int ApplyQueued();  // how many commands it applied
   nlohmann::json StateJson(const runtime::StepContext& context, const Latest& latest);
   void EncodeLoop();
   head::JointState CurrentTargets() const;
@@ -95,6 +95,9 @@ class GuiSession {
   std::mutex effects_mutex_;
   render::RendererOptions effects_;  // as last asked (effects_mutex_)
   nlohmann::json head_status_;       // hw.head's newest status, null without one
+  // The head's state as a hand command left it (its reply: the new targets), newer than the
+  // last step's until the next step ends; the states published meanwhile show it.
+  std::optional<JointStateMessage> commanded_;
   mutable std::mutex joints_mutex_;
   head::JointState targets_;  // the latest targets, for partial joint commands (joints_mutex_)
 
