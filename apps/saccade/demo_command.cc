@@ -196,6 +196,7 @@ int RunDemo(Options o) {
   if (report.pair_counts) report.cameras_description = cameras->Describe();
   report.head = head_status;
   report.interrupted = g_stop.load() && scorer.faces_fixated() < faces_total;
+  report.realtime = o.realtime;
   json report_json = report.Json();
   if (recorder) {
     report_json["record"] = {{"folder", o.record},

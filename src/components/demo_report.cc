@@ -93,6 +93,7 @@ json DemoReport::Json() const {
       {"wall_s", summary.wall_seconds},
       {"real_time_factor", real_time_factor()},
       {"steps_per_second", steps_per_second()},
+      {"overruns", realtime ? json(summary.overruns) : json(nullptr)},
       {"faces", scorer->faces_total()},
       {"faces_fixated", scorer->faces_fixated()},
       {"fixations", fixations},
@@ -135,6 +136,12 @@ std::string DemoReport::Text(const std::string& record) const {
   }
   out += fmt::format("{:.1f} steps per second, real-time factor {:.2f} (simulated s per wall s)\n",
                      steps_per_second(), real_time_factor());
+  if (realtime) {
+    // A step that ends after the next tick was due: the loop skips the missed ticks (no
+    // backlog, no burst), so this counts the camera periods it could not keep.
+    out += fmt::format("real time: {} of {} steps overran their period of {:.1f} ms\n",
+                       summary.overruns, summary.steps, 1e3 * dt);
+  }
   if (pair_counts) out += fmt::format("cameras: {}\n", cameras_description);
   if (!exposure_samples.empty()) {
     out += "motion blur: frames by sub-frames drawn";

@@ -177,6 +177,16 @@ TEST(DemoCli, RunsInRealTime) {
   EXPECT_DOUBLE_EQ(report["steps_per_second"].get<double>(),
                    steps / report["wall_s"].get<double>());
   EXPECT_LE(report["real_time_factor"].get<double>(), 1.0 + 0.04 / report["wall_s"].get<double>());
+  // --duration is wall seconds here: no step starts at or after 0.4 s, however slow the steps.
+  EXPECT_LT(time - 0.04, 0.4);
+  // The steps that overran their 40 ms are counted, and only on the real-time clock.
+  ASSERT_TRUE(report["overruns"].is_number_integer()) << report;
+  EXPECT_GE(report["overruns"].get<int64_t>(), 0);
+  EXPECT_LE(report["overruns"].get<int64_t>(), steps);
+  const CommandRun simulated = Saccade("demo --scene " + kTwoPictures + " --duration 0.08 --json");
+  const std::size_t b = simulated.output.find('{'), e = simulated.output.rfind('}');
+  ASSERT_NE(b, std::string::npos) << simulated.output;
+  EXPECT_TRUE(json::parse(simulated.output.substr(b, e - b + 1))["overruns"].is_null());
 }
 
 TEST(DemoCli, ListsItsComponents) {

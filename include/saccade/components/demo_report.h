@@ -74,6 +74,7 @@ struct DemoReport {
   std::string cameras_description;              ///< real cameras: a line about the sources
   std::optional<HeadStatusMessage> head;        ///< the head's last status
   bool interrupted = false;                     ///< stopped before every face was fixated
+  bool realtime = false;                        ///< on the real-time clock (overruns count)
 
   double sim_time() const { return summary.sim_time + dt; }
   double steps_per_second() const;
