@@ -168,6 +168,11 @@ void AddRendererOptions(CLI::App* command, render::RendererOptions* options) {
   command->add_flag_callback(
       "--no-blur", [options] { options->motion_blur = false; },
       "No motion blur (the scene's sensor: exposure, blur_samples): each frame an instant");
+  command->add_flag_callback(
+      "--no-turn-blur", [options] { options->turn_blur = false; },
+      "Motion blur of a turning camera draws every sub-frame, instead of a few drawn instants "
+      "seen through the turn (used while the parallax and moving items depart from drawing by "
+      "at most 1 px)");
 }
 
 }  // namespace

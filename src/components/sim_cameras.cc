@@ -19,6 +19,14 @@ SimCameras::SimCameras() : joints_(AddInput<JointStateMessage>("joints")) {
   DeclareParam("distortion", &options_.distortion, "the calibrations' lens distortion");
   DeclareParam("noise", &options_.noise, "sensor noise, seeded per camera and frame");
   DeclareParam("motion_blur", &options_.motion_blur, "blur over each camera's exposure");
+  DeclareParam("turn_blur", &options_.turn_blur,
+               "motion blur of a turning camera (a saccade) from a few drawn instants seen "
+               "through the turn, while the parallax and moving items stay within "
+               "turn_blur_max_error_px; false: every sub-frame drawn");
+  DeclareParam("turn_blur_max_error_px", &options_.turn_blur_max_error_px,
+               "turn_blur's bound on how far a sub-frame may depart from drawing it")
+      .Range(0.0, 1e6)
+      .Unit("px");
   DeclareParam("msaa", &options_.msaa_samples, "multisample anti-aliasing: 0, 2, 4 or 8 samples")
       .Range(0, 8);
   DeclareParam("lod_max_error_px", &options_.lod_max_error_px,

@@ -18,6 +18,9 @@ bool RendererOptions::IsValid(std::string* error) const {
     message =
         fmt::format("lod_max_error_px must be finite and >= 0 (0: full detail always), got {}",
                     lod_max_error_px);
+  } else if (!std::isfinite(turn_blur_max_error_px) || turn_blur_max_error_px < 0.0) {
+    message = fmt::format("turn_blur_max_error_px must be finite and >= 0, got {}",
+                          turn_blur_max_error_px);
   } else {
     std::set<std::string> seen;
     for (const std::string& name : cameras) {

@@ -57,6 +57,16 @@ struct RendererOptions {
   bool noise = true;
   /// Motion blur over the exposure (SensorSpec::exposure, blur_samples).
   bool motion_blur = true;
+  /// Motion blur of a turning camera (a saccade): the exposure is cut into the fewest
+  /// stretches whose sub-frames are each the instant drawn at the stretch's middle seen
+  /// through the turn's homographies (a scene pass and a pass of fetches a stretch, instead of
+  /// a scene pass a sub-frame) while what the turn alone cannot explain (the parallax of the
+  /// camera's shift, items moving in the world) moves no sub-frame more than
+  /// turn_blur_max_error_px from where drawing it would put it (a bound); used when that takes
+  /// fewer stretches than sub-frames and the lens needs one source view (not a cube). false, or
+  /// a bound of 0 with anything but a pure turn: every sub-frame drawn.
+  bool turn_blur = true;
+  double turn_blur_max_error_px = 1.0;  ///< finite, >= 0
 
   /// Ground truth per frame (Frame::depth, ids, objects), consistent with the distortion:
   /// drawn at the frame's time (the middle of the exposure), without blur or noise.

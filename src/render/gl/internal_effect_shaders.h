@@ -29,6 +29,32 @@ void main() {
 }
 )";
 
+/// Motion blur of a camera that turns over the exposure: one instant is drawn and each
+/// sub-frame k of its stretch of the exposure is that view seen through the homography of the
+/// turn, u_h[k] (maps a pixel of sub-frame k, image coordinates with pixel centres at integers,
+/// to the drawn view's), so the pixel gets u_weight times the sum of u_count bilinear fetches
+/// along its path. Writes (or, blending, adds to) the accumulation layer (RGBA32F); outside the
+/// drawn view the fetch clamps to its edge.
+inline constexpr int kMaxTurnBlurSamples = 64;
+inline constexpr const char* kTurnBlurFragmentSource = R"(#version 330 core
+uniform sampler2DArray u_source;
+uniform int u_layer;
+uniform int u_count;
+uniform float u_weight;
+uniform mat3 u_h[64];
+out vec4 o_color;
+void main() {
+  vec2 inverse_size = 1.0 / vec2(textureSize(u_source, 0).xy);
+  vec3 p = vec3(gl_FragCoord.xy - 0.5, 1.0);
+  vec4 sum = vec4(0.0);
+  for (int k = 0; k < u_count; ++k) {
+    vec3 q = u_h[k] * p;
+    sum += texture(u_source, vec3((q.xy / q.z + 0.5) * inverse_size, float(u_layer)));
+  }
+  o_color = u_weight * sum;
+}
+)";
+
 /// The camera's image: lens remap, sensor noise, quantisation to 8 bits.
 /// IDENTITY 1: the source is the image itself (no distortion), one layer at the image's size.
 /// Otherwise u_map holds, per pixel, (x, y, view, taps) (internal_effects.h, RemapTable):

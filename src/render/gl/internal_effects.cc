@@ -198,6 +198,14 @@ EffectPrograms::EffectPrograms() {
   accumulate_weight_ = Uniform(accumulate_, "u_weight");
   glUseProgram(accumulate_);
   glUniform1i(Uniform(accumulate_, "u_source"), kSourceUnit);
+  turn_blur_ = BuildProgram("motion blur of a turning camera", kFullscreenVertexSource,
+                            kTurnBlurFragmentSource);
+  turn_blur_layer_ = Uniform(turn_blur_, "u_layer");
+  turn_blur_count_ = Uniform(turn_blur_, "u_count");
+  turn_blur_weight_ = Uniform(turn_blur_, "u_weight");
+  turn_blur_h_ = Uniform(turn_blur_, "u_h");
+  glUseProgram(turn_blur_);
+  glUniform1i(Uniform(turn_blur_, "u_source"), kSourceUnit);
   truth_.program = BuildProgram("ground truth", kTruthVertexSource, kTruthFragmentSource);
   truth_.mvp = Uniform(truth_.program, "u_mvp");
   truth_.mv = Uniform(truth_.program, "u_mv");
@@ -214,6 +222,7 @@ EffectPrograms::~EffectPrograms() {
   glDeleteVertexArrays(1, &vao_);
   glDeleteTextures(1, &gauss_);
   glDeleteProgram(accumulate_);
+  glDeleteProgram(turn_blur_);
   glDeleteProgram(truth_.program);
   for (const auto& [variant, final] : finals_) glDeleteProgram(final.program);
   for (const auto& [variant, program] : truth_remaps_) glDeleteProgram(program);
@@ -443,6 +452,37 @@ void EffectTarget::WriteBack(const EffectPrograms& programs, int view) const {
   glUniform1f(programs.accumulate_weight(), 1.0f);
   BindTexture(kSourceUnit, GL_TEXTURE_2D_ARRAY, accumulation_);
   programs.DrawFullscreen();
+  glEnable(GL_DEPTH_TEST);
+  glActiveTexture(GL_TEXTURE0);
+}
+
+void EffectTarget::TurnBlur(const EffectPrograms& programs, int view,
+                            const std::vector<Eigen::Matrix3f>& homographies, float weight,
+                            Accumulation mode) const {
+  const int count = static_cast<int>(homographies.size());
+  if (count < 1 || count > kMaxTurnBlurSamples) {
+    throw Error(
+        fmt::format("TurnBlur: {} homographies, expected 1 to {}", count, kMaxTurnBlurSamples));
+  }
+  std::vector<float> h;  // column-major, as GL takes mat3s without transposing
+  h.reserve(9 * homographies.size());
+  for (const Eigen::Matrix3f& m : homographies) h.insert(h.end(), m.data(), m.data() + 9);
+  glBindFramebuffer(GL_FRAMEBUFFER, accumulation_framebuffer_);
+  glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, accumulation_, 0, view);
+  glViewport(0, 0, source_width_, source_height_);
+  glDisable(GL_DEPTH_TEST);
+  if (mode == Accumulation::kAdd) {
+    glEnable(GL_BLEND);
+    glBlendFunc(GL_ONE, GL_ONE);
+  }
+  glUseProgram(programs.turn_blur());
+  glUniform1i(programs.turn_blur_layer(), view);
+  glUniform1i(programs.turn_blur_count(), count);
+  glUniform1f(programs.turn_blur_weight(), weight);
+  glUniformMatrix3fv(programs.turn_blur_h(), count, GL_FALSE, h.data());
+  BindTexture(kSourceUnit, GL_TEXTURE_2D_ARRAY, source_);
+  programs.DrawFullscreen();
+  glDisable(GL_BLEND);
   glEnable(GL_DEPTH_TEST);
   glActiveTexture(GL_TEXTURE0);
 }

@@ -22,6 +22,7 @@
 
 #include <epoxy/gl.h>
 
+#include <Eigen/Core>
 #include <array>
 #include <cstdint>
 #include <map>
@@ -79,6 +80,11 @@ class EffectPrograms {
   GLuint accumulate() const { return accumulate_; }
   GLint accumulate_layer() const { return accumulate_layer_; }
   GLint accumulate_weight() const { return accumulate_weight_; }
+  GLuint turn_blur() const { return turn_blur_; }
+  GLint turn_blur_layer() const { return turn_blur_layer_; }
+  GLint turn_blur_count() const { return turn_blur_count_; }
+  GLint turn_blur_weight() const { return turn_blur_weight_; }
+  GLint turn_blur_h() const { return turn_blur_h_; }
   /// GaussianTable() as a kGaussianTableSide^2 RGB32F texture.
   GLuint gauss() const { return gauss_; }
   /// Draws the full-screen triangle (program and framebuffer bound by the caller).
@@ -89,6 +95,8 @@ class EffectPrograms {
   GLuint accumulate_ = 0;
   GLuint gauss_ = 0;
   GLint accumulate_layer_ = -1, accumulate_weight_ = -1;
+  GLuint turn_blur_ = 0;
+  GLint turn_blur_layer_ = -1, turn_blur_count_ = -1, turn_blur_weight_ = -1, turn_blur_h_ = -1;
   std::map<int, Final> finals_;
   std::map<int, GLuint> truth_remaps_;
   Truth truth_;
@@ -145,6 +153,13 @@ class EffectTarget {
   /// source layer (to 8 bits, as the scene passes draw), honouring the scissor test; the final
   /// pass then reads the source (Finish with `accumulated` false).
   void WriteBack(const EffectPrograms& programs, int view) const;
+  /// Motion blur of a turning camera (kTurnBlurFragmentSource): writes (kReplace) or adds to
+  /// (kAdd) the view's accumulation layer `weight` times the sum of its drawn layer seen
+  /// through each homography (at most kMaxTurnBlurSamples); the final pass then reads the
+  /// accumulation.
+  void TurnBlur(const EffectPrograms& programs, int view,
+                const std::vector<Eigen::Matrix3f>& homographies, float weight,
+                Accumulation mode) const;
   /// Binds the truth framebuffer of `view`, sets the viewport and clears it (id 0, z 0).
   void BindTruthForDrawing(int view) const;
 

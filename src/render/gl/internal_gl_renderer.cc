@@ -9,6 +9,7 @@
 #include <optional>
 #include <utility>
 
+#include "render/gl/internal_effect_shaders.h"
 #include "render/gl/internal_gl_renderer_impl.h"
 #include "render/gl/internal_lod.h"
 #include "render/gl/internal_shaders.h"
@@ -96,6 +97,7 @@ GlRenderer::GlRenderer(const scene::Scene& scene, const RendererOptions& options
     if (object.model) AddItem(*object.model, object.scale, static_cast<int>(i), -1);
   }
   draw_robot_ = options_.draw_robot && scene_.robot().has_value() && scene_.robot()->visible;
+  turn_blur_max_error_px_ = options_.turn_blur ? options_.turn_blur_max_error_px : -1.0;
   if (draw_robot_) {
     const std::vector<scene::RobotPart>& parts = scene_.robot()->parts;
     for (std::size_t i = 0; i < parts.size(); ++i) {
@@ -399,7 +401,7 @@ geometry::Pose GlRenderer::ItemPose(const DrawItem& item, const scene::SceneStat
 
 double GlRenderer::ImageMotionPx(int camera, const scene::SceneState& s0,
                                  const scene::SceneState& s1, double* camera_px,
-                                 std::vector<double>* item_px) const {
+                                 std::vector<double>* item_px, double* turn_only_px) const {
   const scene::CameraSpec& spec = *cameras_[camera];
   const geometry::Intrinsics& k = spec.model.intrinsics();
   const double near = spec.clip.near;
@@ -421,9 +423,21 @@ double GlRenderer::ImageMotionPx(int camera, const scene::SceneState& s0,
   // its height) and each item by its own depth, as do the items' own motions.
   const double turn = angle(X_WC0.linear().transpose() * X_WC1.linear());
   const Eigen::Vector3d camera_shift = X_WC1.translation() - X_WC0.translation();
-  double px = turn_gain * turn +
-              shift_gain * camera_shift.norm() / std::max(std::abs(X_WC0.translation().z()), near);
+  const double ground_shift_px =
+      shift_gain * camera_shift.norm() / std::max(std::abs(X_WC0.translation().z()), near);
+  double px = turn_gain * turn + ground_shift_px;
   if (camera_px != nullptr) *camera_px = px;
+  // What a homography of the turn cannot follow: the parallax of a shift d (camera frame)
+  // moves a point at depth z and normalised image position q by (q d_z - d_xy) / (z - d_z),
+  // at most (|d_xy| + |q|max |d_z|) / (z - |d_z|): a sideways shift (the eyes swung by the
+  // neck's pan) is not charged the corners' gain, which only the shift along the axis has.
+  const double corner = std::hypot(tx, ty);
+  const auto parallax_px = [&](const Eigen::Vector3d& d_C, double depth) {
+    return f * (d_C.head<2>().norm() + corner * std::abs(d_C.z())) /
+           std::max(depth - std::abs(d_C.z()), near);
+  };
+  double off_turn = parallax_px(X_WC0.linear().transpose() * camera_shift,
+                                std::max(std::abs(X_WC0.translation().z()), near));
   std::optional<head::HeadFrames> frames0, frames1;
   if (draw_robot_) {
     frames0 = head::ForwardKinematics(scene_.robot()->head, s0.joints);
@@ -439,6 +453,7 @@ double GlRenderer::ImageMotionPx(int camera, const scene::SceneState& s0,
   };
   const geometry::Pose X_CW0 = X_WC0.inverse(), X_CW1 = X_WC1.inverse();
   if (item_px != nullptr) item_px->assign(items_.size(), 0.0);
+  const std::vector<ViewSetup>& views = setups_[camera].views;
   for (std::size_t i = 0; i < items_.size(); ++i) {
     const DrawItem& item = items_[i];
     const geometry::Pose X_WO0 = ItemPose(item, s0, frames0);
@@ -466,7 +481,27 @@ double GlRenderer::ImageMotionPx(int camera, const scene::SceneState& s0,
     const double item_motion = std::min(in_camera, in_world);
     if (item_px != nullptr) (*item_px)[i] = item_motion;
     px = std::max(px, item_motion);
+    // Where the item is at s1 in the camera, against where the camera's turn alone would put
+    // it: a still item is off by the camera's shift (parallax), a part that moves with the
+    // camera by the turn itself, a moving item by its motion. An item whose box is out of the
+    // (single) view at both ends is not seen: the head's body behind the eyes, whose bounding
+    // sphere reaches past them.
+    if (item.model != nullptr && !item.model->bounds.isEmpty() && views.size() == 1) {
+      const auto box_outside = [&](const geometry::Pose& X_WC, const geometry::Pose& X_WO) {
+        geometry::Pose X_WV = X_WC;
+        X_WV.linear() = X_WC.linear() * views[0].R_CV;
+        Eigen::Affine3d MV = EyeFromWorld(X_WV) * X_WO;
+        MV.linear() = MV.linear() * item.scale.asDiagonal();
+        return OutsideFrustum(views[0].projection * MV.matrix(), item.model->bounds);
+      };
+      if (box_outside(X_WC0, X_WO0) && box_outside(X_WC1, X_WO1)) continue;
+    }
+    const Eigen::Vector3d p0 = X_CW0 * c0, p1 = X_CW1 * c1;
+    const Eigen::Vector3d turned = X_CW1.linear() * X_WC0.linear() * p0;
+    off_turn = std::max(
+        off_turn, parallax_px(p1 - turned, depth) + f * (1.0 + corner) * item_turn * r / depth);
   }
+  if (turn_only_px != nullptr) *turn_only_px = off_turn;
   return px;
 }
 
@@ -576,11 +611,12 @@ void GlRenderer::DrawEffects(int camera, const scene::SceneState& state, int64_t
   int n = 1;
   double camera_px = 0.0;       // the camera's own share of the image motion
   std::vector<double> item_px;  // and each item's
+  double turn_only_px = 0.0;    // how far the image departs from the camera's turn alone
   bool accumulated = false;     // the final pass reads the accumulation
   if (setup.blur) {
     const double exposure = spec.sensor.exposure;
-    const double motion_px =
-        ImageMotionPx(camera, at(-0.5 * exposure), at(0.5 * exposure), &camera_px, &item_px);
+    const double motion_px = ImageMotionPx(camera, at(-0.5 * exposure), at(0.5 * exposure),
+                                           &camera_px, &item_px, &turn_only_px);
     n = static_cast<int>(
         std::clamp(std::ceil(motion_px), 1.0, static_cast<double>(spec.sensor.blur_samples)));
     if (n > 1) {
@@ -589,7 +625,52 @@ void GlRenderer::DrawEffects(int camera, const scene::SceneState& state, int64_t
   }
   pending_[slot].exposure_samples[camera] = n;
   const int views = static_cast<int>(setup.views.size());
-  if (sub_states.empty()) {
+  // A turning camera (a saccade): the n sub-frames fall into m stretches of the exposure, and
+  // each stretch's are the instant drawn at its middle seen through the turn's homographies:
+  // m scene passes and m passes of fetches instead of n scene passes. What the turn cannot
+  // explain -- the parallax of the camera's shift, items moving in the world -- accrues
+  // turn_only_px over the whole exposure, so a sub-frame departs from drawing it by at most
+  // turn_only_px times its distance from its stretch's middle, a fraction of the exposure
+  // (at most half a stretch): m is the fewest stretches that keep that within
+  // turn_blur_max_error_px, and the turn is used when m < n (an eye's saccade: 1; the neck's
+  // pan, whose turn swings the eyes, or a ball rolling by: 2 or 3).
+  const int count = static_cast<int>(sub_states.size());
+  int stretches = 0;  // 0: every sub-frame drawn
+  if (count > 1 && views == 1 && camera_px >= 1.0 && count <= kMaxTurnBlurSamples &&
+      turn_blur_max_error_px_ >= 0.0) {
+    for (int m = 1; m < count && stretches == 0; ++m) {
+      const int longest = (count + m - 1) / m;  // sub-frames in the longest stretch
+      if (0.5 * longest * turn_only_px / count <= turn_blur_max_error_px_) stretches = m;
+    }
+  }
+  if (stretches > 0) {
+    const Eigen::Matrix3d K = effects.lens().views[0].intrinsics.Matrix();
+    const Eigen::Matrix3d K_inv = K.inverse();
+    const double exposure = spec.sensor.exposure;
+    std::vector<Eigen::Matrix3f> homographies;
+    for (int g = 0; g < stretches; ++g) {
+      const int first = g * count / stretches, end = (g + 1) * count / stretches;
+      const scene::SceneState middle = at(exposure * (0.5 * (first + end) / count - 0.5));
+      UpdatePoses(middle);
+      const geometry::Pose X_WV = view_pose(scene_.CameraPose(spec, middle), 0);
+      effects.BindViewForDrawing(0);
+      glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+      DrawScene(setup.views[0], near, X_WV);
+      effects.FinishView(0);
+      homographies.clear();
+      for (int k = first; k < end; ++k) {
+        // A pixel of sub-frame k: its ray in view k, in the world, in the drawn view, its pixel.
+        const Eigen::Matrix3d R_VVk = X_WV.linear().transpose() *
+                                      view_pose(scene_.CameraPose(spec, sub_states[k]), 0).linear();
+        homographies.push_back((K * R_VVk * K_inv).cast<float>());
+      }
+      effects.TurnBlur(
+          *effect_programs_, 0, homographies, 1.0f / static_cast<float>(count),
+          g == 0 ? EffectTarget::Accumulation::kReplace : EffectTarget::Accumulation::kAdd);
+    }
+    UpdatePoses(state);
+    accumulated = true;
+  } else if (sub_states.empty()) {
     for (int v = 0; v < views; ++v) {
       effects.BindViewForDrawing(v);
       glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);

@@ -210,9 +210,13 @@ class GlRenderer final : public Renderer {
   // How far, at most, anything the camera sees moves on its image between s0 and s1
   // (pixels, a bound through the pinhole of K): motion blur draws that many sub-frames.
   // `camera_px`, when given, gets the camera's own share (its turn and shift), `item_px` each
-  // item's bound (0 for items out of view).
+  // item's bound (0 for items out of view), `turn_only_px` a bound on how far the image
+  // between s0 and s1 departs from the camera's turn alone (a homography): the parallax of its
+  // shift (its sideways and its axial part apart) at the nearest depth it sees, plus the
+  // items' own motion in the world.
   double ImageMotionPx(int camera, const scene::SceneState& s0, const scene::SceneState& s1,
-                       double* camera_px = nullptr, std::vector<double>* item_px = nullptr) const;
+                       double* camera_px = nullptr, std::vector<double>* item_px = nullptr,
+                       double* turn_only_px = nullptr) const;
   // Motion blur's sub-frames with the camera still: per view of the camera, the window
   // rectangle (x, y, width, height) outside which every sub-frame equals sub-frame `whole`
   // (the items that move by a pixel or more, by `item_px`, do not reach there), or nullopt for
@@ -249,6 +253,7 @@ class GlRenderer final : public Renderer {
   GLuint ground_vao_ = 0;
   bool draw_ground_ = false;
   bool draw_robot_ = false;
+  double turn_blur_max_error_px_ = -1.0;  // RendererOptions::turn_blur*; < 0: off
   std::vector<DrawItem> items_;
   std::vector<Eigen::Isometry3d> item_poses_;  // X_WO (X_WLink X_LinkPart) per item, this state
   std::vector<std::pair<double, int>> order_;  // per view: depth, item
