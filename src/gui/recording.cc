@@ -58,8 +58,12 @@ void Recorder::Write(int64_t step, const cv::Mat& bgr) {
   }
   fs::rename(partial, frame);
   if (!writer_.isOpened()) {
-    writer_.open((dir_ / "demo.avi").string(), cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), fps_,
-                 bgr.size());
+    // OpenCV's own AVI writer, not FFmpeg's or GStreamer's: it writes each frame's chunk as it
+    // comes (through a buffer of about 32 KB, less than one frame), so a recording cut by a kill
+    // plays back up to its last frame or two in players that read an AVI without its index
+    // (FFmpeg, VLC, mpv); the others buffered many frames, or everything, until closed.
+    writer_.open((dir_ / "demo.avi").string(), cv::CAP_OPENCV_MJPEG,
+                 cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), fps_, bgr.size());
     if (!writer_.isOpened()) {
       throw Error("demo: cannot write " + (dir_ / "demo.avi").string() +
                   " (OpenCV's MJPEG writer failed)");

@@ -1,7 +1,9 @@
 #pragma once
 // `saccade demo --record DIR`: the annotated frames of both eyes side by side with a status
 // line, as DIR/frames/NNNNNN.jpg (each written whole: a temporary file renamed into place),
-// DIR/demo.avi (MJPEG), one DIR/fixation_N_<object>.png per fixation, and DIR/summary.json.
+// DIR/demo.avi (MJPEG, OpenCV's own writer: a recording cut by a kill plays back up to its
+// last frame or two, without the index that closing writes), one DIR/fixation_N_<object>.png per
+// fixation, and DIR/summary.json.
 #include <cstdint>
 #include <filesystem>
 #include <nlohmann/json.hpp>
