@@ -322,21 +322,32 @@ cameras:
   EXPECT_FALSE(SamePixels(*blurred, *first));  // the box did smear
 }
 
-TEST(MotionBlurTest, ASaccadeDuringTheExposureBlursTheEyesAStillHeadDoesNot) {
-  const std::string scene_text = std::string(R"(
+// The POPEYE head 1.2 m high before a checker floor and a red ball 2 m ahead, its eyes
+// exposed 10 ms in up to `blur_samples` sub-frames; `ball_motion` (YAML, e.g. "{type:
+// constant_velocity, linear: [0, -2, 0]}") moves the ball.
+std::string HeadAndBallScene(int blur_samples, const std::string& ball_motion = "") {
+  const std::string motion = ball_motion.empty() ? "" : ", motion: " + ball_motion;
+  const std::string sensor =
+      "{sensor: {exposure: 0.01, blur_samples: " + std::to_string(blur_samples) + "}}";
+  return R"(
 background: [0.6, 0.7, 0.8]
 lights: [{type: ambient, intensity: 0.4}, {type: directional, direction: [1, 0, -1]}]
 ground: {pattern: checker, cell: 0.25}
 objects:
-  - {name: ball, kind: sphere, radius: 0.2, pose: {position: [2, 0.3, 1.2]}, color: [0.9, 0.2, 0.1, 1]}
+  - {name: ball, kind: sphere, radius: 0.2, pose: {position: [2, 0.3, 1.2]}, color: [0.9, 0.2, 0.1, 1])" +
+         motion + R"(}
 robot:
   head: ../robots/popeye.yaml
   pose: {position: [0, 0, 1.2]}
   cameras:
-    left: {sensor: {exposure: 0.01, blur_samples: 8}}
-    right: {sensor: {exposure: 0.01, blur_samples: 8}}
-)");
-  const scene::Scene world = SceneFrom(scene_text);
+    left: )" +
+         sensor + R"(
+    right: )" +
+         sensor + "\n";
+}
+
+TEST(MotionBlurTest, ASaccadeDuringTheExposureBlursTheEyesAStillHeadDoesNot) {
+  const scene::Scene world = SceneFrom(HeadAndBallScene(8));
   scene::SceneState still = world.InitialState();
   RendererOptions no_blur;
   no_blur.motion_blur = false;
@@ -397,26 +408,13 @@ robot:
   }
 }
 
-// A camera that turns in a still world blurs through its turn (RendererOptions::turn_blur: one
-// drawn instant seen through the homographies of the sub-frames' orientations) as drawing every
-// sub-frame does. The eyes turning about their centres is a pure turn: the two agree within
+// A turning camera blurs through its turn (RendererOptions::turn_blur: a few drawn instants
+// seen through the homographies of the sub-frames' orientations) as drawing every sub-frame
+// does. The eyes turning about their centres is a pure turn, one instant: the two agree within
 // the bilinear resampling, away from the borders (where the turned view reaches past the drawn
-// one, whose edge is then repeated). A moving ball is not a turn: the sub-frames are drawn.
+// one, whose edge is then repeated).
 TEST(MotionBlurTest, ATurningCameraBlursThroughItsTurnAsDrawingEverySubFrameDoes) {
-  const std::string scene_text = std::string(R"(
-background: [0.6, 0.7, 0.8]
-lights: [{type: ambient, intensity: 0.4}, {type: directional, direction: [1, 0, -1]}]
-ground: {pattern: checker, cell: 0.25}
-objects:
-  - {name: ball, kind: sphere, radius: 0.2, pose: {position: [2, 0.3, 1.2]}, color: [0.9, 0.2, 0.1, 1]}
-robot:
-  head: ../robots/popeye.yaml
-  pose: {position: [0, 0, 1.2]}
-  cameras:
-    left: {sensor: {exposure: 0.01, blur_samples: 16}}
-    right: {sensor: {exposure: 0.01, blur_samples: 16}}
-)");
-  const scene::Scene world = SceneFrom(scene_text);
+  const scene::Scene world = SceneFrom(HeadAndBallScene(16));
   RendererOptions drawn;
   drawn.turn_blur = false;
   drawn.noise = false;
@@ -504,21 +502,8 @@ robot:
   // ball's own motion (about 5 px over the exposure), so the exposure is cut into stretches
   // and the ball smears over its path as when every sub-frame is drawn; one instant for the
   // whole exposure (a bound opened wide) leaves it sharp, many times further off.
-  const std::string moving = std::string(R"(
-background: [0.6, 0.7, 0.8]
-lights: [{type: ambient, intensity: 0.4}, {type: directional, direction: [1, 0, -1]}]
-ground: {pattern: checker, cell: 0.25}
-objects:
-  - {name: ball, kind: sphere, radius: 0.2, pose: {position: [2, 0.3, 1.2]},
-     color: [0.9, 0.2, 0.1, 1], motion: {type: constant_velocity, linear: [0, -2, 0]}}
-robot:
-  head: ../robots/popeye.yaml
-  pose: {position: [0, 0, 1.2]}
-  cameras:
-    left: {sensor: {exposure: 0.01, blur_samples: 16}}
-    right: {sensor: {exposure: 0.01, blur_samples: 16}}
-)");
-  const scene::Scene world2 = SceneFrom(moving);
+  const scene::Scene world2 =
+      SceneFrom(HeadAndBallScene(16, "{type: constant_velocity, linear: [0, -2, 0]}"));
   RendererOptions wide = turned;
   wide.turn_blur_max_error_px = 100.0;
   const std::vector<Frame> drawn2 = MakeRenderer(world2, drawn)->Render(turning, 0);

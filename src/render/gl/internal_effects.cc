@@ -423,6 +423,15 @@ void EffectTarget::FinishView(int view) const {
 
 void EffectTarget::Accumulate(const EffectPrograms& programs, int view, float weight,
                               Accumulation mode) const {
+  BeginAccumulationPass(view, mode);
+  glUseProgram(programs.accumulate());
+  glUniform1i(programs.accumulate_layer(), view);
+  glUniform1f(programs.accumulate_weight(), weight);
+  programs.DrawFullscreen();
+  EndAccumulationPass();
+}
+
+void EffectTarget::BeginAccumulationPass(int view, Accumulation mode) const {
   glBindFramebuffer(GL_FRAMEBUFFER, accumulation_framebuffer_);
   glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, accumulation_, 0, view);
   glViewport(0, 0, source_width_, source_height_);
@@ -431,11 +440,10 @@ void EffectTarget::Accumulate(const EffectPrograms& programs, int view, float we
     glEnable(GL_BLEND);
     glBlendFunc(GL_ONE, GL_ONE);
   }
-  glUseProgram(programs.accumulate());
-  glUniform1i(programs.accumulate_layer(), view);
-  glUniform1f(programs.accumulate_weight(), weight);
   BindTexture(kSourceUnit, GL_TEXTURE_2D_ARRAY, source_);
-  programs.DrawFullscreen();
+}
+
+void EffectTarget::EndAccumulationPass() const {
   glDisable(GL_BLEND);
   glEnable(GL_DEPTH_TEST);
   glActiveTexture(GL_TEXTURE0);
@@ -467,24 +475,14 @@ void EffectTarget::TurnBlur(const EffectPrograms& programs, int view,
   std::vector<float> h;  // column-major, as GL takes mat3s without transposing
   h.reserve(9 * homographies.size());
   for (const Eigen::Matrix3f& m : homographies) h.insert(h.end(), m.data(), m.data() + 9);
-  glBindFramebuffer(GL_FRAMEBUFFER, accumulation_framebuffer_);
-  glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, accumulation_, 0, view);
-  glViewport(0, 0, source_width_, source_height_);
-  glDisable(GL_DEPTH_TEST);
-  if (mode == Accumulation::kAdd) {
-    glEnable(GL_BLEND);
-    glBlendFunc(GL_ONE, GL_ONE);
-  }
+  BeginAccumulationPass(view, mode);
   glUseProgram(programs.turn_blur());
   glUniform1i(programs.turn_blur_layer(), view);
   glUniform1i(programs.turn_blur_count(), count);
   glUniform1f(programs.turn_blur_weight(), weight);
   glUniformMatrix3fv(programs.turn_blur_h(), count, GL_FALSE, h.data());
-  BindTexture(kSourceUnit, GL_TEXTURE_2D_ARRAY, source_);
   programs.DrawFullscreen();
-  glDisable(GL_BLEND);
-  glEnable(GL_DEPTH_TEST);
-  glActiveTexture(GL_TEXTURE0);
+  EndAccumulationPass();
 }
 
 void EffectTarget::BindTruthForDrawing(int view) const {

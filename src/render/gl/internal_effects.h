@@ -174,6 +174,12 @@ class EffectTarget {
   const PixelBuffers& depth_buffers() const { return *depth_buffers_; }
 
  private:
+  // Binds the view's accumulation layer as the target of a full-screen pass that reads the
+  // source views (blending onto what is there for kAdd); EndAccumulationPass restores the
+  // state the scene passes expect.
+  void BeginAccumulationPass(int view, Accumulation mode) const;
+  void EndAccumulationPass() const;
+
   geometry::LensMap lens_;
   int samples_;
   bool blur_;
