@@ -132,7 +132,11 @@ inline void CheckSpec(const rt::PipelineSpec& spec) {
     Check(!c.type.empty());
     for (const rt::ConnectionSpec& in : c.inputs) {
       Check(in.delay == 0 || in.delay == 1);
-      Check(IsName(in.from_component) && IsName(in.from_output));
+      if (in.topic.empty()) {
+        Check(IsName(in.from_component) && IsName(in.from_output));
+      } else {  // another process's topic ({topic: NAME, ...}): no port of this pipeline
+        Check(in.from_component.empty() && in.from_output.empty());
+      }
     }
   }
 }
