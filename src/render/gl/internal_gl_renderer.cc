@@ -481,6 +481,7 @@ double GlRenderer::ImageMotionPx(int camera, const scene::SceneState& s0,
     const double item_motion = std::min(in_camera, in_world);
     if (item_px != nullptr) (*item_px)[i] = item_motion;
     px = std::max(px, item_motion);
+    if (turn_only_px == nullptr) continue;  // turn blur off: the bound below is not needed
     // Where the item is at s1 in the camera, against where the camera's turn alone would put
     // it: a still item is off by the camera's shift (parallax), a part that moves with the
     // camera by the turn itself, a moving item by its motion. An item whose box is out of the
@@ -615,8 +616,9 @@ void GlRenderer::DrawEffects(int camera, const scene::SceneState& state, int64_t
   bool accumulated = false;     // the final pass reads the accumulation
   if (setup.blur) {
     const double exposure = spec.sensor.exposure;
-    const double motion_px = ImageMotionPx(camera, at(-0.5 * exposure), at(0.5 * exposure),
-                                           &camera_px, &item_px, &turn_only_px);
+    const double motion_px =
+        ImageMotionPx(camera, at(-0.5 * exposure), at(0.5 * exposure), &camera_px, &item_px,
+                      turn_blur_max_error_px_ >= 0.0 ? &turn_only_px : nullptr);
     n = static_cast<int>(
         std::clamp(std::ceil(motion_px), 1.0, static_cast<double>(spec.sensor.blur_samples)));
     if (n > 1) {
