@@ -2,15 +2,21 @@
 // Runs the `saccade` program under test (SACCADE_BINARY) as a shell would, or a program in
 // the background whose standard output the test reads line by line.
 
+#include <poll.h>
 #include <signal.h>
 #include <spawn.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <array>
+#include <cerrno>
+#include <chrono>
+#include <cstdint>
 #include <cstdio>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 extern char** environ;
@@ -54,21 +60,66 @@ class BackgroundProcess {
     if (posix_spawn(&pid_, args[0], &actions, nullptr, args.data(), environ) != 0) pid_ = -1;
     posix_spawn_file_actions_destroy(&actions);
     close(out[1]);
-    out_ = fdopen(out[0], "r");
+    out_ = out[0];
   }
   ~BackgroundProcess() {
     Stop();
-    if (out_ != nullptr) fclose(out_);
+    if (out_ >= 0) close(out_);
   }
   BackgroundProcess(const BackgroundProcess&) = delete;
   BackgroundProcess& operator=(const BackgroundProcess&) = delete;
 
-  bool started() const { return pid_ > 0 && out_ != nullptr; }
-  /// The next line it prints (with its newline); nullopt once its output ends.
-  std::optional<std::string> ReadLine() {
-    char line[4096];
-    if (out_ == nullptr || std::fgets(line, sizeof line, out_) == nullptr) return std::nullopt;
-    return std::string(line);
+  bool started() const { return pid_ > 0 && out_ >= 0; }
+  /// The next line it prints (with its newline); nullopt once its output ends, or when no
+  /// whole line came within `timeout` (what came of it is kept for the next call).
+  std::optional<std::string> ReadLine(
+      std::chrono::milliseconds timeout = std::chrono::milliseconds::max()) {
+    using Clock = std::chrono::steady_clock;
+    const bool forever = timeout == std::chrono::milliseconds::max();
+    const Clock::time_point deadline = forever ? Clock::time_point::max() : Clock::now() + timeout;
+    while (true) {
+      const std::size_t newline = buffer_.find('\n');
+      if (newline != std::string::npos) {
+        std::string line = buffer_.substr(0, newline + 1);
+        buffer_.erase(0, newline + 1);
+        return line;
+      }
+      if (out_ < 0 || ended_) {
+        if (buffer_.empty()) return std::nullopt;
+        return std::exchange(buffer_, std::string());  // the last line, without a newline
+      }
+      int wait_ms = -1;
+      if (!forever) {
+        const auto left =
+            std::chrono::duration_cast<std::chrono::milliseconds>(deadline - Clock::now());
+        if (left.count() <= 0) return std::nullopt;
+        wait_ms = static_cast<int>(std::min<int64_t>(left.count(), 60'000));
+      }
+      pollfd pfd{out_, POLLIN, 0};
+      if (poll(&pfd, 1, wait_ms) <= 0) continue;  // (EINTR or no data yet)
+      char chunk[4096];
+      const ssize_t n = read(out_, chunk, sizeof chunk);
+      if (n < 0 && errno == EINTR) continue;
+      if (n <= 0) {
+        ended_ = true;
+        continue;
+      }
+      buffer_.append(chunk, static_cast<std::size_t>(n));
+    }
+  }
+  /// Reads until a line holding `text`, appending every line read to `*seen`; false when the
+  /// output ended or `timeout` passed first.
+  bool ReadUntil(const std::string& text, std::string* seen, std::chrono::milliseconds timeout) {
+    const auto deadline = std::chrono::steady_clock::now() + timeout;
+    while (true) {
+      const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(
+          deadline - std::chrono::steady_clock::now());
+      if (left.count() <= 0) return false;
+      const std::optional<std::string> line = ReadLine(left);
+      if (!line) return false;
+      *seen += *line;
+      if (line->find(text) != std::string::npos) return true;
+    }
   }
   /// SIGTERM, then everything it prints until it exits; its exit status (-1 when it did not
   /// exit normally or was already stopped).
@@ -86,7 +137,9 @@ class BackgroundProcess {
 
  private:
   pid_t pid_ = -1;
-  FILE* out_ = nullptr;
+  int out_ = -1;
+  bool ended_ = false;
+  std::string buffer_;  // read but not yet returned
 };
 
 }  // namespace saccade::e2e
