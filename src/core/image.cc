@@ -60,4 +60,29 @@ Image::Image(int width, int height, PixelFormat format)
   pixels_.assign(static_cast<std::size_t>(width) * height * BytesPerPixel(format), 0);
 }
 
+Image::Image(int width, int height, PixelFormat format, const uint8_t* pixels, std::size_t stride)
+    : width_(width), height_(height), format_(format) {
+  if (width < 0 || height < 0) {
+    throw InvalidArgument(
+        fmt::format("Image: width and height must be >= 0, got {} x {}", width, height));
+  }
+  const std::size_t row = static_cast<std::size_t>(width) * BytesPerPixel(format);
+  if (stride < row) {
+    throw InvalidArgument(
+        fmt::format("Image: a stride of {} bytes is shorter than a {} x {} {} "
+                    "row ({} bytes)",
+                    stride, width, height, ToString(format), row));
+  }
+  if (row * height == 0) return;
+  if (stride == row) {
+    pixels_.assign(pixels, pixels + row * height);  // one copy, no zero-fill first
+    return;
+  }
+  pixels_.reserve(row * height);
+  for (int y = 0; y < height; ++y) {
+    const uint8_t* begin = pixels + static_cast<std::size_t>(y) * stride;
+    pixels_.insert(pixels_.end(), begin, begin + row);
+  }
+}
+
 }  // namespace saccade

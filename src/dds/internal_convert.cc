@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <Eigen/Geometry>
+#include <bit>
 #include <cstring>
 
 #include "saccade/geometry/image_camera.h"
@@ -176,7 +177,114 @@ geometry::Pose PoseOf(const geometry_msgs_msg_dds__Transform_& transform) {
   return geometry::MakePose(q.toRotationMatrix(), Eigen::Vector3d(t.x, t.y, t.z));
 }
 
-std::shared_ptr<Image> ImageOf(const sensor_msgs_msg_dds__Image_& msg, std::string* error) {
+namespace {
+
+// XCDR1 read cursor: alignment counts from after the encapsulation header.
+class CdrCursor {
+ public:
+  CdrCursor(const uint8_t* bytes, std::size_t size, bool swap)
+      : bytes_(bytes), size_(size), swap_(swap) {}
+  std::size_t pos() const { return pos_; }
+  bool U32(uint32_t* v) {
+    pos_ = 4 + ((pos_ - 4 + 3) / 4) * 4;
+    if (pos_ > size_ || size_ - pos_ < 4) return false;
+    std::memcpy(v, bytes_ + pos_, 4);
+    if (swap_) *v = __builtin_bswap32(*v);
+    pos_ += 4;
+    return true;
+  }
+  bool U8(uint8_t* v) {
+    if (pos_ >= size_) return false;
+    *v = bytes_[pos_++];
+    return true;
+  }
+  // A string: its length (with the NUL), its bytes, NUL-terminated in place.
+  bool String(char** s) {
+    uint32_t length = 0;
+    if (!U32(&length) || length > size_ - pos_) return false;
+    if (length == 0) {
+      *s = const_cast<char*>("");
+      return true;
+    }
+    if (bytes_[pos_ + length - 1] != 0) return false;
+    *s = reinterpret_cast<char*>(const_cast<uint8_t*>(bytes_ + pos_));
+    pos_ += length;
+    return true;
+  }
+  // A sequence<uint8>: its length, then its bytes in place.
+  bool Bytes(uint32_t* length, const uint8_t** data) {
+    if (!U32(length) || *length > size_ - pos_) return false;
+    *data = bytes_ + pos_;
+    pos_ += *length;
+    return true;
+  }
+
+ private:
+  const uint8_t* bytes_;
+  std::size_t size_;
+  bool swap_;
+  std::size_t pos_ = 4;
+};
+
+}  // namespace
+
+bool ImageViewOfCdr(const uint8_t* cdr, std::size_t size, sensor_msgs_msg_dds__Image_* out,
+                    std::string* error) {
+  *out = {};
+  if (size < 4) {
+    *error = fmt::format("{} bytes: shorter than the encapsulation header", size);
+    return false;
+  }
+  // Encapsulation: 0x0000 CDR big-endian, 0x0001 CDR little-endian (XCDR1, as ROS 2 writes).
+  const unsigned id = (unsigned{cdr[0]} << 8) | cdr[1];
+  if (id != 0x0000 && id != 0x0001) {
+    *error = fmt::format("encapsulation 0x{:04x} is not plain CDR (0x0000 or 0x0001)", id);
+    return false;
+  }
+  const bool little = id == 0x0001;
+  CdrCursor c(cdr, size, little != (std::endian::native == std::endian::little));
+  uint32_t sec = 0, nanosec = 0, data_length = 0;
+  uint8_t is_bigendian = 0;
+  const uint8_t* data = nullptr;
+  const auto Fail = [&](const char* what) {
+    *error = fmt::format("sensor_msgs/Image of {} bytes ends inside its {} (byte {})", size, what,
+                         c.pos());
+    return false;
+  };
+  if (!c.U32(&sec) || !c.U32(&nanosec)) return Fail("header.stamp");
+  if (!c.String(&out->header.frame_id)) return Fail("header.frame_id");
+  if (!c.U32(&out->height) || !c.U32(&out->width)) return Fail("height and width");
+  if (!c.String(&out->encoding)) return Fail("encoding");
+  if (!c.U8(&is_bigendian)) return Fail("is_bigendian");
+  if (!c.U32(&out->step)) return Fail("step");
+  if (!c.Bytes(&data_length, &data)) return Fail("data");
+  out->header.stamp = {static_cast<int32_t>(sec), nanosec};
+  out->is_bigendian = is_bigendian;
+  out->data = {data_length, data_length, const_cast<uint8_t*>(data), false};
+  return true;
+}
+
+std::shared_ptr<Image> ImagePool::Get(int width, int height, PixelFormat format) {
+  for (std::shared_ptr<Image>& image : images_) {
+    if (image.use_count() != 1) continue;  // still held by whoever it was handed to
+    if (image->width() != width || image->height() != height || image->format() != format) {
+      image = std::make_shared<Image>(width, height, format);  // the stream changed size
+    }
+    image->metadata() = ImageMetadata{};
+    return image;
+  }
+  auto image = std::make_shared<Image>(width, height, format);
+  if (images_.size() < capacity_) {
+    images_.push_back(image);
+  } else if (capacity_ > 0) {
+    images_[next_] = image;  // the one it replaces lives on with its holders
+    next_ = (next_ + 1) % capacity_;
+  }
+  return image;
+}
+
+std::shared_ptr<Image> ImageOf(const sensor_msgs_msg_dds__Image_& msg, std::string* error,
+                               ImagePool* pool) {
   const std::string encoding = msg.encoding ? msg.encoding : "";
   const std::optional<PixelFormat> format = FormatOfEncoding(encoding);
   if (!format) {
@@ -194,14 +302,19 @@ std::shared_ptr<Image> ImageOf(const sensor_msgs_msg_dds__Image_& msg, std::stri
                          msg.height, encoding, msg.step, msg.data._length);
     return nullptr;
   }
-  auto image =
-      std::make_shared<Image>(static_cast<int>(msg.width), static_cast<int>(msg.height), *format);
-  if (msg.step == row) {
-    std::memcpy(image->data(), msg.data._buffer, row * msg.height);
+  const int width = static_cast<int>(msg.width), height = static_cast<int>(msg.height);
+  std::shared_ptr<Image> image;
+  if (pool == nullptr) {
+    // One copy out of Cyclone's sample, rows packed (no zero-fill first).
+    image = std::make_shared<Image>(width, height, *format, msg.data._buffer, msg.step);
   } else {
-    for (uint32_t y = 0; y < msg.height; ++y) {
-      std::memcpy(image->row(static_cast<int>(y)), msg.data._buffer + std::size_t{y} * msg.step,
-                  row);
+    image = pool->Get(width, height, *format);
+    if (row > 0 && msg.step == row) {
+      std::memcpy(image->data(), msg.data._buffer, row * height);
+    } else if (row > 0) {
+      for (int y = 0; y < height; ++y) {
+        std::memcpy(image->row(y), msg.data._buffer + std::size_t{msg.step} * y, row);
+      }
     }
   }
   image->metadata().camera = CameraOfFrame(msg.header.frame_id ? msg.header.frame_id : "");

@@ -1,7 +1,7 @@
 #pragma once
 // Helpers of the DDS tests: loopback pinning, a plain Cyclone DDS reader and writer of the
 // tests' own ROS 2 types (tests/dds/idl/ros2_reference.idl, ref_* symbols), raw CDR bytes, and
-// Foxglove's independent serializer under Node.
+// (reference_serializer.h) Foxglove's independent serializer under Node.
 #include <dds/dds.h>
 #include <dds/ddsi/ddsi_serdata.h>
 #include <gtest/gtest.h>
@@ -16,6 +16,7 @@
 #include <thread>
 #include <vector>
 
+#include "reference_serializer.h"
 #include "ros2_reference.h"
 #include "saccade/dds/participant.h"
 #include "saccade/dds/topics.h"
@@ -158,48 +159,6 @@ bool TakeSample(dds_entity_t reader, T* out, double timeout_s = 10) {
     std::this_thread::sleep_for(std::chrono::milliseconds(2));
   }
   return false;
-}
-
-inline std::string Hex(const std::vector<uint8_t>& bytes) {
-  static const char* kDigits = "0123456789abcdef";
-  std::string text;
-  for (const uint8_t b : bytes) {
-    text += kDigits[b >> 4];
-    text += kDigits[b & 15];
-  }
-  return text;
-}
-
-/// Serializes each {"type", "message"} with Foxglove's ROS 2 writer under Node; the hex of
-/// each, in order. Fails the test (and returns {}) when Node or its packages are missing.
-inline std::vector<std::string> ReferenceSerialize(const nlohmann::json& inputs) {
-  const std::filesystem::path dir = SACCADE_SOURCE_DIR "/tests/dds/ros2_reference";
-  if (!std::filesystem::exists(dir / "node_modules/@foxglove/rosmsg2-serialization")) {
-    ADD_FAILURE() << "the reference serializer's npm packages are missing: run "
-                     "scripts/setup.sh (npm ci in tests/dds/ros2_reference)";
-    return {};
-  }
-  const std::filesystem::path input =
-      std::filesystem::temp_directory_path() /
-      ("saccade-ros2-reference-" + std::to_string(::getpid()) + ".json");
-  std::ofstream(input) << inputs.dump();
-  const std::string command =
-      "node " + (dir / "ros2_serialize.mjs").string() + " " + input.string();
-  FILE* pipe = popen(command.c_str(), "r");
-  std::vector<std::string> lines;
-  std::string line;
-  for (int c; (c = std::fgetc(pipe)) != EOF;) {
-    if (c == '\n') {
-      lines.push_back(line);
-      line.clear();
-    } else {
-      line += static_cast<char>(c);
-    }
-  }
-  const int status = pclose(pipe);
-  std::filesystem::remove(input);
-  EXPECT_EQ(status, 0) << command;
-  return lines;
 }
 
 }  // namespace saccade::dds::testing

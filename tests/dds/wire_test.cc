@@ -5,8 +5,13 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
+#include <chrono>
 #include <cmath>
+#include <cstring>
+#include <memory>
 #include <random>
+#include <thread>
+#include <vector>
 
 #include "dds_test_util.h"
 #include "saccade/components/messages.h"
@@ -328,6 +333,55 @@ TEST_F(WireTest, ImageRoundTripKeepsPixelsModelAndPose) {
   EXPECT_TRUE(pose->isApprox(*geometry::FindCameraPose(image->metadata()), kPoseTolerance));
   EXPECT_EQ(reader->stats().incomplete, 0);
   EXPECT_EQ(reader->stats().messages, 1);
+}
+
+// The reader converts only the newest of the images waiting (the older ones are counted lost),
+// and reuses the memory of images nobody holds any more, never of one still held.
+TEST_F(WireTest, ImageReaderKeepsTheNewestAndReusesOnlyReleasedFrames) {
+  constexpr int kDomain = 167;
+  const Qos keep_five{Reliability::kReliable, Durability::kVolatile, 5};
+  auto participant = Participant::Create(Domain(kDomain));
+  auto reader = Reader::Create(participant, "runtime.image",
+                               Topic("/saccade/left/image_raw", keep_five, 0.04));
+  auto writer =
+      Writer::Create(participant, "runtime.image", Topic("/saccade/left/image_raw", keep_five));
+  ASSERT_TRUE(writer->WaitForReaders(1, 10));
+  ASSERT_TRUE(reader->WaitForWriters(1, 10));
+  std::vector<std::shared_ptr<Image>> sent;
+  for (uint32_t seed = 1; seed <= 6; ++seed) {
+    sent.push_back(MakeImage(64, 48, PixelFormat::kRgb8, seed, RationalDistortion()));
+  }
+  const auto Same = [](const Image& a, const Image& b) {
+    return a.size_bytes() == b.size_bytes() && std::memcmp(a.data(), b.data(), a.size_bytes()) == 0;
+  };
+  // Three written before one take (a history of five keeps them all): the newest only.
+  for (int i = 0; i < 3; ++i) writer->Write(ImageMessage{sent[i]});
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  auto first = reader->Take<ImageMessage>(10.0);
+  ASSERT_TRUE(first && first->image);
+  EXPECT_TRUE(Same(*first->image, *sent[2]));
+  EXPECT_EQ(reader->stats().lost, 2);
+  // Held: the next image is somewhere else, and the held one keeps its pixels.
+  writer->Write(ImageMessage{sent[3]});
+  auto second = reader->Take<ImageMessage>(10.0);
+  ASSERT_TRUE(second && second->image);
+  EXPECT_NE(second->image->data(), first->image->data());
+  EXPECT_TRUE(Same(*second->image, *sent[3]));
+  EXPECT_TRUE(Same(*first->image, *sent[2]));
+  // Released: its memory comes back with a later image's pixels and metadata, and the image
+  // still held is untouched.
+  const uint8_t* released = first->image->data();
+  first.reset();
+  writer->Write(ImageMessage{sent[4]});
+  auto third = reader->Take<ImageMessage>(10.0);
+  ASSERT_TRUE(third && third->image);
+  EXPECT_EQ(third->image->data(), released);
+  EXPECT_TRUE(Same(*third->image, *sent[4]));
+  EXPECT_TRUE(Same(*second->image, *sent[3]));
+  EXPECT_NE(geometry::FindCameraModel(third->image->metadata()), nullptr);
+  EXPECT_NE(geometry::FindCameraPose(third->image->metadata()), nullptr);
+  EXPECT_EQ(reader->stats().lost, 2);
+  EXPECT_EQ(reader->stats().incomplete, 0);
 }
 
 TEST_F(WireTest, ReaderCountsLateWaitsAndSkippedMessages) {

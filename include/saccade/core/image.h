@@ -103,6 +103,10 @@ class Image {
   Image() = default;
   /// Zero-filled. Throws InvalidArgument when width or height is negative.
   Image(int width, int height, PixelFormat format);
+  /// A copy of `height` rows of `pixels`, each `stride` bytes apart (at least a packed row),
+  /// without the zero-fill first: for frames that arrive in another's memory (a DDS sample, a
+  /// device's buffer). Throws InvalidArgument as above, or when `stride` is shorter than a row.
+  Image(int width, int height, PixelFormat format, const uint8_t* pixels, std::size_t stride);
 
   int width() const { return width_; }
   int height() const { return height_; }
