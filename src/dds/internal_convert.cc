@@ -5,6 +5,7 @@
 #include <Eigen/Geometry>
 #include <bit>
 #include <cstring>
+#include <limits>
 
 #include "saccade/geometry/image_camera.h"
 
@@ -293,6 +294,11 @@ std::shared_ptr<Image> ImageOf(const sensor_msgs_msg_dds__Image_& msg, std::stri
   }
   if (msg.is_bigendian && BytesPerPixel(*format) > 1) {
     *error = "big-endian " + encoding + " images are not supported";
+    return nullptr;
+  }
+  if (msg.width > static_cast<uint32_t>(std::numeric_limits<int>::max()) ||
+      msg.height > static_cast<uint32_t>(std::numeric_limits<int>::max())) {
+    *error = fmt::format("a {}x{} image is too large", msg.width, msg.height);
     return nullptr;
   }
   const std::size_t row = static_cast<std::size_t>(msg.width) * BytesPerPixel(*format);

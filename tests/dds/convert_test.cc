@@ -149,6 +149,14 @@ TEST(ImageViewOfCdr, ReadsBigEndianCdrAndRefusesOtherEncapsulations) {
   unterminated[19] = 'x';
   EXPECT_FALSE(internal::ImageViewOfCdr(unterminated.data(), unterminated.size(), &msg, &error));
   EXPECT_NE(error.find("header.frame_id"), std::string::npos) << error;
+  // A width past what an image can hold, with no rows to hold it (so no data is missing), is
+  // refused by the conversion, not thrown.
+  std::vector<uint8_t> wide = big;
+  wide[20 + 3] = 0x00;  // height 0
+  wide[24] = 0x80;      // width 0x80000002
+  ASSERT_TRUE(internal::ImageViewOfCdr(wide.data(), wide.size(), &msg, &error)) << error;
+  EXPECT_EQ(internal::ImageOf(msg, &error), nullptr);
+  EXPECT_NE(error.find("too large"), std::string::npos) << error;
   std::vector<uint8_t> overlong = big;
   overlong[47] = 0x03;  // three bytes of data claimed, two there
   EXPECT_FALSE(internal::ImageViewOfCdr(overlong.data(), overlong.size(), &msg, &error));
