@@ -5,10 +5,12 @@
 
 #include <CLI/CLI.hpp>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "saccade/head/head_description.h"
+#include "saccade/runtime/pipeline.h"
 
 namespace saccade::app {
 
@@ -33,5 +35,17 @@ std::string ShippedFile(const std::string& relative);
 
 /// Joint angles from 4 command-line values, radians or degrees.
 head::JointState JointsFromArgs(const std::vector<double>& values, bool degrees);
+
+/// The --dds-* options of the commands that run a pipeline with topics (run, gui): they
+/// override the pipeline file's `transport:` map (dds/transport.h).
+struct DdsOverrides {
+  std::optional<int> domain;
+  std::string ns;
+  std::string config;
+  std::string interface;
+  std::vector<std::string> peers;
+};
+void AddDdsOptions(CLI::App* command, DdsOverrides& o);
+void ApplyDdsOverrides(const DdsOverrides& o, runtime::PipelineSpec& spec);
 
 }  // namespace saccade::app

@@ -19,4 +19,31 @@ head::JointState JointsFromArgs(const std::vector<double>& values, bool degrees)
   return {values[0] * s, values[1] * s, values[2] * s, values[3] * s};
 }
 
+void AddDdsOptions(CLI::App* command, DdsOverrides& o) {
+  command->add_option("--dds-domain", o.domain,
+                      "DDS domain id, 0..232 (ROS_DOMAIN_ID; default the file's "
+                      "transport.domain, else 0)");
+  command->add_option("--dds-namespace", o.ns,
+                      "ROS namespace of the relative topic names (e.g. /saccade)");
+  command->add_option("--dds-config", o.config,
+                      "Cyclone DDS configuration: loopback (default: nothing leaves the machine), "
+                      "network (with --dds-interface), env (CYCLONEDDS_URI) or a file.xml");
+  command->add_option("--dds-interface", o.interface,
+                      "Network interface for DDS (e.g. eth0); implies --dds-config network");
+  command->add_option("--dds-peer", o.peers,
+                      "Unicast discovery peer (host or address) for networks without multicast; "
+                      "repeatable");
+}
+
+void ApplyDdsOverrides(const DdsOverrides& o, runtime::PipelineSpec& spec) {
+  if (o.domain) spec.transport["domain"] = *o.domain;
+  if (!o.ns.empty()) spec.transport["namespace"] = o.ns;
+  if (!o.config.empty()) spec.transport["config"] = o.config;
+  if (!o.interface.empty()) {
+    spec.transport["interface"] = o.interface;
+    if (o.config.empty()) spec.transport["config"] = "network";
+  }
+  if (!o.peers.empty()) spec.transport["peers"] = o.peers;
+}
+
 }  // namespace saccade::app

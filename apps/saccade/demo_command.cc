@@ -20,6 +20,7 @@
 #include "saccade/components/register.h"
 #include "saccade/components/roles.h"
 #include "saccade/core/error.h"
+#include "saccade/dds/transport.h"
 #include "saccade/gui/overlay.h"
 #include "saccade/gui/recording.h"
 #include "saccade/gui/session.h"
@@ -53,6 +54,8 @@ struct Options {
   bool list = false;
   bool markdown = false;
   bool gui = false;
+  bool dds = false;  // gui --dds: pipelines/remote.yaml unless --pipeline names another
+  DdsOverrides dds_overrides;
   gui::GuiOptions gui_options;
 };
 
@@ -69,8 +72,11 @@ int RunDemo(Options o) {
   if (!(o.duration > 0.0) || !std::isfinite(o.duration)) {
     throw InvalidArgument(fmt::format("demo: --duration must be > 0 s, got {}", o.duration));
   }
+  // Topic connections (pipelines/remote.yaml, or any file with topics) go over DDS.
+  dds::RegisterDdsTransport(runtime::ComponentRegistry::Global());
   runtime::PipelineSpec spec = runtime::LoadPipelineFile(o.pipeline, o.hardware);
   if (!o.scene.empty()) runtime::ReplaceScene(spec, o.scene, "--scene");
+  ApplyDdsOverrides(o.dds_overrides, spec);
   if (o.keep_going) spec.on_error = runtime::OnError::kContinue;
   const double dt = spec.clock.step;
   if (o.realtime) {
@@ -85,8 +91,9 @@ int RunDemo(Options o) {
   const components::EyeCamerasRole* cameras =
       pipeline.FindRole<components::EyeCamerasRole>(&cameras_name);
   if (!cameras) {
-    throw InvalidArgument("demo: pipeline " + o.pipeline +
-                          " has no eye cameras (a sim.cameras or hw.cameras component)");
+    throw InvalidArgument(
+        "demo: pipeline " + o.pipeline +
+        " has no eye cameras (a sim.cameras, hw.cameras or remote.cameras component)");
   }
   pipeline.FindRole<components::HeadRole>(&head_name);
   components::CaptureToCommand latency(spec, cameras_name, head_name);
@@ -268,11 +275,24 @@ Runner AddGuiCommand(CLI::App& app) {
   gui->add_option("--pipeline", o->pipeline, "Pipeline YAML (default: the demo's)")
       ->check(CLI::ExistingFile)
       ->capture_default_str();
+  auto* pipeline_option = gui->get_option("--pipeline");
   gui->add_option("--hardware", o->hardware,
                   "Hardware file (pipelines/hardware/): the GUI drives the real head too")
       ->check(CLI::ExistingFile);
+  gui->add_flag("--dds", o->dds,
+                "Attach to a robot running in another process or on another machine, over DDS "
+                "(pipelines/remote.yaml: its images and joint states in, the GUI's commands "
+                "out; start the robot with `saccade run pipelines/robot.yaml --realtime "
+                "--steps 0`, with the same --scene and DDS domain)")
+      ->excludes("--hardware");
+  AddDdsOptions(gui, o->dds_overrides);
   AddGuiOptions(gui, *o);
-  return [o] { return RunDemo(*o); };
+  return [o, pipeline_option] {
+    if (o->dds && pipeline_option->count() == 0) {
+      o->pipeline = ShippedFile("pipelines/remote.yaml");
+    }
+    return RunDemo(*o);
+  };
 }
 
 Runner AddDemoCommand(CLI::App& app) {

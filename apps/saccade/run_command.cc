@@ -38,12 +38,7 @@ struct RunCommandOptions {
   bool realtime = false;
   bool json = false;
   std::string joints_csv;
-  // DDS (the pipeline's `transport:` map; these override it)
-  std::optional<int> domain;
-  std::string ns;
-  std::string config;
-  std::string interface;
-  std::vector<std::string> peers;
+  DdsOverrides dds;  // the pipeline's `transport:` map, overridden
 };
 
 int Run(const RunCommandOptions& o) {
@@ -55,14 +50,7 @@ int Run(const RunCommandOptions& o) {
     spec.clock.rate_hz = 1.0 / spec.clock.step;
     spec.clock.mode = runtime::ClockMode::kRealtime;
   }
-  if (o.domain) spec.transport["domain"] = *o.domain;
-  if (!o.ns.empty()) spec.transport["namespace"] = o.ns;
-  if (!o.config.empty()) spec.transport["config"] = o.config;
-  if (!o.interface.empty()) {
-    spec.transport["interface"] = o.interface;
-    if (o.config.empty()) spec.transport["config"] = "network";
-  }
-  if (!o.peers.empty()) spec.transport["peers"] = o.peers;
+  ApplyDdsOverrides(o.dds, spec);
   runtime::Pipeline pipeline = runtime::Pipeline::Build(spec);
 
   // The head's state as the pipeline's components emit it: a fixation is the head coming to
@@ -149,19 +137,7 @@ Runner AddRunCommand(CLI::App& app) {
   run->add_option("--joints-csv", o->joints_csv,
                   "Write every head state the pipeline emits (time, pan, tilt, left, right in "
                   "rad, arrived) to this CSV file");
-  run->add_option("--dds-domain", o->domain,
-                  "DDS domain id, 0..232 (ROS_DOMAIN_ID; default the "
-                  "file's transport.domain, else 0)");
-  run->add_option("--dds-namespace", o->ns,
-                  "ROS namespace of the relative topic names (e.g. /saccade)");
-  run->add_option("--dds-config", o->config,
-                  "Cyclone DDS configuration: loopback (default: nothing leaves the machine), "
-                  "network (with --dds-interface), env (CYCLONEDDS_URI) or a file.xml");
-  run->add_option("--dds-interface", o->interface,
-                  "Network interface for DDS (e.g. eth0); implies --dds-config network");
-  run->add_option("--dds-peer", o->peers,
-                  "Unicast discovery peer (host or address) for networks without multicast; "
-                  "repeatable");
+  AddDdsOptions(run, o->dds);
   return [o] { return Run(*o); };
 }
 

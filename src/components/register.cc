@@ -4,6 +4,7 @@
 #include "saccade/components/fixation_component.h"
 #include "saccade/components/hw_components.h"
 #include "saccade/components/messages.h"
+#include "saccade/components/remote_components.h"
 #include "saccade/components/sim_components.h"
 #include "saccade/components/vision_components.h"
 
@@ -32,6 +33,10 @@ void RegisterComponents(runtime::ComponentRegistry& registry) {
                             "a real head's driver (Dynamixel bus), with its safety rules");
   registry.Register<HwCameras>("hw.cameras",
                                "real cameras (V4L2, GStreamer, IIDC, video files, image lists)");
+  registry.Register<RemoteHead>("remote.head",
+                                "the head of a robot process, through topics (the GUI over DDS)");
+  registry.Register<RemoteCameras>("remote.cameras",
+                                   "the eye cameras of a robot process, through topics");
   registry.Register<DebugFault>("debug.fault", "throws at a given step (fault injection)");
 }
 

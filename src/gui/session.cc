@@ -11,6 +11,7 @@
 #include <map>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include <set>
 
 #include "gui/internal_scene_document.h"
 #include "saccade/core/error.h"
@@ -74,8 +75,17 @@ GuiSession::GuiSession(runtime::Pipeline& pipeline, const scene::Scene& scene,
   hw_head_ = head_ != nullptr && head_->has_emergency_stop();
   cameras_ = pipeline.FindRole<components::EyeCamerasRole>();
   rendered_ = cameras_ != nullptr && cameras_->rendered() != nullptr;
+  // The readers of the robot's topics (a robot in another process, pipelines/remote.yaml)
+  // belong to the robot too.
+  std::set<std::string> robot;
   for (const auto& component : pipeline.components()) {
-    if (components::IsRobotRole(*component)) continue;
+    if (components::IsRobotRole(*component)) robot.insert(component->name());
+  }
+  for (std::size_t k = 0; k < pipeline.components().size(); ++k) {
+    const auto& component = pipeline.components()[k];
+    const auto& specs = pipeline.spec().components;  // in the components' order
+    const std::string reads_for = k < specs.size() ? specs[k].reads_for : std::string();
+    if (robot.contains(component->name()) || robot.contains(reads_for)) continue;
     perception_components_.push_back(component.get());
     component->SetEnabled(options.perception);
   }

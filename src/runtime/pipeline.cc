@@ -537,6 +537,7 @@ Pipeline Pipeline::Build(const PipelineSpec& spec, const ComponentRegistry& regi
         ComponentSpec reader;
         reader.name = c.name + "-" + connection.to_input + "-topic";
         reader.type = transport->name + " reader of " + connection.topic;
+        reader.reads_for = c.name;
         reader.line = reader.type_line = reader.params_line = connection.line;
         TopicEndpoint endpoint{connection.topic, input->message_type(), connection.topic_options,
                                &spec, c.name + "." + connection.to_input};

@@ -362,6 +362,49 @@ TEST(GuiCli, DemoWithTheGuiRunsTheLoopUntilStoppedThenReports) {
   EXPECT_THAT(demo.output(), HasSubstr("images encoded"));
 }
 
+// `saccade gui --dds` attaches to a robot running in another process (pipelines/robot.yaml
+// under `saccade run`), on loopback in a DDS domain of its own: the robot's images and joint
+// states reach the page, and the page's commands move the robot's head.
+TEST(GuiCli, DdsAttachesToARobotInAnotherProcessAndDrivesItsHead) {
+  setenv("CYCLONEDDS_URI", "file://" SACCADE_SOURCE_DIR "/config/dds/loopback.xml", 0);
+  saccade::e2e::BackgroundProcess robot({SACCADE_BINARY, "run", kSource + "/pipelines/robot.yaml",
+                                         "--realtime", "--steps", "0", "--dds-domain", "213"});
+  ASSERT_TRUE(robot.started());
+  GuiProcess gui({"gui", "--dds", "--dds-domain", "213", "--port", "0"});
+  ASSERT_GT(gui.port(), 0) << gui.output();
+  const json scene = json::parse(Get(gui, "/api/scene").body());
+  EXPECT_EQ(scene["commands"]["effects"], false) << "the robot's cameras are not rendered here";
+  EXPECT_EQ(scene["commands"]["perception"], true);
+  Client client(gui);
+  // The robot's state, and both eyes' images, from the other process.
+  client.State([](const json& s) { return !s["joints"].is_null(); });
+  client.State([&client](const json&) {
+    int left = 0, right = 0;
+    for (const std::string& frame : client.binary()) {
+      uint32_t n = 0;
+      std::memcpy(&n, frame.data(), 4);
+      const json header = json::parse(frame.substr(4, n));
+      left += header["camera"] == "left";
+      right += header["camera"] == "right";
+    }
+    return left >= 2 && right >= 2;
+  });
+  // A joints command moves the robot's head: the state the robot sends back comes to rest there.
+  json reply = client.Command({{"type", "joints"}, {"positions", {{"pan", -0.25}}}});
+  ASSERT_EQ(reply["type"], "reply") << reply;
+  const json moved = client.State([](const json& s) {
+    return !s["joints"].is_null() &&
+           std::abs(s["joints"]["positions"]["pan"].get<double>() + 0.25) < 1e-4 &&
+           std::abs(s["joints"]["velocities"]["pan"].get<double>()) < 1e-6;
+  });
+  EXPECT_NEAR(moved["joints"]["positions"]["tilt"].get<double>(), 0.0, 1e-4);
+  // Outside the limits: refused here, nothing sent.
+  reply = client.Command({{"type", "joints"}, {"positions", {{"pan", 9.0}}}});
+  EXPECT_EQ(reply["type"], "error") << reply;
+  EXPECT_EQ(gui.Stop(), 0) << gui.output();
+  EXPECT_THAT(gui.output(), HasSubstr("remote.cameras"));
+}
+
 // The handshake's HTTP status for a raw WebSocket to `target` naming `host` and `origin`, as a
 // page of another origin (or a DNS-rebinding page) would open it; 101 when it opened.
 int WebSocketStatus(const GuiProcess& gui, const std::string& target, const std::string& host,

@@ -129,6 +129,9 @@ struct ComponentSpec {
   /// The hardware file that gave the type and params ("" when the pipeline file did): the
   /// lines above are that file's, and relative paths in the params resolve against its folder.
   std::string params_file;
+  /// The consumer's component whose topic input this component reads (set by Build for the
+  /// readers the topic transport makes, "<consumer>-<input>-topic"); "" for the file's own.
+  std::string reads_for;
 };
 
 /// A shared resource named at the top of a pipeline or hardware file.
