@@ -205,6 +205,10 @@ describe('saccade gui (portraits.yaml)', () => {
 
   test('the page loads, draws the world and shows both cameras', async () => {
     await waitReady(page);
+    // Both <img> hold a decoded frame (ready counts decoded frames; a newer one may be loading).
+    await page.waitForFunction(() => ['left', 'right'].every(
+      (n) => document.getElementById(`image-${n}`).naturalWidth > 0), null,
+    { timeout: kMoveTimeoutMs, polling: 100 });
     // Both camera views: images of the cameras' size, not uniform.
     const views = await page.evaluate(() => ['left', 'right'].map((name) => {
       const img = document.getElementById(`image-${name}`);

@@ -17,8 +17,9 @@ export class CameraView {
     this.waiting = null;       // [header, blob]
     this.received = 0;         // frames received
     this.shown = 0;            // frames decoded and shown
-    this.image.addEventListener('load', () => this.loaded());
-    this.image.addEventListener('error', () => this.loaded());
+    this.failed = 0;           // frames that did not decode (not shown)
+    this.image.addEventListener('load', () => this.loaded(true));
+    this.image.addEventListener('error', () => this.loaded(false));
   }
 
   frame(header, blob) {
@@ -35,14 +36,20 @@ export class CameraView {
     this.image.src = this.url;
   }
 
-  loaded() {
+  // `ok`: the frame decoded (an <img> whose frame failed shows nothing: naturalWidth 0), so
+  // only those count as shown; either way the next waiting frame goes on.
+  loaded(ok) {
     if (this.previousUrl) URL.revokeObjectURL(this.previousUrl);
     this.previousUrl = null;
     this.decoding = false;
-    this.shown++;
-    const h = this.header;
-    this.label.textContent = `${this.name} camera · ${h.width}×${h.height} · frame ${h.frame} · t ${Number(h.time).toFixed(2)} s`;
-    this.onImage?.(this.name);
+    if (ok) {
+      this.shown++;
+      const h = this.header;
+      this.label.textContent = `${this.name} camera · ${h.width}×${h.height} · frame ${h.frame} · t ${Number(h.time).toFixed(2)} s`;
+      this.onImage?.(this.name);
+    } else {
+      this.failed++;
+    }
     if (this.waiting) {
       const [header, blob] = this.waiting;
       this.waiting = null;
