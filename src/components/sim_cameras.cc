@@ -68,9 +68,11 @@ void SimCameras::SetEffects(bool distortion, bool noise, bool motion_blur) {
 }
 
 void SimCameras::Step(const runtime::StepContext& context) {
+  std::vector<render::Frame> frames;
   if (options_changed_ && renderer_) {
-    renderer_.reset();  // one GL context at a time
-    renderer_ = render::MakeRenderer(*scene_, options_);
+    // The frames in flight were drawn with the old effects: they go out with this step's.
+    if (renderer_->InFlight() > 0) frames = renderer_->Retrieve();
+    renderer_->SetEffects(options_.distortion, options_.noise, options_.motion_blur);
     options_changed_ = false;
   }
   scene::SceneState state = scene_->InitialState();
@@ -80,7 +82,6 @@ void SimCameras::Step(const runtime::StepContext& context) {
     state.joint_velocities = joints->velocities;
   }
   const bool pipelined = pipelined_ == "always" || (pipelined_ == "auto" && context.realtime);
-  std::vector<render::Frame> frames;
   if (pipelined) {
     if (renderer_->InFlight() > 0) frames = renderer_->Retrieve();
     renderer_->Submit(state, context.step);

@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "image_camera_helpers.h"
+#include "saccade/core/error.h"
 #include "saccade/core/image.h"
 #include "saccade/core/image_io.h"
 #include "saccade/geometry/camera_model.h"
@@ -732,6 +733,75 @@ TEST(TruthTest, DistortionOffRendersThePinholeAndSaysSo) {
   EXPECT_FALSE(SamePixels(*distorted.color, *plain.color));
   EXPECT_FALSE(distorted.depth);  // not asked for
   EXPECT_TRUE(distorted.objects.empty());
+}
+
+// --- switching effects -------------------------------------------------------------------
+
+// Renderer::SetEffects keeps the context and everything uploaded, and remakes only the
+// cameras' targets: after a switch the frames are bit for bit those of a renderer made with
+// the new options, for every combination, both ways, and with the head turning and the ball
+// moving (blur), the lens (distortion) and the sensor (noise) all in play.
+TEST(SetEffectsTest, SwitchedEffectsGiveTheFramesOfARendererMadeWithThem) {
+  const std::string camera =
+      "{calibration: {width: 320, height: 240, fx: 250, fy: 250, distortion: {model: radtan, "
+      "coefficients: [-0.25, 0.08, 0.001, -0.0005, 0]}}, sensor: {exposure: 0.01, "
+      "blur_samples: 8, read_noise_dn: 2.0, gain_dn_per_e: 0.1, seed: 3}}";
+  const scene::Scene world = SceneFrom(R"(
+background: [0.6, 0.7, 0.8]
+lights: [{type: ambient, intensity: 0.4}, {type: directional, direction: [1, 0, -1]}]
+ground: {pattern: checker, cell: 0.25}
+objects:
+  - {name: ball, kind: sphere, radius: 0.2, pose: {position: [2, 0.3, 1.2]}, color: [0.9, 0.2, 0.1, 1],
+     motion: {type: constant_velocity, linear: [0, -2, 0]}}
+robot:
+  head: ../robots/popeye.yaml
+  pose: {position: [0, 0, 1.2]}
+  cameras:
+    left: )" + camera +
+                                       "\n    right: " + camera + "\n");
+  scene::SceneState state = world.InitialState();
+  state.time = 0.1;
+  state.joint_velocities.pan = 2.0;
+
+  std::unique_ptr<Renderer> switched = MakeRenderer(world);
+  int64_t frame = 0;
+  std::vector<std::vector<uint8_t>> seen;  // the left images, in the order switched to
+  // Every combination, and every switch of the noise alone (which keeps the targets).
+  for (const int bits : {0, 2, 7, 5, 1, 3, 6, 4, 7, 2, 0}) {
+    RendererOptions options;
+    options.distortion = (bits & 1) != 0;
+    options.noise = (bits & 2) != 0;
+    options.motion_blur = (bits & 4) != 0;
+    SCOPED_TRACE("distortion " + std::to_string(options.distortion) + ", noise " +
+                 std::to_string(options.noise) + ", blur " + std::to_string(options.motion_blur));
+    switched->SetEffects(options.distortion, options.noise, options.motion_blur);
+    ++frame;
+    const std::vector<Frame> got = switched->Render(state, frame);
+    const std::vector<Frame> made = RenderOnce(world, options, &state, frame);
+    ASSERT_EQ(got.size(), 2u);
+    for (int i = 0; i < 2; ++i) {
+      EXPECT_TRUE(SamePixels(*got[i].color, *made[i].color))
+          << i << ": " << Keep(*got[i].color, "switched");
+      EXPECT_EQ(testing_helpers::DistortionName(got[i].color->metadata()),
+                options.distortion ? "radtan" : "none");
+      EXPECT_EQ(got[i].color->metadata().exposure_samples,
+                made[i].color->metadata().exposure_samples);
+      EXPECT_EQ(got[i].color->metadata().exposure_samples > 1, options.motion_blur) << i;
+    }
+    const uint8_t* left = got[0].color->data();
+    seen.emplace_back(left, left + got[0].color->size_bytes());
+  }
+  for (int a = 0; a < 8; ++a) {  // the first eight are the eight combinations
+    for (int b = 0; b < a; ++b) EXPECT_NE(seen[a], seen[b]) << "switches " << b << " and " << a;
+  }
+
+  // Not while a state is in flight: its pixels were drawn with the effects it was submitted with.
+  switched->Submit(state, ++frame);
+  EXPECT_THROW(switched->SetEffects(false, false, false), Error);
+  EXPECT_EQ(switched->Retrieve()[0].color->metadata().frame_index, frame);
+  switched->SetEffects(false, false, false);
+  EXPECT_EQ(testing_helpers::DistortionName(switched->Render(state, ++frame)[0].color->metadata()),
+            "none");
 }
 
 }  // namespace

@@ -148,6 +148,14 @@ class Renderer {
   /// Submitted states not yet retrieved (0, 1 or 2). Submit with 2 in flight throws Error.
   virtual int InFlight() const = 0;
 
+  /// Switches the effects for every camera, as RendererOptions' distortion, noise and
+  /// motion_blur would at creation: the next frames are those a renderer made with these
+  /// options gives, bit for bit. Only the cameras' targets are remade; the context, the
+  /// uploaded models and textures and the compiled programs are kept (remaking the renderer
+  /// instead costs a context and every upload, and churns over a hundred MiB on llvmpipe).
+  /// Throws Error while states are in flight (Retrieve them first).
+  virtual void SetEffects(bool distortion, bool noise, bool motion_blur) = 0;
+
   /// Batch rendering: draws every head of `heads` through every selected camera into one
   /// framebuffer of tiles and reads them back at once into `out`: heads.size() x cameras x
   /// height x width x 3 bytes (kRgb8, row 0 at the top), tightly packed, `out_bytes` long.

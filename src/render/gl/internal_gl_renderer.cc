@@ -113,8 +113,62 @@ GlRenderer::GlRenderer(const scene::Scene& scene, const RendererOptions& options
   }
 
   truth_ = options_.truth_depth || options_.truth_ids || options_.truth_objects;
-  for (const scene::CameraSpec* camera : cameras_) {
+  BuildCameraSetups();
+  for (Pending& pending : pending_) {
+    pending.X_WC.resize(cameras_.size());
+    pending.exposure_samples.assign(cameras_.size(), 1);
+  }
+  image_pools_.resize(cameras_.size());
+
+  // Fixed state. The projection negates y (flip_rows), which mirrors the winding of every
+  // triangle: front faces (counter-clockwise in the model) are clockwise in window
+  // coordinates. Closed meshes have their back faces culled; open ones are two-sided, where
+  // gl_FrontFacing says which side is seen.
+  glFrontFace(GL_CW);
+  glCullFace(GL_BACK);
+  glEnable(GL_DEPTH_TEST);
+  glDepthFunc(GL_LESS);
+  glDisable(GL_BLEND);
+  glDisable(GL_DITHER);  // bit-identical pixels, whatever the device likes
+  if (samples_ > 0) glEnable(GL_MULTISAMPLE);
+  const Eigen::Vector3f background = scene_.background();
+  glClearColor(background.x(), background.y(), background.z(), 1.0f);
+  glClearDepth(1.0);
+  glActiveTexture(GL_TEXTURE0);
+  CheckGlError("MakeRenderer: setting up");
+
+  description_ = fmt::format("OpenGL {}, {} (EGL: {})", version, renderer, context_.display_name());
+  if (options_.msaa_samples > 0) {
+    description_ += samples_ == options_.msaa_samples
+                        ? fmt::format(", MSAA {}x", samples_)
+                        : fmt::format(", MSAA {}x ({}x asked; the device's maximum)", samples_,
+                                      options_.msaa_samples);
+  }
+}
+
+// How each camera renders, from options_'s effects: its source views, and its effect target
+// (or its plain target when it needs no effect). `reuse`: the previous setups (SetEffects), whose
+// effect targets are kept where the lens and the blur stay as they were (a switch of the noise
+// alone remakes nothing); `reuse_distortion`: the distortion switch they were made with. Needs
+// the context current.
+void GlRenderer::BuildCameraSetups(std::vector<CameraSetup> reuse, bool reuse_distortion) {
+  targets_.clear();
+  setups_.clear();
+  for (std::size_t i = 0; i < cameras_.size(); ++i) {
+    const scene::CameraSpec* camera = cameras_[i];
     CameraSetup setup;
+    if (i < reuse.size() && reuse[i].effects && reuse_distortion == options_.distortion &&
+        reuse[i].blur == (options_.motion_blur && camera->sensor.HasBlur())) {
+      setup = std::move(reuse[i]);
+      setup.noise = options_.noise && camera->sensor.HasNoise();
+      if (setup.distorted || setup.noise || setup.blur || truth_) {
+        effect_programs_->GetFinal(!setup.distorted, setup.noise);
+        targets_.push_back(nullptr);
+        setups_.push_back(std::move(setup));
+        continue;
+      }
+      setup = CameraSetup();  // no effect left: the plain path
+    }
     const geometry::Intrinsics& K = camera->model.intrinsics();
     // The lens: distortion as calibrated, or the pinhole of K when switched off.
     const geometry::CameraModel model =
@@ -150,36 +204,26 @@ GlRenderer::GlRenderer(const scene::Scene& scene, const RendererOptions& options
     }
     setups_.push_back(std::move(setup));
   }
-  for (Pending& pending : pending_) {
-    pending.X_WC.resize(cameras_.size());
-    pending.exposure_samples.assign(cameras_.size(), 1);
-  }
-  image_pools_.resize(cameras_.size());
+}
 
-  // Fixed state. The projection negates y (flip_rows), which mirrors the winding of every
-  // triangle: front faces (counter-clockwise in the model) are clockwise in window
-  // coordinates. Closed meshes have their back faces culled; open ones are two-sided, where
-  // gl_FrontFacing says which side is seen.
-  glFrontFace(GL_CW);
-  glCullFace(GL_BACK);
-  glEnable(GL_DEPTH_TEST);
-  glDepthFunc(GL_LESS);
-  glDisable(GL_BLEND);
-  glDisable(GL_DITHER);  // bit-identical pixels, whatever the device likes
-  if (samples_ > 0) glEnable(GL_MULTISAMPLE);
-  const Eigen::Vector3f background = scene_.background();
-  glClearColor(background.x(), background.y(), background.z(), 1.0f);
-  glClearDepth(1.0);
+void GlRenderer::SetEffects(bool distortion, bool noise, bool motion_blur) {
+  if (in_flight_ > 0) {
+    throw Error(fmt::format(
+        "Renderer::SetEffects: {} submitted state(s) not yet retrieved; Retrieve them first",
+        in_flight_));
+  }
+  if (options_.distortion == distortion && options_.noise == noise &&
+      options_.motion_blur == motion_blur) {
+    return;
+  }
+  context_.MakeCurrent();
+  const bool previous_distortion = options_.distortion;
+  options_.distortion = distortion;
+  options_.noise = noise;
+  options_.motion_blur = motion_blur;
+  BuildCameraSetups(std::move(setups_), previous_distortion);
   glActiveTexture(GL_TEXTURE0);
-  CheckGlError("MakeRenderer: setting up");
-
-  description_ = fmt::format("OpenGL {}, {} (EGL: {})", version, renderer, context_.display_name());
-  if (options_.msaa_samples > 0) {
-    description_ += samples_ == options_.msaa_samples
-                        ? fmt::format(", MSAA {}x", samples_)
-                        : fmt::format(", MSAA {}x ({}x asked; the device's maximum)", samples_,
-                                      options_.msaa_samples);
-  }
+  CheckGlError("Renderer::SetEffects");
 }
 
 GlRenderer::~GlRenderer() {

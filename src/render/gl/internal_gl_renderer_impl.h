@@ -160,6 +160,7 @@ class GlRenderer final : public Renderer {
   void Submit(const scene::SceneState& state, int64_t frame_index) override;
   std::vector<Frame> Retrieve() override;
   int InFlight() const override { return in_flight_; }
+  void SetEffects(bool distortion, bool noise, bool motion_blur) override;
   // Batch rendering (internal_batch.cc).
   void RenderBatch(const std::vector<BatchHead>& heads, uint8_t* out,
                    std::size_t out_bytes) override;
@@ -168,6 +169,8 @@ class GlRenderer final : public Renderer {
   const RenderStats& stats() const override { return stats_; }
 
  private:
+  struct CameraSetup;
+  void BuildCameraSetups(std::vector<CameraSetup> reuse = {}, bool reuse_distortion = false);
   // A submitted state whose pixels are on their way.
   struct Pending {
     scene::SceneState state;
