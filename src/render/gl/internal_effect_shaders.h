@@ -17,6 +17,19 @@ void main() {
 }
 )";
 
+/// The lens remap's cells (internal_effects.h, LensMesh): rectangles of the camera's pixels,
+/// given in NDC, with the source position (x, y, view) at their corners, which the rasterizer
+/// interpolates linearly to every pixel centre (for the cells drawn through the map, unused).
+inline constexpr const char* kLensMeshVertexSource = R"(#version 330 core
+layout(location = 0) in vec2 a_position;
+layout(location = 1) in vec3 a_source;
+out vec3 v_source;
+void main() {
+  v_source = a_source;
+  gl_Position = vec4(a_position, 0.0, 1.0);
+}
+)";
+
 /// Motion blur: adds one sub-frame's layer, times its weight, into the accumulation layer
 /// (additive blending into RGBA32F).
 inline constexpr const char* kAccumulateFragmentSource = R"(#version 330 core
@@ -57,6 +70,10 @@ void main() {
 
 /// The camera's image: lens remap, sensor noise, quantisation to 8 bits.
 /// IDENTITY 1: the source is the image itself (no distortion), one layer at the image's size.
+/// MESH 1: the pixel's source position (x, y, view) comes interpolated from the lens mesh's
+/// cell corners (v_source; LensMesh: within 0.01 source pixel of the map, one sample), with no
+/// fetch of the map: on llvmpipe the map's RGBA32F fetch was what made the lens cost (10 ms of
+/// the pass an eye on the bench scene, the bilinear fetch of the source next to nothing).
 /// Otherwise u_map holds, per pixel, (x, y, view, taps) (internal_effects.h, RemapTable):
 /// (x, y) in source view `view` (geometry/lens_map.h; view < 0: no ray, black), and the pixel
 /// is the mean of the source over its footprint, a box as a sensor's pixel integrates: taps =
@@ -79,7 +96,9 @@ void main() {
 /// image (three fetches a pixel took 6 ms).
 inline constexpr const char* kFinalFragmentSource = R"(
 uniform sampler2DArray u_source;
-#if !IDENTITY
+#if MESH
+in vec3 v_source;
+#elif !IDENTITY
 uniform sampler2D u_map;
 uniform sampler2D u_footprint;
 #endif
@@ -113,6 +132,8 @@ void main() {
   vec3 c;
 #if IDENTITY
   c = texelFetch(u_source, ivec3(pixel, 0), 0).rgb;
+#elif MESH
+  c = Bilinear(v_source.xy, v_source.z, 1.0 / vec2(textureSize(u_source, 0).xy));
 #else
   vec4 m = texelFetch(u_map, pixel, 0);
   if (m.z < 0.0) {

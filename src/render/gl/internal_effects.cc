@@ -82,6 +82,138 @@ RemapTable MakeRemapTable(const geometry::LensMap& lens) {
   return table;
 }
 
+namespace {
+
+// Builds LensMesh's cells (see internal_effects.h).
+class LensMeshBuilder {
+ public:
+  LensMeshBuilder(const RemapTable& table, int width, int height, double tolerance)
+      : table_(table), width_(width), height_(height), tolerance_(tolerance) {
+    // The source position at each pixel corner (X, Y) (window coordinates, integers): the
+    // map bilinearly interpolated between the four pixel centres around it, extrapolated at the
+    // image's edges; invalid where they do not share one view.
+    corners_.resize(static_cast<std::size_t>(width + 1) * (height + 1));
+    for (int Y = 0; Y <= height; ++Y) {
+      for (int X = 0; X <= width; ++X) corners_[Index(X, Y)] = Corner(X, Y);
+    }
+  }
+
+  LensMesh Build() {
+    for (int y = 0; y < height_; y += kLensCell) {
+      for (int x = 0; x < width_; x += kLensCell) {
+        Add(x, y, std::min(kLensCell, width_ - x), std::min(kLensCell, height_ - y));
+      }
+    }
+    return std::move(mesh_);
+  }
+
+ private:
+  struct Source {
+    Eigen::Vector2f p = Eigen::Vector2f::Zero();  // as the vertex holds it
+    float view = -1.0f;                           // < 0: invalid
+  };
+
+  std::size_t Index(int X, int Y) const { return static_cast<std::size_t>(Y) * (width_ + 1) + X; }
+  const float* Map(int u, int v) const {
+    return &table_.map[4 * (static_cast<std::size_t>(v) * width_ + u)];
+  }
+
+  Source Corner(int X, int Y) const {
+    if (width_ < 2 || height_ < 2) return {};
+    const int u0 = std::clamp(X - 1, 0, width_ - 2), v0 = std::clamp(Y - 1, 0, height_ - 2);
+    const double a = (X - 0.5) - u0, b = (Y - 0.5) - v0;  // -0.5 or 1.5 at the edges
+    Source out;
+    out.view = Map(u0, v0)[2];
+    if (out.view < 0.0f) return {};
+    Eigen::Vector2d p = Eigen::Vector2d::Zero();
+    const double w[4] = {(1 - a) * (1 - b), a * (1 - b), (1 - a) * b, a * b};
+    const int du[4] = {0, 1, 0, 1}, dv[4] = {0, 0, 1, 1};
+    for (int k = 0; k < 4; ++k) {
+      const float* m = Map(u0 + du[k], v0 + dv[k]);
+      if (m[2] != out.view) return {};
+      p += w[k] * Eigen::Vector2d(m[0], m[1]);
+    }
+    out.p = p.cast<float>();
+    return out;
+  }
+
+  // The cell [x, x + w) x [y, y + h) as linear, or halved, or exact at the smallest size.
+  void Add(int x, int y, int w, int h) {
+    double error = 0.0;
+    if (Linear(x, y, w, h, &error)) {
+      Emit(x, y, w, h, /*linear=*/true);
+      mesh_.linear_pixels += static_cast<int64_t>(w) * h;
+      mesh_.max_error_px = std::max(mesh_.max_error_px, error);
+      return;
+    }
+    if (w <= 4 && h <= 4) {
+      Emit(x, y, w, h, /*linear=*/false);
+      return;
+    }
+    const int w0 = w > 4 ? w / 2 : w, h0 = h > 4 ? h / 2 : h;
+    for (int j = 0; j < (h > 4 ? 2 : 1); ++j) {
+      for (int i = 0; i < (w > 4 ? 2 : 1); ++i) {
+        Add(x + i * w0, y + j * h0, i == 0 ? w0 : w - w0, j == 0 ? h0 : h - h0);
+      }
+    }
+  }
+
+  // Whether every pixel of the cell is one sample of one view, within tolerance of the
+  // position interpolated over the two triangles (00, 10, 11) and (00, 11, 01) as the
+  // rasterizer does at its centre.
+  bool Linear(int x, int y, int w, int h, double* error) const {
+    const Source& c00 = corners_[Index(x, y)];
+    const Source& c10 = corners_[Index(x + w, y)];
+    const Source& c01 = corners_[Index(x, y + h)];
+    const Source& c11 = corners_[Index(x + w, y + h)];
+    const float view = c00.view;
+    if (view < 0.0f || c10.view != view || c01.view != view || c11.view != view) return false;
+    for (int v = y; v < y + h; ++v) {
+      for (int u = x; u < x + w; ++u) {
+        const float* m = Map(u, v);
+        if (m[2] != view || m[3] != 17.0f) return false;  // 17: one sample (nu = nv = 1)
+        const double s = (u + 0.5 - x) / w, t = (v + 0.5 - y) / h;
+        const Eigen::Vector2d p00 = c00.p.cast<double>(), p10 = c10.p.cast<double>(),
+                              p01 = c01.p.cast<double>(), p11 = c11.p.cast<double>();
+        const Eigen::Vector2d p = s >= t ? p00 + s * (p10 - p00) + t * (p11 - p10)
+                                         : p00 + s * (p11 - p01) + t * (p01 - p00);
+        const double e = (p - Eigen::Vector2d(m[0], m[1])).norm();
+        if (e > tolerance_) return false;
+        *error = std::max(*error, e);
+      }
+    }
+    return true;
+  }
+
+  void Emit(int x, int y, int w, int h, bool linear) {
+    const auto first = static_cast<uint32_t>(mesh_.vertices.size() / 5);
+    const int X[4] = {x, x + w, x, x + w}, Y[4] = {y, y, y + h, y + h};
+    for (int k = 0; k < 4; ++k) {
+      mesh_.vertices.push_back(static_cast<float>(2.0 * X[k] / width_ - 1.0));
+      mesh_.vertices.push_back(static_cast<float>(2.0 * Y[k] / height_ - 1.0));
+      const Source& c = corners_[Index(X[k], Y[k])];
+      mesh_.vertices.push_back(linear ? c.p.x() : 0.0f);
+      mesh_.vertices.push_back(linear ? c.p.y() : 0.0f);
+      mesh_.vertices.push_back(linear ? c.view : 0.0f);
+    }
+    // Corners 0 = 00, 1 = 10, 2 = 01, 3 = 11: triangles (00, 10, 11) and (00, 11, 01).
+    std::vector<uint32_t>& indices = linear ? mesh_.linear : mesh_.exact;
+    for (const uint32_t k : {0u, 1u, 3u, 0u, 3u, 2u}) indices.push_back(first + k);
+  }
+
+  const RemapTable& table_;
+  int width_, height_;
+  double tolerance_;
+  std::vector<Source> corners_;
+  LensMesh mesh_;
+};
+
+}  // namespace
+
+LensMesh MakeLensMesh(const RemapTable& table, int width, int height, double tolerance_px) {
+  return LensMeshBuilder(table, width, height, tolerance_px).Build();
+}
+
 std::vector<float> GaussianTable() {
   // Quantile i of the standard normal at probability (i + 1/2) / n, by bisection on erfc (to
   // float precision: 40 halvings of [-9, 0]), then scaled to unit variance (the n quantiles
@@ -124,9 +256,9 @@ std::vector<float> GaussianTable() {
 
 namespace {
 
-std::string Defines(bool identity, bool noise) {
-  return fmt::format("#version 330 core\n#define IDENTITY {}\n#define NOISE {}\n", identity ? 1 : 0,
-                     noise ? 1 : 0);
+std::string Defines(bool identity, bool noise, bool mesh = false) {
+  return fmt::format("#version 330 core\n#define IDENTITY {}\n#define NOISE {}\n#define MESH {}\n",
+                     identity ? 1 : 0, noise ? 1 : 0, mesh ? 1 : 0);
 }
 
 // Texel-exact sampling only (texelFetch): no filtering, no mipmaps (a texture whose minifying
@@ -228,13 +360,15 @@ EffectPrograms::~EffectPrograms() {
   for (const auto& [variant, program] : truth_remaps_) glDeleteProgram(program);
 }
 
-const EffectPrograms::Final& EffectPrograms::GetFinal(bool identity, bool noise) {
-  const int variant = (identity ? 1 : 0) | (noise ? 2 : 0);
+const EffectPrograms::Final& EffectPrograms::GetFinal(bool identity, bool noise, bool mesh) {
+  mesh = mesh && !identity;
+  const int variant = (identity ? 1 : 0) | (noise ? 2 : 0) | (mesh ? 4 : 0);
   if (const auto it = finals_.find(variant); it != finals_.end()) return it->second;
   Final f;
-  f.program =
-      BuildProgram(fmt::format("final pass (identity {}, noise {})", identity, noise),
-                   kFullscreenVertexSource, Defines(identity, noise) + kFinalFragmentSource);
+  f.program = BuildProgram(
+      fmt::format("final pass (identity {}, noise {}, mesh {})", identity, noise, mesh),
+      identity ? kFullscreenVertexSource : kLensMeshVertexSource,
+      Defines(identity, noise, mesh) + kFinalFragmentSource);
   f.read_sigma = Uniform(f.program, "u_read_sigma");
   f.gain = Uniform(f.program, "u_gain");
   f.key = Uniform(f.program, "u_key");
@@ -356,6 +490,30 @@ EffectTarget::EffectTarget(const geometry::LensMap& lens, int samples, bool blur
         MakeTexture2d(GL_RGBA32F, GL_RGBA, GL_FLOAT, lens_.width, lens_.height, table.map.data());
     footprint_ = MakeTexture2d(GL_RGBA32F, GL_RGBA, GL_FLOAT, lens_.width, lens_.height,
                                table.footprint.data());
+    const LensMesh mesh = MakeLensMesh(table, lens_.width, lens_.height);
+    std::vector<uint32_t> indices = mesh.linear;
+    indices.insert(indices.end(), mesh.exact.begin(), mesh.exact.end());
+    mesh_linear_ = static_cast<GLsizei>(mesh.linear.size());
+    mesh_exact_ = static_cast<GLsizei>(mesh.exact.size());
+    glGenVertexArrays(1, &mesh_vao_);
+    glBindVertexArray(mesh_vao_);
+    glGenBuffers(1, &mesh_vertices_);
+    glBindBuffer(GL_ARRAY_BUFFER, mesh_vertices_);
+    glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(mesh.vertices.size() * sizeof(float)),
+                 mesh.vertices.data(), GL_STATIC_DRAW);
+    glGenBuffers(1, &mesh_indices_);
+    glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, mesh_indices_);
+    glBufferData(GL_ELEMENT_ARRAY_BUFFER,
+                 static_cast<GLsizeiptr>(indices.size() * sizeof(uint32_t)), indices.data(),
+                 GL_STATIC_DRAW);
+    constexpr GLsizei kStride = 5 * sizeof(float);
+    glEnableVertexAttribArray(0);
+    glVertexAttribPointer(0, 2, GL_FLOAT, GL_FALSE, kStride, nullptr);
+    glEnableVertexAttribArray(1);
+    glVertexAttribPointer(1, 3, GL_FLOAT, GL_FALSE, kStride,
+                          reinterpret_cast<const void*>(2 * sizeof(float)));
+    glBindVertexArray(0);
+    glBindBuffer(GL_ARRAY_BUFFER, 0);
   }
   output_color_ = MakeArray(GL_RGBA8, GL_RGBA, GL_UNSIGNED_BYTE, lens_.width, lens_.height, 1);
   glGenFramebuffers(1, &output_framebuffer_);
@@ -402,6 +560,9 @@ EffectTarget::~EffectTarget() {
   glDeleteTextures(9, textures);
   const GLuint renderbuffers[] = {msaa_color_, depth_, truth_depth_};
   glDeleteRenderbuffers(3, renderbuffers);
+  glDeleteVertexArrays(1, &mesh_vao_);
+  const GLuint buffers[] = {mesh_vertices_, mesh_indices_};
+  glDeleteBuffers(2, buffers);
 }
 
 void EffectTarget::BindViewForDrawing(int view) const {
@@ -508,17 +669,35 @@ void EffectTarget::Finish(EffectPrograms& programs, bool accumulated, const Nois
     BindTexture(kFootprintUnit, GL_TEXTURE_2D, footprint_);
   }
 
-  const EffectPrograms::Final& final = programs.GetFinal(identity, noise != nullptr);
   glBindFramebuffer(GL_FRAMEBUFFER, output_framebuffer_);
-  glUseProgram(final.program);
-  if (noise != nullptr) {
-    glUniform1f(final.read_sigma, noise->read_sigma_dn);
-    glUniform1f(final.gain, noise->gain_dn_per_e);
-    glUniform1ui(final.key, noise->key);
-    BindTexture(kGaussUnit, GL_TEXTURE_2D, programs.gauss());
-  }
+  if (noise != nullptr) BindTexture(kGaussUnit, GL_TEXTURE_2D, programs.gauss());
   BindTexture(kSourceUnit, GL_TEXTURE_2D_ARRAY, accumulated ? accumulation_ : source_);
-  programs.DrawFullscreen();
+  // Identity: the full-screen triangle; a lens: its linear cells, then its exact ones.
+  const auto pass = [&](bool mesh) {
+    const EffectPrograms::Final& final = programs.GetFinal(identity, noise != nullptr, mesh);
+    glUseProgram(final.program);
+    if (noise != nullptr) {
+      glUniform1f(final.read_sigma, noise->read_sigma_dn);
+      glUniform1f(final.gain, noise->gain_dn_per_e);
+      glUniform1ui(final.key, noise->key);
+    }
+  };
+  if (identity) {
+    pass(false);
+    programs.DrawFullscreen();
+  } else {
+    glBindVertexArray(mesh_vao_);
+    if (mesh_linear_ > 0) {
+      pass(true);
+      glDrawElements(GL_TRIANGLES, mesh_linear_, GL_UNSIGNED_INT, nullptr);
+    }
+    if (mesh_exact_ > 0) {
+      pass(false);
+      glDrawElements(GL_TRIANGLES, mesh_exact_, GL_UNSIGNED_INT,
+                     reinterpret_cast<const void*>(mesh_linear_ * sizeof(uint32_t)));
+    }
+    glBindVertexArray(0);
+  }
   glBindFramebuffer(GL_READ_FRAMEBUFFER, output_framebuffer_);
   glReadBuffer(GL_COLOR_ATTACHMENT0);
   color_buffers_.Read(slot, GL_RGBA, GL_UNSIGNED_BYTE);

@@ -9,9 +9,10 @@
 //        only inside the region that the moving items sweep (scissored), the first standing
 //        for all of them elsewhere
 //   -> one final pass at the camera's size: lens remap (per-pixel map; each pixel the mean of
-//      the source over its footprint, RemapTable, by bilinear texture fetches), sensor noise
-//      (a hashed table of normal deviates, GaussianTable), quantisation to 8 bits
-//      (internal_effect_shaders.h)
+//      the source over its footprint, RemapTable, by bilinear texture fetches; drawn as the
+//      lens mesh's cells, LensMesh, most of which interpolate the map instead of reading it),
+//      sensor noise (a hashed table of normal deviates, GaussianTable), quantisation to 8
+//      bits (internal_effect_shaders.h)
 //   -> readback through pixel buffer objects, one per in-flight slot.
 //
 // Ground truth, when asked: one more scene pass per view into an R32UI id array and an RG32F
@@ -48,6 +49,28 @@ struct RemapTable {
 };
 RemapTable MakeRemapTable(const geometry::LensMap& lens);
 
+/// The lens remap as cells drawn by the rasterizer (kLensMeshVertexSource): the camera's image
+/// cut into rectangles of pixels (edges on pixel boundaries, so every pixel centre falls in
+/// exactly one), each two triangles whose corners carry the source position (x, y, view).
+/// - linear cells: one view, one sample a pixel, and the position interpolated linearly over
+///   each triangle within `tolerance` source pixels of the map's at every pixel centre (checked
+///   here as the rasterizer interpolates); drawn with the MESH final pass, no map fetch;
+/// - exact cells: the rest (a view's edge, no ray, several samples a pixel, a map that bends
+///   too fast), drawn with the map's final pass, pixel by pixel as before.
+/// Cells start at kLensCell pixels a side and are halved where they fail, down to 4.
+struct LensMesh {
+  /// Per vertex: NDC x, y, then source x, y, view (exact cells: zero).
+  std::vector<float> vertices;
+  std::vector<uint32_t> linear;  ///< triangle indices of the linear cells
+  std::vector<uint32_t> exact;   ///< and of the exact ones
+  int64_t linear_pixels = 0;
+  double max_error_px = 0.0;  ///< the largest error over the linear cells' pixels
+};
+inline constexpr int kLensCell = 32;
+inline constexpr double kLensMeshTolerancePx = 0.01;
+LensMesh MakeLensMesh(const RemapTable& table, int width, int height,
+                      double tolerance_px = kLensMeshTolerancePx);
+
 /// The sensor noise's table (kFinalFragmentSource): kGaussianTableSide^2 entries of three
 /// standard normal deviates (RGB), each channel the quantiles at (i + 1/2) / 2^16 scaled to
 /// unit variance (mean exactly 0) in an order of its own.
@@ -72,8 +95,11 @@ class EffectPrograms {
   EffectPrograms(const EffectPrograms&) = delete;
   EffectPrograms& operator=(const EffectPrograms&) = delete;
 
-  /// The final pass for an identity map or not, with noise or not (built on first use).
-  const Final& GetFinal(bool identity, bool noise);
+  /// The final pass for an identity map or not, with noise or not, from the lens mesh's
+  /// interpolated positions or the map (`mesh`; not with identity) (built on first use). The
+  /// passes of a lens draw the lens mesh's cells (kLensMeshVertexSource), the identity one the
+  /// full-screen triangle.
+  const Final& GetFinal(bool identity, bool noise, bool mesh = false);
   /// The truth remap for an identity map or not.
   GLuint GetTruthRemap(bool identity);
   const Truth& truth() const { return truth_; }
@@ -189,6 +215,8 @@ class EffectTarget {
   GLuint accumulation_ = 0;  // RGBA32F array
   GLuint map_ = 0;           // RGBA32F, camera size: RemapTable::map
   GLuint footprint_ = 0;     // RGBA32F, camera size: RemapTable::footprint
+  GLuint mesh_vao_ = 0, mesh_vertices_ = 0, mesh_indices_ = 0;  // LensMesh
+  GLsizei mesh_linear_ = 0, mesh_exact_ = 0;                    // indices of each kind
   GLuint draw_framebuffer_ = 0;
   GLuint msaa_color_ = 0, depth_ = 0;  // renderbuffers (colour only with MSAA)
   GLuint resolve_framebuffer_ = 0;     // MSAA: the layer to resolve into

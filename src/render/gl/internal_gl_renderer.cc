@@ -163,6 +163,7 @@ void GlRenderer::BuildCameraSetups(std::vector<CameraSetup> reuse, bool reuse_di
       setup.noise = options_.noise && camera->sensor.HasNoise();
       if (setup.distorted || setup.noise || setup.blur || truth_) {
         effect_programs_->GetFinal(!setup.distorted, setup.noise);
+        if (setup.distorted) effect_programs_->GetFinal(false, setup.noise, /*mesh=*/true);
         targets_.push_back(nullptr);
         setups_.push_back(std::move(setup));
         continue;
@@ -197,6 +198,7 @@ void GlRenderer::BuildCameraSetups(std::vector<CameraSetup> reuse, bool reuse_di
       setup.effects = std::make_unique<EffectTarget>(lens, samples_, setup.blur, truth_);
       // Build the programs now, not in the first frame.
       effect_programs_->GetFinal(!setup.distorted, setup.noise);
+      if (setup.distorted) effect_programs_->GetFinal(false, setup.noise, /*mesh=*/true);
       if (truth_) effect_programs_->GetTruthRemap(!setup.distorted);
       targets_.push_back(nullptr);
     } else {
