@@ -151,6 +151,16 @@ void BindRender(py::module_& m) {
                              [](const PyRenderer& r) { return r.renderer->DeviceDescription(); })
       .def_property_readonly("stats", [](const PyRenderer& r) { return r.renderer->stats(); })
       .def(
+          "set_effects",
+          [](PyRenderer& r, bool distortion, bool noise, bool motion_blur) {
+            py::gil_scoped_release release;
+            r.renderer->SetEffects(distortion, noise, motion_blur);
+          },
+          "distortion"_a, "noise"_a, "motion_blur"_a,
+          "Switches the effects of every camera in place, as the constructor's arguments would: "
+          "the next renders are bit for bit those of a Renderer made with them, without a new "
+          "context or uploads (say, effects drawn at random per episode).")
+      .def(
           "render",
           [](PyRenderer& r, const scene::SceneState& state, int64_t frame_index,
              std::optional<py::array> out) -> py::object {

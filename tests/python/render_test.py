@@ -172,3 +172,23 @@ def test_rendering_releases_the_gil(scene):
 def test_unknown_camera_is_named(scene):
     with pytest.raises(saccade.InvalidArgument, match="nose"):
         saccade.render.Renderer(scene, cameras=["nose"])
+
+
+def test_set_effects_gives_the_frames_of_a_renderer_made_with_them():
+    # The bench scene's eyes have a lens, sensor noise and an exposure; the head pans (blur).
+    bench = saccade.scene.Scene.load(path("scenes", "bench.yaml"))
+    state = bench.initial_state()
+    state.time = 0.1
+    velocities = state.joint_velocities
+    velocities.pan = 2.0
+    state.joint_velocities = velocities
+    switched = saccade.render.Renderer(bench, cameras=["left"])
+    images = []
+    for distortion, noise, blur in [(False, True, False), (True, False, True), (True, True, True)]:
+        switched.set_effects(distortion=distortion, noise=noise, motion_blur=blur)
+        got = switched.render(state, 3)[0]
+        made = saccade.render.Renderer(bench, cameras=["left"], distortion=distortion,
+                                       noise=noise, motion_blur=blur).render(state, 3)[0]
+        assert np.array_equal(got.color, made.color), (distortion, noise, blur)
+        images.append(got.color.copy())
+    assert not np.array_equal(images[0], images[1]) and not np.array_equal(images[1], images[2])
