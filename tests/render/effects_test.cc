@@ -766,8 +766,9 @@ robot:
   std::unique_ptr<Renderer> switched = MakeRenderer(world);
   int64_t frame = 0;
   std::vector<std::vector<uint8_t>> seen;  // the left images, in the order switched to
-  // Every combination, and every switch of the noise alone (which keeps the targets).
-  for (const int bits : {0, 2, 7, 5, 1, 3, 6, 4, 7, 2, 0}) {
+  // Every combination; switches of the noise or the blur alone, which keep the targets (blur
+  // on again, and on for a target made without it).
+  for (const int bits : {0, 2, 7, 5, 1, 3, 6, 4, 7, 2, 0, 2, 6, 2, 6}) {
     RendererOptions options;
     options.distortion = (bits & 1) != 0;
     options.noise = (bits & 2) != 0;

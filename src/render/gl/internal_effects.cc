@@ -476,14 +476,7 @@ EffectTarget::EffectTarget(const geometry::LensMap& lens, int samples, bool blur
     glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, source_, 0, 0);
     CheckComplete("source view", w, h);
   }
-  if (blur_) {
-    accumulation_ = MakeArray(GL_RGBA32F, GL_RGBA, GL_FLOAT, w, h, layers_);
-    FilterLinearly(accumulation_);
-    glGenFramebuffers(1, &accumulation_framebuffer_);
-    glBindFramebuffer(GL_FRAMEBUFFER, accumulation_framebuffer_);
-    glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, accumulation_, 0, 0);
-    CheckComplete("motion blur accumulation", w, h);
-  }
+  if (blur_) EnableBlur();
   if (lens_.kind != geometry::LensMap::Kind::kIdentity) {
     const RemapTable table = MakeRemapTable(lens_);
     map_ =
@@ -548,6 +541,19 @@ EffectTarget::EffectTarget(const geometry::LensMap& lens, int samples, bool blur
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
   CheckGlError(
       fmt::format("Renderer: making the effect targets ({} view(s) of {} x {})", layers_, w, h));
+}
+
+void EffectTarget::EnableBlur() {
+  if (accumulation_ != 0) return;
+  const int w = source_width_, h = source_height_;
+  accumulation_ = MakeArray(GL_RGBA32F, GL_RGBA, GL_FLOAT, w, h, layers_);
+  FilterLinearly(accumulation_);
+  glGenFramebuffers(1, &accumulation_framebuffer_);
+  glBindFramebuffer(GL_FRAMEBUFFER, accumulation_framebuffer_);
+  glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, accumulation_, 0, 0);
+  CheckComplete("motion blur accumulation", w, h);
+  glBindFramebuffer(GL_FRAMEBUFFER, 0);
+  blur_ = true;
 }
 
 EffectTarget::~EffectTarget() {

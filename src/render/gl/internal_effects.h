@@ -163,6 +163,10 @@ class EffectTarget {
   EffectTarget(const EffectTarget&) = delete;
   EffectTarget& operator=(const EffectTarget&) = delete;
 
+  /// Adds the accumulation array (nothing if there is one): motion blur switched on. It is
+  /// kept when blur is switched off again, so that switching does not allocate each time.
+  void EnableBlur();
+
   const geometry::LensMap& lens() const { return lens_; }
   bool has_truth() const { return truth_; }
 

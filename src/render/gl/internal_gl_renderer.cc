@@ -148,19 +148,20 @@ GlRenderer::GlRenderer(const scene::Scene& scene, const RendererOptions& options
 
 // How each camera renders, from options_'s effects: its source views, and its effect target
 // (or its plain target when it needs no effect). `reuse`: the previous setups (SetEffects), whose
-// effect targets are kept where the lens and the blur stay as they were (a switch of the noise
-// alone remakes nothing); `reuse_distortion`: the distortion switch they were made with. Needs
-// the context current.
+// effect targets are kept where the lens stays as it was (a switch of the noise or the blur
+// remakes nothing: blur adds the accumulation array once, and keeps it); `reuse_distortion`:
+// the distortion switch they were made with. Needs the context current.
 void GlRenderer::BuildCameraSetups(std::vector<CameraSetup> reuse, bool reuse_distortion) {
   targets_.clear();
   setups_.clear();
   for (std::size_t i = 0; i < cameras_.size(); ++i) {
     const scene::CameraSpec* camera = cameras_[i];
     CameraSetup setup;
-    if (i < reuse.size() && reuse[i].effects && reuse_distortion == options_.distortion &&
-        reuse[i].blur == (options_.motion_blur && camera->sensor.HasBlur())) {
+    if (i < reuse.size() && reuse[i].effects && reuse_distortion == options_.distortion) {
       setup = std::move(reuse[i]);
       setup.noise = options_.noise && camera->sensor.HasNoise();
+      setup.blur = options_.motion_blur && camera->sensor.HasBlur();
+      if (setup.blur) setup.effects->EnableBlur();
       if (setup.distorted || setup.noise || setup.blur || truth_) {
         effect_programs_->GetFinal(!setup.distorted, setup.noise);
         if (setup.distorted) effect_programs_->GetFinal(false, setup.noise, /*mesh=*/true);
