@@ -4,6 +4,7 @@
 
 #include <map>
 #include <mutex>
+#include <optional>
 #include <set>
 
 #include "saccade/components/messages.h"
@@ -87,8 +88,17 @@ Endpoint Resolve(const runtime::TopicEndpoint& endpoint, const std::set<std::str
   return out;
 }
 
+// A received message's capture time (its header.stamp), seconds.
+double StampOf(const ImageMessage& m) { return m.image ? m.image->metadata().time : 0.0; }
+template <typename M>
+double StampOf(const M& m) {
+  return m.time;
+}
+
+// Emits what the topic received each step. As the pipeline's time source (clock.source) it
+// takes the step's message before the step, in NextTime, and emits that one in Step.
 template <runtime::Message M>
-class TopicReaderComponent final : public runtime::Component {
+class TopicReaderComponent final : public runtime::Component, public runtime::TimeSource {
  public:
   TopicReaderComponent(std::unique_ptr<Reader> reader, double wait_s, double start_wait_s)
       : reader_(std::move(reader)),
@@ -102,10 +112,17 @@ class TopicReaderComponent final : public runtime::Component {
                reader_->topic(), start_wait_s_);
     }
   }
+  std::optional<double> NextTime() override {
+    taken_ = true;
+    pending_ = Take();
+    if (!pending_) return std::nullopt;
+    return StampOf(*pending_);
+  }
   void Step(const runtime::StepContext&) override {
-    // Waits only while a writer is there: a sender that went away never blocks the loop.
-    const double wait = wait_s_ > 0 && reader_->matched() > 0 ? wait_s_ : 0.0;
-    if (auto message = reader_->Take<M>(wait)) output_.Emit(*message);
+    std::shared_ptr<const M> message = taken_ ? std::move(pending_) : Take();
+    taken_ = false;
+    pending_.reset();
+    if (message) output_.Emit(*message);
   }
   void Stop() override {
     const LinkStats& s = reader_->stats();
@@ -115,10 +132,18 @@ class TopicReaderComponent final : public runtime::Component {
   }
 
  private:
+  // Waits only while a writer is there: a sender that went away never blocks the loop.
+  std::shared_ptr<const M> Take() {
+    const double wait = wait_s_ > 0 && reader_->matched() > 0 ? wait_s_ : 0.0;
+    return reader_->Take<M>(wait);
+  }
+
   std::unique_ptr<Reader> reader_;
   double wait_s_;
   double start_wait_s_;
   runtime::Output<M>& output_;
+  bool taken_ = false;  // NextTime took this step's message
+  std::shared_ptr<const M> pending_;
 };
 
 template <runtime::Message M>

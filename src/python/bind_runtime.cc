@@ -5,9 +5,9 @@
 //
 // Stepping: Pipeline.step runs the serial schedule of runtime::RunPipeline (scheduler.cc) one
 // tick at a time: delayed messages delivered, then every enabled component in execution order,
-// its inputs marked seen; simulated time step * dt; a failing component raises saccade.Error
-// "component 'name' failed at step k: ..." (on_error: stop). The GIL is released while C++
-// components step; a Python component takes it back for its own step.
+// its inputs marked seen; simulated time step * dt (or clock.source's stamps); a failing component
+// raises saccade.Error "component 'name' failed at step k: ..." (on_error: stop). The GIL is
+// released while C++ components step; a Python component takes it back for its own step.
 #include <fmt/format.h>
 #include <pybind11/eigen.h>
 #include <pybind11/functional.h>
@@ -21,6 +21,7 @@
 #include "saccade/core/error.h"
 #include "saccade/runtime/component_registry.h"
 #include "saccade/runtime/pipeline.h"
+#include "saccade/runtime/scheduler.h"
 
 namespace saccade::python {
 namespace {
@@ -288,7 +289,6 @@ class PyPipeline {
 
   runtime::Pipeline& pipeline() { return pipeline_; }
   int64_t steps_done() const { return step_; }
-  double time() const { return static_cast<double>(step_ - 1) * pipeline_.spec().clock.step; }
 
   void Step(int64_t count) {
     if (closed_) throw Error("Pipeline.step: the pipeline is closed");
@@ -303,7 +303,9 @@ class PyPipeline {
     for (int64_t n = 0; n < count; ++n) {
       runtime::StepContext context;
       context.step = step_;
-      context.time = static_cast<double>(step_) * dt;
+      // step * dt, or the stamps of `clock.source` (scheduler.h)
+      context.time = runtime::SimulatedStepTime(pipeline_, step_, time_);
+      time_ = context.time;
       context.dt = dt;
       pipeline_.DeliverDelayed();
       for (const auto& component : components) {
@@ -421,6 +423,7 @@ class PyPipeline {
   bool started_ = false;
   bool closed_ = false;
   int64_t step_ = 0;
+  double time_ = 0.0;  // the last step's
 };
 
 py::object TapValue(const Tap& tap) {

@@ -72,7 +72,8 @@ nlohmann::json ToJson(const Entry& e) {
 }
 
 ClockSpec ParseClock(const Entry& e) {
-  e.ExpectMap({"mode", "step", "rate_hz", "steps"}, "a clock {mode, step | rate_hz, steps}");
+  e.ExpectMap({"mode", "step", "rate_hz", "steps", "source"},
+              "a clock {mode, step | rate_hz, steps, source}");
   ClockSpec clock;
   const Entry mode = e.Get("mode");
   const std::string name = mode.AsString();
@@ -83,6 +84,9 @@ ClockSpec ParseClock(const Entry& e) {
   } else if (name == "realtime") {
     clock.mode = ClockMode::kRealtime;
     if (const auto s = e.Find("step")) s->Fail("'step' is for mode simulated; use 'rate_hz'");
+    if (const auto s = e.Find("source")) {
+      s->Fail("'source' is for mode simulated: in real time the wall clock gives the time");
+    }
     if (const auto r = e.Find("rate_hz")) clock.rate_hz = r->AsPositive();
     clock.step = 1.0 / clock.rate_hz;
   } else {
@@ -90,6 +94,14 @@ ClockSpec ParseClock(const Entry& e) {
   }
   if (const auto s = e.Find("steps")) {
     clock.steps = s->AsInteger(0, std::numeric_limits<int64_t>::max());
+  }
+  if (const auto s = e.Find("source")) {
+    clock.source = s->AsString();
+    clock.source_line = s->line();
+    if (clock.source.find('.') == std::string::npos) {
+      s->Fail("expected <component>.<input> (an input that reads a topic), got '" + clock.source +
+              "'");
+    }
   }
   return clock;
 }
@@ -575,6 +587,42 @@ Pipeline Pipeline::Build(const PipelineSpec& spec, const ComponentRegistry& regi
   if (has_topics) {
     index.clear();
     for (std::size_t i = 0; i < m; ++i) index.emplace(built.components[i].name, i);
+  }
+
+  // The clock's source: the reader of a topic input, whose stamps time the steps.
+  if (!built.clock.source.empty()) {
+    const std::string& source = built.clock.source;
+    const auto Fail = [&](const std::string& what) {
+      throw FileError(file, built.clock.source_line, "clock.source", what);
+    };
+    const std::string name = source.substr(0, source.find('.'));
+    const std::string input = source.substr(source.find('.') + 1);
+    const auto consumer = index.find(name);
+    if (consumer == index.end() || !built.components[consumer->second].reads_for.empty()) {
+      std::vector<std::string> names;
+      for (const ComponentSpec& c : built.components) {
+        if (c.reads_for.empty()) names.push_back(c.name);
+      }
+      Fail(
+          fmt::format("unknown component '{}' in '{}'; components: {}", name, source, Join(names)));
+    }
+    const std::vector<ConnectionSpec>& inputs = built.components[consumer->second].inputs;
+    const auto connection = std::find_if(inputs.begin(), inputs.end(),
+                                         [&](const auto& c) { return c.to_input == input; });
+    if (connection == inputs.end()) {
+      Fail(fmt::format("component '{}' has no input '{}' connected in the file", name, input));
+    }
+    const auto reader = index.find(connection->from_component);
+    if (reader == index.end() || built.components[reader->second].reads_for != name) {
+      Fail(
+          fmt::format("input '{}' reads '{}.{}', not a topic: only a topic's stamps can time "
+                      "the steps",
+                      source, connection->from_component, connection->from_output));
+    }
+    pipeline.time_source_ = dynamic_cast<TimeSource*>(pipeline.components_[reader->second].get());
+    if (pipeline.time_source_ == nullptr) {
+      Fail(fmt::format("the {} transport's reader of '{}' gives no time", transport->name, source));
+    }
   }
 
   // Immediate edges producer -> consumer, to name the components of a cycle.

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <exception>
 #include <map>
+#include <optional>
 #include <thread>
 #include <utility>
 
@@ -102,6 +103,15 @@ std::string RunSummary::FullReport() const {
   return text;
 }
 
+double SimulatedStepTime(const Pipeline& pipeline, int64_t step, double previous) {
+  const double dt = pipeline.spec().clock.step;
+  // A product, not a running sum: no drift, the same on every run.
+  if (pipeline.time_source() == nullptr) return static_cast<double>(step) * dt;
+  const std::optional<double> stamp = pipeline.time_source()->NextTime();
+  if (stamp) return *stamp;
+  return step == 0 ? 0.0 : previous + dt;
+}
+
 RunSummary RunPipeline(Pipeline& pipeline, const RunOptions& options) {
   const PipelineSpec& spec = pipeline.spec();
   const int64_t steps = options.steps >= 0 ? options.steps : spec.clock.steps;
@@ -142,6 +152,14 @@ RunSummary RunPipeline(Pipeline& pipeline, const RunOptions& options) {
       summary.errors.push_back(std::move(error));
   };
 
+  std::size_t source_index = n;  // the time source's component (n: none)
+  for (std::size_t i = 0; i < n; ++i) {
+    if (pipeline.time_source() != nullptr &&
+        dynamic_cast<TimeSource*>(components[i].get()) == pipeline.time_source()) {
+      source_index = i;
+    }
+  }
+
   const Clock::time_point run_start = Clock::now();
   std::size_t started = 0;
   for (; started < n; ++started) {
@@ -168,8 +186,10 @@ RunSummary RunPipeline(Pipeline& pipeline, const RunOptions& options) {
       const Clock::time_point tick_start = Clock::now();
       StepContext context;
       context.step = k;
-      // Simulated time is a product, not a running sum: no drift, the same on every run.
-      context.time = realtime ? Seconds(tick_start - loop_start) : static_cast<double>(k) * dt;
+      context.time = realtime ? Seconds(tick_start - loop_start)
+                              : SimulatedStepTime(pipeline, k, summary.sim_time);
+      // The source's wait for the step's message is its reader's time, as a Step's wait is.
+      const double source_seconds = realtime ? 0.0 : Seconds(Clock::now() - tick_start);
       context.dt = dt;
       context.realtime = realtime || options.live;
       if (options.seconds > 0.0 && context.time >= options.seconds) break;
@@ -211,6 +231,7 @@ RunSummary RunPipeline(Pipeline& pipeline, const RunOptions& options) {
               // Serial: deliveries made while it emitted are the bus's time, not its own.
               timing.own[i] = std::max(0.0, Seconds(Clock::now() - start) -
                                                 (parallel ? 0.0 : pipeline.TakeDeliverySeconds()));
+              if (i == source_index) timing.own[i] += source_seconds;
               deferred = nullptr;
             },
             affine[&level - levels.data()]);

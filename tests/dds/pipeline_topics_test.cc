@@ -94,6 +94,101 @@ TEST_F(PipelineTopics, PlainPublisherOfJointStateCommandsMovesTheHead) {
   dds_sample_free(&state, &ref_sensor_msgs_msg_dds__JointState__desc, DDS_FREE_CONTENTS);
 }
 
+// The receiving half of a split pipeline steps on the sender's stamps (clock.source): each
+// step's time is the stamp of the message its reader took for it, that message is the one the
+// step hands on, and a step that received nothing goes on one clock step later.
+TEST_F(PipelineTopics, ClockSourceStepsOnTheReceivedStamps) {
+  constexpr int kDomain = 184;
+  std::string text = HeadPipeline(kDomain, "{topic: head/command, wait_s: 1, start_wait_s: 10}");
+  text.replace(text.find("steps: 50}"), 10, "steps: 5, source: head.command}");
+  runtime::Pipeline pipeline = runtime::Pipeline::LoadString(text, "head.yaml");
+  ASSERT_NE(pipeline.time_source(), nullptr);
+
+  Raw raw(RawParticipant(kDomain));
+  Raw writer(
+      RawWriter(raw.get(), &ref_sensor_msgs_msg_dds__JointState__desc, "rt/saccade/head/command"));
+  ASSERT_TRUE(WaitWriterMatched(writer.get()));
+  // A command stamped `seconds` pans to seconds / 10 rad.
+  const auto Send = [&](int32_t sec, uint32_t nanosec) {
+    char* names[4] = {const_cast<char*>("pan"), const_cast<char*>("tilt"),
+                      const_cast<char*>("left"), const_cast<char*>("right")};
+    double position[4] = {(sec + 1e-9 * nanosec) / 10.0, 0.0, 0.0, 0.0};
+    ref_sensor_msgs_msg_dds__JointState_ command{};
+    command.header.stamp.sec = sec;
+    command.header.stamp.nanosec = nanosec;
+    command.header.frame_id = const_cast<char*>("");
+    command.name = {4, 4, names, false};
+    command.position = {4, 4, position, false};
+    ASSERT_EQ(dds_write(writer.get(), &command), DDS_RETCODE_OK);
+  };
+  Send(1, 0);
+  std::vector<double> times;
+  std::vector<double> targets;  // the head's pan target after each step
+  components::Tap<components::JointStateMessage>(
+      pipeline, [&](const components::JointStateMessage& m) { targets.push_back(m.targets.pan); });
+  runtime::RunOptions options;
+  options.after_step = [&](const runtime::StepContext& context) {
+    times.push_back(context.time);
+    // After step 2 the sender says nothing: step 3 waits its second and goes on.
+    if (context.step == 0) Send(1, 500000000);
+    if (context.step == 1) Send(2, 0);
+    if (context.step == 3) Send(3, 0);
+  };
+  const runtime::RunSummary summary = runtime::RunPipeline(pipeline, options);
+  ASSERT_EQ(summary.errors_total, 0) << summary.FullReport();
+  EXPECT_THAT(times, ::testing::ElementsAre(1.0, 1.5, 2.0, 2.04, 3.0));
+  EXPECT_DOUBLE_EQ(summary.sim_time, 3.0);
+  // Each step handed on the message whose stamp timed it (step 3 had none: the target stays).
+  EXPECT_THAT(targets, ::testing::ElementsAre(::testing::DoubleEq(0.1), ::testing::DoubleEq(0.15),
+                                              ::testing::DoubleEq(0.2), ::testing::DoubleEq(0.2),
+                                              ::testing::DoubleEq(0.3)));
+}
+
+TEST_F(PipelineTopics, ClockSourceMustBeATopicInputOfASimulatedClock) {
+  const auto ErrorOf = [](const std::string& clock, const std::string& command_input) {
+    std::string text = HeadPipeline(185, command_input);
+    text.replace(0, text.find('\n'), "clock: " + clock);
+    try {
+      runtime::Pipeline::LoadString(text, "head.yaml");
+    } catch (const FileError& e) {
+      return std::string(e.what());
+    }
+    return std::string("(no error)");
+  };
+  const std::string topic = "{topic: head/command}";
+  EXPECT_EQ(ErrorOf("{mode: simulated, steps: 1, source: head.command}", topic), "(no error)");
+  EXPECT_THAT(ErrorOf("{mode: realtime, rate_hz: 25, source: head.command}", topic),
+              HasSubstr("head.yaml:1: clock.source: 'source' is for mode simulated"));
+  EXPECT_THAT(ErrorOf("{mode: simulated, source: head}", topic),
+              HasSubstr("head.yaml:1: clock.source: expected <component>.<input>"));
+  EXPECT_THAT(ErrorOf("{mode: simulated, source: haed.command}", topic),
+              HasSubstr("head.yaml:1: clock.source: unknown component 'haed' in 'haed.command'; "
+                        "components: head"));
+  EXPECT_THAT(ErrorOf("{mode: simulated, source: head.comand}", topic),
+              HasSubstr("clock.source: component 'head' has no input 'comand' connected"));
+  // Only a topic's messages carry a sender's stamps.
+  const std::string local =
+      "clock: {mode: simulated, steps: 1, source: head.command}\n"
+      "scene: " +
+      kScene +
+      "\n"
+      "transport: {domain: 185}\n"
+      "components:\n"
+      "  - name: fixation\n"
+      "    type: control.fixation\n"
+      "    inputs: {target: {topic: target}}\n"
+      "  - name: head\n"
+      "    type: sim.head\n"
+      "    inputs: {command: fixation.command}\n";
+  try {
+    runtime::Pipeline::LoadString(local, "local.yaml");
+    FAIL() << "no error";
+  } catch (const FileError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("local.yaml:1: clock.source: input 'head.command' reads "
+                                    "'fixation.command', not a topic"));
+  }
+}
+
 TEST_F(PipelineTopics, BadTopicConnectionsNameFileLineAndKey) {
   const auto ErrorOf = [](const std::string& text, const runtime::ComponentRegistry& registry =
                                                        runtime::ComponentRegistry::Global()) {

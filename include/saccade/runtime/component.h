@@ -16,6 +16,7 @@
 #include <cstdint>
 #include <memory>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -212,6 +213,17 @@ class Component {
   std::vector<std::unique_ptr<InputBase>> inputs_;
   std::vector<std::unique_ptr<OutputBase>> outputs_;
   std::vector<std::unique_ptr<MethodBase>> methods_;
+};
+
+/// A component that gives its pipeline the time of each step from what it receives: a topic
+/// reader, from the sender's capture stamps (`clock.source`, pipeline.h). Before each step of
+/// the simulated clock the scheduler asks it; it takes the step's message then (waiting as its
+/// options say) and emits that message in Step.
+class TimeSource {
+ public:
+  virtual ~TimeSource() = default;
+  /// The stamp, in seconds, of the message this step will emit; nullopt when none came.
+  virtual std::optional<double> NextTime() = 0;
 };
 
 }  // namespace saccade::runtime

@@ -66,6 +66,12 @@
 // A topic input is read by a component the transport makes, stepped just before its reader
 // (named "<component>-<input>-topic"); a topic output is written as its component emits.
 //
+// The receiving half of a split pipeline steps on the sender's clock: `clock.source` names a
+// topic input whose messages carry capture stamps (the images), and each simulated step takes
+// the time of the message its reader takes for it (scheduler.h) rather than step * step.
+//
+//   clock: {mode: simulated, step: 0.04, source: faces_left.image}
+//
 // Parallel steps (scheduler.h): components that do not depend on each other within a step
 // (the two eyes' detectors, say) run at the same time on `threads` threads; the run is the
 // same, bit for bit, as with `threads: 1`.
@@ -95,6 +101,11 @@ struct ClockSpec {
   double step = 0.04;   ///< s, > 0 (simulated)
   double rate_hz = 25;  ///< Hz, > 0 (real time)
   int64_t steps = 0;    ///< steps to run; 0: until RunOptions::stop is set (scheduler.h)
+  /// Simulated only: "<component>.<input>", an input that reads a topic; each step's time is
+  /// then the stamp of the message its reader takes for the step (Pipeline::time_source), so
+  /// a receiving pipeline steps on the sender's capture times. "" : step * `step`.
+  std::string source;
+  int source_line = 0;  ///< of `source`, in the pipeline file
 };
 
 /// One input's connection: `to_input` of the component reads `from_component.from_output`,
@@ -231,6 +242,10 @@ class Pipeline {
   nlohmann::json Call(const std::string& component, const std::string& method,
                       const nlohmann::json& request) const;
 
+  /// The reader that gives the steps their time (`clock.source`); nullptr when the clock is
+  /// step * clock.step.
+  TimeSource* time_source() const { return time_source_; }
+
   /// Hands over messages held back by delayed connections (the scheduler, each step).
   void DeliverDelayed();
   /// Seconds spent delivering messages since the last call (and resets the count).
@@ -242,6 +257,7 @@ class Pipeline {
   PipelineSpec spec_;
   std::shared_ptr<Resources> resources_;
   std::vector<std::unique_ptr<Component>> components_;
+  TimeSource* time_source_ = nullptr;  // one of components_
   // Boxed so that the delivery callbacks' pointer stays valid when the pipeline moves.
   std::unique_ptr<double> delivery_seconds_ = std::make_unique<double>(0.0);
 };

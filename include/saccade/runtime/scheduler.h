@@ -9,9 +9,12 @@
 // serial one. A thread-affine component (Component::thread_affine) runs on the calling thread.
 //
 // Simulated clock: time = step * clock.step, no waiting; the same pipeline and seed give
-// the same run, bit for bit. Real time: one tick every 1 / rate_hz seconds of wall clock
-// (the loop sleeps until the next tick; a tick that ends after the next one was due is an
-// overrun, counted, and the missed ticks are skipped rather than bunched).
+// the same run, bit for bit. With `clock.source` (pipeline.h) a step's time is instead the
+// stamp of the message the source's topic reader takes for it, waiting as that input's options
+// say: the receiving half of a split pipeline steps on the sender's capture times.
+// Real time: one tick every 1 / rate_hz seconds of wall clock (the loop sleeps until the next
+// tick; a tick that ends after the next one was due is an overrun, counted, and the missed
+// ticks are skipped rather than bunched).
 
 #include <atomic>
 #include <cstdint>
@@ -105,6 +108,12 @@ struct RunOptions {
   /// latencies; may be empty.
   std::function<void(const StepContext&, const StepTiming&)> step_timing;
 };
+
+/// The time of simulated step `step`: step * clock.step; with a time source
+/// (Pipeline::time_source), the stamp of the message it takes for the step, or, when none came,
+/// `previous` (the last step's time) + clock.step: a sender gone quiet never stops the clock.
+/// A sender that restarted starts its stamps, and so the time, again.
+double SimulatedStepTime(const Pipeline& pipeline, int64_t step, double previous);
 
 /// Runs `pipeline` once. Component failures are reported in the summary, not thrown;
 /// throws InvalidArgument when neither steps nor a stop flag bound the run.
