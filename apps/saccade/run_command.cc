@@ -14,6 +14,8 @@
 #include <vector>
 
 #include "commands.h"
+#include "saccade/components/demo_report.h"
+#include "saccade/components/fixation_scoring.h"
 #include "saccade/components/loop_outputs.h"
 #include "saccade/components/messages.h"
 #include "saccade/components/register.h"
@@ -21,6 +23,7 @@
 #include "saccade/dds/transport.h"
 #include "saccade/runtime/pipeline.h"
 #include "saccade/runtime/scheduler.h"
+#include "saccade/scene/scene.h"
 
 namespace saccade::app {
 namespace {
@@ -37,6 +40,7 @@ struct RunCommandOptions {
   int64_t steps = -1;
   bool realtime = false;
   bool json = false;
+  bool score = false;
   std::string joints_csv;
   DdsOverrides dds;  // the pipeline's `transport:` map, overridden
 };
@@ -87,8 +91,48 @@ int Run(const RunCommandOptions& o) {
         was_arrived = m.arrived;
       });
 
+  // --score: the fixations attention selected, against the scene's ground truth, as `saccade
+  // demo` scores them, from what this process sees (its images, selection, target, joints):
+  // perception.yaml's half of a simulated robot scores the split loop.
+  std::unique_ptr<components::FixationScorer> scorer;
+  components::Latest latest;
+  if (o.score) {
+    std::shared_ptr<const scene::Scene> scene = pipeline.resources().Default<scene::Scene>("scene");
+    if (!scene) {
+      throw InvalidArgument("run: --score needs the pipeline's scene (`scene:` in " + o.pipeline +
+                            "): the ground truth comes from it");
+    }
+    bool selects = false;
+    for (const auto& component : pipeline.components()) {
+      for (const auto& output : component->outputs()) {
+        selects = selects ||
+                  output->message_type() == runtime::MessageName<components::SelectionMessage>();
+      }
+    }
+    if (!selects) {
+      throw InvalidArgument("run: --score: " + o.pipeline +
+                            " selects no targets (no vision.attention): there are no fixations "
+                            "to score in this process");
+    }
+    scorer = std::make_unique<components::FixationScorer>(*scene, /*truth=*/true);
+    if (scorer->faces_total() == 0) {
+      throw InvalidArgument("run: --score: the scene has no pictures of faces to score against");
+    }
+    components::TapLoopOutputs(pipeline, &latest);
+  }
+
   runtime::RunOptions run;
   run.steps = o.steps;
+  const double dt = spec.clock.step;
+  run.after_step = [&](const runtime::StepContext& context) {
+    if (!scorer) return;
+    // The frame index of the step's images (the sender's, with clock.source).
+    const auto frame = static_cast<int64_t>(std::llround(context.time / dt));
+    if (scorer->Update(frame, context.time, latest).fixated_now && !o.json) {
+      fmt::print("{}", components::FixationText(scorer->fixations().back(), context.time));
+      std::fflush(stdout);
+    }
+  };
   g_run_stop = false;
   run.stop = &g_run_stop;
   run.on_error = [&](const runtime::StepError& error) {
@@ -102,12 +146,24 @@ int Run(const RunCommandOptions& o) {
   std::signal(SIGTERM, previous_term);
   if (csv) csv->flush();
   if (o.json) {
-    fmt::print("{}\n", json{{"pipeline", o.pipeline},
-                            {"steps", summary.steps},
-                            {"errors", summary.errors_total},
-                            {"fixations", fixations}}
-                           .dump(2));
+    json out = {{"pipeline", o.pipeline},
+                {"steps", summary.steps},
+                {"errors", summary.errors_total},
+                {"fixations", fixations}};
+    if (scorer) {
+      json scored = json::array();
+      for (const components::Fixation& f : scorer->fixations()) {
+        scored.push_back(components::FixationJson(f));
+      }
+      out["faces"] = scorer->faces_total();
+      out["faces_fixated"] = scorer->faces_fixated();
+      out["scored"] = scored;
+    }
+    fmt::print("{}\n", out.dump(2));
   } else {
+    if (scorer) {
+      fmt::print("{} of {} faces fixated\n", scorer->faces_fixated(), scorer->faces_total());
+    }
     fmt::print("{}: {}\n", o.pipeline, summary.BriefReport());
   }
   // Stops the components (the DDS readers report what crossed) before exiting.
@@ -133,7 +189,13 @@ Runner AddRunCommand(CLI::App& app) {
                   "Steps to run (default: the file's clock.steps; 0 until "
                   "Ctrl-C)");
   run->add_flag("--realtime", o->realtime, "Run at the wall clock's pace (rate 1 / clock.step)");
-  run->add_flag("--json", o->json, "Print the result as JSON: steps, errors, fixations");
+  run->add_flag("--json", o->json,
+                "Print the result as JSON: steps, errors, fixations (and, with --score, the "
+                "scored fixations)");
+  run->add_flag("--score", o->score,
+                "Score the fixations that attention selects against the ground truth of the "
+                "pipeline's scene, as `saccade demo` does (3D error, eye axis errors), from what "
+                "this process receives: for the perception half of a simulated robot");
   run->add_option("--joints-csv", o->joints_csv,
                   "Write every head state the pipeline emits (time, pan, tilt, left, right in "
                   "rad, arrived) to this CSV file");

@@ -287,7 +287,9 @@ class ImageReader final : public Reader {
     wait_ = std::make_unique<DataWait>(image_);
   }
 
-  std::shared_ptr<const void> TakeErased(double timeout_s) override {
+  // Images: the newest, whatever `up_to` (each step's pair is the newest; only one image, the
+  // newest, is converted).
+  std::shared_ptr<const void> TakeErased(double timeout_s, double /*up_to*/) override {
     stats_.lost += LostSince(image_);
     std::shared_ptr<Image> newest;
     int64_t newest_stamp = 0;  // exact, in ns: the time in seconds does not round-trip
@@ -444,9 +446,10 @@ class SimpleReader final : public Reader {
     reader_ = MakeReader(*participant_, topic_, options.qos, options.topic);
     wait_ = std::make_unique<DataWait>(reader_);
   }
-  std::shared_ptr<const void> TakeErased(double timeout_s) override {
+  std::shared_ptr<const void> TakeErased(double timeout_s, double up_to) override {
     stats_.lost += LostSince(reader_);
-    std::shared_ptr<M> newest;
+    // Every message that arrived, in order, after those kept from earlier calls (stamped after
+    // their step's time).
     const auto Take = [&] {
       TakeAll<Sample>(reader_, [&](const Sample& sample) {
         std::string error;
@@ -456,15 +459,30 @@ class SimpleReader final : public Reader {
           log::Log(log::Level::kWarn, "dds: {}: message dropped: {}", topic(), error);
           return;
         }
-        if (newest) ++stats_.lost;
-        newest = std::move(message);
+        // The sender restarted (its stamps went back): what it sent before is of no step now.
+        if (!pending_.empty() && message->time < pending_.back()->time) {
+          stats_.lost += static_cast<int64_t>(pending_.size());
+          pending_.clear();
+        }
+        pending_.push_back(std::move(message));
+        if (pending_.size() > kMaxPending) {
+          pending_.pop_front();
+          ++stats_.lost;
+        }
       });
     };
     Take();
-    if (!newest && timeout_s > 0) {
+    if (pending_.empty() && timeout_s > 0) {
       wait_->Wait(timeout_s);
       Take();
-      if (!newest) ++stats_.late;
+      if (pending_.empty()) ++stats_.late;
+    }
+    // The newest at or before `up_to`; those before it are lost, those after it kept.
+    std::shared_ptr<M> newest;
+    while (!pending_.empty() && pending_.front()->time <= up_to) {
+      if (newest) ++stats_.lost;
+      newest = std::move(pending_.front());
+      pending_.pop_front();
     }
     if (!newest) return nullptr;
     if (last_time_ && newest->time < *last_time_) ++stats_.restarts;
@@ -509,6 +527,10 @@ class SimpleReader final : public Reader {
     return true;
   }
 
+  // Messages stamped after the time they were asked for (TakeErased's up_to), kept for a later
+  // step: at most a reader's deepest history.
+  static constexpr std::size_t kMaxPending = kMaxQosDepth;
+  std::deque<std::shared_ptr<M>> pending_;
   std::shared_ptr<Participant> participant_;
   Entity topic_, reader_;
   std::unique_ptr<DataWait> wait_;

@@ -2,6 +2,8 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
+#include <limits>
 #include <map>
 #include <mutex>
 #include <optional>
@@ -57,6 +59,13 @@ std::shared_ptr<Participant> SharedParticipant(const DomainOptions& options) {
   return participant;
 }
 
+// The pipeline steps on the sender's stamps (runtime's clock.source).
+bool OnStamps(const runtime::TopicEndpoint& endpoint) {
+  return endpoint.pipeline != nullptr && !endpoint.pipeline->clock.source.empty();
+}
+// History of a reader in such a pipeline: 2.5 s of a 25 Hz sender running ahead.
+constexpr int kOnStampsDepth = 64;
+
 struct Endpoint {
   std::shared_ptr<Participant> participant;
   TopicOptions options;
@@ -84,6 +93,10 @@ Endpoint Resolve(const runtime::TopicEndpoint& endpoint, const std::set<std::str
   if (endpoint.pipeline && endpoint.pipeline->clock.mode == runtime::ClockMode::kSimulated) {
     out.options.frame_period_s = endpoint.pipeline->clock.step;
   }
+  if (OnStamps(endpoint)) {
+    // Deep enough to hold the message of the step's time while the sender runs ahead.
+    out.options.qos.depth = std::max(out.options.qos.depth, kOnStampsDepth);
+  }
   out.participant = SharedParticipant(domain);
   return out;
 }
@@ -100,10 +113,14 @@ double StampOf(const M& m) {
 template <runtime::Message M>
 class TopicReaderComponent final : public runtime::Component, public runtime::TimeSource {
  public:
-  TopicReaderComponent(std::unique_ptr<Reader> reader, double wait_s, double start_wait_s)
+  // `on_stamps`: the pipeline steps on the sender's stamps (clock.source); each step takes
+  // the newest message stamped at or before its time.
+  TopicReaderComponent(std::unique_ptr<Reader> reader, double wait_s, double start_wait_s,
+                       bool on_stamps)
       : reader_(std::move(reader)),
         wait_s_(wait_s),
         start_wait_s_(start_wait_s),
+        on_stamps_(on_stamps),
         output_(AddOutput<M>("message")) {}
 
   void Start() override {
@@ -114,12 +131,15 @@ class TopicReaderComponent final : public runtime::Component, public runtime::Ti
   }
   std::optional<double> NextTime() override {
     taken_ = true;
-    pending_ = Take();
+    pending_ = Take(std::numeric_limits<double>::infinity());
     if (!pending_) return std::nullopt;
     return StampOf(*pending_);
   }
-  void Step(const runtime::StepContext&) override {
-    std::shared_ptr<const M> message = taken_ ? std::move(pending_) : Take();
+  void Step(const runtime::StepContext& context) override {
+    // Stamps are whole nanoseconds: the step's time is one of them, or on the step grid.
+    const double up_to =
+        on_stamps_ ? context.time + 0.5e-9 : std::numeric_limits<double>::infinity();
+    std::shared_ptr<const M> message = taken_ ? std::move(pending_) : Take(up_to);
     taken_ = false;
     pending_.reset();
     if (message) output_.Emit(*message);
@@ -133,14 +153,15 @@ class TopicReaderComponent final : public runtime::Component, public runtime::Ti
 
  private:
   // Waits only while a writer is there: a sender that went away never blocks the loop.
-  std::shared_ptr<const M> Take() {
+  std::shared_ptr<const M> Take(double up_to) {
     const double wait = wait_s_ > 0 && reader_->matched() > 0 ? wait_s_ : 0.0;
-    return reader_->Take<M>(wait);
+    return reader_->Take<M>(wait, up_to);
   }
 
   std::unique_ptr<Reader> reader_;
   double wait_s_;
   double start_wait_s_;
+  bool on_stamps_;
   runtime::Output<M>& output_;
   bool taken_ = false;  // NextTime took this step's message
   std::shared_ptr<const M> pending_;
@@ -236,7 +257,8 @@ void RegisterDdsTransport(runtime::ComponentRegistry& registry) {
     auto reader = Reader::Create(e.participant, endpoint.message_type, e.options);
     return Dispatch(endpoint.message_type, [&](auto tag) -> std::unique_ptr<runtime::Component> {
       using M = decltype(tag);
-      return std::make_unique<TopicReaderComponent<M>>(std::move(reader), wait_s, start_wait_s);
+      return std::make_unique<TopicReaderComponent<M>>(std::move(reader), wait_s, start_wait_s,
+                                                       OnStamps(endpoint));
     });
   };
   transport.attach_writer = [](const runtime::TopicEndpoint& endpoint,

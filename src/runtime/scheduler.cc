@@ -108,7 +108,12 @@ double SimulatedStepTime(const Pipeline& pipeline, int64_t step, double previous
   // A product, not a running sum: no drift, the same on every run.
   if (pipeline.time_source() == nullptr) return static_cast<double>(step) * dt;
   const std::optional<double> stamp = pipeline.time_source()->NextTime();
-  if (stamp) return *stamp;
+  if (stamp) {
+    // Stamps cross as whole nanoseconds: one within a nanosecond of the step grid is the
+    // sender's simulated time, k * step, exactly (the same timers as in one process).
+    const double k = std::round(*stamp / dt);
+    return std::abs(*stamp - k * dt) <= 1e-9 ? k * dt : *stamp;
+  }
   return step == 0 ? 0.0 : previous + dt;
 }
 

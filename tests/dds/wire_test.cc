@@ -410,5 +410,42 @@ TEST_F(WireTest, ReaderCountsLateWaitsAndSkippedMessages) {
   EXPECT_EQ(reader->stats().restarts, 1);
 }
 
+// A pipeline stepping on the sender's stamps (clock.source) asks for the message of its step's
+// time: the newest stamped at or before it, with later ones kept for their own steps.
+TEST_F(WireTest, ReaderHandsOverTheMessageOfTheAskedTimeAndKeepsLaterOnes) {
+  constexpr int kDomain = 167;
+  auto participant = Participant::Create(Domain(kDomain));
+  auto reader = Reader::Create(participant, "head.joints",
+                               Topic("/saccade/joint_states", Qos{Qos::Latched().reliability,
+                                                                  Qos::Latched().durability, 64}));
+  auto writer =
+      Writer::Create(participant, "head.joints", Topic("/saccade/joint_states", Qos::Latched()));
+  ASSERT_TRUE(writer->WaitForReaders(1, 10));
+  // The sender runs ahead: four states before the receiver's first step.
+  JointStateMessage state;
+  for (const double t : {0.04, 0.08, 0.12, 0.16}) {
+    state.time = t;
+    state.positions.pan = t;
+    writer->Write(state);
+  }
+  ASSERT_TRUE(reader->WaitForWriters(1, 5));
+  std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  auto first = reader->Take<JointStateMessage>(1.0, 0.08 + 0.5e-9);
+  ASSERT_NE(first, nullptr);
+  EXPECT_DOUBLE_EQ(first->time, 0.08);  // not the newest (0.16): the one of the step's time
+  EXPECT_EQ(reader->stats().lost, 1);   // 0.04, before it
+  // A step before every kept one gets nothing and does not wait for what is already there.
+  EXPECT_EQ(reader->Take<JointStateMessage>(1.0, 0.1), nullptr);
+  EXPECT_EQ(reader->stats().late, 0);
+  auto second = reader->Take<JointStateMessage>(1.0, 0.12 + 0.5e-9);
+  ASSERT_NE(second, nullptr);
+  EXPECT_DOUBLE_EQ(second->time, 0.12);
+  auto third = reader->Take<JointStateMessage>(1.0);  // no time asked: the newest
+  ASSERT_NE(third, nullptr);
+  EXPECT_DOUBLE_EQ(third->time, 0.16);
+  EXPECT_EQ(reader->stats().lost, 1);
+  EXPECT_EQ(reader->stats().messages, 3);
+}
+
 }  // namespace
 }  // namespace saccade::dds

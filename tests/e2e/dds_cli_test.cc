@@ -58,14 +58,16 @@ constexpr int kSteps = 30;
 
 TEST_F(DdsCli, SplitDemoFixatesLikeTheSingleProcess) {
   const std::string steps = std::to_string(kSteps);
-  ASSERT_EQ(Shell(kBinary + " run " + kPipelines + "demo.yaml --steps " + steps + " --json > " +
-                  (dir_ / "single.json").string() + " 2> " + (dir_ / "single.err").string()),
-            0)
+  ASSERT_EQ(
+      Shell(kBinary + " run " + kPipelines + "demo.yaml --score --steps " + steps + " --json > " +
+            (dir_ / "single.json").string() + " 2> " + (dir_ / "single.err").string()),
+      0)
       << Read(dir_ / "single.err");
-  ASSERT_EQ(Shell(kBinary + " run " + kPipelines + "perception.yaml --dds-domain 211 --steps " +
-                  steps + " > " + (dir_ / "perception.txt").string() + " 2>&1 &\n" + kBinary +
-                  " run " + kPipelines + "robot.yaml --dds-domain 211 --steps " + steps +
-                  " --json > " + (dir_ / "robot.json").string() + " 2> " +
+  ASSERT_EQ(Shell(kBinary + " run " + kPipelines +
+                  "perception.yaml --score --json --dds-domain 211 --steps " + steps + " > " +
+                  (dir_ / "scored.json").string() + " 2> " + (dir_ / "perception.txt").string() +
+                  " &\n" + kBinary + " run " + kPipelines + "robot.yaml --dds-domain 211 --steps " +
+                  steps + " --json > " + (dir_ / "robot.json").string() + " 2> " +
                   (dir_ / "robot.err").string() + "\nstatus=$?\nwait\nexit $status\n"),
             0)
       << Read(dir_ / "robot.err");
@@ -87,6 +89,23 @@ TEST_F(DdsCli, SplitDemoFixatesLikeTheSingleProcess) {
           << "fixation " << i << ", " << joint << "\nsingle: " << a.dump()
           << "\nsplit: " << b.dump();
     }
+  }
+  // Scored against the scene's ground truth where perception is (its images, the joints of
+  // their capture time), the split loop fixates the faces the single one does, as accurately:
+  // the bounds, 3D error <= 15 mm and eyes within 0.15 deg.
+  const json scored = json::parse(Read(dir_ / "scored.json"));
+  const json& single_scored = single["scored"];
+  const json& split_scored = scored["scored"];
+  ASSERT_GE(split_scored.size(), 1u) << scored.dump();
+  for (std::size_t i = 0; i < split_scored.size(); ++i) {
+    const json& f = split_scored[i];
+    if (!f["fixated"].get<bool>()) continue;
+    ASSERT_LT(i, single_scored.size()) << scored.dump() << "\n" << single.dump();
+    EXPECT_EQ(f["object"], single_scored[i]["object"]) << scored.dump() << "\n" << single.dump();
+    EXPECT_TRUE(f["is_face"].get<bool>()) << f.dump();
+    EXPECT_LE(f["error_3d_m"].get<double>(), 0.015) << f.dump();
+    EXPECT_LE(f["eye_error_deg"]["left"].get<double>(), 0.15) << f.dump();
+    EXPECT_LE(f["eye_error_deg"]["right"].get<double>(), 0.15) << f.dump();
   }
 }
 
@@ -136,6 +155,24 @@ TEST_F(DdsCli, RunNamesTheFileLineAndKeyOfABadTopic) {
   const CommandRun domain = Saccade("run " + file.string() + " --dds-domain 999");
   EXPECT_EQ(domain.status, 1) << domain.output;
   EXPECT_THAT(domain.output, HasSubstr("transport.domain: expected an integer 0..232, got 999"));
+}
+
+TEST_F(DdsCli, RunScoreSaysWhyItCannotScore) {
+  // The robot half has a scene but selects no targets: nothing to score there.
+  const CommandRun robot = Saccade("run " + kPipelines + "robot.yaml --score --steps 1");
+  EXPECT_EQ(robot.status, 1) << robot.output;
+  EXPECT_THAT(robot.output, HasSubstr("--score: " + kPipelines +
+                                      "robot.yaml selects no targets (no vision.attention)"));
+  // A pipeline without a scene has no ground truth.
+  const fs::path file = dir_ / "sceneless.yaml";
+  std::ofstream(file) << "clock: {mode: simulated, step: 0.04, steps: 1}\n"
+                         "components:\n"
+                         "  - name: fault\n"
+                         "    type: debug.fault\n"
+                         "    params: {at_step: 5}\n";
+  const CommandRun sceneless = Saccade("run " + file.string() + " --score");
+  EXPECT_EQ(sceneless.status, 1) << sceneless.output;
+  EXPECT_THAT(sceneless.output, HasSubstr("--score needs the pipeline's scene"));
 }
 
 }  // namespace

@@ -23,6 +23,7 @@
 //
 // Thread-safety: one Writer or Reader is used by one thread at a time.
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <string>
 #include <vector>
@@ -110,12 +111,18 @@ class Reader {
   /// `timeout_s` (0: do not wait); nullptr when none came (counted late when it waited).
   /// Older messages that arrived in between are skipped and counted lost. The pointer holds
   /// a T of the reader's type (M must be it, else InvalidArgument).
+  ///
+  /// `up_to` (seconds, a pipeline stepping on the sender's stamps: runtime's clock.source):
+  /// the newest message stamped at or before it; messages stamped after it are kept for a
+  /// later call (and waiting ends when they arrive), so that a step takes the joints of its
+  /// own time even when the sender is steps ahead. Images take the newest whatever it says.
   template <runtime::Message M>
-  std::shared_ptr<const M> Take(double timeout_s = 0.0) {
+  std::shared_ptr<const M> Take(double timeout_s = 0.0,
+                                double up_to = std::numeric_limits<double>::infinity()) {
     CheckType(runtime::MessageName<M>());
-    return std::static_pointer_cast<const M>(TakeErased(timeout_s));
+    return std::static_pointer_cast<const M>(TakeErased(timeout_s, up_to));
   }
-  virtual std::shared_ptr<const void> TakeErased(double timeout_s) = 0;
+  virtual std::shared_ptr<const void> TakeErased(double timeout_s, double up_to) = 0;
   /// Writers matched now.
   virtual int matched() const = 0;
   /// Waits until at least `count` writers match, at most `timeout_s`; true when they do.

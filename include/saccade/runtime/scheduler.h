@@ -110,8 +110,9 @@ struct RunOptions {
 };
 
 /// The time of simulated step `step`: step * clock.step; with a time source
-/// (Pipeline::time_source), the stamp of the message it takes for the step, or, when none came,
-/// `previous` (the last step's time) + clock.step: a sender gone quiet never stops the clock.
+/// (Pipeline::time_source), the stamp of the message it takes for the step (k * clock.step
+/// exactly when the stamp is within a nanosecond of it: stamps cross in whole ns), or, when none
+/// came, `previous` (the last step's time) + clock.step: a sender gone quiet never stops the clock.
 /// A sender that restarted starts its stamps, and so the time, again.
 double SimulatedStepTime(const Pipeline& pipeline, int64_t step, double previous);
 
