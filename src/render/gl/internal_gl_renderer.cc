@@ -151,6 +151,13 @@ GlRenderer::GlRenderer(const scene::Scene& scene, const RendererOptions& options
 // effect targets are kept where the lens stays as it was (a switch of the noise or the blur
 // remakes nothing: blur adds the accumulation array once, and keeps it); `reuse_distortion`:
 // the distortion switch they were made with. Needs the context current.
+// Builds the final pass's programs of `setup` now, not in its first frame: the map variant,
+// and the mesh one where there is a lens.
+void GlRenderer::PrebuildFinal(const CameraSetup& setup) {
+  effect_programs_->GetFinal(!setup.distorted, setup.noise);
+  if (setup.distorted) effect_programs_->GetFinal(false, setup.noise, /*mesh=*/true);
+}
+
 void GlRenderer::BuildCameraSetups(std::vector<CameraSetup> reuse, bool reuse_distortion) {
   targets_.clear();
   setups_.clear();
@@ -163,8 +170,7 @@ void GlRenderer::BuildCameraSetups(std::vector<CameraSetup> reuse, bool reuse_di
       setup.blur = options_.motion_blur && camera->sensor.HasBlur();
       if (setup.blur) setup.effects->EnableBlur();
       if (setup.distorted || setup.noise || setup.blur || truth_) {
-        effect_programs_->GetFinal(!setup.distorted, setup.noise);
-        if (setup.distorted) effect_programs_->GetFinal(false, setup.noise, /*mesh=*/true);
+        PrebuildFinal(setup);
         targets_.push_back(nullptr);
         setups_.push_back(std::move(setup));
         continue;
@@ -197,9 +203,7 @@ void GlRenderer::BuildCameraSetups(std::vector<CameraSetup> reuse, bool reuse_di
     if (setup.distorted || setup.noise || setup.blur || truth_) {
       if (!effect_programs_) effect_programs_ = std::make_unique<EffectPrograms>();
       setup.effects = std::make_unique<EffectTarget>(lens, samples_, setup.blur, truth_);
-      // Build the programs now, not in the first frame.
-      effect_programs_->GetFinal(!setup.distorted, setup.noise);
-      if (setup.distorted) effect_programs_->GetFinal(false, setup.noise, /*mesh=*/true);
+      PrebuildFinal(setup);
       if (truth_) effect_programs_->GetTruthRemap(!setup.distorted);
       targets_.push_back(nullptr);
     } else {

@@ -171,6 +171,7 @@ class GlRenderer final : public Renderer {
  private:
   struct CameraSetup;
   void BuildCameraSetups(std::vector<CameraSetup> reuse = {}, bool reuse_distortion = false);
+  void PrebuildFinal(const CameraSetup& setup);
   // A submitted state whose pixels are on their way.
   struct Pending {
     scene::SceneState state;
