@@ -4,8 +4,11 @@
 #include <fmt/format.h>
 
 #include <chrono>
+#include <cmath>
 #include <deque>
+#include <limits>
 #include <map>
+#include <optional>
 #include <thread>
 
 #include "dds/internal_convert.h"
@@ -287,67 +290,113 @@ class ImageReader final : public Reader {
     wait_ = std::make_unique<DataWait>(image_);
   }
 
-  // Images: the newest, whatever `up_to` (each step's pair is the newest; only one image, the
-  // newest, is converted).
-  std::shared_ptr<const void> TakeErased(double timeout_s, double /*up_to*/) override {
+  ~ImageReader() override {
+    for (const Received& r : pending_) ddsi_serdata_unref(r.sample);
+  }
+
+  // The newest image stamped at or before `up_to` (every image when it is infinite); later ones
+  // are kept, serialized, for a later call. Only the image handed over is converted (a copy of
+  // megabytes): those before it are counted lost, never converted (converting each, a reader
+  // that fell behind spent its time copying images it then dropped, and fell further behind).
+  // Samples are taken serialized and the pixels copied once, from the received bytes into the
+  // image.
+  std::shared_ptr<const void> TakeErased(double timeout_s, double up_to) override {
     stats_.lost += LostSince(image_);
-    std::shared_ptr<Image> newest;
-    int64_t newest_stamp = 0;  // exact, in ns: the time in seconds does not round-trip
-    // Only the newest valid sample is converted (a copy of megabytes); older ones taken with
-    // it are counted lost, never handed over (converting each, a reader that fell behind
-    // spent its time copying images it then dropped, and fell further behind). Samples are
-    // taken serialized and the pixels copied once, from the received bytes into the image.
-    int64_t valid = 0;
-    const auto TakeImages = [&] {
-      for (;;) {
-        ddsi_serdata* samples[kMaxTake] = {nullptr};
-        dds_sample_info_t infos[kMaxTake];
-        const dds_return_t n = dds_takecdr(image_.get(), samples, kMaxTake, infos, DDS_ANY_STATE);
-        if (n <= 0) break;
-        ddsi_serdata* last = nullptr;
-        for (dds_return_t i = 0; i < n; ++i) {
-          if (!infos[i].valid_data) continue;
-          ++valid;
-          last = samples[i];
-        }
-        if (last != nullptr) {
-          std::string error;
-          const uint32_t size = ddsi_serdata_size(last);
-          ddsrt_iovec_t bytes{};
-          ddsi_serdata* ref = ddsi_serdata_to_ser_ref(last, 0, size, &bytes);
-          sensor_msgs_msg_dds__Image_ msg{};
-          std::shared_ptr<Image> image;
-          if (internal::ImageViewOfCdr(static_cast<const uint8_t*>(bytes.iov_base), bytes.iov_len,
-                                       &msg, &error)) {
-            image = internal::ImageOf(msg, &error, &pool_);
-          }
-          ddsi_serdata_to_ser_unref(ref, &bytes);
-          if (image) {
-            newest = std::move(image);
-            newest_stamp = internal::StampNs(msg.header.stamp);
-          } else {
-            log::Log(log::Level::kWarn, "dds: {}: image dropped: {}", topic(), error);
-          }
-        }
-        for (dds_return_t i = 0; i < n; ++i) ddsi_serdata_unref(samples[i]);
-        if (n < kMaxTake) break;
-      }
-    };
     TakeImages();
-    if (!newest && timeout_s > 0) {
+    if (pending_.empty() && timeout_s > 0) {
       wait_->Wait(timeout_s);
       TakeImages();
-      if (!newest) ++stats_.late;
+      if (pending_.empty()) ++stats_.late;
     }
-    stats_.lost += valid - (newest ? 1 : 0);  // every valid sample but the one handed over
-    if (!newest) return nullptr;
-    Complete(*newest, newest_stamp);
-    return std::make_shared<const ImageMessage>(ImageMessage{std::move(newest)});
+    const int64_t limit = std::isinf(up_to) ? std::numeric_limits<int64_t>::max()
+                                            : static_cast<int64_t>(std::floor(up_to * 1e9));
+    std::optional<Received> chosen;
+    while (!pending_.empty() && pending_.front().stamp <= limit) {
+      if (chosen) {
+        ddsi_serdata_unref(chosen->sample);
+        ++stats_.lost;
+      }
+      chosen = pending_.front();
+      pending_.pop_front();
+    }
+    if (!chosen) return nullptr;
+    std::string error;
+    const uint32_t size = ddsi_serdata_size(chosen->sample);
+    ddsrt_iovec_t bytes{};
+    ddsi_serdata* ref = ddsi_serdata_to_ser_ref(chosen->sample, 0, size, &bytes);
+    sensor_msgs_msg_dds__Image_ msg{};
+    std::shared_ptr<Image> image;
+    if (internal::ImageViewOfCdr(static_cast<const uint8_t*>(bytes.iov_base), bytes.iov_len, &msg,
+                                 &error)) {
+      image = internal::ImageOf(msg, &error, &pool_);
+    }
+    ddsi_serdata_to_ser_unref(ref, &bytes);
+    ddsi_serdata_unref(chosen->sample);
+    if (!image) {
+      ++stats_.lost;
+      log::Log(log::Level::kWarn, "dds: {}: image dropped: {}", topic(), error);
+      return nullptr;
+    }
+    Complete(*image, chosen->stamp);
+    return std::make_shared<const ImageMessage>(ImageMessage{std::move(image)});
   }
   int matched() const override { return SubscriptionMatches(image_); }
   const LinkStats& stats() const override { return stats_; }
 
  private:
+  // A valid sample taken, with its reference, and its stamp in ns.
+  struct Received {
+    ddsi_serdata* sample;
+    int64_t stamp;
+  };
+  // Images kept for a later step (TakeErased's up_to): a few frames of a sender running ahead.
+  static constexpr std::size_t kMaxPendingImages = 16;
+
+  // Appends every valid image sample there is to pending_, in arrival order, with its stamp
+  // (read in place); drops the unreadable ones (counted lost, logged).
+  void TakeImages() {
+    for (;;) {
+      ddsi_serdata* samples[kMaxTake] = {nullptr};
+      dds_sample_info_t infos[kMaxTake];
+      const dds_return_t n = dds_takecdr(image_.get(), samples, kMaxTake, infos, DDS_ANY_STATE);
+      if (n <= 0) break;
+      for (dds_return_t i = 0; i < n; ++i) {
+        if (!infos[i].valid_data) {
+          ddsi_serdata_unref(samples[i]);
+          continue;
+        }
+        std::string error;
+        const uint32_t size = ddsi_serdata_size(samples[i]);
+        ddsrt_iovec_t bytes{};
+        ddsi_serdata* ref = ddsi_serdata_to_ser_ref(samples[i], 0, size, &bytes);
+        sensor_msgs_msg_dds__Image_ msg{};
+        const bool readable = internal::ImageViewOfCdr(static_cast<const uint8_t*>(bytes.iov_base),
+                                                       bytes.iov_len, &msg, &error);
+        ddsi_serdata_to_ser_unref(ref, &bytes);
+        if (!readable) {
+          ++stats_.lost;
+          log::Log(log::Level::kWarn, "dds: {}: image dropped: {}", topic(), error);
+          ddsi_serdata_unref(samples[i]);
+          continue;
+        }
+        const int64_t stamp = internal::StampNs(msg.header.stamp);
+        // The sender restarted (its stamps went back): what it sent before is of no step now.
+        if (!pending_.empty() && stamp < pending_.back().stamp) Drop(pending_.size());
+        pending_.push_back({samples[i], stamp});
+        if (pending_.size() > kMaxPendingImages) Drop(1);
+      }
+      if (n < kMaxTake) break;
+    }
+  }
+  // Drops the `count` oldest kept images, counted lost.
+  void Drop(std::size_t count) {
+    for (std::size_t i = 0; i < count && !pending_.empty(); ++i) {
+      ddsi_serdata_unref(pending_.front().sample);
+      pending_.pop_front();
+      ++stats_.lost;
+    }
+  }
+
   // Camera model, pose and frame index of a received image.
   void Complete(Image& image, int64_t stamp) {
     ImageMetadata& meta = image.metadata();
@@ -434,6 +483,7 @@ class ImageReader final : public Reader {
   std::optional<int64_t> last_stamp_;
   int64_t received_ = 0;
   LinkStats stats_;
+  std::deque<Received> pending_;
 };
 
 template <typename M, typename Sample>

@@ -63,8 +63,10 @@ std::shared_ptr<Participant> SharedParticipant(const DomainOptions& options) {
 bool OnStamps(const runtime::TopicEndpoint& endpoint) {
   return endpoint.pipeline != nullptr && !endpoint.pipeline->clock.source.empty();
 }
-// History of a reader in such a pipeline: 2.5 s of a 25 Hz sender running ahead.
+// History of a reader in such a pipeline: 2.5 s of a 25 Hz sender running ahead; images,
+// 2.25 MiB each at 1024x768, 16 (the image reader keeps as many).
 constexpr int kOnStampsDepth = 64;
+constexpr int kOnStampsImageDepth = 16;
 
 struct Endpoint {
   std::shared_ptr<Participant> participant;
@@ -95,7 +97,9 @@ Endpoint Resolve(const runtime::TopicEndpoint& endpoint, const std::set<std::str
   }
   if (OnStamps(endpoint)) {
     // Deep enough to hold the message of the step's time while the sender runs ahead.
-    out.options.qos.depth = std::max(out.options.qos.depth, kOnStampsDepth);
+    const bool image = endpoint.message_type == MessageName<ImageMessage>();
+    out.options.qos.depth =
+        std::max(out.options.qos.depth, image ? kOnStampsImageDepth : kOnStampsDepth);
   }
   out.participant = SharedParticipant(domain);
   return out;

@@ -413,7 +413,7 @@ TEST_F(WireTest, ReaderCountsLateWaitsAndSkippedMessages) {
 // A pipeline stepping on the sender's stamps (clock.source) asks for the message of its step's
 // time: the newest stamped at or before it, with later ones kept for their own steps.
 TEST_F(WireTest, ReaderHandsOverTheMessageOfTheAskedTimeAndKeepsLaterOnes) {
-  constexpr int kDomain = 167;
+  constexpr int kDomain = 168;
   auto participant = Participant::Create(Domain(kDomain));
   auto reader = Reader::Create(participant, "head.joints",
                                Topic("/saccade/joint_states", Qos{Qos::Latched().reliability,
@@ -445,6 +445,43 @@ TEST_F(WireTest, ReaderHandsOverTheMessageOfTheAskedTimeAndKeepsLaterOnes) {
   EXPECT_DOUBLE_EQ(third->time, 0.16);
   EXPECT_EQ(reader->stats().lost, 1);
   EXPECT_EQ(reader->stats().messages, 3);
+}
+
+// The other eye's image of the step's time, not the newest: a stereo pair from one capture
+// while the sender runs ahead. Images kept for later are converted only when handed over.
+TEST_F(WireTest, ImageReaderHandsOverTheImageOfTheAskedTime) {
+  constexpr int kDomain = 169;
+  const Qos keep{Reliability::kReliable, Durability::kVolatile, 16};
+  auto participant = Participant::Create(Domain(kDomain));
+  auto reader =
+      Reader::Create(participant, "runtime.image", Topic("/saccade/right/image_raw", keep, 0.04));
+  auto writer =
+      Writer::Create(participant, "runtime.image", Topic("/saccade/right/image_raw", keep));
+  ASSERT_TRUE(writer->WaitForReaders(1, 10));
+  ASSERT_TRUE(reader->WaitForWriters(1, 10));
+  std::vector<std::shared_ptr<Image>> sent;
+  for (uint32_t k = 1; k <= 4; ++k) {
+    sent.push_back(MakeImage(64, 48, PixelFormat::kRgb8, k, RationalDistortion()));
+    sent.back()->metadata().time = 0.04 * k;
+    writer->Write(ImageMessage{sent.back()});
+  }
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  const auto Same = [](const Image& a, const Image& b) {
+    return a.size_bytes() == b.size_bytes() && std::memcmp(a.data(), b.data(), a.size_bytes()) == 0;
+  };
+  auto second = reader->Take<ImageMessage>(1.0, 0.08 + 0.5e-9);
+  ASSERT_TRUE(second && second->image);
+  EXPECT_TRUE(Same(*second->image, *sent[1]));
+  EXPECT_EQ(second->image->metadata().frame_index, 2);
+  EXPECT_EQ(reader->stats().lost, 1);                        // the first, before it
+  EXPECT_EQ(reader->Take<ImageMessage>(1.0, 0.1), nullptr);  // kept ones are later: no wait
+  EXPECT_EQ(reader->stats().late, 0);
+  auto newest = reader->Take<ImageMessage>(1.0);
+  ASSERT_TRUE(newest && newest->image);
+  EXPECT_TRUE(Same(*newest->image, *sent[3]));
+  EXPECT_NE(geometry::FindCameraPose(newest->image->metadata()), nullptr);
+  EXPECT_EQ(reader->stats().lost, 2);
+  EXPECT_EQ(reader->stats().messages, 2);
 }
 
 }  // namespace

@@ -114,8 +114,9 @@ class Reader {
   ///
   /// `up_to` (seconds, a pipeline stepping on the sender's stamps: runtime's clock.source):
   /// the newest message stamped at or before it; messages stamped after it are kept for a
-  /// later call (and waiting ends when they arrive), so that a step takes the joints of its
-  /// own time even when the sender is steps ahead. Images take the newest whatever it says.
+  /// later call (and waiting ends when they arrive), so that a step takes the joints and the
+  /// other eye's image of its own time even when the sender is steps ahead. Images are kept
+  /// serialized and converted only when handed over, at most 16.
   template <runtime::Message M>
   std::shared_ptr<const M> Take(double timeout_s = 0.0,
                                 double up_to = std::numeric_limits<double>::infinity()) {
