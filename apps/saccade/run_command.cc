@@ -53,6 +53,7 @@ int Run(const RunCommandOptions& o) {
   if (o.realtime) {
     spec.clock.rate_hz = 1.0 / spec.clock.step;
     spec.clock.mode = runtime::ClockMode::kRealtime;
+    spec.clock.source.clear();  // the wall clock times the steps, not the sender's stamps
   }
   ApplyDdsOverrides(o.dds, spec);
   runtime::Pipeline pipeline = runtime::Pipeline::Build(spec);
@@ -188,7 +189,9 @@ Runner AddRunCommand(CLI::App& app) {
   run->add_option("--steps", o->steps,
                   "Steps to run (default: the file's clock.steps; 0 until "
                   "Ctrl-C)");
-  run->add_flag("--realtime", o->realtime, "Run at the wall clock's pace (rate 1 / clock.step)");
+  run->add_flag("--realtime", o->realtime,
+                "Run at the wall clock's pace (rate 1 / clock.step); a clock.source is then "
+                "not used: the steps take the wall clock's time and the newest messages");
   run->add_flag("--json", o->json,
                 "Print the result as JSON: steps, errors, fixations (and, with --score, the "
                 "scored fixations)");

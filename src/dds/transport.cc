@@ -61,7 +61,8 @@ std::shared_ptr<Participant> SharedParticipant(const DomainOptions& options) {
 
 // The pipeline steps on the sender's stamps (runtime's clock.source).
 bool OnStamps(const runtime::TopicEndpoint& endpoint) {
-  return endpoint.pipeline != nullptr && !endpoint.pipeline->clock.source.empty();
+  return endpoint.pipeline != nullptr && !endpoint.pipeline->clock.source.empty() &&
+         endpoint.pipeline->clock.mode == runtime::ClockMode::kSimulated;
 }
 // History of a reader in such a pipeline: 2.5 s of a 25 Hz sender running ahead; images,
 // 2.25 MiB each at 1024x768, 16 (the image reader keeps as many).

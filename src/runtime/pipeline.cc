@@ -595,6 +595,9 @@ Pipeline Pipeline::Build(const PipelineSpec& spec, const ComponentRegistry& regi
     const auto Fail = [&](const std::string& what) {
       throw FileError(file, built.clock.source_line, "clock.source", what);
     };
+    if (built.clock.mode != ClockMode::kSimulated) {
+      Fail("'source' is for mode simulated: in real time the wall clock gives the time");
+    }
     const std::string name = source.substr(0, source.find('.'));
     const std::string input = source.substr(source.find('.') + 1);
     const auto consumer = index.find(name);
