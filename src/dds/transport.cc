@@ -141,9 +141,9 @@ class TopicReaderComponent final : public runtime::Component, public runtime::Ti
     return StampOf(*pending_);
   }
   void Step(const runtime::StepContext& context) override {
-    // Stamps are whole nanoseconds: the step's time is one of them, or on the step grid.
-    const double up_to =
-        on_stamps_ ? context.time + 0.5e-9 : std::numeric_limits<double>::infinity();
+    // The step's time is its message's stamp (whole nanoseconds) or that put on the step grid
+    // (SimulatedStepTime): a microsecond's margin, far below a sender's step, covers both.
+    const double up_to = on_stamps_ ? context.time + 1e-6 : std::numeric_limits<double>::infinity();
     std::shared_ptr<const M> message = taken_ ? std::move(pending_) : Take(up_to);
     taken_ = false;
     pending_.reset();
