@@ -321,16 +321,10 @@ class ImageReader final : public Reader {
     }
     if (!chosen) return nullptr;
     std::string error;
-    const uint32_t size = ddsi_serdata_size(chosen->sample);
-    ddsrt_iovec_t bytes{};
-    ddsi_serdata* ref = ddsi_serdata_to_ser_ref(chosen->sample, 0, size, &bytes);
-    sensor_msgs_msg_dds__Image_ msg{};
     std::shared_ptr<Image> image;
-    if (internal::ImageViewOfCdr(static_cast<const uint8_t*>(bytes.iov_base), bytes.iov_len, &msg,
-                                 &error)) {
+    WithView(chosen->sample, &error, [&](const sensor_msgs_msg_dds__Image_& msg) {
       image = internal::ImageOf(msg, &error, &pool_);
-    }
-    ddsi_serdata_to_ser_unref(ref, &bytes);
+    });
     ddsi_serdata_unref(chosen->sample);
     if (!image) {
       ++stats_.lost;
@@ -352,6 +346,20 @@ class ImageReader final : public Reader {
   // Images kept for a later step (TakeErased's up_to): a few frames of a sender running ahead.
   static constexpr std::size_t kMaxPendingImages = 16;
 
+  // Calls `use` with the image message of serialized `sample`, read in place (its pointers
+  // into the sample's bytes, valid during the call); false (and `error`) when it is unreadable.
+  template <typename Use>
+  static bool WithView(ddsi_serdata* sample, std::string* error, Use use) {
+    ddsrt_iovec_t bytes{};
+    ddsi_serdata* ref = ddsi_serdata_to_ser_ref(sample, 0, ddsi_serdata_size(sample), &bytes);
+    sensor_msgs_msg_dds__Image_ msg{};
+    const bool readable = internal::ImageViewOfCdr(static_cast<const uint8_t*>(bytes.iov_base),
+                                                   bytes.iov_len, &msg, error);
+    if (readable) use(msg);
+    ddsi_serdata_to_ser_unref(ref, &bytes);
+    return readable;
+  }
+
   // Appends every valid image sample there is to pending_, in arrival order, with its stamp
   // (read in place); drops the unreadable ones (counted lost, logged).
   void TakeImages() {
@@ -366,20 +374,15 @@ class ImageReader final : public Reader {
           continue;
         }
         std::string error;
-        const uint32_t size = ddsi_serdata_size(samples[i]);
-        ddsrt_iovec_t bytes{};
-        ddsi_serdata* ref = ddsi_serdata_to_ser_ref(samples[i], 0, size, &bytes);
-        sensor_msgs_msg_dds__Image_ msg{};
-        const bool readable = internal::ImageViewOfCdr(static_cast<const uint8_t*>(bytes.iov_base),
-                                                       bytes.iov_len, &msg, &error);
-        ddsi_serdata_to_ser_unref(ref, &bytes);
-        if (!readable) {
+        int64_t stamp = 0;
+        if (!WithView(samples[i], &error, [&](const sensor_msgs_msg_dds__Image_& msg) {
+              stamp = internal::StampNs(msg.header.stamp);
+            })) {
           ++stats_.lost;
           log::Log(log::Level::kWarn, "dds: {}: image dropped: {}", topic(), error);
           ddsi_serdata_unref(samples[i]);
           continue;
         }
-        const int64_t stamp = internal::StampNs(msg.header.stamp);
         // The sender restarted (its stamps went back): what it sent before is of no step now.
         if (!pending_.empty() && stamp < pending_.back().stamp) Drop(pending_.size());
         pending_.push_back({samples[i], stamp});
