@@ -4,10 +4,11 @@
 # ground truth (`saccade run --score`: the object, the 3D error of the triangulated target and
 # each eye's axis error at arrival), the single process's beside the split loop's, which
 # perception.yaml scores from what it receives. Perception runs STEPS steps, on its images'
-# stamps (clock.source); the robot runs until perception is done, free (simulated clock, as
-# fast as it renders: perception, slower, takes the newest frames and the joints of their
-# capture time) unless --realtime-robot paces it at its clock's rate. Everything on loopback,
-# in DDS domain 195.
+# stamps (clock.source); the robot runs until perception is done, in lockstep with it
+# (simulated clock: its head waits for perception's answer to each frame pair, so the split
+# loop is the single one), unless --realtime-robot paces it at its clock's rate (lockstep off:
+# perception takes the newest frames and the joints of their capture time, and misses the
+# others). Everything on loopback, in DDS domain 195.
 #
 #   bash bench/split_demo.sh [BUILD_DIR] [STEPS] [--realtime-robot]
 set -euo pipefail

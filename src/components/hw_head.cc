@@ -220,6 +220,7 @@ JointStateMessage HwHead::Joints(const hw::HeadStatus& status, double time) cons
     out.positions = virtual_->positions();
     out.velocities = virtual_->velocities();
     out.targets = virtual_->targets();
+    out.target_velocities = virtual_->target_velocities();
     out.arrived = virtual_->Arrived(1e-4);
     out.clamped_commands = virtual_->clamped_commands();
     return out;

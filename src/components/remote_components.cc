@@ -32,7 +32,10 @@ JointStateMessage RemoteHead::HeadState() {
                     name()));
   }
   JointStateMessage state = *state_now_;
-  if (pending_) state.targets = pending_->positions;  // where it was just told to go
+  if (pending_) {  // where it was just told to go
+    state.targets = pending_->positions;
+    state.target_velocities = pending_->velocities;
+  }
   return state;
 }
 

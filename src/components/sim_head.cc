@@ -56,6 +56,7 @@ JointStateMessage SimHead::State(double time) const {
   out.positions = motors_->positions();
   out.velocities = motors_->velocities();
   out.targets = motors_->targets();
+  out.target_velocities = motors_->target_velocities();
   out.arrived = motors_->Arrived(1e-4);
   out.clamped_commands = motors_->clamped_commands();
   return out;

@@ -349,6 +349,26 @@ void FillJointState(double time, const head::JointState& positions,
   out->effort = {0, 0, nullptr, false};
 }
 
+bool ArrivedOn(const head::JointState& positions, const head::JointState& velocities,
+               const head::JointState& targets, const head::JointState& target_velocities) {
+  constexpr double kTolerance = 1e-4;  // sim.head's (SimHead::State)
+  for (const head::Joint joint : head::kAllJoints) {
+    if (!(std::abs(positions[joint] - targets[joint]) <= kTolerance &&
+          std::abs(velocities[joint] - target_velocities[joint]) <= kTolerance)) {
+      return false;
+    }
+  }
+  return true;
+}
+
+void TargetsToSend(const components::JointStateMessage& m, head::JointState* targets,
+                   head::JointState* target_velocities) {
+  const bool here =
+      m.arrived && !ArrivedOn(m.positions, m.velocities, m.targets, m.target_velocities);
+  *targets = here ? m.positions : m.targets;
+  *target_velocities = here ? m.velocities : m.target_velocities;
+}
+
 bool JointsOf(const sensor_msgs_msg_dds__JointState_& msg, head::JointState* positions,
               head::JointState* velocities, std::string* error) {
   const uint32_t n = msg.name._length;

@@ -97,4 +97,16 @@ void FillJointState(double time, const head::JointState& positions,
 bool JointsOf(const sensor_msgs_msg_dds__JointState_& msg, head::JointState* positions,
               head::JointState* velocities, std::string* error);
 
+/// Whether a head with these positions and velocities has arrived on these targets: every
+/// joint within sim.head's 1e-4 (rad, rad/s) of its target in position and velocity.
+bool ArrivedOn(const head::JointState& positions, const head::JointState& velocities,
+               const head::JointState& targets, const head::JointState& target_velocities);
+/// The targets to send with a joint state (TopicOptions::targets_topic) so that the receiver's
+/// ArrivedOn gives the sender's `arrived`: its targets and their velocities, except for a head
+/// that has arrived by a tolerance of its own, wider than ArrivedOn's (servos settle within a
+/// tick): then where it is. (A head that says it has not arrived while within 1e-4 of its
+/// targets reads as arrived.)
+void TargetsToSend(const components::JointStateMessage& m, head::JointState* targets,
+                   head::JointState* target_velocities);
+
 }  // namespace saccade::dds::internal

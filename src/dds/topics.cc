@@ -9,7 +9,9 @@
 #include <limits>
 #include <map>
 #include <optional>
+#include <string_view>
 #include <thread>
+#include <type_traits>
 
 #include "dds/internal_convert.h"
 #include "dds/internal_cyclone.h"
@@ -28,6 +30,7 @@ using runtime::MessageName;
 
 namespace {
 
+constexpr double kInfinity = std::numeric_limits<double>::infinity();
 constexpr int kMaxTake = 32;  // samples taken at once: older ones are skipped (counted lost)
 
 // Cyclone's QoS for `qos` (XCDR1 explicitly: the only representation rmw_cyclonedds reads).
@@ -72,9 +75,16 @@ Entity MakeTopic(const Participant& participant, const dds_topic_descriptor_t* d
       fmt::format("dds: cannot create topic {} ({})", name, descriptor->m_typename)));
 }
 
+// What a lockstep writer puts in its DDS user data (TopicOptions::lockstep), in ROS 2's
+// "key=value;" form.
+constexpr char kLockstepUserData[] = "saccade.lockstep=1;";
+// A step mark within this of the step's time is the step's (stamps are whole nanoseconds).
+constexpr double kStepMargin = 1e-6;
+
 Entity MakeWriter(const Participant& participant, const Entity& topic, const Qos& qos,
-                  const std::string& what) {
+                  const std::string& what, bool lockstep = false) {
   dds_qos_t* q = MakeQos(qos);
+  if (lockstep) dds_qset_userdata(q, kLockstepUserData, sizeof(kLockstepUserData) - 1);
   const dds_entity_t writer = dds_create_writer(participant.handle(), topic.get(), q, nullptr);
   dds_delete_qos(q);
   return Entity(internal::Check(writer, "dds: cannot create the writer of " + what));
@@ -119,8 +129,8 @@ void WriteSample(const Entity& writer, const void* sample, const std::string& to
   }
 }
 
-// Takes every sample there is from `reader` (loaned), calls `each` on the valid ones in
-// arrival order, returns the count of valid samples.
+// Takes every sample there is from `reader` (loaned), calls `each(sample, info)` on the
+// valid ones in arrival order, returns the count of valid samples.
 template <typename Sample, typename Each>
 int TakeAll(const Entity& reader, Each each) {
   int valid = 0;
@@ -131,7 +141,7 @@ int TakeAll(const Entity& reader, Each each) {
     if (n <= 0) break;
     for (dds_return_t i = 0; i < n; ++i) {
       if (infos[i].valid_data) {
-        each(*static_cast<const Sample*>(samples[i]));
+        each(*static_cast<const Sample*>(samples[i]), infos[i]);
         ++valid;
       }
     }
@@ -226,18 +236,52 @@ class SimpleWriter final : public Writer {
  public:
   SimpleWriter(std::shared_ptr<Participant> participant, const TopicOptions& options,
                const dds_topic_descriptor_t* descriptor)
-      : Writer(MessageName<M>(), options.topic), participant_(std::move(participant)) {
+      : Writer(MessageName<M>(), options.topic),
+        participant_(std::move(participant)),
+        lockstep_(options.lockstep) {
     topic_ = MakeTopic(*participant_, descriptor, options.topic);
-    writer_ = MakeWriter(*participant_, topic_, options.qos, options.topic);
+    writer_ = MakeWriter(*participant_, topic_, options.qos, options.topic, lockstep_);
+    if (std::is_same_v<M, JointStateMessage> && !options.targets_topic.empty()) {
+      targets_topic_ = MakeTopic(*participant_, descriptor, options.targets_topic);
+      targets_ = MakeWriter(*participant_, targets_topic_, options.qos, options.targets_topic);
+      targets_topic_name_ = options.targets_topic;
+    }
   }
   void WriteErased(const void* message) override {
     const M& m = *static_cast<const M*>(message);
     if (!Publishable(m)) return;
+    if constexpr (std::is_same_v<M, JointStateMessage>) {
+      // The targets first, so that a reader has them when the state arrives.
+      if (targets_.get() > 0) {
+        head::JointState targets, velocities;
+        internal::TargetsToSend(m, &targets, &velocities);
+        internal::Holder holder;
+        Sample sample{};
+        internal::FillJointState(m.time, targets, &velocities, holder, &sample);
+        WriteSample(targets_, &sample, targets_topic_name_, stats_);
+      }
+    }
     internal::Holder holder;
     Sample sample{};
     Fill(m, holder, &sample);
     WriteSample(writer_, &sample, topic(), stats_);
     ++stats_.messages;
+    written_up_to_ = std::max(written_up_to_, m.time);
+  }
+  void MarkStep(double time) override {
+    if (!lockstep_) Writer::MarkStep(time);
+    if constexpr (std::is_same_v<Sample, sensor_msgs_msg_dds__JointState_>) {
+      if (written_up_to_ < time - kStepMargin) {
+        // No joint named: a step mark, not a command (JointsOf's readers skip it).
+        internal::Holder holder;
+        Sample mark{};
+        internal::FillJointState(time, {}, nullptr, holder, &mark);
+        mark.name = {0, 0, nullptr, false};
+        mark.position = mark.velocity = {0, 0, nullptr, false};
+        WriteSample(writer_, &mark, topic(), stats_);
+      }
+    }
+    written_up_to_ = -std::numeric_limits<double>::infinity();
   }
   int matched() const override { return PublicationMatches(writer_); }
   const LinkStats& stats() const override { return stats_; }
@@ -266,6 +310,11 @@ class SimpleWriter final : public Writer {
 
   std::shared_ptr<Participant> participant_;
   Entity topic_, writer_;
+  Entity targets_topic_, targets_;  // joint states: their targets (TopicOptions::targets_topic)
+  std::string targets_topic_name_;
+  bool lockstep_;
+  // The latest stamp written since the last step mark (MarkStep).
+  double written_up_to_ = -std::numeric_limits<double>::infinity();
   LinkStats stats_;
 };
 
@@ -417,7 +466,7 @@ class ImageReader final : public Reader {
     const std::string frame = internal::OpticalFrame(meta.camera);
     const auto Poll = [&] {
       TakeAll<sensor_msgs_msg_dds__CameraInfo_>(
-          info_, [&](const sensor_msgs_msg_dds__CameraInfo_& info) {
+          info_, [&](const sensor_msgs_msg_dds__CameraInfo_& info, const dds_sample_info_t&) {
             std::string error;
             if (auto model = internal::CameraModelOf(info, &error)) {
               models_[info.header.frame_id ? info.header.frame_id : ""] =
@@ -427,7 +476,8 @@ class ImageReader final : public Reader {
             }
           });
       if (tf_.get() > 0) {
-        TakeAll<tf2_msgs_msg_dds__TFMessage_>(tf_, [&](const tf2_msgs_msg_dds__TFMessage_& tf) {
+        TakeAll<tf2_msgs_msg_dds__TFMessage_>(tf_, [&](const tf2_msgs_msg_dds__TFMessage_& tf,
+                                                       const dds_sample_info_t&) {
           for (uint32_t i = 0; i < tf.transforms._length; ++i) {
             const auto& t = tf.transforms._buffer[i];
             if (!t.child_frame_id) continue;
@@ -494,42 +544,26 @@ class SimpleReader final : public Reader {
  public:
   SimpleReader(std::shared_ptr<Participant> participant, const TopicOptions& options,
                const dds_topic_descriptor_t* descriptor)
-      : Reader(MessageName<M>(), options.topic), participant_(std::move(participant)) {
+      : Reader(MessageName<M>(), options.topic),
+        participant_(std::move(participant)),
+        lockstep_(options.lockstep) {
     topic_ = MakeTopic(*participant_, descriptor, options.topic);
     reader_ = MakeReader(*participant_, topic_, options.qos, options.topic);
+    if (std::is_same_v<M, JointStateMessage> && !options.targets_topic.empty()) {
+      targets_topic_ = MakeTopic(*participant_, descriptor, options.targets_topic);
+      targets_ = MakeReader(*participant_, targets_topic_, options.qos, options.targets_topic);
+    }
     wait_ = std::make_unique<DataWait>(reader_);
   }
   std::shared_ptr<const void> TakeErased(double timeout_s, double up_to) override {
     stats_.lost += LostSince(reader_);
-    // Every message that arrived, in order, after those kept from earlier calls (stamped after
-    // their step's time).
-    const auto Take = [&] {
-      TakeAll<Sample>(reader_, [&](const Sample& sample) {
-        std::string error;
-        auto message = std::make_shared<M>();
-        if (!Convert(sample, message.get(), &error)) {
-          ++stats_.lost;
-          log::Log(log::Level::kWarn, "dds: {}: message dropped: {}", topic(), error);
-          return;
-        }
-        // The sender restarted (its stamps went back): what it sent before is of no step now.
-        if (!pending_.empty() && message->time < pending_.back()->time) {
-          stats_.lost += static_cast<int64_t>(pending_.size());
-          pending_.clear();
-        }
-        pending_.push_back(std::move(message));
-        if (pending_.size() > kMaxPending) {
-          pending_.pop_front();
-          ++stats_.lost;
-        }
-      });
-    };
-    Take();
+    Drain();
     if (pending_.empty() && timeout_s > 0) {
       wait_->Wait(timeout_s);
-      Take();
+      Drain();
       if (pending_.empty()) ++stats_.late;
     }
+    reached_.clear();  // a lockstep step's marks are its own
     // The newest at or before `up_to`; those before it are lost, those after it kept.
     std::shared_ptr<M> newest;
     while (!pending_.empty() && pending_.front()->time <= up_to) {
@@ -541,18 +575,141 @@ class SimpleReader final : public Reader {
     if (last_time_ && newest->time < *last_time_) ++stats_.restarts;
     last_time_ = newest->time;
     ++stats_.messages;
+    if constexpr (std::is_same_v<M, JointStateMessage>) Complete(*newest);
     return newest;
   }
+  bool WaitForStep(double time, double timeout_s) override {
+    if (!lockstep_) return true;
+    const auto deadline =
+        std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
+    for (;;) {
+      Drain();
+      // Matched writers are looked at again every 50 ms: one that went away ends the wait.
+      bool reached = true;
+      for (const dds_instance_handle_t writer : LockstepWriters()) {
+        const auto it = reached_.find(writer);
+        reached = reached && it != reached_.end() && it->second >= time - kStepMargin;
+      }
+      if (reached) return true;
+      const double left =
+          std::chrono::duration<double>(deadline - std::chrono::steady_clock::now()).count();
+      if (left <= 0) {
+        ++stats_.late;
+        return false;
+      }
+      wait_->Wait(std::min(left, 0.05));
+    }
+  }
+  int lockstep_writers() override { return static_cast<int>(LockstepWriters().size()); }
   int matched() const override { return SubscriptionMatches(reader_); }
   const LinkStats& stats() const override { return stats_; }
 
  private:
+  // Every message that arrived, in order, after those kept from earlier calls (stamped after
+  // their step's time); step marks (empty JointStates) only note their writer's stamp.
+  void Drain() {
+    if constexpr (std::is_same_v<M, JointStateMessage>) {
+      // Before the states: each state's targets were written before it.
+      if (targets_.get() > 0) {
+        TakeAll<Sample>(targets_, [&](const Sample& sample, const dds_sample_info_t&) {
+          Target target;
+          std::string error;
+          if (!internal::JointsOf(sample, &target.positions, &target.velocities, &error)) {
+            log::Log(log::Level::kWarn, "dds: {}: targets dropped: {}", topic(), error);
+            return;
+          }
+          const double time = internal::FromStamp(sample.header.stamp);
+          // The sender restarted (its stamps went back): its earlier targets are of no state.
+          if (!targets_by_time_.empty() && time < targets_by_time_.rbegin()->first) {
+            targets_by_time_.clear();
+          }
+          targets_by_time_[time] = target;
+          if (targets_by_time_.size() > kMaxPending) {
+            targets_by_time_.erase(targets_by_time_.begin());
+          }
+        });
+      }
+    }
+    TakeAll<Sample>(reader_, [&](const Sample& sample, const dds_sample_info_t& info) {
+      if (lockstep_) {
+        double& reached = reached_.try_emplace(info.publication_handle, -kInfinity).first->second;
+        reached = std::max(reached, internal::FromStamp(sample.header.stamp));
+      }
+      if (IsStepMark(sample)) return;
+      std::string error;
+      auto message = std::make_shared<M>();
+      if (!Convert(sample, message.get(), &error)) {
+        ++stats_.lost;
+        log::Log(log::Level::kWarn, "dds: {}: message dropped: {}", topic(), error);
+        return;
+      }
+      // The sender restarted (its stamps went back): what it sent before is of no step now.
+      if (!pending_.empty() && message->time < pending_.back()->time) {
+        stats_.lost += static_cast<int64_t>(pending_.size());
+        pending_.clear();
+      }
+      pending_.push_back(std::move(message));
+      if (pending_.size() > kMaxPending) {
+        pending_.pop_front();
+        ++stats_.lost;
+      }
+    });
+  }
+
+  // The matched writers that announce lockstep in their user data (asked once per writer).
+  std::vector<dds_instance_handle_t> LockstepWriters() {
+    dds_instance_handle_t handles[kMaxLockstepQuery];
+    const dds_return_t n = dds_get_matched_publications(reader_.get(), handles, kMaxLockstepQuery);
+    std::vector<dds_instance_handle_t> out;
+    for (dds_return_t i = 0; i < std::min<dds_return_t>(n, kMaxLockstepQuery); ++i) {
+      auto [it, added] = announces_.try_emplace(handles[i], false);
+      if (added) {
+        if (dds_builtintopic_endpoint_t* e =
+                dds_get_matched_publication_data(reader_.get(), handles[i])) {
+          void* data = nullptr;
+          size_t size = 0;
+          if (e->qos && dds_qget_userdata(e->qos, &data, &size) && data != nullptr) {
+            it->second =
+                std::string_view(static_cast<const char*>(data), size).find(kLockstepUserData) !=
+                std::string_view::npos;
+          }
+          dds_free(data);
+          dds_builtintopic_free_endpoint(e);
+        }
+      }
+      if (it->second) out.push_back(handles[i]);
+    }
+    return out;
+  }
+
+  // The targets of the same stamp, and whether the head has arrived on them as the sender
+  // said; without them (a sender that sends none, or they were lost) the state is taken as
+  // at rest on its positions when every velocity is within sim.head's 1e-4, and counted
+  // incomplete.
+  void Complete(JointStateMessage& m) {
+    const auto it = targets_by_time_.find(m.time);
+    if (it == targets_by_time_.end()) {
+      if (targets_.get() > 0) ++stats_.incomplete;
+      return;
+    }
+    m.targets = it->second.positions;
+    m.target_velocities = it->second.velocities;
+    m.arrived = internal::ArrivedOn(m.positions, m.velocities, m.targets, m.target_velocities);
+    targets_by_time_.erase(targets_by_time_.begin(), std::next(it));
+  }
+
+  // An empty JointState (no joint named) marks a lockstep writer's step (Writer::MarkStep).
+  static bool IsStepMark(const sensor_msgs_msg_dds__JointState_& s) {
+    return s.name._length == 0 && s.position._length == 0;
+  }
+  static bool IsStepMark(const geometry_msgs_msg_dds__PointStamped_&) { return false; }
+
   static bool Convert(const sensor_msgs_msg_dds__JointState_& s, JointStateMessage* m,
                       std::string* error) {
     if (!internal::JointsOf(s, &m->positions, &m->velocities, error)) return false;
     m->time = internal::FromStamp(s.header.stamp);
-    // JointState has no targets: at rest (every velocity within sim.head's 1e-4 tolerance)
-    // the head is where it is heading.
+    // JointState has no targets; until Complete finds them, at rest (every velocity within
+    // sim.head's 1e-4 tolerance) the head is where it is heading.
     m->arrived = true;
     for (const head::Joint joint : head::kAllJoints) {
       m->arrived = m->arrived && std::abs(m->velocities[joint]) <= 1e-4;
@@ -585,7 +742,19 @@ class SimpleReader final : public Reader {
   static constexpr std::size_t kMaxPending = kMaxQosDepth;
   std::deque<std::shared_ptr<M>> pending_;
   std::shared_ptr<Participant> participant_;
+  bool lockstep_;
+  // Lockstep: each writer's latest stamp since the last Take, and whether a matched writer
+  // announced lockstep (by DDS instance handle).
+  static constexpr dds_return_t kMaxLockstepQuery = 64;
+  std::map<dds_instance_handle_t, double> reached_;
+  std::map<dds_instance_handle_t, bool> announces_;
+  // Joint states: the targets received, by stamp (TopicOptions::targets_topic).
+  struct Target {
+    head::JointState positions, velocities;
+  };
+  std::map<double, Target> targets_by_time_;
   Entity topic_, reader_;
+  Entity targets_topic_, targets_;
   std::unique_ptr<DataWait> wait_;
   std::optional<double> last_time_;
   LinkStats stats_;
@@ -637,6 +806,16 @@ void Reader::CheckType(const char* name) const {
     throw InvalidArgument(
         fmt::format("dds: the reader of {} gives {}, not {}", topic_, message_type_, name));
   }
+}
+
+void Writer::MarkStep(double) {
+  throw InvalidArgument("dds: " + topic_ + ": the writer is not in lockstep");
+}
+
+bool Reader::WaitForStep(double, double) { return true; }
+
+bool Reader::WaitForLockstepWriter(double timeout_s) {
+  return WaitUntil(timeout_s, [&] { return lockstep_writers() > 0; });
 }
 
 bool Writer::WaitForReaders(int count, double timeout_s) const {

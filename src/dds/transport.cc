@@ -8,6 +8,7 @@
 #include <mutex>
 #include <optional>
 #include <set>
+#include <type_traits>
 
 #include "saccade/components/messages.h"
 #include "saccade/core/log.h"
@@ -45,6 +46,24 @@ double Seconds(const nlohmann::json& map, const char* key, const std::string& wh
   return it->get<double>();
 }
 
+// `lockstep: true` (TopicOptions::lockstep): head commands only; on the real-time clock the
+// wall clock paces the steps, so it is off there.
+bool Lockstep(const runtime::TopicEndpoint& endpoint) {
+  const auto it = endpoint.options.find("lockstep");
+  if (it == endpoint.options.end()) return false;
+  if (!it->is_boolean()) {
+    throw InvalidArgument(
+        fmt::format("{}.lockstep: expected true or false, got {}", endpoint.where, it->dump()));
+  }
+  if (it->get<bool>() && endpoint.message_type != MessageName<JointCommand>()) {
+    throw InvalidArgument(
+        fmt::format("{}.lockstep: only head commands ({}) mark steps; this port carries {}",
+                    endpoint.where, MessageName<JointCommand>(), endpoint.message_type));
+  }
+  return it->get<bool>() && endpoint.pipeline != nullptr &&
+         endpoint.pipeline->clock.mode == runtime::ClockMode::kSimulated;
+}
+
 // One participant per domain and configuration in the process: Cyclone allows few per host.
 std::shared_ptr<Participant> SharedParticipant(const DomainOptions& options) {
   static std::mutex mutex;
@@ -68,6 +87,10 @@ bool OnStamps(const runtime::TopicEndpoint& endpoint) {
 // 2.25 MiB each at 1024x768, 16 (the image reader keeps as many).
 constexpr int kOnStampsDepth = 64;
 constexpr int kOnStampsImageDepth = 16;
+// How long a lockstep reader's step waits for its answer when the file does not say (wait_s).
+constexpr double kLockstepWaitS = 10.0;
+// Where joint states' targets go by default: /saccade/joint_states -> /saccade/joint_targets.
+constexpr char kTargetsSibling[] = "joint_targets";
 
 struct Endpoint {
   std::shared_ptr<Participant> participant;
@@ -93,6 +116,20 @@ Endpoint Resolve(const runtime::TopicEndpoint& endpoint, const std::set<std::str
     const std::string tf = it->get<std::string>();
     out.options.tf_topic = tf.empty() ? "" : ResolveTopic(tf, ns);
   }
+  // Joint states carry their targets on a sibling topic (TopicOptions::targets_topic).
+  const bool joints = endpoint.message_type == MessageName<JointStateMessage>();
+  if (joints) out.options.targets_topic = SiblingTopic(out.options.topic, kTargetsSibling);
+  if (const auto it = endpoint.options.find("targets"); it != endpoint.options.end()) {
+    if (!joints) {
+      throw InvalidArgument(
+          fmt::format("{}.targets: only joint states have targets; this port "
+                      "carries {}",
+                      where, endpoint.message_type));
+    }
+    if (!it->is_string()) throw InvalidArgument(where + ".targets: expected a topic or \"\"");
+    const std::string targets = it->get<std::string>();
+    out.options.targets_topic = targets.empty() ? "" : ResolveTopic(targets, ns);
+  }
   if (endpoint.pipeline && endpoint.pipeline->clock.mode == runtime::ClockMode::kSimulated) {
     out.options.frame_period_s = endpoint.pipeline->clock.step;
   }
@@ -102,6 +139,7 @@ Endpoint Resolve(const runtime::TopicEndpoint& endpoint, const std::set<std::str
     out.options.qos.depth =
         std::max(out.options.qos.depth, image ? kOnStampsImageDepth : kOnStampsDepth);
   }
+  out.options.lockstep = Lockstep(endpoint);
   out.participant = SharedParticipant(domain);
   return out;
 }
@@ -120,16 +158,27 @@ class TopicReaderComponent final : public runtime::Component, public runtime::Ti
  public:
   // `on_stamps`: the pipeline steps on the sender's stamps (clock.source); each step takes
   // the newest message stamped at or before its time.
+  // `lockstep`: each step waits for the writers in lockstep (TopicOptions::lockstep).
   TopicReaderComponent(std::unique_ptr<Reader> reader, double wait_s, double start_wait_s,
-                       bool on_stamps)
+                       bool on_stamps, bool lockstep)
       : reader_(std::move(reader)),
         wait_s_(wait_s),
         start_wait_s_(start_wait_s),
         on_stamps_(on_stamps),
+        lockstep_(lockstep),
         output_(AddOutput<M>("message")) {}
 
   void Start() override {
-    if (start_wait_s_ > 0 && !reader_->WaitForWriters(1, start_wait_s_)) {
+    if (start_wait_s_ <= 0) return;
+    if (lockstep_) {
+      // Before the first step, so that it is in lockstep already.
+      if (!reader_->WaitForLockstepWriter(start_wait_s_)) {
+        log::Log(log::Level::kWarn,
+                 "dds: {}: no writer in lockstep after {} s; stepping on without waiting for one "
+                 "(until one comes)",
+                 reader_->topic(), start_wait_s_);
+      }
+    } else if (!reader_->WaitForWriters(1, start_wait_s_)) {
       log::Log(log::Level::kWarn, "dds: {}: no writer after {} s; stepping on without one",
                reader_->topic(), start_wait_s_);
     }
@@ -144,7 +193,22 @@ class TopicReaderComponent final : public runtime::Component, public runtime::Ti
     // The step's time is its message's stamp (whole nanoseconds) or that put on the step grid
     // (SimulatedStepTime): a microsecond's margin, far below a sender's step, covers both.
     const double up_to = on_stamps_ ? context.time + 1e-6 : std::numeric_limits<double>::infinity();
-    std::shared_ptr<const M> message = taken_ ? std::move(pending_) : Take(up_to);
+    std::shared_ptr<const M> message;
+    if (taken_) {
+      message = std::move(pending_);
+    } else if (lockstep_) {
+      // The step's answer from every writer in lockstep (a command or a step mark), then the
+      // newest command that came, without a second wait.
+      if (!reader_->WaitForStep(context.time, wait_s_) && ++late_steps_ == 1) {
+        log::Log(log::Level::kWarn,
+                 "dds: {}: no answer in lockstep for the step at {:.3f} s within {} s; stepping "
+                 "on (the late ones are counted)",
+                 reader_->topic(), context.time, wait_s_);
+      }
+      message = reader_->Take<M>(0.0, up_to);
+    } else {
+      message = Take(up_to);
+    }
     taken_ = false;
     pending_.reset();
     if (message) output_.Emit(*message);
@@ -153,7 +217,10 @@ class TopicReaderComponent final : public runtime::Component, public runtime::Ti
     const LinkStats& s = reader_->stats();
     log::Info("dds: {} ({}): {} messages, {} lost, {} late, {} restarts{}", reader_->topic(),
               RosTypeOf(reader_->message_type()), s.messages, s.lost, s.late, s.restarts,
-              s.incomplete ? fmt::format(", {} without camera info or pose", s.incomplete) : "");
+              s.incomplete
+                  ? fmt::format(", {} without {}", s.incomplete,
+                                std::is_same_v<M, ImageMessage> ? "camera info or pose" : "targets")
+                  : "");
   }
 
  private:
@@ -167,13 +234,19 @@ class TopicReaderComponent final : public runtime::Component, public runtime::Ti
   double wait_s_;
   double start_wait_s_;
   bool on_stamps_;
+  bool lockstep_;
+  int64_t late_steps_ = 0;
   runtime::Output<M>& output_;
   bool taken_ = false;  // NextTime took this step's message
   std::shared_ptr<const M> pending_;
 };
 
+// A lockstep writer also marks each step done (Writer::MarkStep), returned for the pipeline's
+// EndStep; an empty function otherwise.
 template <runtime::Message M>
-void AttachWriter(std::shared_ptr<Writer> writer, double start_wait_s, runtime::OutputBase& port) {
+std::function<void(const runtime::StepContext&)> AttachWriter(std::shared_ptr<Writer> writer,
+                                                              double start_wait_s, bool lockstep,
+                                                              runtime::OutputBase& port) {
   auto* typed = dynamic_cast<runtime::Output<M>*>(&port);
   SACCADE_ASSERT(typed != nullptr, "output of the wrong type");
   auto first = std::make_shared<bool>(true);
@@ -187,6 +260,8 @@ void AttachWriter(std::shared_ptr<Writer> writer, double start_wait_s, runtime::
     }
     writer->Write(message);
   });
+  if (!lockstep) return {};
+  return [writer](const runtime::StepContext& context) { writer->MarkStep(context.time); };
 }
 
 template <typename F>
@@ -256,25 +331,28 @@ void RegisterDdsTransport(runtime::ComponentRegistry& registry) {
   transport.name = "dds";
   transport.make_reader =
       [](const runtime::TopicEndpoint& endpoint) -> std::unique_ptr<runtime::Component> {
-    Endpoint e = Resolve(endpoint, {"qos", "wait_s", "start_wait_s", "tf"});
-    const double wait_s = Seconds(endpoint.options, "wait_s", endpoint.where);
+    Endpoint e = Resolve(endpoint, {"qos", "wait_s", "start_wait_s", "tf", "targets", "lockstep"});
+    // In lockstep a step waits for its answer: 10 s unless the file says.
+    const double wait_s = e.options.lockstep && !endpoint.options.contains("wait_s")
+                              ? kLockstepWaitS
+                              : Seconds(endpoint.options, "wait_s", endpoint.where);
     const double start_wait_s = Seconds(endpoint.options, "start_wait_s", endpoint.where);
     auto reader = Reader::Create(e.participant, endpoint.message_type, e.options);
     return Dispatch(endpoint.message_type, [&](auto tag) -> std::unique_ptr<runtime::Component> {
       using M = decltype(tag);
       return std::make_unique<TopicReaderComponent<M>>(std::move(reader), wait_s, start_wait_s,
-                                                       OnStamps(endpoint));
+                                                       OnStamps(endpoint), e.options.lockstep);
     });
   };
-  transport.attach_writer = [](const runtime::TopicEndpoint& endpoint,
-                               runtime::OutputBase& output) {
-    Endpoint e = Resolve(endpoint, {"qos", "start_wait_s", "tf"});
+  transport.attach_writer =
+      [](const runtime::TopicEndpoint& endpoint,
+         runtime::OutputBase& output) -> std::function<void(const runtime::StepContext&)> {
+    Endpoint e = Resolve(endpoint, {"qos", "start_wait_s", "tf", "targets", "lockstep"});
     const double start_wait_s = Seconds(endpoint.options, "start_wait_s", endpoint.where);
     std::shared_ptr<Writer> writer =
         Writer::Create(e.participant, endpoint.message_type, e.options);
-    Dispatch(endpoint.message_type, [&](auto tag) {
-      AttachWriter<decltype(tag)>(writer, start_wait_s, output);
-      return 0;
+    return Dispatch(endpoint.message_type, [&](auto tag) {
+      return AttachWriter<decltype(tag)>(writer, start_wait_s, e.options.lockstep, output);
     });
   };
   registry.SetTopicTransport(std::move(transport));

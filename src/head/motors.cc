@@ -137,6 +137,14 @@ JointState Motors::accelerations() const {
   return state;
 }
 
+JointState Motors::target_velocities() const {
+  JointState state;
+  for (Joint joint : kAllJoints) {
+    state[joint] = profiles_[Index(joint)].TargetVelocity(elapsed_[Index(joint)]);
+  }
+  return state;
+}
+
 JointState Motors::targets() const {
   JointState state;
   for (Joint joint : kAllJoints) {

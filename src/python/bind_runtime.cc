@@ -323,6 +323,7 @@ class PyPipeline {
         }
         for (const auto& input : component->inputs()) input->MarkSeen();
       }
+      pipeline_.EndStep(context);
       ++step_;
     }
   }

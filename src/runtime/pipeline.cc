@@ -736,9 +736,11 @@ Pipeline Pipeline::Build(const PipelineSpec& spec, const ComponentRegistry& regi
                                   PortNames(pipeline.components_[i]->outputs())));
     }
     try {
-      transport->attach_writer(TopicEndpoint{out.topic, output->message_type(), out.topic_options,
-                                             &spec, built.components[i].name + "." + out.output},
-                               *output);
+      auto step_end = transport->attach_writer(
+          TopicEndpoint{out.topic, output->message_type(), out.topic_options, &spec,
+                        built.components[i].name + "." + out.output},
+          *output);
+      if (step_end) pipeline.step_ends_.push_back(std::move(step_end));
     } catch (const std::exception& error) {
       throw FileError(file, out.line, key, error.what());
     }
@@ -751,6 +753,10 @@ Component* Pipeline::Find(const std::string& name) const {
     if (component->name() == name) return component.get();
   }
   return nullptr;
+}
+
+void Pipeline::EndStep(const StepContext& context) {
+  for (const auto& step_end : step_ends_) step_end(context);
 }
 
 void Pipeline::DeliverDelayed() {

@@ -266,6 +266,7 @@ RunSummary RunPipeline(Pipeline& pipeline, const RunOptions& options) {
         component_seconds += longest;
         if (stop_now) break;
       }
+      pipeline.EndStep(context);
       const double loop = Seconds(Clock::now() - tick_start);
       const double overhead = std::max(0.0, loop - component_seconds);
       timing.overhead = overhead;

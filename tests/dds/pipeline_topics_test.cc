@@ -207,7 +207,20 @@ TEST_F(PipelineTopics, BadTopicConnectionsNameFileLineAndKey) {
                         "character ' ' is not allowed"));
   EXPECT_THAT(
       ErrorOf(HeadPipeline(182, "{topic: head/command, wait: 3}")),
-      HasSubstr("head.command: unknown key 'wait'; expected qos, start_wait_s, tf, wait_s"));
+      HasSubstr("head.command: unknown key 'wait'; expected lockstep, qos, start_wait_s, targets, "
+                "tf, wait_s"));
+  EXPECT_THAT(ErrorOf(HeadPipeline(182, "{topic: head/command, lockstep: 1}")),
+              HasSubstr("head.yaml:8: components[0].inputs.command: head.command.lockstep: "
+                        "expected true or false, got 1"));
+  EXPECT_THAT(ErrorOf(HeadPipeline(182, "{topic: head/command, targets: head/goal}")),
+              HasSubstr("head.command.targets: only joint states have targets; this port "
+                        "carries head.command"));
+  std::string joints = HeadPipeline(182, "{topic: head/command}");
+  joints.replace(joints.find("joints: joint_states"), 20,
+                 "joints: {topic: joint_states, lockstep: true}");
+  EXPECT_THAT(ErrorOf(joints),
+              HasSubstr("head.yaml:9: components.head.outputs.joints: head.joints.lockstep: only "
+                        "head commands (head.command) mark steps; this port carries head.joints"));
   EXPECT_THAT(ErrorOf(HeadPipeline(300, "{topic: head/command}")),
               HasSubstr("transport.domain: expected an integer 0..232, got 300"));
   // A program without a topic transport says so.
@@ -216,6 +229,50 @@ TEST_F(PipelineTopics, BadTopicConnectionsNameFileLineAndKey) {
   EXPECT_THAT(ErrorOf(HeadPipeline(182, "{topic: head/command}"), plain),
               HasSubstr("reads the topic 'head/command', but this program has no topic "
                         "transport (DDS)"));
+}
+
+// A lockstep writer answers every step of its pipeline (runtime::Pipeline::EndStep): with the
+// step's command when the component sent one, else an empty JointState stamped with the step's
+// time, so that the robot in lockstep knows the step is done.
+TEST_F(PipelineTopics, LockstepCommandsAnswerEveryStep) {
+  constexpr int kDomain = 186;
+  const std::string text =
+      "clock: {mode: simulated, step: 0.04, steps: 3}\n"
+      "scene: " +
+      kScene +
+      "\n"
+      "transport: {domain: 186, namespace: /saccade}\n"
+      "components:\n"
+      "  - name: fixation\n"
+      "    type: control.fixation\n"
+      "    inputs: {target: {topic: target, wait_s: 0.5, start_wait_s: 10}}\n"
+      "    outputs: {command: {topic: head/command, lockstep: true}}\n";
+  runtime::Pipeline pipeline = runtime::Pipeline::LoadString(text, "perception.yaml");
+  Raw raw(RawParticipant(kDomain));
+  Raw commands(RawReader(raw.get(), &ref_sensor_msgs_msg_dds__JointState__desc,
+                         "rt/saccade/head/command", 10));
+  Raw target(
+      RawWriter(raw.get(), &ref_geometry_msgs_msg_dds__PointStamped__desc, "rt/saccade/target"));
+  ASSERT_TRUE(WaitWriterMatched(target.get()));
+  ASSERT_TRUE(WaitReaderMatched(commands.get()));
+  // One target, before the first step: step 0 commands the head; steps 1 and 2 have nothing.
+  ref_geometry_msgs_msg_dds__PointStamped_ point{};
+  point.header.frame_id = const_cast<char*>("world");
+  point.point = {2.0, 0.3, 1.0};
+  ASSERT_EQ(dds_write(target.get(), &point), DDS_RETCODE_OK);
+  const runtime::RunSummary summary = runtime::RunPipeline(pipeline);
+  ASSERT_EQ(summary.errors_total, 0) << summary.FullReport();
+  ASSERT_EQ(summary.steps, 3);
+
+  std::vector<std::pair<uint32_t, uint32_t>> got;  // (joints named, stamp in ns)
+  ref_sensor_msgs_msg_dds__JointState_ sample{};
+  while (TakeSample(commands.get(), &sample, 1.0)) {
+    got.emplace_back(sample.name._length, sample.header.stamp.nanosec);
+    dds_sample_free(&sample, &ref_sensor_msgs_msg_dds__JointState__desc, DDS_FREE_CONTENTS);
+    sample = {};  // freed contents: Cyclone would reuse the pointers
+  }
+  EXPECT_THAT(got, ::testing::ElementsAre(::testing::Pair(4u, 0u), ::testing::Pair(0u, 40000000u),
+                                          ::testing::Pair(0u, 80000000u)));
 }
 
 TEST_F(PipelineTopics, OutputsMustExistAndHaveARosForm) {

@@ -484,5 +484,168 @@ TEST_F(WireTest, ImageReaderHandsOverTheImageOfTheAskedTime) {
   EXPECT_EQ(reader->stats().messages, 2);
 }
 
+// Lockstep (TopicOptions::lockstep): a reader waits each step for the step's answer of every
+// writer that announces lockstep, a command or an empty JointState marking the step; it never
+// waits for other writers (a GUI's), and a mark is not a command.
+TEST_F(WireTest, LockstepReaderWaitsForTheStepOfLockstepWritersOnly) {
+  constexpr int kDomain = 170;
+  auto robot = Participant::Create(Domain(kDomain));
+  TopicOptions in = Topic("/saccade/head/command");
+  in.lockstep = true;
+  auto reader = Reader::Create(robot, "head.command", in);
+  // A writer not in lockstep: it is never waited for.
+  auto gui = Writer::Create(robot, "head.command", Topic("/saccade/head/command"));
+  ASSERT_TRUE(gui->WaitForReaders(1, 10));
+  EXPECT_EQ(reader->lockstep_writers(), 0);
+  EXPECT_TRUE(reader->WaitForStep(0.0, 30.0));  // at once: nobody to wait for
+  JointCommand command;
+  command.time = 5.0;
+  command.positions.pan = 0.3;
+  gui->Write(command);
+
+  // Perception's writer, in its own participant, announces lockstep in its user data.
+  auto perception = Participant::Create(Domain(kDomain));
+  TopicOptions out = Topic("/saccade/head/command");
+  out.lockstep = true;
+  auto answer = Writer::Create(perception, "head.command", out);
+  ASSERT_TRUE(reader->WaitForLockstepWriter(10));
+  EXPECT_EQ(reader->lockstep_writers(), 1);
+  // The GUI's command came meanwhile: handed over as ever.
+  auto got = reader->Take<JointCommand>(1.0);
+  ASSERT_NE(got, nullptr);
+  EXPECT_EQ(got->positions.pan, 0.3);
+
+  // A plain subscriber sees what the lockstep writer sends, as ROS 2 would.
+  Raw raw(RawParticipant(kDomain));
+  Raw wire(RawReader(raw.get(), &ref_sensor_msgs_msg_dds__JointState__desc,
+                     "rt/saccade/head/command", 10));
+  ASSERT_TRUE(WaitReaderMatched(wire.get()));
+  ASSERT_TRUE(answer->WaitForReaders(2, 10));
+
+  // Step 0.04: no answer yet, so the wait runs out and is counted late.
+  EXPECT_FALSE(reader->WaitForStep(0.04, 0.3));
+  EXPECT_EQ(reader->stats().late, 1);
+  // Perception had no command for it: the step mark ends the wait, and is not a command.
+  answer->MarkStep(0.04);
+  EXPECT_TRUE(reader->WaitForStep(0.04, 30.0));
+  EXPECT_EQ(reader->Take<JointCommand>(0.0), nullptr);
+  EXPECT_EQ(reader->stats().lost, 0);
+  // Step 0.08: the command is the answer; the mark adds nothing after it.
+  command.time = 0.08;
+  command.positions.pan = -0.2;
+  answer->Write(command);
+  answer->MarkStep(0.08);
+  EXPECT_TRUE(reader->WaitForStep(0.08, 30.0));
+  got = reader->Take<JointCommand>(0.0);
+  ASSERT_NE(got, nullptr);
+  EXPECT_EQ(got->positions.pan, -0.2);
+  // An answer of an earlier step does not answer a later one (stamps are the steps' times).
+  answer->MarkStep(0.08);
+  EXPECT_FALSE(reader->WaitForStep(0.12, 0.3));
+
+  // On the wire: the mark, an empty sensor_msgs/JointState stamped 0.04 s; then the command.
+  ref_sensor_msgs_msg_dds__JointState_ sample{};
+  ASSERT_TRUE(TakeSample(wire.get(), &sample));
+  EXPECT_EQ(sample.name._length, 0u);
+  EXPECT_EQ(sample.position._length, 0u);
+  EXPECT_EQ(sample.header.stamp.sec, 0);
+  EXPECT_EQ(sample.header.stamp.nanosec, 40000000u);
+  dds_sample_free(&sample, &ref_sensor_msgs_msg_dds__JointState__desc, DDS_FREE_CONTENTS);
+  sample = {};
+  ASSERT_TRUE(TakeSample(wire.get(), &sample));
+  EXPECT_EQ(sample.name._length, 4u);
+  EXPECT_EQ(sample.header.stamp.nanosec, 80000000u);
+  dds_sample_free(&sample, &ref_sensor_msgs_msg_dds__JointState__desc, DDS_FREE_CONTENTS);
+  sample = {};
+  ASSERT_TRUE(TakeSample(wire.get(), &sample));  // the second mark of 0.08: nothing came before it
+  EXPECT_EQ(sample.name._length, 0u);
+  dds_sample_free(&sample, &ref_sensor_msgs_msg_dds__JointState__desc, DDS_FREE_CONTENTS);
+
+  // A lockstep writer that goes away ends the wait: a process that quit never stalls the loop.
+  answer.reset();
+  EXPECT_TRUE(reader->WaitForStep(0.16, 30.0));
+  EXPECT_EQ(reader->lockstep_writers(), 0);
+  // Only lockstep writers mark steps.
+  EXPECT_THROW(gui->MarkStep(0.2), InvalidArgument);
+}
+
+// A joint state carries no targets: the writer sends them, of the same stamp, on a sibling
+// topic, so the reader knows whether the head has arrived as the sender does, in smooth
+// pursuit too (moving, on a moving target), which the velocities alone cannot tell.
+TEST_F(WireTest, JointStatesBringTheirTargetsAndArrivalAsTheSenderSaysIt) {
+  constexpr int kDomain = 171;
+  auto participant = Participant::Create(Domain(kDomain));
+  const Qos keep{Reliability::kReliable, Durability::kVolatile, 10};
+  TopicOptions options = Topic("/saccade/joint_states", keep);
+  options.targets_topic = "/saccade/joint_targets";
+  auto writer = Writer::Create(participant, "head.joints", options);
+  auto reader = Reader::Create(participant, "head.joints", options);
+  // One that does not ask for the targets: the old rule, at rest on its positions.
+  auto plain = Reader::Create(participant, "head.joints", Topic("/saccade/joint_states", keep));
+  Raw raw(RawParticipant(kDomain));
+  Raw wire(RawReader(raw.get(), &ref_sensor_msgs_msg_dds__JointState__desc,
+                     "rt/saccade/joint_targets", 10));
+  ASSERT_TRUE(WaitReaderMatched(wire.get()));
+  ASSERT_TRUE(writer->WaitForReaders(2, 10));
+  ASSERT_TRUE(reader->WaitForWriters(1, 10));
+
+  // Pursuit, on its target: sim.head says arrived while every joint moves at 0.02 rad/s.
+  JointStateMessage pursuit;
+  pursuit.time = 0.04;
+  pursuit.positions = {0.2, -0.1, 0.05, -0.05};
+  pursuit.velocities = {0.02, 0.0, 0.01, -0.01};
+  pursuit.targets = {0.20005, -0.1, 0.05, -0.05};
+  pursuit.target_velocities = {0.02, 0.0, 0.01, -0.01};
+  pursuit.arrived = true;
+  writer->Write(pursuit);
+  auto got = reader->Take<JointStateMessage>(5.0);
+  ASSERT_NE(got, nullptr);
+  EXPECT_TRUE(got->arrived);
+  EXPECT_EQ(got->targets.pan, 0.20005);
+  EXPECT_EQ(got->target_velocities.pan, 0.02);
+  auto old = plain->Take<JointStateMessage>(5.0);
+  ASSERT_NE(old, nullptr);
+  EXPECT_FALSE(old->arrived);               // moving: what the velocities alone say
+  EXPECT_EQ(plain->stats().incomplete, 0);  // it asked for no targets
+
+  // On the way to a target 0.1 rad off, at rest for an instant: not arrived.
+  JointStateMessage turning = pursuit;
+  turning.time = 0.08;
+  turning.velocities = {};
+  turning.targets.pan = 0.3;
+  turning.target_velocities = {};
+  turning.arrived = false;
+  writer->Write(turning);
+  got = reader->Take<JointStateMessage>(5.0);
+  ASSERT_NE(got, nullptr);
+  EXPECT_FALSE(got->arrived);
+  EXPECT_EQ(got->targets.pan, 0.3);
+  old = plain->Take<JointStateMessage>(5.0);
+  ASSERT_NE(old, nullptr);
+  EXPECT_TRUE(old->arrived);  // at rest: the velocities alone are wrong again
+
+  // A servo head settled within its own tolerance (3 mrad off its goal) says arrived: the
+  // target sent is where it is, so the reader says so too.
+  JointStateMessage servo = turning;
+  servo.time = 0.12;
+  servo.targets.pan = servo.positions.pan + 0.003;
+  servo.arrived = true;
+  writer->Write(servo);
+  got = reader->Take<JointStateMessage>(5.0);
+  ASSERT_NE(got, nullptr);
+  EXPECT_TRUE(got->arrived);
+  EXPECT_EQ(reader->stats().incomplete, 0);
+
+  // On the wire: ROS 2 JointStates of the four joints, stamped as their states.
+  ref_sensor_msgs_msg_dds__JointState_ sample{};
+  ASSERT_TRUE(TakeSample(wire.get(), &sample));
+  ASSERT_EQ(sample.name._length, 4u);
+  EXPECT_STREQ(sample.name._buffer[0], "pan");
+  EXPECT_EQ(sample.position._buffer[0], 0.20005);
+  EXPECT_EQ(sample.velocity._buffer[0], 0.02);
+  EXPECT_EQ(sample.header.stamp.nanosec, 40000000u);
+  dds_sample_free(&sample, &ref_sensor_msgs_msg_dds__JointState__desc, DDS_FREE_CONTENTS);
+}
+
 }  // namespace
 }  // namespace saccade::dds

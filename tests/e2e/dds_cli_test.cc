@@ -50,25 +50,43 @@ class DdsCli : public ::testing::Test {
   fs::path dir_;
 };
 
-// Head rest positions of two runs agree when their fixations are the same faces.
-constexpr double kSameFixationRad = 0.02;
-// The first fixation comes at about step 5 (0.2 s); the shared 2-core development machine
-// renders a step in 1 to 10 s, so the runs stay short.
+// The split loop in lockstep is the single one: its joints agree to the last bits of the eyes'
+// poses, which cross as quaternions (6e-14 rad measured over 150 steps).
+constexpr double kSameRad = 1e-9;
+// The first fixation comes at step 4 (0.16 s) and the head pursues it after; the shared 2-core
+// development machine renders a step in 0.2 to 10 s, so the runs stay short.
 constexpr int kSteps = 30;
+
+// The rows of a --joints-csv file: time, pan, tilt, left, right, arrived.
+std::vector<std::vector<double>> JointRows(const fs::path& csv) {
+  std::ifstream in(csv);
+  std::string line;
+  std::getline(in, line);  // header
+  std::vector<std::vector<double>> rows;
+  while (std::getline(in, line)) {
+    std::vector<double> row;
+    std::stringstream fields(line);
+    std::string field;
+    while (std::getline(fields, field, ',')) row.push_back(std::stod(field));
+    rows.push_back(row);
+  }
+  return rows;
+}
 
 TEST_F(DdsCli, SplitDemoFixatesLikeTheSingleProcess) {
   const std::string steps = std::to_string(kSteps);
-  ASSERT_EQ(
-      Shell(kBinary + " run " + kPipelines + "demo.yaml --score --steps " + steps + " --json > " +
-            (dir_ / "single.json").string() + " 2> " + (dir_ / "single.err").string()),
-      0)
+  ASSERT_EQ(Shell(kBinary + " run " + kPipelines + "demo.yaml --score --steps " + steps +
+                  " --joints-csv " + (dir_ / "single.csv").string() + " --json > " +
+                  (dir_ / "single.json").string() + " 2> " + (dir_ / "single.err").string()),
+            0)
       << Read(dir_ / "single.err");
   ASSERT_EQ(Shell(kBinary + " run " + kPipelines +
                   "perception.yaml --score --json --dds-domain 211 --steps " + steps + " > " +
                   (dir_ / "scored.json").string() + " 2> " + (dir_ / "perception.txt").string() +
                   " &\n" + kBinary + " run " + kPipelines + "robot.yaml --dds-domain 211 --steps " +
-                  steps + " --json > " + (dir_ / "robot.json").string() + " 2> " +
-                  (dir_ / "robot.err").string() + "\nstatus=$?\nwait\nexit $status\n"),
+                  steps + " --joints-csv " + (dir_ / "split.csv").string() + " --json > " +
+                  (dir_ / "robot.json").string() + " 2> " + (dir_ / "robot.err").string() +
+                  "\nstatus=$?\nwait\nexit $status\n"),
             0)
       << Read(dir_ / "robot.err");
   const json single = json::parse(Read(dir_ / "single.json"));
@@ -77,31 +95,52 @@ TEST_F(DdsCli, SplitDemoFixatesLikeTheSingleProcess) {
   // The images crossed, with their camera info and pose.
   EXPECT_THAT(perception, HasSubstr("/saccade/left/image_raw (sensor_msgs/msg/Image)"));
   EXPECT_THAT(perception, ::testing::Not(HasSubstr("without camera info or pose")));
+  // Perception answered every step (lockstep): nothing lost, nothing late, on either side.
+  EXPECT_THAT(perception, HasSubstr("/saccade/left/image_raw (sensor_msgs/msg/Image): " + steps +
+                                    " messages, 0 lost, 0 late"));
+  EXPECT_THAT(Read(dir_ / "robot.err"), ::testing::ContainsRegex("head/command .* 0 lost, 0 late"));
+  EXPECT_THAT(perception, ::testing::Not(HasSubstr("without targets")));
+  // The head moved as the single process's did, step by step.
+  const auto single_joints = JointRows(dir_ / "single.csv");
+  const auto split_joints = JointRows(dir_ / "split.csv");
+  ASSERT_EQ(single_joints.size(), static_cast<std::size_t>(kSteps));
+  ASSERT_EQ(split_joints.size(), single_joints.size());
+  for (std::size_t k = 0; k < single_joints.size(); ++k) {
+    ASSERT_EQ(split_joints[k].size(), 6u);
+    EXPECT_EQ(split_joints[k][0], single_joints[k][0]) << "time of step " << k;
+    for (std::size_t j = 1; j <= 4; ++j) {
+      EXPECT_NEAR(split_joints[k][j], single_joints[k][j], kSameRad) << "step " << k;
+    }
+    EXPECT_EQ(split_joints[k][5], single_joints[k][5]) << "arrived at step " << k;
+  }
   const json& a = single["fixations"];
   const json& b = split["fixations"];
   ASSERT_GE(a.size(), 1u) << single.dump();
-  ASSERT_GE(b.size(), 1u) << split.dump() << "\n" << perception;
-  // The split loop runs a little behind the single one (commands cross a process boundary),
-  // so it may reach fewer fixations in the same steps; those it reaches are the same.
-  for (std::size_t i = 0; i < std::min(a.size(), b.size()); ++i) {
+  ASSERT_EQ(b.size(), a.size()) << split.dump() << "\n" << perception;
+  for (std::size_t i = 0; i < a.size(); ++i) {
     for (const char* joint : {"pan", "tilt", "left", "right"}) {
-      EXPECT_NEAR(a[i][joint].get<double>(), b[i][joint].get<double>(), kSameFixationRad)
+      EXPECT_NEAR(a[i][joint].get<double>(), b[i][joint].get<double>(), kSameRad)
           << "fixation " << i << ", " << joint << "\nsingle: " << a.dump()
           << "\nsplit: " << b.dump();
     }
   }
   // Scored against the scene's ground truth where perception is (its images, the joints of
-  // their capture time), the split loop fixates the faces the single one does, as accurately:
-  // the bounds, 3D error <= 15 mm and eyes within 0.15 deg.
+  // their capture time), the split loop fixates the faces the single one does, at the same
+  // times, as accurately; and within the bounds, 3D error <= 15 mm and eyes 0.15 deg.
   const json scored = json::parse(Read(dir_ / "scored.json"));
   const json& single_scored = single["scored"];
   const json& split_scored = scored["scored"];
   ASSERT_GE(split_scored.size(), 1u) << scored.dump();
+  ASSERT_EQ(split_scored.size(), single_scored.size()) << scored.dump() << "\n" << single.dump();
   for (std::size_t i = 0; i < split_scored.size(); ++i) {
     const json& f = split_scored[i];
-    if (!f["fixated"].get<bool>()) continue;
-    ASSERT_LT(i, single_scored.size()) << scored.dump() << "\n" << single.dump();
     EXPECT_EQ(f["object"], single_scored[i]["object"]) << scored.dump() << "\n" << single.dump();
+    EXPECT_EQ(f["fixated"], single_scored[i]["fixated"]) << f.dump();
+    EXPECT_EQ(f["selected_at_s"], single_scored[i]["selected_at_s"]) << f.dump();
+    if (!f["fixated"].get<bool>()) continue;
+    EXPECT_EQ(f["fixated_at_s"], single_scored[i]["fixated_at_s"]) << f.dump();
+    EXPECT_NEAR(f["error_3d_m"].get<double>(), single_scored[i]["error_3d_m"].get<double>(), 1e-9)
+        << f.dump();
     EXPECT_TRUE(f["is_face"].get<bool>()) << f.dump();
     EXPECT_LE(f["error_3d_m"].get<double>(), 0.015) << f.dump();
     EXPECT_LE(f["eye_error_deg"]["left"].get<double>(), 0.15) << f.dump();

@@ -308,6 +308,9 @@ TEST(MotorsTest, PursuitConvergesThenTracksWithZeroLag) {
             << JointName(joint) << " t=" << t;
         EXPECT_NEAR(motors.velocities()[joint], vt, kTrackingTolerance);
         EXPECT_TRUE(motors.Arrived(joint));
+        // The target the joint is on, and how fast it moves (what a joint state sends).
+        EXPECT_NEAR(motors.targets()[joint], p0 + vt * t, kTrackingTolerance);
+        EXPECT_EQ(motors.target_velocities()[joint], vt);
         motors.Step(1e-3);
         t = motors.command_time(joint);
       }

@@ -28,12 +28,13 @@ namespace saccade::components {
 /// The head's joints at `time` (sim.head's output, and a real head's): where the eye cameras
 /// are and how fast they move (motion blur).
 struct JointStateMessage {
-  double time = 0.0;             ///< s
-  head::JointState positions;    ///< rad
-  head::JointState velocities;   ///< rad/s
-  head::JointState targets;      ///< rad: where the motors are heading (clamped)
-  bool arrived = true;           ///< every joint at rest on its target
-  int64_t clamped_commands = 0;  ///< commands clamped to the joint limits so far
+  double time = 0.0;                   ///< s
+  head::JointState positions;          ///< rad
+  head::JointState velocities;         ///< rad/s
+  head::JointState targets;            ///< rad: where the motors are heading (clamped)
+  head::JointState target_velocities;  ///< rad/s: how fast the targets move (pursuit), or 0
+  bool arrived = true;                 ///< every joint on its target, in position and velocity
+  int64_t clamped_commands = 0;        ///< commands clamped to the joint limits so far
 };
 
 /// A joint command: a saccade (velocities zero) or smooth pursuit (the target moves at
@@ -178,7 +179,8 @@ struct MessageTraits<components::JointStateMessage> : FieldMessage<components::J
   static constexpr auto kFields = std::make_tuple(
       JsonField("time", &T::time), JsonField("positions", &T::positions),
       JsonField("velocities", &T::velocities), JsonField("targets", &T::targets),
-      JsonField("arrived", &T::arrived), JsonField("clamped_commands", &T::clamped_commands));
+      JsonField("target_velocities", &T::target_velocities), JsonField("arrived", &T::arrived),
+      JsonField("clamped_commands", &T::clamped_commands));
 };
 
 template <>

@@ -8,7 +8,9 @@
 //                                                          sibling camera_info topic;
 //                                                          tf2_msgs/TFMessage world -> the
 //                                                          camera's optical frame on /tf
-//   head.joints            sensor_msgs/JointState          names pan, tilt, left, right
+//   head.joints            sensor_msgs/JointState          names pan, tilt, left, right;
+//                                                          the targets as a JointState on
+//                                                          the sibling joint_targets topic
 //   head.command           sensor_msgs/JointState          positions, velocities
 //   vision.target          geometry_msgs/PointStamped      frame "world"; only valid targets
 //
@@ -40,9 +42,22 @@ struct TopicOptions {
   std::string topic;  ///< fully qualified ROS topic (ResolveTopic), e.g. "/saccade/joint_states"
   Qos qos = Qos::Default();      ///< of the main topic (camera_info and tf: reliable, keep last)
   std::string tf_topic = "/tf";  ///< images: where the camera poses go ("" : none)
+  /// Joint states: where the head's targets go, as a JointState of the same stamp written
+  /// just before it (positions: where each joint is heading, velocities: how fast that target
+  /// moves), so that a reader knows whether the head has arrived exactly as the sender does
+  /// (a joint state has no targets). "" : none.
+  std::string targets_topic;
   /// Images received: the frame index is round(stamp / frame_period_s) when > 0 (the
   /// sender's clock step), else a count of the frames received.
   double frame_period_s = 0.0;
+  /// Head commands (sensor_msgs/JointState) only. A writer in lockstep announces it in its
+  /// DDS user data ("saccade.lockstep=1;") and answers every step of its pipeline: with the
+  /// step's command, or an empty JointState (no joint named) stamped with the step's time
+  /// (Writer::MarkStep). A reader in lockstep waits, each step, for the message of the step's
+  /// time from every matched writer in lockstep (Reader::WaitForStep); writers not in
+  /// lockstep (a GUI, a ROS 2 tool) are never waited for. Empty JointStates are step marks,
+  /// not commands, for every reader.
+  bool lockstep = false;
 };
 
 /// What crossed a link, for reports.
@@ -51,7 +66,8 @@ struct LinkStats {
   int64_t lost = 0;        ///< known lost: best-effort gaps and samples overwritten unread
   int64_t late = 0;        ///< Take calls whose wait ended without a new message
   int64_t restarts = 0;    ///< the sender's stamps went back (it restarted)
-  int64_t incomplete = 0;  ///< images without camera info or pose (handed over without them)
+  int64_t incomplete = 0;  ///< images without camera info or pose, joint states without
+                           ///< targets (handed over without them)
 };
 
 /// The saccade message types that have a ROS 2 form (MessageTraits names: "image", ...).
@@ -80,6 +96,10 @@ class Writer {
   }
   /// Publishes a message of the writer's type given by address.
   virtual void WriteErased(const void* message) = 0;
+  /// A lockstep writer (TopicOptions::lockstep): marks its pipeline's step at `time`
+  /// (seconds) done, writing an empty JointState stamped `time` unless a message stamped at
+  /// or after it was written since the last mark. InvalidArgument for other writers.
+  virtual void MarkStep(double time);
   /// Readers matched now.
   virtual int matched() const = 0;
   /// Waits until at least `count` readers match, at most `timeout_s`; true when they do.
@@ -124,6 +144,16 @@ class Reader {
     return std::static_pointer_cast<const M>(TakeErased(timeout_s, up_to));
   }
   virtual std::shared_ptr<const void> TakeErased(double timeout_s, double up_to) = 0;
+  /// A lockstep reader (TopicOptions::lockstep): waits until every matched writer in lockstep
+  /// has sent, since the last Take, a message stamped at or after `time` (seconds, a
+  /// microsecond's margin), at most `timeout_s`; a writer that goes away ends its wait. True
+  /// when they did (or none is matched); false when the wait ran out (counted late). Other
+  /// readers: true at once.
+  virtual bool WaitForStep(double time, double timeout_s);
+  /// Writers in lockstep matched now (0 for readers not in lockstep).
+  virtual int lockstep_writers() { return 0; }
+  /// Waits until a writer in lockstep matches, at most `timeout_s`; true when one does.
+  bool WaitForLockstepWriter(double timeout_s);
   /// Writers matched now.
   virtual int matched() const = 0;
   /// Waits until at least `count` writers match, at most `timeout_s`; true when they do.

@@ -73,6 +73,8 @@ class Motors {
   JointState accelerations() const;
   /// Where the (clamped) targets are now (rad).
   JointState targets() const;
+  /// How fast the targets move now (rad/s): a pursuit's velocities, zero for a saccade.
+  JointState target_velocities() const;
 
   /// Whether the joint is within `tolerance` of its target in position (rad) and velocity
   /// (rad/s).

@@ -34,8 +34,12 @@ struct TopicTransport {
   /// A component with one output "message" of the endpoint's type, that emits what the
   /// topic receives each step (configured: the pipeline only names and seeds it).
   std::function<std::unique_ptr<Component>(const TopicEndpoint& endpoint)> make_reader;
-  /// Writes every message `output` emits to the topic from now on.
-  std::function<void(const TopicEndpoint& endpoint, OutputBase& output)> attach_writer;
+  /// Writes every message `output` emits to the topic from now on. Returns what the writer
+  /// does at the end of each step, after every component stepped (a lockstep writer marks
+  /// the step done), or an empty function.
+  std::function<std::function<void(const StepContext&)>(const TopicEndpoint& endpoint,
+                                                        OutputBase& output)>
+      attach_writer;
 };
 
 /// Makes components by type name ("vision.face_detector"). Modules register theirs.

@@ -77,6 +77,7 @@
 // same, bit for bit, as with `threads: 1`.
 
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -248,6 +249,9 @@ class Pipeline {
 
   /// Hands over messages held back by delayed connections (the scheduler, each step).
   void DeliverDelayed();
+  /// Ends a step after its components: the topic writers' end-of-step work (a lockstep
+  /// writer marks the step done, docs/dds.md). The scheduler and Python's step call it.
+  void EndStep(const StepContext& context);
   /// Seconds spent delivering messages since the last call (and resets the count).
   double TakeDeliverySeconds();
 
@@ -257,7 +261,8 @@ class Pipeline {
   PipelineSpec spec_;
   std::shared_ptr<Resources> resources_;
   std::vector<std::unique_ptr<Component>> components_;
-  TimeSource* time_source_ = nullptr;  // one of components_
+  TimeSource* time_source_ = nullptr;                               // one of components_
+  std::vector<std::function<void(const StepContext&)>> step_ends_;  // EndStep's, in file order
   // Boxed so that the delivery callbacks' pointer stays valid when the pipeline moves.
   std::unique_ptr<double> delivery_seconds_ = std::make_unique<double>(0.0);
 };
