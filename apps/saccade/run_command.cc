@@ -180,8 +180,10 @@ Runner AddRunCommand(CLI::App& app) {
       "Run any pipeline file headless (runtime/pipeline.h). Connections that name a topic go "
       "over DDS on ROS 2's wire (docs/dds.md), so that one pipeline split in two files runs as "
       "two processes, on one machine or two: e.g. `saccade run pipelines/robot.yaml` and "
-      "`saccade run pipelines/perception.yaml`. Prints each fixation (the head coming to rest) "
-      "and the run's summary; the DDS readers log what crossed (messages, lost, late, "
+      "`saccade run pipelines/perception.yaml`, which step in lockstep on the simulated clock "
+      "(the robot's head waits for perception's answer to each frame pair) and so move the "
+      "head as pipelines/demo.yaml does in one process. Prints each fixation (the head coming "
+      "to rest) and the run's summary; the DDS readers log what crossed (messages, lost, late, "
       "restarts).");
   run->add_option("pipeline", o->pipeline, "The pipeline file")->required();
   run->add_option("--hardware", o->hardware, "Hardware file replacing the pipeline's own");
@@ -190,8 +192,9 @@ Runner AddRunCommand(CLI::App& app) {
                   "Steps to run (default: the file's clock.steps; 0 until "
                   "Ctrl-C)");
   run->add_flag("--realtime", o->realtime,
-                "Run at the wall clock's pace (rate 1 / clock.step); a clock.source is then "
-                "not used: the steps take the wall clock's time and the newest messages");
+                "Run at the wall clock's pace (rate 1 / clock.step); a clock.source and "
+                "lockstep are then not used: the steps take the wall clock's time and the "
+                "newest messages, and wait for no answer");
   run->add_flag("--json", o->json,
                 "Print the result as JSON: steps, errors, fixations (and, with --score, the "
                 "scored fixations)");
