@@ -185,6 +185,15 @@ class TopicReaderComponent final : public runtime::Component, public runtime::Ti
   }
   std::optional<double> NextTime() override {
     taken_ = true;
+    // With no sender the steps have nothing to time them: each waits its wait_s for one to
+    // come (picked up at once when it does) rather than spinning through empty steps.
+    if (wait_s_ > 0 && reader_->matched() == 0) {
+      if (!waiting_for_writer_) {
+        log::Info("dds: {}: no writer; each step waits up to {} s for one", reader_->topic(),
+                  wait_s_);
+      }
+      waiting_for_writer_ = !reader_->WaitForWriters(1, wait_s_);
+    }
     pending_ = Take(std::numeric_limits<double>::infinity());
     if (!pending_) return std::nullopt;
     return StampOf(*pending_);
@@ -237,7 +246,8 @@ class TopicReaderComponent final : public runtime::Component, public runtime::Ti
   bool lockstep_;
   int64_t late_steps_ = 0;
   runtime::Output<M>& output_;
-  bool taken_ = false;  // NextTime took this step's message
+  bool taken_ = false;               // NextTime took this step's message
+  bool waiting_for_writer_ = false;  // NextTime found no writer (said once)
   std::shared_ptr<const M> pending_;
 };
 

@@ -4,7 +4,9 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <optional>
+#include <thread>
 
 #include "dds_test_util.h"
 #include "saccade/components/loop_outputs.h"
@@ -142,6 +144,47 @@ TEST_F(PipelineTopics, ClockSourceStepsOnTheReceivedStamps) {
   EXPECT_THAT(targets, ::testing::ElementsAre(::testing::DoubleEq(0.1), ::testing::DoubleEq(0.15),
                                               ::testing::DoubleEq(0.2), ::testing::DoubleEq(0.2),
                                               ::testing::DoubleEq(0.3)));
+}
+
+// With no sender, a pipeline stepping on its stamps has nothing to time its steps: each waits
+// its wait_s for a sender (instead of spinning through empty steps at full speed), and one that
+// comes is picked up at once.
+TEST_F(PipelineTopics, ClockSourceWithoutASenderWaitsForOne) {
+  constexpr int kDomain = 187;
+  std::string text = HeadPipeline(kDomain, "{topic: head/command, wait_s: 0.2}");
+  text.replace(text.find("steps: 50}"), 10, "steps: 3, source: head.command}");
+  runtime::Pipeline pipeline = runtime::Pipeline::LoadString(text, "head.yaml");
+  const runtime::RunSummary alone = runtime::RunPipeline(pipeline);
+  ASSERT_EQ(alone.errors_total, 0) << alone.FullReport();
+  EXPECT_EQ(alone.steps, 3);
+  EXPECT_GE(alone.wall_seconds, 3 * 0.2);  // each step waited its wait_s
+
+  // A sender that comes during the wait: its first message times the step.
+  text = HeadPipeline(kDomain, "{topic: head/command, wait_s: 60}");
+  text.replace(text.find("steps: 50}"), 10, "steps: 1, source: head.command}");
+  runtime::Pipeline waiting = runtime::Pipeline::LoadString(text, "head.yaml");
+  std::thread sender([] {
+    std::this_thread::sleep_for(std::chrono::milliseconds(300));
+    Raw raw(RawParticipant(kDomain));
+    Raw writer(RawWriter(raw.get(), &ref_sensor_msgs_msg_dds__JointState__desc,
+                         "rt/saccade/head/command"));
+    ASSERT_TRUE(WaitWriterMatched(writer.get()));
+    char* names[4] = {const_cast<char*>("pan"), const_cast<char*>("tilt"),
+                      const_cast<char*>("left"), const_cast<char*>("right")};
+    double position[4] = {0.1, 0.0, 0.0, 0.0};
+    ref_sensor_msgs_msg_dds__JointState_ command{};
+    command.header.stamp.sec = 7;
+    command.header.frame_id = const_cast<char*>("");
+    command.name = {4, 4, names, false};
+    command.position = {4, 4, position, false};
+    ASSERT_EQ(dds_write(writer.get(), &command), DDS_RETCODE_OK);
+    std::this_thread::sleep_for(std::chrono::seconds(2));  // until the step took it
+  });
+  const runtime::RunSummary joined = runtime::RunPipeline(waiting);
+  sender.join();
+  ASSERT_EQ(joined.errors_total, 0) << joined.FullReport();
+  EXPECT_DOUBLE_EQ(joined.sim_time, 7.0);
+  EXPECT_LT(joined.wall_seconds, 60.0);  // picked up, not waited out
 }
 
 TEST_F(PipelineTopics, ClockSourceMustBeATopicInputOfASimulatedClock) {
