@@ -19,6 +19,7 @@
 #include "saccade/components/messages.h"
 #include "saccade/components/register.h"
 #include "saccade/core/error.h"
+#include "saccade/dds/transport.h"
 #include "saccade/runtime/component_registry.h"
 #include "saccade/runtime/pipeline.h"
 #include "saccade/runtime/scheduler.h"
@@ -437,6 +438,8 @@ py::object TapValue(const Tap& tap) {
 
 void BindRuntime(py::module_& m) {
   components::RegisterComponents(runtime::ComponentRegistry::Global());
+  // Pipeline connections that name a topic go over DDS, as under `saccade run` (docs/dds.md).
+  dds::RegisterDdsTransport(runtime::ComponentRegistry::Global());
 
   m.def(
       "register_component",
