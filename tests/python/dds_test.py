@@ -12,8 +12,9 @@ import pytest
 import saccade
 from conftest import path
 
-# Cyclone reads its configuration when the first participant is made: loopback only.
-os.environ.setdefault("CYCLONEDDS_URI", "file://" + path("config", "dds", "loopback.xml"))
+# Cyclone reads its configuration when the first participant is made: loopback only, whatever
+# the environment says (every DDS test stays on this machine).
+os.environ["CYCLONEDDS_URI"] = "file://" + path("config", "dds", "loopback.xml")
 
 SCENE = path("scenes", "portraits.yaml")
 DOMAIN = 189
