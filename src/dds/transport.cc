@@ -122,9 +122,8 @@ Endpoint Resolve(const runtime::TopicEndpoint& endpoint, const std::set<std::str
   if (const auto it = endpoint.options.find("targets"); it != endpoint.options.end()) {
     if (!joints) {
       throw InvalidArgument(
-          fmt::format("{}.targets: only joint states have targets; this port "
-                      "carries {}",
-                      where, endpoint.message_type));
+          fmt::format("{}.targets: only joint states have targets; this port carries {}", where,
+                      endpoint.message_type));
     }
     if (!it->is_string()) throw InvalidArgument(where + ".targets: expected a topic or \"\"");
     const std::string targets = it->get<std::string>();
