@@ -710,11 +710,8 @@ class SimpleReader final : public Reader {
     m->time = internal::FromStamp(s.header.stamp);
     // JointState has no targets; until Complete finds them, at rest (every velocity within
     // sim.head's 1e-4 tolerance) the head is where it is heading.
-    m->arrived = true;
-    for (const head::Joint joint : head::kAllJoints) {
-      m->arrived = m->arrived && std::abs(m->velocities[joint]) <= 1e-4;
-    }
     m->targets = m->positions;
+    m->arrived = internal::ArrivedOn(m->positions, m->velocities, m->targets, {});
     return true;
   }
   static bool Convert(const sensor_msgs_msg_dds__JointState_& s, JointCommand* m,
