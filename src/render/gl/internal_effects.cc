@@ -256,9 +256,11 @@ std::vector<float> GaussianTable() {
 
 namespace {
 
-std::string Defines(bool identity, bool noise, bool mesh = false) {
-  return fmt::format("#version 330 core\n#define IDENTITY {}\n#define NOISE {}\n#define MESH {}\n",
-                     identity ? 1 : 0, noise ? 1 : 0, mesh ? 1 : 0);
+std::string Defines(bool identity, bool noise, bool mesh = false, int turn = 0) {
+  return fmt::format(
+      "#version 330 core\n#define IDENTITY {}\n#define NOISE {}\n#define MESH {}\n"
+      "#define TURN {}\n",
+      identity ? 1 : 0, noise ? 1 : 0, mesh ? 1 : 0, turn);
 }
 
 // Texel-exact sampling only (texelFetch): no filtering, no mipmaps (a texture whose minifying
@@ -360,18 +362,25 @@ EffectPrograms::~EffectPrograms() {
   for (const auto& [variant, program] : truth_remaps_) glDeleteProgram(program);
 }
 
-const EffectPrograms::Final& EffectPrograms::GetFinal(bool identity, bool noise, bool mesh) {
+const EffectPrograms::Final& EffectPrograms::GetFinal(bool identity, bool noise, bool mesh,
+                                                      int turn) {
   mesh = mesh && !identity;
-  const int variant = (identity ? 1 : 0) | (noise ? 2 : 0) | (mesh ? 4 : 0);
+  if (turn < 0 || turn > kMaxTurnBlurSamples) {
+    throw Error(
+        fmt::format("final pass: {} turn sub-frames, expected 0 to {}", turn, kMaxTurnBlurSamples));
+  }
+  const int variant = (identity ? 1 : 0) | (noise ? 2 : 0) | (mesh ? 4 : 0) | (turn << 3);
   if (const auto it = finals_.find(variant); it != finals_.end()) return it->second;
   Final f;
-  f.program = BuildProgram(
-      fmt::format("final pass (identity {}, noise {}, mesh {})", identity, noise, mesh),
-      identity ? kFullscreenVertexSource : kLensMeshVertexSource,
-      Defines(identity, noise, mesh) + kFinalFragmentSource);
+  f.program = BuildProgram(fmt::format("final pass (identity {}, noise {}, mesh {}, turn {})",
+                                       identity, noise, mesh, turn),
+                           identity ? kFullscreenVertexSource : kLensMeshVertexSource,
+                           Defines(identity, noise, mesh, turn) + kFinalFragmentSource);
   f.read_sigma = Uniform(f.program, "u_read_sigma");
   f.gain = Uniform(f.program, "u_gain");
   f.key = Uniform(f.program, "u_key");
+  f.turn_h = Uniform(f.program, "u_turn_h");
+  f.turn_layer = Uniform(f.program, "u_turn_layer");
   glUseProgram(f.program);
   glUniform1i(Uniform(f.program, "u_source"), kSourceUnit);
   glUniform1i(Uniform(f.program, "u_map"), kMapUnit);
@@ -553,6 +562,10 @@ void EffectTarget::EnableBlur() {
   glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, accumulation_, 0, 0);
   CheckComplete("motion blur accumulation", w, h);
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
+  if (layers_ == 1) {
+    stretches_ = MakeArray(GL_RGBA8, GL_RGBA, GL_UNSIGNED_BYTE, w, h, kMaxTurnStretches);
+    FilterLinearly(stretches_);
+  }
   blur_ = true;
 }
 
@@ -561,9 +574,9 @@ EffectTarget::~EffectTarget() {
                                  accumulation_framebuffer_, truth_framebuffer_,
                                  output_framebuffer_,       output_truth_framebuffer_};
   glDeleteFramebuffers(6, framebuffers);
-  const GLuint textures[] = {source_,  accumulation_, map_,        footprint_, truth_ids_,
-                             truth_z_, output_color_, output_ids_, output_z_};
-  glDeleteTextures(9, textures);
+  const GLuint textures[] = {source_,    accumulation_, stretches_,    map_,        footprint_,
+                             truth_ids_, truth_z_,      output_color_, output_ids_, output_z_};
+  glDeleteTextures(10, textures);
   const GLuint renderbuffers[] = {msaa_color_, depth_, truth_depth_};
   glDeleteRenderbuffers(3, renderbuffers);
   glDeleteVertexArrays(1, &mesh_vao_);
@@ -584,6 +597,23 @@ void EffectTarget::FinishView(int view) const {
   glBindFramebuffer(GL_READ_FRAMEBUFFER, draw_framebuffer_);
   glBindFramebuffer(GL_DRAW_FRAMEBUFFER, resolve_framebuffer_);
   glFramebufferTextureLayer(GL_DRAW_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, source_, 0, view);
+  glBlitFramebuffer(0, 0, source_width_, source_height_, 0, 0, source_width_, source_height_,
+                    GL_COLOR_BUFFER_BIT, GL_NEAREST);
+}
+
+void EffectTarget::BindStretchForDrawing(int stretch) const {
+  glBindFramebuffer(GL_FRAMEBUFFER, draw_framebuffer_);
+  if (samples_ == 0) {
+    glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, stretches_, 0, stretch);
+  }
+  glViewport(0, 0, source_width_, source_height_);
+}
+
+void EffectTarget::FinishStretch(int stretch) const {
+  if (samples_ == 0) return;
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, draw_framebuffer_);
+  glBindFramebuffer(GL_DRAW_FRAMEBUFFER, resolve_framebuffer_);
+  glFramebufferTextureLayer(GL_DRAW_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, stretches_, 0, stretch);
   glBlitFramebuffer(0, 0, source_width_, source_height_, 0, 0, source_width_, source_height_,
                     GL_COLOR_BUFFER_BIT, GL_NEAREST);
 }
@@ -666,8 +696,22 @@ void EffectTarget::BindTruthForDrawing(int view) const {
 }
 
 void EffectTarget::Finish(EffectPrograms& programs, bool accumulated, const NoiseParams* noise,
-                          int slot) const {
+                          int slot, const TurnSamples* turn) const {
   const bool identity = lens_.kind == geometry::LensMap::Kind::kIdentity;
+  const int turn_count = turn != nullptr ? static_cast<int>(turn->homographies.size()) : 0;
+  std::vector<float> turn_h;  // column-major, as GL takes mat3s without transposing
+  if (turn != nullptr) {
+    if (stretches_ == 0 || turn_count < 1 || turn_count > kMaxTurnBlurSamples ||
+        turn->layers.size() != turn->homographies.size()) {
+      throw Error(fmt::format("Finish: {} turn sub-frames with {} layers, expected 1 to {}{}",
+                              turn_count, turn->layers.size(), kMaxTurnBlurSamples,
+                              stretches_ == 0 ? " (this target has no stretches)" : ""));
+    }
+    turn_h.reserve(9 * turn->homographies.size());
+    for (const Eigen::Matrix3f& m : turn->homographies) {
+      turn_h.insert(turn_h.end(), m.data(), m.data() + 9);
+    }
+  }
   glDisable(GL_DEPTH_TEST);
   glViewport(0, 0, lens_.width, lens_.height);
   if (!identity) {
@@ -677,15 +721,21 @@ void EffectTarget::Finish(EffectPrograms& programs, bool accumulated, const Nois
 
   glBindFramebuffer(GL_FRAMEBUFFER, output_framebuffer_);
   if (noise != nullptr) BindTexture(kGaussUnit, GL_TEXTURE_2D, programs.gauss());
-  BindTexture(kSourceUnit, GL_TEXTURE_2D_ARRAY, accumulated ? accumulation_ : source_);
+  BindTexture(kSourceUnit, GL_TEXTURE_2D_ARRAY,
+              turn != nullptr ? stretches_ : (accumulated ? accumulation_ : source_));
   // Identity: the full-screen triangle; a lens: its linear cells, then its exact ones.
   const auto pass = [&](bool mesh) {
-    const EffectPrograms::Final& final = programs.GetFinal(identity, noise != nullptr, mesh);
+    const EffectPrograms::Final& final =
+        programs.GetFinal(identity, noise != nullptr, mesh, turn_count);
     glUseProgram(final.program);
     if (noise != nullptr) {
       glUniform1f(final.read_sigma, noise->read_sigma_dn);
       glUniform1f(final.gain, noise->gain_dn_per_e);
       glUniform1ui(final.key, noise->key);
+    }
+    if (turn != nullptr) {
+      glUniformMatrix3fv(final.turn_h, turn_count, GL_FALSE, turn_h.data());
+      glUniform1fv(final.turn_layer, turn_count, turn->layers.data());
     }
   };
   if (identity) {

@@ -83,6 +83,7 @@ class EffectPrograms {
   struct Final {
     GLuint program = 0;
     GLint read_sigma = -1, gain = -1, key = -1;
+    GLint turn_h = -1, turn_layer = -1;  // TURN > 0 only
   };
   struct Truth {
     GLuint program = 0;
@@ -99,7 +100,8 @@ class EffectPrograms {
   /// interpolated positions or the map (`mesh`; not with identity) (built on first use). The
   /// passes of a lens draw the lens mesh's cells (kLensMeshVertexSource), the identity one the
   /// full-screen triangle.
-  const Final& GetFinal(bool identity, bool noise, bool mesh = false);
+  /// `turn` > 0: with that many sub-frames of a turning camera's blur folded in (TURN).
+  const Final& GetFinal(bool identity, bool noise, bool mesh = false, int turn = 0);
   /// The truth remap for an identity map or not.
   GLuint GetTruthRemap(bool identity);
   const Truth& truth() const { return truth_; }
@@ -133,6 +135,14 @@ struct NoiseParams {
   float read_sigma_dn = 0.0f;
   float gain_dn_per_e = 0.0f;
   uint32_t key = 0;
+};
+
+/// Motion blur of a turning camera folded into the final pass (TURN): sub-frame k is stretch
+/// layer `layers[k]` seen through `homographies[k]` (a pixel of sub-frame k, pixel centres at
+/// integers, to the stretch's drawn instant). At most kMaxTurnBlurSamples sub-frames.
+struct TurnSamples {
+  std::vector<Eigen::Matrix3f> homographies;
+  std::vector<float> layers;
 };
 
 /// Pixel buffer objects, one per in-flight slot, for one image of fixed size and format.
@@ -190,12 +200,23 @@ class EffectTarget {
   void TurnBlur(const EffectPrograms& programs, int view,
                 const std::vector<Eigen::Matrix3f>& homographies, float weight,
                 Accumulation mode) const;
+  /// Stretches a turning camera's blur may draw for the final pass (Finish with `turn`): the
+  /// layers of the stretch array; 0 without blur or with a lens of several source views (a
+  /// wide fisheye), which blur through the accumulation (TurnBlur).
+  int turn_stretches() const { return stretches_ != 0 ? kMaxTurnStretches : 0; }
+  static constexpr int kMaxTurnStretches = 4;
+  /// As BindViewForDrawing and FinishView, for stretch `stretch` of the stretch array.
+  void BindStretchForDrawing(int stretch) const;
+  void FinishStretch(int stretch) const;
+
   /// Binds the truth framebuffer of `view`, sets the viewport and clears it (id 0, z 0).
   void BindTruthForDrawing(int view) const;
 
-  /// The final pass (from the accumulation array when `accumulated`), the truth remap when
-  /// the target has truth, and the start of every readback into `slot`. `noise` may be null.
-  void Finish(EffectPrograms& programs, bool accumulated, const NoiseParams* noise, int slot) const;
+  /// The final pass (from the accumulation array when `accumulated`; from the stretch array
+  /// seen through the turn when `turn` is given), the truth remap when the target has truth,
+  /// and the start of every readback into `slot`. `noise` and `turn` may be null.
+  void Finish(EffectPrograms& programs, bool accumulated, const NoiseParams* noise, int slot,
+              const TurnSamples* turn = nullptr) const;
 
   /// After the slot's fence: the camera-size RGBA8 pixels, ids (uint32) and depth (float),
   /// row 0 at the top; nullptr on failure. Unmap each after use.
@@ -217,6 +238,7 @@ class EffectTarget {
   int source_width_, source_height_, layers_;
   GLuint source_ = 0;        // RGBA8 array
   GLuint accumulation_ = 0;  // RGBA32F array
+  GLuint stretches_ = 0;     // RGBA8 array of kMaxTurnStretches layers (one source view only)
   GLuint map_ = 0;           // RGBA32F, camera size: RemapTable::map
   GLuint footprint_ = 0;     // RGBA32F, camera size: RemapTable::footprint
   GLuint mesh_vao_ = 0, mesh_vertices_ = 0, mesh_indices_ = 0;  // LensMesh

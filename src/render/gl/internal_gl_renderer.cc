@@ -696,6 +696,11 @@ void GlRenderer::DrawEffects(int camera, const scene::SceneState& state, int64_t
       if (0.5 * longest * turn_only_px / count <= turn_blur_max_error_px_) stretches = m;
     }
   }
+  // Up to kMaxTurnStretches stretches are drawn into layers of their own and the final pass
+  // fetches every sub-frame through its homography (TurnSamples): no accumulation pass. More
+  // stretches accumulate each one's sub-frames (TurnBlur) and the final pass reads the sum.
+  TurnSamples turn;
+  const bool fused = stretches > 0 && stretches <= effects.turn_stretches();
   if (stretches > 0) {
     const Eigen::Matrix3d K = effects.lens().views[0].intrinsics.Matrix();
     const Eigen::Matrix3d K_inv = K.inverse();
@@ -706,10 +711,18 @@ void GlRenderer::DrawEffects(int camera, const scene::SceneState& state, int64_t
       const scene::SceneState middle = at(exposure * (0.5 * (first + end) / count - 0.5));
       UpdatePoses(middle);
       const geometry::Pose X_WV = view_pose(scene_.CameraPose(spec, middle), 0);
-      effects.BindViewForDrawing(0);
+      if (fused) {
+        effects.BindStretchForDrawing(g);
+      } else {
+        effects.BindViewForDrawing(0);
+      }
       glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
       DrawScene(setup.views[0], near, X_WV);
-      effects.FinishView(0);
+      if (fused) {
+        effects.FinishStretch(g);
+      } else {
+        effects.FinishView(0);
+      }
       homographies.clear();
       for (int k = first; k < end; ++k) {
         // A pixel of sub-frame k: its ray in view k, in the world, in the drawn view, its pixel.
@@ -717,12 +730,17 @@ void GlRenderer::DrawEffects(int camera, const scene::SceneState& state, int64_t
                                       view_pose(scene_.CameraPose(spec, sub_states[k]), 0).linear();
         homographies.push_back((K * R_VVk * K_inv).cast<float>());
       }
+      if (fused) {
+        turn.homographies.insert(turn.homographies.end(), homographies.begin(), homographies.end());
+        turn.layers.insert(turn.layers.end(), homographies.size(), static_cast<float>(g));
+        continue;
+      }
       effects.TurnBlur(
           *effect_programs_, 0, homographies, 1.0f / static_cast<float>(count),
           g == 0 ? EffectTarget::Accumulation::kReplace : EffectTarget::Accumulation::kAdd);
     }
     UpdatePoses(state);
-    accumulated = true;
+    accumulated = !fused;
   } else if (sub_states.empty()) {
     for (int v = 0; v < views; ++v) {
       effects.BindViewForDrawing(v);
@@ -792,7 +810,8 @@ void GlRenderer::DrawEffects(int camera, const scene::SceneState& state, int64_t
   noise.read_sigma_dn = static_cast<float>(spec.sensor.read_noise_dn);
   noise.gain_dn_per_e = static_cast<float>(spec.sensor.gain_dn_per_e);
   noise.key = NoiseKey(spec.sensor.seed, spec.name, frame_index);
-  effects.Finish(*effect_programs_, accumulated, setup.noise ? &noise : nullptr, slot);
+  effects.Finish(*effect_programs_, accumulated, setup.noise ? &noise : nullptr, slot,
+                 fused ? &turn : nullptr);
 }
 
 std::vector<Frame> GlRenderer::Render(const scene::SceneState& state, int64_t frame_index) {
