@@ -15,7 +15,8 @@ gui: `saccade gui --port 0 --no-token` with --clients WebSocket clients of the b
   and sends a command a second (ping, joints, effects, fixate, in turn) and must get a reply
   to each; the run lasts --seconds.
 
-The program's resident set (VmRSS) is sampled every --every seconds. After the warm-up
+The program's resident set (VmRSS) is sampled every --every seconds (and written as it is
+taken to --log FILE, when given). After the warm-up
 (--warmup, a fraction of the run, 0.2 by default), the largest sample may exceed the first one
 by at most --tolerance (5 %): memory must stay flat. With --asan the binary is expected to be
 built with AddressSanitizer: its leak report at exit (LeakSanitizer) must be empty, and RSS
@@ -54,19 +55,28 @@ def rss_kib(pid):
 class Sampler(threading.Thread):
     """Samples a process's RSS every `every` seconds until it exits or stop() is called."""
 
-    def __init__(self, pid, every):
+    def __init__(self, pid, every, log=None):
         super().__init__(daemon=True)
         self.pid, self.every = pid, every
         self.samples = []  # (seconds since start, KiB)
         self._halt = threading.Event()
         self.start_time = time.monotonic()
+        self._log = None
+        if log:
+            self._log = open(log, 'w')
+            self._log.write('seconds,rss_kib\n')
+            self._log.flush()
 
     def run(self):
         while not self._halt.is_set():
             kib = rss_kib(self.pid)
             if kib is None:
                 return
-            self.samples.append((time.monotonic() - self.start_time, kib))
+            t = time.monotonic() - self.start_time
+            self.samples.append((t, kib))
+            if self._log:  # as it is taken: a run cut short keeps its record
+                self._log.write(f'{t:.1f},{kib}\n')
+                self._log.flush()
             self._halt.wait(self.every)
 
     def stop(self):
@@ -132,7 +142,7 @@ def run_demo(args):
         with open(out_path, 'w') as out, open(err_path, 'w') as err:
             started = time.monotonic()
             process = subprocess.Popen(command, stdout=out, stderr=err, cwd=ROOT)
-            sampler = Sampler(process.pid, args.every)
+            sampler = Sampler(process.pid, args.every, args.log)
             sampler.start()
             status = process.wait()
             wall = time.monotonic() - started
@@ -342,7 +352,7 @@ def run_gui(args):
                 return 1
             threading.Thread(target=lambda: process.stdout.read(), daemon=True).start()
             started = time.monotonic()
-            sampler = Sampler(process.pid, args.every)
+            sampler = Sampler(process.pid, args.every, args.log)
             sampler.start()
             stop = threading.Event()
             clients = [Client(i, port, stop) for i in range(args.clients)]
@@ -395,6 +405,8 @@ def main():
     parser.add_argument('--seconds', type=float, default=3600, help='gui: wall seconds (3600)')
     parser.add_argument('--clients', type=int, default=5, help='gui: WebSocket clients (5)')
     parser.add_argument('--every', type=float, default=2.0, help='RSS sample period, s (2)')
+    parser.add_argument('--log', help='also write each RSS sample to this CSV as it is taken '
+                        '(seconds,rss_kib), so that a run cut short keeps its record')
     parser.add_argument('--warmup', type=float, default=0.2,
                         help='fraction of the run before RSS is judged (0.2)')
     parser.add_argument('--tolerance', type=float, default=0.05,
