@@ -254,13 +254,30 @@ std::vector<float> GaussianTable() {
   return table;
 }
 
+std::vector<uint32_t> PackGaussianTable(const std::vector<float>& table) {
+  std::vector<uint32_t> packed(table.size() / 3);
+  for (std::size_t i = 0; i < packed.size(); ++i) {
+    uint32_t entry = 0;
+    for (int c = 0; c < 3; ++c) {
+      const double code = std::round((table[3 * i + c] + kGaussianRange) / kGaussianStep);
+      if (!(code >= 0.0 && code <= 1023.0)) {
+        throw Error(fmt::format("PackGaussianTable: {} is beyond +-{} sigma", table[3 * i + c],
+                                kGaussianRange));
+      }
+      entry |= static_cast<uint32_t>(code) << (10 * c);
+    }
+    packed[i] = entry;
+  }
+  return packed;
+}
+
 namespace {
 
 std::string Defines(bool identity, bool noise, bool mesh = false, int turn = 0) {
   return fmt::format(
       "#version 330 core\n#define IDENTITY {}\n#define NOISE {}\n#define MESH {}\n"
-      "#define TURN {}\n",
-      identity ? 1 : 0, noise ? 1 : 0, mesh ? 1 : 0, turn);
+      "#define TURN {}\n#define GAUSS_RANGE {:.9e}\n#define GAUSS_STEP {:.9e}\n",
+      identity ? 1 : 0, noise ? 1 : 0, mesh ? 1 : 0, turn, kGaussianRange, kGaussianStep);
 }
 
 // Texel-exact sampling only (texelFetch): no filtering, no mipmaps (a texture whose minifying
@@ -346,9 +363,9 @@ EffectPrograms::EffectPrograms() {
   truth_.depth_axis = Uniform(truth_.program, "u_depth_axis");
   truth_.id = Uniform(truth_.program, "u_id");
   glUseProgram(0);
-  const std::vector<float> gauss = GaussianTable();
-  gauss_ = MakeTexture2d(GL_RGB32F, GL_RGB, GL_FLOAT, kGaussianTableSide, kGaussianTableSide,
-                         gauss.data());
+  const std::vector<uint32_t> gauss = PackGaussianTable(GaussianTable());
+  gauss_ = MakeTexture2d(GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, kGaussianTableSide,
+                         kGaussianTableSide, gauss.data());
   CheckGlError("MakeRenderer: building the effect programs");
 }
 

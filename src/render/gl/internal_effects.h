@@ -76,6 +76,13 @@ LensMesh MakeLensMesh(const RemapTable& table, int width, int height,
 /// unit variance (mean exactly 0) in an order of its own.
 inline constexpr int kGaussianTableSide = 256;
 std::vector<float> GaussianTable();
+/// The table as the shader reads it: each entry's three deviates z as 10-bit codes
+/// round((z + kGaussianRange) / kGaussianStep), channel c in bits 10c..10c+9 (the step is
+/// 0.009 of a standard deviation: far below the 8-bit output's quantisation at any sigma the
+/// noise test sees, and the codes are symmetric about 0, so the mean stays 0).
+inline constexpr double kGaussianRange = 4.6;  // the quantiles reach 4.36 (unit variance)
+inline constexpr double kGaussianStep = 2.0 * kGaussianRange / 1023.0;
+std::vector<uint32_t> PackGaussianTable(const std::vector<float>& table);
 
 /// Programs and the empty vertex array shared by every camera's effect passes.
 class EffectPrograms {
@@ -113,7 +120,7 @@ class EffectPrograms {
   GLint turn_blur_count() const { return turn_blur_count_; }
   GLint turn_blur_weight() const { return turn_blur_weight_; }
   GLint turn_blur_h() const { return turn_blur_h_; }
-  /// GaussianTable() as a kGaussianTableSide^2 RGB32F texture.
+  /// PackGaussianTable(GaussianTable()) as a kGaussianTableSide^2 R32UI texture.
   GLuint gauss() const { return gauss_; }
   /// Draws the full-screen triangle (program and framebuffer bound by the caller).
   void DrawFullscreen() const;
