@@ -19,15 +19,18 @@ namespace saccade::render::gl {
 namespace {
 
 struct Coverage {
-  std::vector<int> count;  // cells over each pixel
-  std::vector<int> kind;   // 1 linear, 2 exact (of the last cell over it)
-  double max_error = 0.0;  // over the linear cells' pixels, recomputed here
+  std::vector<int> count;           // cells over each pixel
+  std::vector<int> kind;            // 1 linear, 2 exact (of the last cell over it)
+  double max_error = 0.0;           // over the linear cells' pixels, recomputed here
+  double max_residual_error = 0.0;  // and with the residual added back
   int64_t linear_pixels = 0;
 };
 
 // Reads the cells back from the vertices (NDC to pixel edges) and, for the linear ones,
 // interpolates each pixel centre's position over the cell's two triangles.
-Coverage Cover(const LensMesh& mesh, const RemapTable& table, int width, int height) {
+Coverage Cover(const LensMesh& mesh, const RemapTable& table, int width, int height,
+               double tolerance = kLensMeshTolerancePx) {
+  EXPECT_EQ(mesh.residual.size(), 2u * width * height);
   Coverage c;
   c.count.assign(static_cast<std::size_t>(width) * height, 0);
   c.kind.assign(c.count.size(), 0);
@@ -50,7 +53,11 @@ Coverage Cover(const LensMesh& mesh, const RemapTable& table, int width, int hei
           const std::size_t p = static_cast<std::size_t>(v) * width + u;
           ++c.count[p];
           c.kind[p] = kind;
-          if (kind != 1) continue;
+          const Eigen::Vector2d residual(mesh.residual[2 * p], mesh.residual[2 * p + 1]);
+          if (kind != 1) {
+            EXPECT_EQ(residual.norm(), 0.0) << "a residual in an exact cell, at " << u << ", " << v;
+            continue;
+          }
           ++c.linear_pixels;
           const float* m = &table.map[4 * p];
           EXPECT_EQ(m[3], 17.0f) << "a pixel of several samples in a linear cell, at " << u << ", "
@@ -64,6 +71,9 @@ Coverage Cover(const LensMesh& mesh, const RemapTable& table, int width, int hei
           EXPECT_EQ(q.z(), m[2]) << "the cell's view is not the pixel's, at " << u << ", " << v;
           const double e = (q.head<2>() - Eigen::Vector2d(m[0], m[1])).norm();
           c.max_error = std::max(c.max_error, e);
+          const Eigen::Vector2d corrected = q.head<2>() + (tolerance / 127.0) * residual;
+          c.max_residual_error =
+              std::max(c.max_residual_error, (corrected - Eigen::Vector2d(m[0], m[1])).norm());
         }
       }
     }
@@ -97,6 +107,11 @@ TEST(LensMeshTest, TheBenchLensIsAllLinearCellsWithinTheTolerance) {
   EXPECT_TRUE(mesh.exact.empty());
   EXPECT_LE(c.max_error, kLensMeshTolerancePx);
   EXPECT_NEAR(mesh.max_error_px, c.max_error, 1e-6);
+  // With the residual added back, every pixel is within half a code of the map on each axis
+  // (tolerance / 254, 0.002 px), within the 0.01 px the mesh alone was held to before.
+  EXPECT_LE(c.max_residual_error, std::sqrt(2.0) * kLensMeshTolerancePx / 254.0 + 1e-5);
+  EXPECT_NEAR(mesh.max_residual_error_px, c.max_residual_error, 1e-5);
+  EXPECT_GT(c.max_error, 10.0 * c.max_residual_error);
   // Cells as large as the tolerance lets them be: far fewer than the 4 x 4 floor would give.
   EXPECT_LT(mesh.linear.size() / 6, 1024u * 768u / 64u);
 }
@@ -137,7 +152,7 @@ TEST(LensMeshTest, AToleranceOfZeroLeavesOnlyCellsTheMapItselfDraws) {
   const RemapTable table = MakeRemapTable(lens);
   const LensMesh exact = MakeLensMesh(table, lens.width, lens.height, 0.0);
   const LensMesh loose = MakeLensMesh(table, lens.width, lens.height, 0.05);
-  const Coverage c = Cover(exact, table, lens.width, lens.height);
+  const Coverage c = Cover(exact, table, lens.width, lens.height, 0.0);
   for (const int n : c.count) ASSERT_EQ(n, 1);
   EXPECT_LT(exact.linear_pixels, int64_t{320} * 240 / 10);  // a curved map is not linear
   EXPECT_GT(loose.linear_pixels, exact.linear_pixels);

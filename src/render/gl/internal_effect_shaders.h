@@ -71,9 +71,13 @@ void main() {
 /// The camera's image: lens remap, sensor noise, quantisation to 8 bits.
 /// IDENTITY 1: the source is the image itself (no distortion), one layer at the image's size.
 /// MESH 1: the pixel's source position (x, y, view) comes interpolated from the lens mesh's
-/// cell corners (v_source; LensMesh: within 0.01 source pixel of the map, one sample), with no
-/// fetch of the map: on llvmpipe the map's RGBA32F fetch was what made the lens cost (10 ms of
-/// the pass an eye on the bench scene, the bilinear fetch of the source next to nothing).
+/// cell corners (v_source; LensMesh: within kLensMeshTolerancePx, half a source pixel, of the
+/// map, one sample), plus the pixel's residual (u_residual, two signed bytes in units of
+/// RESIDUAL_SCALE / 127: what the map departs from the interpolation), so within 0.003 px of
+/// the map, with no fetch of the map itself: on llvmpipe the map's RGBA32F fetch was what made
+/// the lens cost (10 ms of the pass an eye on the bench scene), and each triangle of a mesh
+/// held to 0.01 px without residuals (8,100 cells an eye instead of 192) cost about 0.3 us of
+/// setup on the calling thread; the residual's coherent 2-byte fetch costs less than either.
 /// Otherwise u_map holds, per pixel, (x, y, view, taps) (internal_effects.h, RemapTable):
 /// (x, y) in source view `view` (geometry/lens_map.h; view < 0: no ray, black), and the pixel
 /// is the mean of the source over its footprint, a box as a sensor's pixel integrates: taps =
@@ -107,6 +111,7 @@ inline constexpr const char* kFinalFragmentSource = R"(
 uniform sampler2DArray u_source;
 #if MESH
 in vec3 v_source;
+uniform sampler2D u_residual;
 #elif !IDENTITY
 uniform sampler2D u_map;
 uniform sampler2D u_footprint;
@@ -158,7 +163,8 @@ void main() {
 #elif IDENTITY
   c = texelFetch(u_source, ivec3(pixel, 0), 0).rgb;
 #elif MESH
-  c = Bilinear(v_source.xy, v_source.z, 1.0 / vec2(textureSize(u_source, 0).xy));
+  vec2 s = v_source.xy + RESIDUAL_SCALE * texelFetch(u_residual, pixel, 0).xy;
+  c = Bilinear(s, v_source.z, 1.0 / vec2(textureSize(u_source, 0).xy));
 #else
   vec4 m = texelFetch(u_map, pixel, 0);
   if (m.z < 0.0) {

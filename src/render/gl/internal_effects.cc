@@ -21,6 +21,7 @@ constexpr GLint kIdsUnit = 3;
 constexpr GLint kZUnit = 4;
 constexpr GLint kFootprintUnit = 5;
 constexpr GLint kGaussUnit = 6;
+constexpr GLint kResidualUnit = 7;
 
 // The lens remap's samples of a pixel's footprint (kFinalFragmentSource): one per
 // kTapSpacing source pixels of the footprint's side, at most kMaxTaps a side. Up to 1.5 source
@@ -99,6 +100,7 @@ class LensMeshBuilder {
   }
 
   LensMesh Build() {
+    mesh_.residual.assign(2 * static_cast<std::size_t>(width_) * height_, 0);
     for (int y = 0; y < height_; y += kLensCell) {
       for (int x = 0; x < width_; x += kLensCell) {
         Add(x, y, std::min(kLensCell, width_ - x), std::min(kLensCell, height_ - y));
@@ -142,6 +144,7 @@ class LensMeshBuilder {
     double error = 0.0;
     if (Linear(x, y, w, h, &error)) {
       Emit(x, y, w, h, /*linear=*/true);
+      Residual(x, y, w, h);
       mesh_.linear_pixels += static_cast<int64_t>(w) * h;
       mesh_.max_error_px = std::max(mesh_.max_error_px, error);
       return;
@@ -154,6 +157,38 @@ class LensMeshBuilder {
     for (int j = 0; j < (h > 4 ? 2 : 1); ++j) {
       for (int i = 0; i < (w > 4 ? 2 : 1); ++i) {
         Add(x + i * w0, y + j * h0, i == 0 ? w0 : w - w0, j == 0 ? h0 : h - h0);
+      }
+    }
+  }
+
+  // The position interpolated at pixel (u, v) of the cell, as the rasterizer does over the
+  // two triangles (00, 10, 11) and (00, 11, 01).
+  Eigen::Vector2d Interpolated(int x, int y, int w, int h, int u, int v) const {
+    const Eigen::Vector2d p00 = corners_[Index(x, y)].p.cast<double>();
+    const Eigen::Vector2d p10 = corners_[Index(x + w, y)].p.cast<double>();
+    const Eigen::Vector2d p01 = corners_[Index(x, y + h)].p.cast<double>();
+    const Eigen::Vector2d p11 = corners_[Index(x + w, y + h)].p.cast<double>();
+    const double s = (u + 0.5 - x) / w, t = (v + 0.5 - y) / h;
+    return s >= t ? p00 + s * (p10 - p00) + t * (p11 - p10)
+                  : p00 + s * (p11 - p01) + t * (p01 - p00);
+  }
+
+  // The linear cell's residuals: the map's position minus the interpolated one, rounded to
+  // tolerance / 127.
+  void Residual(int x, int y, int w, int h) {
+    const double unit = tolerance_ / 127.0;
+    for (int v = y; v < y + h; ++v) {
+      for (int u = x; u < x + w; ++u) {
+        const float* m = Map(u, v);
+        const Eigen::Vector2d e = Eigen::Vector2d(m[0], m[1]) - Interpolated(x, y, w, h, u, v);
+        const std::size_t i = 2 * (static_cast<std::size_t>(v) * width_ + u);
+        Eigen::Vector2d left = e;
+        for (int c = 0; c < 2; ++c) {
+          const double code = unit > 0.0 ? std::clamp(std::round(e[c] / unit), -127.0, 127.0) : 0.0;
+          mesh_.residual[i + c] = static_cast<int8_t>(code);
+          left[c] -= code * unit;
+        }
+        mesh_.max_residual_error_px = std::max(mesh_.max_residual_error_px, left.norm());
       }
     }
   }
@@ -276,8 +311,10 @@ namespace {
 std::string Defines(bool identity, bool noise, bool mesh = false, int turn = 0) {
   return fmt::format(
       "#version 330 core\n#define IDENTITY {}\n#define NOISE {}\n#define MESH {}\n"
-      "#define TURN {}\n#define GAUSS_RANGE {:.9e}\n#define GAUSS_STEP {:.9e}\n",
-      identity ? 1 : 0, noise ? 1 : 0, mesh ? 1 : 0, turn, kGaussianRange, kGaussianStep);
+      "#define TURN {}\n#define GAUSS_RANGE {:.9e}\n#define GAUSS_STEP {:.9e}\n"
+      "#define RESIDUAL_SCALE {:.9e}\n",
+      identity ? 1 : 0, noise ? 1 : 0, mesh ? 1 : 0, turn, kGaussianRange, kGaussianStep,
+      kLensMeshTolerancePx);
 }
 
 // Texel-exact sampling only (texelFetch): no filtering, no mipmaps (a texture whose minifying
@@ -403,6 +440,7 @@ const EffectPrograms::Final& EffectPrograms::GetFinal(bool identity, bool noise,
   glUniform1i(Uniform(f.program, "u_map"), kMapUnit);
   glUniform1i(Uniform(f.program, "u_footprint"), kFootprintUnit);
   glUniform1i(Uniform(f.program, "u_gauss"), kGaussUnit);
+  glUniform1i(Uniform(f.program, "u_residual"), kResidualUnit);
   glUseProgram(0);
   CheckGlError("MakeRenderer: building the final pass");
   return finals_.emplace(variant, f).first->second;
@@ -510,6 +548,8 @@ EffectTarget::EffectTarget(const geometry::LensMap& lens, int samples, bool blur
     footprint_ = MakeTexture2d(GL_RGBA32F, GL_RGBA, GL_FLOAT, lens_.width, lens_.height,
                                table.footprint.data());
     const LensMesh mesh = MakeLensMesh(table, lens_.width, lens_.height);
+    residual_ = MakeTexture2d(GL_RG8_SNORM, GL_RG, GL_BYTE, lens_.width, lens_.height,
+                              mesh.residual.data());
     std::vector<uint32_t> indices = mesh.linear;
     indices.insert(indices.end(), mesh.exact.begin(), mesh.exact.end());
     mesh_linear_ = static_cast<GLsizei>(mesh.linear.size());
@@ -591,9 +631,10 @@ EffectTarget::~EffectTarget() {
                                  accumulation_framebuffer_, truth_framebuffer_,
                                  output_framebuffer_,       output_truth_framebuffer_};
   glDeleteFramebuffers(6, framebuffers);
-  const GLuint textures[] = {source_,    accumulation_, stretches_,    map_,        footprint_,
-                             truth_ids_, truth_z_,      output_color_, output_ids_, output_z_};
-  glDeleteTextures(10, textures);
+  const GLuint textures[] = {source_,       accumulation_, stretches_, map_,
+                             footprint_,    residual_,     truth_ids_, truth_z_,
+                             output_color_, output_ids_,   output_z_};
+  glDeleteTextures(11, textures);
   const GLuint renderbuffers[] = {msaa_color_, depth_, truth_depth_};
   glDeleteRenderbuffers(3, renderbuffers);
   glDeleteVertexArrays(1, &mesh_vao_);
@@ -734,6 +775,7 @@ void EffectTarget::Finish(EffectPrograms& programs, bool accumulated, const Nois
   if (!identity) {
     BindTexture(kMapUnit, GL_TEXTURE_2D, map_);
     BindTexture(kFootprintUnit, GL_TEXTURE_2D, footprint_);
+    BindTexture(kResidualUnit, GL_TEXTURE_2D, residual_);
   }
 
   glBindFramebuffer(GL_FRAMEBUFFER, output_framebuffer_);

@@ -54,7 +54,8 @@ RemapTable MakeRemapTable(const geometry::LensMap& lens);
 /// exactly one), each two triangles whose corners carry the source position (x, y, view).
 /// - linear cells: one view, one sample a pixel, and the position interpolated linearly over
 ///   each triangle within `tolerance` source pixels of the map's at every pixel centre (checked
-///   here as the rasterizer interpolates); drawn with the MESH final pass, no map fetch;
+///   here as the rasterizer interpolates), the rest of the way to the map in `residual`; drawn
+///   with the MESH final pass, no map fetch;
 /// - exact cells: the rest (a view's edge, no ray, several samples a pixel, a map that bends
 ///   too fast), drawn with the map's final pass, pixel by pixel as before.
 /// Cells start at kLensCell pixels a side and are halved where they fail, down to 4.
@@ -65,9 +66,16 @@ struct LensMesh {
   std::vector<uint32_t> exact;   ///< and of the exact ones
   int64_t linear_pixels = 0;
   double max_error_px = 0.0;  ///< the largest error over the linear cells' pixels
+  /// Per pixel of the camera, row 0 first, (x, y): what the map's position departs from the
+  /// interpolated one at the pixel's centre, in units of tolerance / 127 (so within [-127,
+  /// 127]); zero outside the linear cells. The final pass adds it back (RESIDUAL).
+  std::vector<int8_t> residual;
+  /// The largest error left after the residual is added back (its rounding), source pixels.
+  double max_residual_error_px = 0.0;
 };
-inline constexpr int kLensCell = 32;
-inline constexpr double kLensMeshTolerancePx = 0.01;
+inline constexpr int kLensCell = 64;
+/// The interpolation's tolerance, and the residuals' range: they step by 0.5 / 127 px.
+inline constexpr double kLensMeshTolerancePx = 0.5;
 LensMesh MakeLensMesh(const RemapTable& table, int width, int height,
                       double tolerance_px = kLensMeshTolerancePx);
 
@@ -248,6 +256,7 @@ class EffectTarget {
   GLuint stretches_ = 0;     // RGBA8 array of kMaxTurnStretches layers (one source view only)
   GLuint map_ = 0;           // RGBA32F, camera size: RemapTable::map
   GLuint footprint_ = 0;     // RGBA32F, camera size: RemapTable::footprint
+  GLuint residual_ = 0;      // RG8_SNORM, camera size: LensMesh::residual
   GLuint mesh_vao_ = 0, mesh_vertices_ = 0, mesh_indices_ = 0;  // LensMesh
   GLsizei mesh_linear_ = 0, mesh_exact_ = 0;                    // indices of each kind
   GLuint draw_framebuffer_ = 0;
