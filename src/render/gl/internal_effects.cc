@@ -642,39 +642,32 @@ EffectTarget::~EffectTarget() {
   glDeleteBuffers(2, buffers);
 }
 
-void EffectTarget::BindViewForDrawing(int view) const {
+void EffectTarget::BindLayerForDrawing(GLuint array, int layer) const {
   glBindFramebuffer(GL_FRAMEBUFFER, draw_framebuffer_);
   if (samples_ == 0) {
-    glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, source_, 0, view);
+    glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, array, 0, layer);
   }
   glViewport(0, 0, source_width_, source_height_);
 }
 
-void EffectTarget::FinishView(int view) const {
+void EffectTarget::ResolveInto(GLuint array, int layer) const {
   if (samples_ == 0) return;
   glBindFramebuffer(GL_READ_FRAMEBUFFER, draw_framebuffer_);
   glBindFramebuffer(GL_DRAW_FRAMEBUFFER, resolve_framebuffer_);
-  glFramebufferTextureLayer(GL_DRAW_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, source_, 0, view);
+  glFramebufferTextureLayer(GL_DRAW_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, array, 0, layer);
   glBlitFramebuffer(0, 0, source_width_, source_height_, 0, 0, source_width_, source_height_,
                     GL_COLOR_BUFFER_BIT, GL_NEAREST);
 }
+
+void EffectTarget::BindViewForDrawing(int view) const { BindLayerForDrawing(source_, view); }
+
+void EffectTarget::FinishView(int view) const { ResolveInto(source_, view); }
 
 void EffectTarget::BindStretchForDrawing(int stretch) const {
-  glBindFramebuffer(GL_FRAMEBUFFER, draw_framebuffer_);
-  if (samples_ == 0) {
-    glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, stretches_, 0, stretch);
-  }
-  glViewport(0, 0, source_width_, source_height_);
+  BindLayerForDrawing(stretches_, stretch);
 }
 
-void EffectTarget::FinishStretch(int stretch) const {
-  if (samples_ == 0) return;
-  glBindFramebuffer(GL_READ_FRAMEBUFFER, draw_framebuffer_);
-  glBindFramebuffer(GL_DRAW_FRAMEBUFFER, resolve_framebuffer_);
-  glFramebufferTextureLayer(GL_DRAW_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, stretches_, 0, stretch);
-  glBlitFramebuffer(0, 0, source_width_, source_height_, 0, 0, source_width_, source_height_,
-                    GL_COLOR_BUFFER_BIT, GL_NEAREST);
-}
+void EffectTarget::FinishStretch(int stretch) const { ResolveInto(stretches_, stretch); }
 
 void EffectTarget::Accumulate(const EffectPrograms& programs, int view, float weight,
                               Accumulation mode) const {

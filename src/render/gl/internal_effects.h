@@ -245,6 +245,10 @@ class EffectTarget {
   // state the scene passes expect.
   void BeginAccumulationPass(int view, Accumulation mode) const;
   void EndAccumulationPass() const;
+  // The draw framebuffer on layer `layer` of `array` (with MSAA: on the multisampled buffer),
+  // and the multisampled buffer resolved into that layer (nothing to do without MSAA).
+  void BindLayerForDrawing(GLuint array, int layer) const;
+  void ResolveInto(GLuint array, int layer) const;
 
   geometry::LensMap lens_;
   int samples_;
