@@ -160,6 +160,9 @@ class head:
     @staticmethod
     def forward_kinematics(head: "head.HeadDescription", joints: JointsLike) -> "head.HeadFrames": ...
     @staticmethod
+    def axis_errors(head: "head.HeadDescription", joints: npt.ArrayLike,
+                    p_W: npt.ArrayLike) -> npt.NDArray[np.float64]: ...
+    @staticmethod
     def solve_fixation(head: "head.HeadDescription", p_W: Vector, mode: str = "symmetric",
                        seed: JointsLike = ...) -> "head.IkResult": ...
     @staticmethod

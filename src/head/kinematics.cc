@@ -315,14 +315,7 @@ bool SameBranch(const JointState& a, const JointState& b) {
 }
 
 double AxisError(const HeadDescription& head, const Vector3d& p_W, const JointState& q) {
-  const HeadFrames f = ForwardKinematics(head, q);
-  double worst = 0.0;
-  for (const Pose* X : {&f.X_WCamLeft, &f.X_WCamRight}) {
-    const Vector3d axis = X->linear().col(2);
-    const Vector3d to_target = p_W - X->translation();
-    worst = std::max(worst, std::atan2(axis.cross(to_target).norm(), axis.dot(to_target)));
-  }
-  return worst;
+  return AxisErrors(head, q, p_W).maxCoeff();
 }
 
 // Clamps the unconstrained solution to the limits and says why the target is not reachable.
@@ -428,6 +421,19 @@ HeadFrames ForwardKinematics(const HeadDescription& head, const JointState& join
     f.p_WFixation = f.X_WC * *p_c;  // eq. 9 when left = -right
   }
   return f;
+}
+
+Eigen::Vector2d AxisErrors(const HeadDescription& head, const JointState& joints,
+                           const Eigen::Vector3d& p_W) {
+  const HeadFrames f = ForwardKinematics(head, joints);
+  Eigen::Vector2d errors;
+  for (int eye = 0; eye < 2; ++eye) {
+    const Pose& X = eye == 0 ? f.X_WCamLeft : f.X_WCamRight;
+    const Vector3d axis = X.linear().col(2);
+    const Vector3d to_target = p_W - X.translation();
+    errors[eye] = std::atan2(axis.cross(to_target).norm(), axis.dot(to_target));
+  }
+  return errors;
 }
 
 const char* ToString(Reachability reachability) {

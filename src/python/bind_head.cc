@@ -101,6 +101,39 @@ void BindHead(py::module_& m) {
                     "Where the optical axes meet, or None.");
   m.def("forward_kinematics", &ForwardKinematics, "head"_a, "joints"_a,
         "The head's frames for a joint state (appendix A); never raises.");
+  m.def(
+      "axis_errors",
+      [](const HeadDescription& head,
+         const py::array_t<double, py::array::c_style | py::array::forcecast>& joints,
+         const py::array_t<double, py::array::c_style | py::array::forcecast>& p_W) {
+        const bool one = joints.ndim() == 1;
+        if (!(one ? joints.shape(0) == 4 : joints.ndim() == 2 && joints.shape(1) == 4) ||
+            !(p_W.ndim() == joints.ndim() && p_W.shape(p_W.ndim() - 1) == 3 &&
+              (one || p_W.shape(0) == joints.shape(0)))) {
+          throw InvalidArgument(
+              "axis_errors: expected joints (4,) and p_W (3,), or joints (n, 4) and p_W (n, 3)");
+        }
+        const py::ssize_t n = one ? 1 : joints.shape(0);
+        py::array_t<double> out = one ? py::array_t<double>(std::vector<py::ssize_t>{2})
+                                      : py::array_t<double>(std::vector<py::ssize_t>{n, 2});
+        const double* q = joints.data();
+        const double* p = p_W.data();
+        double* e = out.mutable_data();
+        {
+          py::gil_scoped_release release;
+          for (py::ssize_t i = 0; i < n; ++i) {
+            const Eigen::Vector2d errors =
+                AxisErrors(head, JointState{q[4 * i], q[4 * i + 1], q[4 * i + 2], q[4 * i + 3]},
+                           Eigen::Vector3d(p[3 * i], p[3 * i + 1], p[3 * i + 2]));
+            e[2 * i] = errors[0];
+            e[2 * i + 1] = errors[1];
+          }
+        }
+        return out;
+      },
+      "head"_a, "joints"_a, "p_W"_a,
+      "Angle (rad) between each camera's optical axis and the ray to p_W: (left, right); for "
+      "joints (n, 4) and points (n, 3), an (n, 2) array, one row a head.");
 
   py::class_<IkResult>(m, "IkResult")
       .def_readonly("joints", &IkResult::joints, "The solution, within the joint limits.")

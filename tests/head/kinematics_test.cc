@@ -245,6 +245,25 @@ TEST(ForwardKinematicsTest, HeightHTurnsWithTilt) {
 // ---------------------------------------------------------------------------------------
 // Inverse kinematics.
 
+TEST(ForwardKinematicsTest, AxisErrorsAreTheOpticalAxesAnglesToThePoint) {
+  const HeadDescription head = HeadDescription::FromYamlFile(kPopeyePath);
+  // Parallel eyes: a point 2 m along the left axis is on it; the right axis, parallel and one
+  // baseline (2 B, appendix A) away, misses it by atan(2 B / 2 m).
+  const HeadFrames f = ForwardKinematics(head, JointState{});
+  const Vector3d p = f.X_WCamLeft * Vector3d(0.0, 0.0, 2.0);
+  const double baseline = (f.X_WCamLeft.translation() - f.X_WCamRight.translation()).norm();
+  EXPECT_NEAR(baseline, 2.0 * head.geometry().B, 1e-12);  // delta_l = delta_r = 0
+  const Eigen::Vector2d e = AxisErrors(head, JointState{}, p);
+  EXPECT_LT(e[0], 1e-12);
+  EXPECT_NEAR(e[1], std::atan2(baseline, 2.0), 1e-12);
+  // A fixated point: both zero (to the solver's 1e-9 rad); a point behind: near pi.
+  const JointState verged{0.1, -0.05, -0.03, 0.03};
+  const Vector3d fixated = ForwardKinematics(head, verged).p_WFixation.value();
+  EXPECT_LT(AxisErrors(head, verged, fixated).maxCoeff(), 1e-9);
+  const Vector3d behind = f.X_WCamLeft * Vector3d(0.0, 0.0, -2.0);
+  EXPECT_NEAR(AxisErrors(head, JointState{}, behind)[0], M_PI, 1e-9);
+}
+
 TEST(InverseKinematicsTest, PopeyeRandomTargetsAreFixatedExactly) {
   const HeadDescription head = HeadDescription::FromYamlFile(kPopeyePath);
   std::mt19937 rng(2024);

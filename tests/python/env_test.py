@@ -100,6 +100,7 @@ def test_fixating_with_ik_is_rewarded_and_terminates():
 @pytest.mark.parametrize("action, message", [
     (np.zeros(3, np.float32), r"shape \(4,\)"),
     (np.array([np.nan, 0, 0, 0], np.float32), "non-finite"),
+    (np.array([0, 0, -np.inf, 0]), "non-finite"),
     (np.array([0, 100.0, 0, 0], np.float32), "joint 'tilt' is 100 rad/s; expected"),
     ("left", "numbers"),
 ])

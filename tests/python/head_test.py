@@ -35,6 +35,37 @@ def test_ik_then_fk_puts_the_target_on_both_optical_axes(popeye):
         assert np.allclose(frames.p_WFixation, target, atol=1e-6)
 
 
+def test_axis_errors_of_one_head_and_of_many(popeye):
+    # Parallel eyes (all joints 0) and a point 2 m along the left optical axis: the left axis
+    # meets it, the right one misses it by the baseline seen from 2 m.
+    frames = head.forward_kinematics(popeye, [0.0, 0.0, 0.0, 0.0])
+    left, right = frames.X_WCamLeft, frames.X_WCamRight
+    p = left[:3, 3] + 2.0 * left[:3, 2]
+    baseline = np.linalg.norm(left[:3, 3] - right[:3, 3])
+    e = head.axis_errors(popeye, [0.0, 0.0, 0.0, 0.0], p)
+    assert e.shape == (2,)
+    assert e[0] < 1e-12
+    assert e[1] == pytest.approx(np.arctan2(baseline, 2.0), abs=1e-12)
+
+    # Many heads at once: row by row what the frames say.
+    rng = np.random.default_rng(5)
+    joints = rng.uniform(-0.3, 0.3, size=(16, 4))
+    points = popeye.X_WB[:3, 3] + rng.uniform([1.0, -1.0, -0.5], [3.0, 1.0, 0.5], size=(16, 3))
+    errors = head.axis_errors(popeye, joints, points)
+    assert errors.shape == (16, 2)
+    for q, p, e in zip(joints, points, errors):
+        f = head.forward_kinematics(popeye, q)
+        for eye, X in enumerate((f.X_WCamLeft, f.X_WCamRight)):
+            ray = p - X[:3, 3]
+            want = np.arctan2(np.linalg.norm(np.cross(X[:3, 2], ray)), X[:3, 2] @ ray)
+            assert e[eye] == pytest.approx(want, abs=1e-12)
+
+    with pytest.raises(saccade.InvalidArgument, match=r"joints \(n, 4\) and p_W \(n, 3\)"):
+        head.axis_errors(popeye, joints, points[:3])
+    with pytest.raises(saccade.InvalidArgument, match="axis_errors"):
+        head.axis_errors(popeye, [0.0, 0.0, 0.0], p)
+
+
 def test_joint_states_from_sequences(popeye):
     a = head.JointState(0.1, -0.2, 0.05, -0.05)
     assert np.allclose(np.asarray(a), [0.1, -0.2, 0.05, -0.05])

@@ -29,6 +29,11 @@ struct HeadFrames {
 /// Does not check joint limits (the state may come from anywhere); never throws.
 HeadFrames ForwardKinematics(const HeadDescription& head, const JointState& joints);
 
+/// The angle (rad, in [0, pi]) between each camera's optical axis and the ray from it to p_W:
+/// (left, right); 0 for both means p_W is fixated. atan2(|a x t|, a . t), exact near 0.
+Eigen::Vector2d AxisErrors(const HeadDescription& head, const JointState& joints,
+                           const Eigen::Vector3d& p_W);
+
 enum class VergenceMode {
   kSymmetric,    ///< left = -right (paper); solves pan, tilt and vergence
   kIndependent,  ///< pan kept from the seed; solves tilt, left and right
