@@ -203,16 +203,11 @@ class LensMeshBuilder {
     const Source& c11 = corners_[Index(x + w, y + h)];
     const float view = c00.view;
     if (view < 0.0f || c10.view != view || c01.view != view || c11.view != view) return false;
-    const Eigen::Vector2d p00 = c00.p.cast<double>(), p10 = c10.p.cast<double>(),
-                          p01 = c01.p.cast<double>(), p11 = c11.p.cast<double>();
     for (int v = y; v < y + h; ++v) {
       for (int u = x; u < x + w; ++u) {
         const float* m = Map(u, v);
         if (m[2] != view || m[3] != 17.0f) return false;  // 17: one sample (nu = nv = 1)
-        const double s = (u + 0.5 - x) / w, t = (v + 0.5 - y) / h;
-        const Eigen::Vector2d p = s >= t ? p00 + s * (p10 - p00) + t * (p11 - p10)
-                                         : p00 + s * (p11 - p01) + t * (p01 - p00);
-        const double e = (p - Eigen::Vector2d(m[0], m[1])).norm();
+        const double e = (Interpolated(x, y, w, h, u, v) - Eigen::Vector2d(m[0], m[1])).norm();
         if (e > tolerance_) return false;
         *error = std::max(*error, e);
       }
