@@ -27,6 +27,8 @@ inline constexpr double kDefaultNear = 0.05;
 inline constexpr double kDefaultFar = 50.0;
 // Files a scene refers to (models, images, calibrations) larger than this are refused.
 inline constexpr std::uintmax_t kMaxFileBytes = std::uintmax_t{4} << 30;
+// A picture's side (metres): far beyond any scene, and within a float's range (1e6 m a side).
+inline constexpr double kMaxPictureSide = 1e6;
 // A look_at `up` within this sine of the viewing direction leaves the roll undefined.
 inline constexpr double kMinUpSine = 1e-6;
 // Sensor ranges: the same as SensorSpec::Validate's (scene.h), checked here with the line.

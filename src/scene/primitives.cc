@@ -133,6 +133,10 @@ std::shared_ptr<const Model> MakePicture(std::shared_ptr<const Texture> texture,
   }
   const Image& image = texture->image;
   const double width = height * image.width() / image.height();
+  if (!std::isfinite(static_cast<float>(width)) || !std::isfinite(static_cast<float>(height))) {
+    throw InvalidArgument(fmt::format(
+        "MakePicture: a picture of {} m x {} m does not fit in single precision", width, height));
+  }
   Model model;
   model.source = "picture:" + texture->source;
   Material material;

@@ -289,9 +289,18 @@ class SceneReader {
     } else if (kind == "picture") {
       const auto texture = ReadTexture(e.Get("image"), "image");
       const Entry height = e.Get("height");
-      const std::string key = fmt::format("{}\n{}", texture->source, height.AsPositive());
+      const double metres = height.AsPositive();
+      // Its width follows from the image's aspect (a 1 x 100000 image is 100000 times wider).
+      const double width = metres * texture->image.width() / texture->image.height();
+      if (!(metres <= kMaxPictureSide && width <= kMaxPictureSide)) {
+        height.Fail(fmt::format(
+            "a picture of {:g} m x {:g} m (width from the image's {} x {} pixels); at most {:g} m "
+            "a side",
+            width, metres, texture->image.width(), texture->image.height(), kMaxPictureSide));
+      }
+      const std::string key = fmt::format("{}\n{}", texture->source, metres);
       auto& model = pictures_[key];
-      if (model == nullptr) model = MakePicture(texture, height.AsPositive());
+      if (model == nullptr) model = MakePicture(texture, metres);
       object.model = model;
     } else {
       Eigen::Vector4f color = kDefaultPrimitiveColor;

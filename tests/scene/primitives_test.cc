@@ -150,6 +150,8 @@ TEST(Primitives, PictureRejectsNoTextureAndNonPositiveHeights) {
   EXPECT_THROW(MakePicture(MakeTexture(4, 4), -1.0), InvalidArgument);
   EXPECT_THROW(MakePicture(MakeTexture(4, 4), std::numeric_limits<double>::infinity()),
                InvalidArgument);
+  EXPECT_THROW(MakePicture(MakeTexture(4, 4), 1e300), InvalidArgument);  // not a float
+  EXPECT_THROW(MakePicture(MakeTexture(40000, 1), 1e36), InvalidArgument);
 }
 
 }  // namespace

@@ -382,6 +382,9 @@ TEST_F(SceneLoaderTest, NonPositiveSizes) {
               {"expected a positive number", "-0.1"});
   ExpectError(Replace(kValid, "    height: 0.5", "    height: 0"), "height: 0", "objects[0].height",
               {"expected a positive number"});
+  // Finite as a double, not as the float a vertex holds (found by the scene fuzzer).
+  ExpectError(Replace(kValid, "    height: 0.5", "    height: 1e300"), "height: 1e300",
+              "objects[0].height", {"at most 1e+06 m a side", "1e+300 m"});
   ExpectError(Replace(kValid, "unit_scale: 0.1", "unit_scale: 0"), "unit_scale: 0",
               "objects[1].unit_scale", {"expected a positive number"});
   ExpectError(Replace(kValid, "  size: 8\n", "  size: -8\n"), "size: -8", "ground.size",
