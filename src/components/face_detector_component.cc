@@ -46,6 +46,10 @@ FaceDetectorComponent::FaceDetectorComponent()
   DeclareParam("full_scan_every", &full_scan_every_,
                "with a track region: search the whole image every N-th detection")
       .Range(1, 1000000);
+  DeclareParam("new_target_scans", &new_target_scans_,
+               "with a track region: search the whole image too on the first N detections of a "
+               "new target (a saccade's blur may carry a tracker onto another face)")
+      .Range(0, 1000000);
   DeclareParam("region_pyramid_level", &region_pyramid_level_,
                "the pyramid level of the search around the track (the whole image's is "
                "pyramid_level)")
@@ -79,6 +83,10 @@ FaceDetectorComponent::Search FaceDetectorComponent::NextSearch(const Image& ima
   const int64_t n = detections_++;
   if (!(track_region_scale_ > 0.0) || !track_.has_value()) return search;
   const TrackMessage& track = track_.value();
+  if (track.target_id != last_target_id_) {
+    last_target_id_ = track.target_id;
+    whole_scans_left_ = new_target_scans_;
+  }
   if (!track.tracking || track.window.area() <= 0) return search;
   const double w = track_region_scale_ * track.window.width;
   const double h = track_region_scale_ * track.window.height;
@@ -86,7 +94,8 @@ FaceDetectorComponent::Search FaceDetectorComponent::NextSearch(const Image& ima
                         static_cast<int>(std::floor(track.center.y - 0.5 * h)),
                         static_cast<int>(std::ceil(w)), static_cast<int>(std::ceil(h)));
   search.region = region & cv::Rect(0, 0, image.width(), image.height());
-  search.whole = n % full_scan_every_ == 0;
+  search.whole = n % full_scan_every_ == 0 || whole_scans_left_ > 0;
+  if (whole_scans_left_ > 0) --whole_scans_left_;
   return search;
 }
 

@@ -282,7 +282,8 @@ TEST(FaceDetectorComponent, SearchesAroundTheTrackAndTheWholeImageEveryNthTime) 
   ASSERT_TRUE(face);
   const std::size_t candidates = (*faces_full)->faces.size();
 
-  auto around = Make("vision.face_detector", {{"track_region_scale", 2.0}, {"full_scan_every", 2}});
+  auto around = Make("vision.face_detector",
+                     {{"track_region_scale", 2.0}, {"full_scan_every", 2}, {"new_target_scans", 0}});
   auto faces = Capture<FacesMessage>(*around, "faces");
   const auto detect = [&](const cv::Rect& window, int64_t step) {
     TrackMessage track;
@@ -309,6 +310,42 @@ TEST(FaceDetectorComponent, SearchesAroundTheTrackAndTheWholeImageEveryNthTime) 
   EXPECT_NEAR(near[0].box.y + 0.5 * near[0].box.height, face->y + 0.5 * face->height,
               kBoxTolerancePx);
   EXPECT_NEAR(near[0].box.width, face->width, kBoxTolerancePx);
+}
+
+// A new target (the track's target_id changes, as when attention moves on and the eyes make
+// a saccade): its first new_target_scans detections search the whole image as well, so that a
+// tracker the saccade carried onto another face is corrected by the next pairing.
+TEST(FaceDetectorComponent, SearchesTheWholeImageOnTheFirstDetectionsOfANewTarget) {
+  const scene::Scene& scene = Scene();
+  const head::IkResult look =
+      head::SolveFixation(scene.robot()->head, FaceCentreAt(scene, Astronaut(), 0.0));
+  ASSERT_TRUE(look.reachable());
+  const std::shared_ptr<const Image> image = RenderOne(kScene, "left", look.joints, {});
+  auto around = Make("vision.face_detector", {{"track_region_scale", 2.0},
+                                              {"full_scan_every", 1000},
+                                              {"new_target_scans", 2}});
+  auto faces = Capture<FacesMessage>(*around, "faces");
+  int64_t step = 0;
+  // How many faces a detection found with the track on the sky, far from every face: none
+  // around it, all of them when the whole image is searched too.
+  const auto detect = [&](int64_t target_id) {
+    TrackMessage track;
+    track.tracking = true;
+    track.target_id = target_id;
+    track.window = cv::Rect(20, 20, 80, 80);
+    track.center = {60.0, 60.0};
+    In<TrackMessage>(*around, "track").Deliver(track);
+    In<runtime::ImageMessage>(*around, "image").Deliver(runtime::ImageMessage{image});
+    around->Step(At(step++));
+    return (*faces)->faces.size();
+  };
+  EXPECT_GT(detect(0), 0u);  // target 0: the whole image (also the 1st of full_scan_every)
+  EXPECT_GT(detect(0), 0u);  //   and its 2nd detection
+  EXPECT_EQ(detect(0), 0u);  //   then around its track only
+  EXPECT_EQ(detect(0), 0u);
+  EXPECT_GT(detect(1), 0u);  // target 1: the whole image twice again
+  EXPECT_GT(detect(1), 0u);
+  EXPECT_EQ(detect(1), 0u);
 }
 
 // On the real-time clock detection runs on a thread of its own (the loop goes on at camera
@@ -543,7 +580,8 @@ TEST(ComponentParams, UnknownMissingAndOutOfRangeParametersAreNamed) {
   };
   EXPECT_EQ(message("vision.face_detector", {{"min_neighbours", 3}}),
             "unknown parameter 'min_neighbours' (known: cascade, full_scan_every, latency_steps, "
-            "max_size_px, min_neighbors, min_size_px, pyramid_level, realtime_thread, "
+            "max_size_px, min_neighbors, min_size_px, new_target_scans, pyramid_level, "
+            "realtime_thread, "
             "region_pyramid_level, "
             "reject_cats, require_eyes, "
             "scale_factor, track_region_scale)");

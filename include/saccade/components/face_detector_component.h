@@ -8,7 +8,10 @@
 // While the track input follows a target and `track_region_scale` > 0, the detector searches
 // a box that many times the track's window around it (at `region_pyramid_level`), and the
 // whole image too (at `pyramid_level`) every `full_scan_every`-th detection, so that
-// attention still sees the other faces.
+// attention still sees the other faces, and on the first `new_target_scans` detections of a
+// new target (the track's target_id changed): the saccade to it blurs the images and a
+// tracker may slip onto another face meanwhile; a region around that face would keep finding
+// it, and the two eyes' faces would not pair again until the next whole scan.
 // Parameters: declared in the constructor (docs/components.md lists them).
 //
 // Detect slowly, track fast: with latency_steps N > 0 the detector works on a thread of its
@@ -56,7 +59,10 @@ class FaceDetectorComponent : public runtime::Component {
   double track_region_scale_ = 0.0;
   int full_scan_every_ = 5;
   int region_pyramid_level_ = 0;
+  int new_target_scans_ = 5;
   int64_t detections_ = 0;  // started so far
+  int64_t last_target_id_ = -1;  // the track's target at the last detection
+  int whole_scans_left_ = 0;     // of new_target_scans
   // The detection in flight (on its own thread) and the step its faces are due.
   std::future<FacesMessage> running_;
   int64_t due_step_ = 0;
