@@ -41,7 +41,8 @@ FaceDetectorComponent::FaceDetectorComponent()
                "loop runs at camera rate; false: within the step");
   DeclareParam("track_region_scale", &track_region_scale_,
                "with a track input: search a box this many times the track's window around "
-               "it; 0: always the whole image")
+               "it; 0: always the whole image (so does a detector whose track input is not "
+               "connected)")
       .Range(0.0, 100.0);
   DeclareParam("full_scan_every", &full_scan_every_,
                "with a track region: search the whole image every N-th detection")

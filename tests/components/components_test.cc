@@ -282,8 +282,9 @@ TEST(FaceDetectorComponent, SearchesAroundTheTrackAndTheWholeImageEveryNthTime) 
   ASSERT_TRUE(face);
   const std::size_t candidates = (*faces_full)->faces.size();
 
-  auto around = Make("vision.face_detector",
-                     {{"track_region_scale", 2.0}, {"full_scan_every", 2}, {"new_target_scans", 0}});
+  auto around =
+      Make("vision.face_detector",
+           {{"track_region_scale", 2.0}, {"full_scan_every", 2}, {"new_target_scans", 0}});
   auto faces = Capture<FacesMessage>(*around, "faces");
   const auto detect = [&](const cv::Rect& window, int64_t step) {
     TrackMessage track;
@@ -321,9 +322,9 @@ TEST(FaceDetectorComponent, SearchesTheWholeImageOnTheFirstDetectionsOfANewTarge
       head::SolveFixation(scene.robot()->head, FaceCentreAt(scene, Astronaut(), 0.0));
   ASSERT_TRUE(look.reachable());
   const std::shared_ptr<const Image> image = RenderOne(kScene, "left", look.joints, {});
-  auto around = Make("vision.face_detector", {{"track_region_scale", 2.0},
-                                              {"full_scan_every", 1000},
-                                              {"new_target_scans", 2}});
+  auto around =
+      Make("vision.face_detector",
+           {{"track_region_scale", 2.0}, {"full_scan_every", 1000}, {"new_target_scans", 2}});
   auto faces = Capture<FacesMessage>(*around, "faces");
   int64_t step = 0;
   // How many faces a detection found with the track on the sky, far from every face: none

@@ -5,7 +5,8 @@
 //           CamShift track, connect it with delay 1); outputs: faces (vision.faces), with the
 //           image they were found in (its time is their capture time).
 //
-// While the track input follows a target and `track_region_scale` > 0, the detector searches
+// While the track input (when connected) follows a target and `track_region_scale` > 0 (2.5
+// by default), the detector searches
 // a box that many times the track's window around it (at `region_pyramid_level`), and the
 // whole image too (at `pyramid_level`) every `full_scan_every`-th detection, so that
 // attention still sees the other faces, and on the first `new_target_scans` detections of a
@@ -56,11 +57,11 @@ class FaceDetectorComponent : public runtime::Component {
   bool require_eyes_ = true;
   int latency_steps_ = 0;
   bool realtime_thread_ = true;
-  double track_region_scale_ = 0.0;
+  double track_region_scale_ = 2.5;
   int full_scan_every_ = 5;
   int region_pyramid_level_ = 0;
   int new_target_scans_ = 5;
-  int64_t detections_ = 0;  // started so far
+  int64_t detections_ = 0;       // started so far
   int64_t last_target_id_ = -1;  // the track's target at the last detection
   int whole_scans_left_ = 0;     // of new_target_scans
   // The detection in flight (on its own thread) and the step its faces are due.
