@@ -262,14 +262,21 @@ TEST(SimCameras, PipelinedCaptureEmitsThePreviousStepsFrameUnchanged) {
   plain->Stop();
 }
 
-// Detect slowly, track fast: with a track, the detector searches a box around it, and the
-// whole image every full_scan_every-th time.
-TEST(FaceDetectorComponent, SearchesAroundTheTrackAndTheWholeImageEveryNthTime) {
+// The left eye's image with the head fixating the astronaut's face; null when it cannot.
+std::shared_ptr<const Image> LeftEyeOnTheAstronaut() {
   const scene::Scene& scene = Scene();
   const head::IkResult look =
       head::SolveFixation(scene.robot()->head, FaceCentreAt(scene, Astronaut(), 0.0));
-  ASSERT_TRUE(look.reachable());
-  const std::shared_ptr<const Image> image = RenderOne(kScene, "left", look.joints, {});
+  EXPECT_TRUE(look.reachable());
+  if (!look.reachable()) return nullptr;
+  return RenderOne(kScene, "left", look.joints, {});
+}
+
+// Detect slowly, track fast: with a track, the detector searches a box around it, and the
+// whole image every full_scan_every-th time.
+TEST(FaceDetectorComponent, SearchesAroundTheTrackAndTheWholeImageEveryNthTime) {
+  const std::shared_ptr<const Image> image = LeftEyeOnTheAstronaut();
+  ASSERT_TRUE(image);
   auto full = Make("vision.face_detector", json::object());
   auto faces_full = Capture<FacesMessage>(*full, "faces");
   In<runtime::ImageMessage>(*full, "image").Deliver(runtime::ImageMessage{image});
@@ -317,11 +324,8 @@ TEST(FaceDetectorComponent, SearchesAroundTheTrackAndTheWholeImageEveryNthTime) 
 // a saccade): its first new_target_scans detections search the whole image as well, so that a
 // tracker the saccade carried onto another face is corrected by the next pairing.
 TEST(FaceDetectorComponent, SearchesTheWholeImageOnTheFirstDetectionsOfANewTarget) {
-  const scene::Scene& scene = Scene();
-  const head::IkResult look =
-      head::SolveFixation(scene.robot()->head, FaceCentreAt(scene, Astronaut(), 0.0));
-  ASSERT_TRUE(look.reachable());
-  const std::shared_ptr<const Image> image = RenderOne(kScene, "left", look.joints, {});
+  const std::shared_ptr<const Image> image = LeftEyeOnTheAstronaut();
+  ASSERT_TRUE(image);
   auto around =
       Make("vision.face_detector",
            {{"track_region_scale", 2.0}, {"full_scan_every", 1000}, {"new_target_scans", 2}});
@@ -353,11 +357,8 @@ TEST(FaceDetectorComponent, SearchesTheWholeImageOnTheFirstDetectionsOfANewTarge
 // rate): the step that brings the image emits nothing, a later one emits the faces of that
 // image, the same as a detection within the step. realtime_thread: false detects within it.
 TEST(FaceDetectorComponent, OnTheRealTimeClockDetectsOnAThreadOfItsOwn) {
-  const scene::Scene& scene = Scene();
-  const head::IkResult look =
-      head::SolveFixation(scene.robot()->head, FaceCentreAt(scene, Astronaut(), 0.0));
-  ASSERT_TRUE(look.reachable());
-  const std::shared_ptr<const Image> image = RenderOne(kScene, "left", look.joints, {});
+  const std::shared_ptr<const Image> image = LeftEyeOnTheAstronaut();
+  ASSERT_TRUE(image);
   const auto realtime = [](int64_t step) {
     runtime::StepContext context = At(step);
     context.realtime = true;
