@@ -6,13 +6,13 @@
 //           image they were found in (its time is their capture time).
 //
 // While the track input (when connected) follows a target and `track_region_scale` > 0 (2.5
-// by default), the detector searches
-// a box that many times the track's window around it (at `region_pyramid_level`), and the
-// whole image too (at `pyramid_level`) every `full_scan_every`-th detection, so that
-// attention still sees the other faces, and on the first `new_target_scans` detections of a
-// new target (the track's target_id changed): the saccade to it blurs the images and a
-// tracker may slip onto another face meanwhile; a region around that face would keep finding
-// it, and the two eyes' faces would not pair again until the next whole scan.
+// by default), the detector searches a box that many times the track's window around it (at
+// `region_pyramid_level`), and the whole image too (at `pyramid_level`) every
+// `full_scan_every`-th detection, so that attention still sees the other faces, and on the
+// first `new_target_scans` detections of a new target (the track's target_id changed): the
+// saccade to it blurs the images and a tracker may slip onto another face meanwhile; a region
+// around that face would keep finding it, and the two eyes' faces would not pair again until
+// the next whole scan.
 // Parameters: declared in the constructor (docs/components.md lists them).
 //
 // Detect slowly, track fast: with latency_steps N > 0 the detector works on a thread of its
