@@ -60,9 +60,11 @@ void CamShiftComponent::Step(const runtime::StepContext&) {
   TrackMessage out;
   out.image = image;
   const SelectionMessage* selection = selection_.get();
-  if (selection == nullptr || !selection->valid) {
+  if (selection == nullptr || !selection->valid || selection->exploring) {
+    // Nothing to follow: no target, or the home point that attention looks at while it
+    // explores (not a face: no boxes).
     target_id_ = -1;
-    out.reason = "no target";
+    out.reason = selection != nullptr && selection->valid ? "exploring: no face" : "no target";
     track_.Emit(out);
     return;
   }
@@ -94,6 +96,8 @@ void CamShiftComponent::Step(const runtime::StepContext&) {
     out.reseeded = StartAndCatchUp(*found, box);
     if (!out.reseeded) out.reason = "the detection holds no usable colour";
   } else {
+    // A new target and no detection of it yet: the last target's track is not its.
+    if (tracker_->tracking()) tracker_ = std::make_unique<vision::CamShiftTracker>(options_);
     out.reason = "waiting for a detection of the target";
   }
   out.target_id = selection->target_id;

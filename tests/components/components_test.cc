@@ -353,6 +353,55 @@ TEST(FaceDetectorComponent, SearchesTheWholeImageOnTheFirstDetectionsOfANewTarge
   EXPECT_EQ(detect(1), 0u);
 }
 
+// The track follows the selected face, and nothing else: when attention moves to a place it
+// has no detection of yet, or explores (its home point, not a face), the last face's track
+// ends, so that neither triangulation nor the detectors keep following a face attention left.
+TEST(CamShiftComponent, EndsTheLastFacesTrackWhenAttentionMovesOnOrExplores) {
+  const std::shared_ptr<const Image> image = LeftEyeOnTheAstronaut();
+  ASSERT_TRUE(image);
+  auto detector = Make("vision.face_detector", json::object());
+  auto faces = Capture<FacesMessage>(*detector, "faces");
+  In<runtime::ImageMessage>(*detector, "image").Deliver(runtime::ImageMessage{image});
+  detector->Step(At(0));
+  ASSERT_TRUE(faces->has_value());
+  std::optional<cv::Rect> face;
+  for (const FacesMessage::Face& f : (*faces)->faces) {
+    if (!f.rejected) face = f.box;
+  }
+  ASSERT_TRUE(face);
+
+  auto tracker = Make("vision.camshift", {{"eye", "left"}});
+  auto track = Capture<TrackMessage>(*tracker, "track");
+  const auto step = [&](const SelectionMessage& selection, int64_t k) {
+    In<runtime::ImageMessage>(*tracker, "image").Deliver(runtime::ImageMessage{image});
+    In<SelectionMessage>(*tracker, "selection").Deliver(selection);
+    tracker->Step(At(k));
+    return **track;
+  };
+  SelectionMessage selected;  // the astronaut, detected in this image
+  selected.valid = true;
+  selected.target_id = 0;
+  selected.boxes_fresh = true;
+  selected.frame_index = image->metadata().frame_index;
+  selected.left_box = selected.right_box = *face;
+  EXPECT_TRUE(step(selected, 0).tracking);
+  EXPECT_TRUE(step(selected, 1).tracking);  // the same target: tracked on
+  SelectionMessage elsewhere = selected;    // another place, no detection of it yet
+  elsewhere.target_id = 1;
+  elsewhere.boxes_fresh = false;
+  const TrackMessage waiting = step(elsewhere, 2);
+  EXPECT_FALSE(waiting.tracking);
+  EXPECT_EQ(waiting.target_id, 1);
+  EXPECT_TRUE(step(selected, 3).tracking);  // the astronaut again, detected: tracked again
+  SelectionMessage exploring = selected;    // home, straight ahead: not a face
+  exploring.target_id = 2;
+  exploring.exploring = true;
+  exploring.boxes_fresh = false;
+  const TrackMessage none = step(exploring, 4);
+  EXPECT_FALSE(none.tracking);
+  EXPECT_EQ(none.target_id, -1);
+}
+
 // On the real-time clock detection runs on a thread of its own (the loop goes on at camera
 // rate): the step that brings the image emits nothing, a later one emits the faces of that
 // image, the same as a detection within the step. realtime_thread: false detects within it.
