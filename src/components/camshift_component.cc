@@ -96,7 +96,7 @@ void CamShiftComponent::Step(const runtime::StepContext&) {
     out.reseeded = StartAndCatchUp(*found, box);
     if (!out.reseeded) out.reason = "the detection holds no usable colour";
   } else {
-    // A new target and no detection of it yet: the last target's track is not its.
+    // A new target and no detection of it yet: the last target's track does not follow it.
     if (tracker_->tracking()) tracker_ = std::make_unique<vision::CamShiftTracker>(options_);
     out.reason = "waiting for a detection of the target";
   }

@@ -4,6 +4,9 @@
 //   than reseed_fraction of its width from the track, re-detected when lost. A detection that
 //   arrives late (vision.face_detector's latency_steps) seeds the track in the image it was
 //   found in, one of the last few it kept, and the track catches up through the images since.
+//   It follows the selected face only: a new target with no detection of it yet, or attention
+//   exploring (its home point, not a face), ends the last face's track (target_id -1 while
+//   exploring), so that neither triangulation nor the detectors go on following it.
 //   inputs: image (runtime.image, required), selection (vision.selection, required)
 //   outputs: track (vision.track)
 // Parameters: declared in the constructor (docs/components.md lists them).
