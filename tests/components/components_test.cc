@@ -272,22 +272,34 @@ std::shared_ptr<const Image> LeftEyeOnTheAstronaut() {
   return RenderOne(kScene, "left", look.joints, {});
 }
 
+// The faces a default detector finds in the whole image.
+FacesMessage DetectWhole(const std::shared_ptr<const Image>& image) {
+  auto detector = Make("vision.face_detector", json::object());
+  auto faces = Capture<FacesMessage>(*detector, "faces");
+  In<runtime::ImageMessage>(*detector, "image").Deliver(runtime::ImageMessage{image});
+  detector->Step(At(0));
+  EXPECT_TRUE(faces->has_value());
+  return faces->value_or(FacesMessage{});
+}
+
+// The box of the last face not rejected, if any.
+std::optional<cv::Rect> AcceptedBox(const FacesMessage& faces) {
+  std::optional<cv::Rect> box;
+  for (const FacesMessage::Face& f : faces.faces) {
+    if (!f.rejected) box = f.box;
+  }
+  return box;
+}
+
 // Detect slowly, track fast: with a track, the detector searches a box around it, and the
 // whole image every full_scan_every-th time.
 TEST(FaceDetectorComponent, SearchesAroundTheTrackAndTheWholeImageEveryNthTime) {
   const std::shared_ptr<const Image> image = LeftEyeOnTheAstronaut();
   ASSERT_TRUE(image);
-  auto full = Make("vision.face_detector", json::object());
-  auto faces_full = Capture<FacesMessage>(*full, "faces");
-  In<runtime::ImageMessage>(*full, "image").Deliver(runtime::ImageMessage{image});
-  full->Step(At(0));
-  ASSERT_TRUE(faces_full->has_value());
-  std::optional<cv::Rect> face;
-  for (const FacesMessage::Face& f : (*faces_full)->faces) {
-    if (!f.rejected) face = f.box;
-  }
+  const FacesMessage whole = DetectWhole(image);
+  const std::optional<cv::Rect> face = AcceptedBox(whole);
   ASSERT_TRUE(face);
-  const std::size_t candidates = (*faces_full)->faces.size();
+  const std::size_t candidates = whole.faces.size();
 
   auto around =
       Make("vision.face_detector",
@@ -359,15 +371,7 @@ TEST(FaceDetectorComponent, SearchesTheWholeImageOnTheFirstDetectionsOfANewTarge
 TEST(CamShiftComponent, EndsTheLastFacesTrackWhenAttentionMovesOnOrExplores) {
   const std::shared_ptr<const Image> image = LeftEyeOnTheAstronaut();
   ASSERT_TRUE(image);
-  auto detector = Make("vision.face_detector", json::object());
-  auto faces = Capture<FacesMessage>(*detector, "faces");
-  In<runtime::ImageMessage>(*detector, "image").Deliver(runtime::ImageMessage{image});
-  detector->Step(At(0));
-  ASSERT_TRUE(faces->has_value());
-  std::optional<cv::Rect> face;
-  for (const FacesMessage::Face& f : (*faces)->faces) {
-    if (!f.rejected) face = f.box;
-  }
+  const std::optional<cv::Rect> face = AcceptedBox(DetectWhole(image));
   ASSERT_TRUE(face);
 
   auto tracker = Make("vision.camshift", {{"eye", "left"}});
