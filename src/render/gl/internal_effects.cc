@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iterator>
 #include <string>
 #include <vector>
 
@@ -182,13 +183,13 @@ class LensMeshBuilder {
         const float* m = Map(u, v);
         const Eigen::Vector2d e = Eigen::Vector2d(m[0], m[1]) - Interpolated(x, y, w, h, u, v);
         const std::size_t i = 2 * (static_cast<std::size_t>(v) * width_ + u);
-        Eigen::Vector2d left = e;
+        Eigen::Vector2d rest = e;  // what the codes leave
         for (int c = 0; c < 2; ++c) {
           const double code = unit > 0.0 ? std::clamp(std::round(e[c] / unit), -127.0, 127.0) : 0.0;
           mesh_.residual[i + c] = static_cast<int8_t>(code);
-          left[c] -= code * unit;
+          rest[c] -= code * unit;
         }
-        mesh_.max_residual_error_px = std::max(mesh_.max_residual_error_px, left.norm());
+        mesh_.max_residual_error_px = std::max(mesh_.max_residual_error_px, rest.norm());
       }
     }
   }
@@ -625,16 +626,16 @@ EffectTarget::~EffectTarget() {
   const GLuint framebuffers[] = {draw_framebuffer_,         resolve_framebuffer_,
                                  accumulation_framebuffer_, truth_framebuffer_,
                                  output_framebuffer_,       output_truth_framebuffer_};
-  glDeleteFramebuffers(6, framebuffers);
+  glDeleteFramebuffers(std::size(framebuffers), framebuffers);
   const GLuint textures[] = {source_,       accumulation_, stretches_, map_,
                              footprint_,    residual_,     truth_ids_, truth_z_,
                              output_color_, output_ids_,   output_z_};
-  glDeleteTextures(11, textures);
+  glDeleteTextures(std::size(textures), textures);
   const GLuint renderbuffers[] = {msaa_color_, depth_, truth_depth_};
-  glDeleteRenderbuffers(3, renderbuffers);
+  glDeleteRenderbuffers(std::size(renderbuffers), renderbuffers);
   glDeleteVertexArrays(1, &mesh_vao_);
   const GLuint buffers[] = {mesh_vertices_, mesh_indices_};
-  glDeleteBuffers(2, buffers);
+  glDeleteBuffers(std::size(buffers), buffers);
 }
 
 void EffectTarget::BindLayerForDrawing(GLuint array, int layer) const {
