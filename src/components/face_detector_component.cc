@@ -51,6 +51,16 @@ FaceDetectorComponent::FaceDetectorComponent()
                "with a track region: search the whole image too on the first N detections of a "
                "new target (a saccade's blur may carry a tracker onto another face)")
       .Range(0, 1000000);
+  DeclareParam("region_size_factor", &region_size_factor_,
+               "with a track region: search faces from the track window's side / F to its side x "
+               "F (within min_size_px, max_size_px); 0: every size")
+      .Range(0.0, 100.0);
+  DeclareParam("recheck_every", &recheck_every_,
+               "with a track input: a face seen again at about the same place (boxes "
+               "overlapping by 70 % of their union) keeps its cat and eye verdict for N - 1 "
+               "searches, then is checked again; a new target forgets them all (1: check every "
+               "face every time)")
+      .Range(1, 1000000);
   DeclareParam("region_pyramid_level", &region_pyramid_level_,
                "the pyramid level of the search around the track (the whole image's is "
                "pyramid_level)")
@@ -87,6 +97,13 @@ FaceDetectorComponent::Search FaceDetectorComponent::NextSearch(const Image& ima
   if (track.target_id != last_target_id_) {
     last_target_id_ = track.target_id;
     whole_scans_left_ = new_target_scans_;
+    verdicts_.clear();  // the eyes jump to the new target: what was where may have changed
+  }
+  for (const Verdict& v : verdicts_) {
+    if (v.reuses + 1 < recheck_every_) {
+      search.checked.push_back(v.face);
+      search.checked_reuses.push_back(v.reuses);
+    }
   }
   if (!track.tracking || track.window.area() <= 0) return search;
   const double w = track_region_scale_ * track.window.width;
@@ -95,6 +112,12 @@ FaceDetectorComponent::Search FaceDetectorComponent::NextSearch(const Image& ima
                         static_cast<int>(std::floor(track.center.y - 0.5 * h)),
                         static_cast<int>(std::ceil(w)), static_cast<int>(std::ceil(h)));
   search.region = region & cv::Rect(0, 0, image.width(), image.height());
+  if (region_size_factor_ > 0.0) {
+    const int small = std::min(track.window.width, track.window.height);
+    const int large = std::max(track.window.width, track.window.height);
+    search.min_size_px = static_cast<int>(std::floor(small / region_size_factor_));
+    search.max_size_px = static_cast<int>(std::ceil(large * region_size_factor_));
+  }
   search.whole = n % full_scan_every_ == 0 || whole_scans_left_ > 0;
   if (whole_scans_left_ > 0) --whole_scans_left_;
   return search;
@@ -105,12 +128,21 @@ FacesMessage FaceDetectorComponent::Detect(std::shared_ptr<const Image> image,
   FacesMessage out;
   out.image = std::move(image);
   std::vector<vision::FaceDetection> found;
-  if (search.whole) found = detector_->Detect(*out.image);
+  if (search.whole) {
+    vision::FaceDetector::Search whole;
+    whole.regions = {cv::Rect(0, 0, out.image->width(), out.image->height())};
+    whole.checked = search.checked;
+    found = detector_->Detect(*out.image, whole);
+  }
   if (search.region) {
     // The tracked face from the region, at the region's pyramid level: it replaces the whole
     // image's boxes that overlap it.
-    const std::vector<vision::FaceDetection> near =
-        region_detector_->Detect(*out.image, {*search.region});
+    vision::FaceDetector::Search around;
+    around.regions = {*search.region};
+    around.min_size_px = search.min_size_px;
+    around.max_size_px = search.max_size_px;
+    around.checked = search.checked;
+    const std::vector<vision::FaceDetection> near = region_detector_->Detect(*out.image, around);
     std::erase_if(found, [&near](const vision::FaceDetection& d) {
       return std::any_of(near.begin(), near.end(), [&d](const vision::FaceDetection& r) {
         return (d.box & r.box).area() > 0.5 * std::min(d.box.area(), r.box.area());
@@ -123,7 +155,26 @@ FacesMessage FaceDetectorComponent::Detect(std::shared_ptr<const Image> image,
   for (const vision::FaceDetection& d : found) {
     out.faces.push_back({d.box, d.neighbors, d.rejected, d.reason});
   }
+  if (track_region_scale_ > 0.0 && track_.has_value()) Remember(found, search);
   return out;
+}
+
+void FaceDetectorComponent::Remember(const std::vector<vision::FaceDetection>& found,
+                                     const Search& search) {
+  std::vector<Verdict> seen;
+  for (const vision::FaceDetection& d : found) {
+    seen.push_back({d, d.verdict_from >= 0 ? search.checked_reuses[d.verdict_from] + 1 : 0, 0});
+  }
+  // The faces this search did not see (outside the region) are kept until the next whole scan.
+  for (const Verdict& v : verdicts_) {
+    if (v.age + 1 >= full_scan_every_) continue;
+    const bool again = std::any_of(found.begin(), found.end(), [&v](const auto& d) {
+      const double common = (v.face.box & d.box).area();
+      return common > 0.5 * std::min(v.face.box.area(), d.box.area());
+    });
+    if (!again) seen.push_back({v.face, v.reuses, v.age + 1});
+  }
+  verdicts_ = std::move(seen);
 }
 
 void FaceDetectorComponent::Step(const runtime::StepContext& context) {

@@ -70,16 +70,23 @@ FaceDetector::FaceDetector(const Options& options) : options_(options) {
 
 std::vector<FaceDetection> FaceDetector::Detect(const Image& image) {
   const cv::Mat gray = internal::ToGray(image, "FaceDetector::Detect");
-  return DetectIn(gray, {cv::Rect(0, 0, gray.cols, gray.rows)});
+  Search search;
+  search.regions = {cv::Rect(0, 0, gray.cols, gray.rows)};
+  return DetectIn(gray, search);
 }
 
 std::vector<FaceDetection> FaceDetector::Detect(const Image& image,
                                                 const std::vector<cv::Rect>& regions) {
-  return DetectIn(internal::ToGray(image, "FaceDetector::Detect"), regions);
+  Search search;
+  search.regions = regions;
+  return DetectIn(internal::ToGray(image, "FaceDetector::Detect"), search);
 }
 
-std::vector<FaceDetection> FaceDetector::DetectIn(const cv::Mat& gray_image,
-                                                  const std::vector<cv::Rect>& regions) {
+std::vector<FaceDetection> FaceDetector::Detect(const Image& image, const Search& search) {
+  return DetectIn(internal::ToGray(image, "FaceDetector::Detect"), search);
+}
+
+std::vector<FaceDetection> FaceDetector::DetectIn(const cv::Mat& gray_image, const Search& search) {
   cv::Mat gray = gray_image;
   if (options_.equalize_histogram) {
     cv::Mat equalized;
@@ -97,14 +104,17 @@ std::vector<FaceDetection> FaceDetector::DetectIn(const cv::Mat& gray_image,
   const auto reduced = [scale](int px) {
     return std::max(1, static_cast<int>(std::lround(px / scale)));
   };
-  const cv::Size min_size(reduced(options_.min_size_px), reduced(options_.min_size_px));
-  const cv::Size max_size = options_.max_size_px > 0 ? cv::Size(reduced(options_.max_size_px),
-                                                                reduced(options_.max_size_px))
-                                                     : cv::Size();
+  const int min_px = std::max(options_.min_size_px, search.min_size_px);
+  int max_px = options_.max_size_px;
+  if (search.max_size_px > 0)
+    max_px = max_px > 0 ? std::min(max_px, search.max_size_px) : search.max_size_px;
+  if (max_px > 0 && max_px < min_px) return {};  // no size left to search
+  const cv::Size min_size(reduced(min_px), reduced(min_px));
+  const cv::Size max_size = max_px > 0 ? cv::Size(reduced(max_px), reduced(max_px)) : cv::Size();
   const cv::Rect level_rect(0, 0, level.cols, level.rows);
   std::vector<cv::Rect> boxes;
   std::vector<int> neighbors;
-  for (const cv::Rect& region : regions) {
+  for (const cv::Rect& region : search.regions) {
     const cv::Rect r(static_cast<int>(std::floor(region.x / scale)),
                      static_cast<int>(std::floor(region.y / scale)),
                      static_cast<int>(std::ceil(region.width / scale)),
@@ -146,6 +156,18 @@ std::vector<FaceDetection> FaceDetector::DetectIn(const cv::Mat& gray_image,
     FaceDetection& d = out[i];
     d.box = boxes[i];
     d.neighbors = i < neighbors.size() ? neighbors[i] : 0;
+    const auto same =
+        std::find_if(search.checked.begin(), search.checked.end(), [&d](const FaceDetection& c) {
+          const double common = (c.box & d.box).area();
+          const double all = c.box.area() + d.box.area() - common;
+          return all > 0 && common >= kVerdictOverlap * all;
+        });
+    if (same != search.checked.end()) {
+      d.rejected = same->rejected;
+      d.reason = same->reason;
+      d.verdict_from = static_cast<int>(same - search.checked.begin());
+      continue;
+    }
     if (!cat_.empty()) {
       // The cat cascade is trained on tighter, lower boxes than the face cascade's: search a
       // box enlarged by half on each side, for cat faces at least half the candidate's size.

@@ -365,6 +365,49 @@ TEST(FaceDetectorComponent, SearchesTheWholeImageOnTheFirstDetectionsOfANewTarge
   EXPECT_EQ(detect(1), 0u);
 }
 
+// Around a tracked face the detector searches only sizes near the track window's and, between
+// the rechecks, keeps the face's verdict instead of running the cat and eye cascades again
+// (FaceDetector's own tests show both): on the same frames it gives the same faces as checking
+// every time at every size.
+TEST(FaceDetectorComponent, KeepingVerdictsAndBoundingSizesGivesTheSameFaces) {
+  const std::shared_ptr<const Image> image = LeftEyeOnTheAstronaut();
+  ASSERT_TRUE(image);
+  const std::optional<cv::Rect> face = AcceptedBox(DetectWhole(image));
+  ASSERT_TRUE(face);
+  const auto run = [&](const json& params) {
+    auto detector = Make("vision.face_detector", params);
+    auto faces = Capture<FacesMessage>(*detector, "faces");
+    std::vector<std::vector<FacesMessage::Face>> out;
+    for (int64_t step = 0; step < 12; ++step) {
+      TrackMessage track;
+      track.tracking = true;
+      track.target_id = step < 8 ? 0 : 1;  // a new target: whole scans, verdicts forgotten
+      track.window = *face + cv::Point(static_cast<int>(step % 3) - 1, 0);
+      track.center = {track.window.x + 0.5 * track.window.width,
+                      track.window.y + 0.5 * track.window.height};
+      In<TrackMessage>(*detector, "track").Deliver(track);
+      In<runtime::ImageMessage>(*detector, "image").Deliver(runtime::ImageMessage{image});
+      detector->Step(At(step));
+      out.push_back((*faces)->faces);
+    }
+    return out;
+  };
+  const auto every_time =
+      run({{"recheck_every", 1}, {"region_size_factor", 0.0}, {"new_target_scans", 2}});
+  const auto kept =
+      run({{"recheck_every", 5}, {"region_size_factor", 2.0}, {"new_target_scans", 2}});
+  ASSERT_EQ(kept.size(), every_time.size());
+  for (std::size_t k = 0; k < kept.size(); ++k) {
+    ASSERT_EQ(kept[k].size(), every_time[k].size()) << "detection " << k;
+    EXPECT_GT(kept[k].size(), 0u) << "detection " << k;
+    for (std::size_t i = 0; i < kept[k].size(); ++i) {
+      EXPECT_EQ(kept[k][i].box, every_time[k][i].box) << "detection " << k << ", face " << i;
+      EXPECT_EQ(kept[k][i].rejected, every_time[k][i].rejected) << "detection " << k;
+      EXPECT_EQ(kept[k][i].reason, every_time[k][i].reason) << "detection " << k;
+    }
+  }
+}
+
 // The track follows the selected face, and nothing else: when attention moves to a place it
 // has no detection of yet, or explores (its home point, not a face), the last face's track
 // ends, so that neither triangulation nor the detectors keep following a face attention left.
@@ -636,8 +679,7 @@ TEST(ComponentParams, UnknownMissingAndOutOfRangeParametersAreNamed) {
   EXPECT_EQ(message("vision.face_detector", {{"min_neighbours", 3}}),
             "unknown parameter 'min_neighbours' (known: cascade, full_scan_every, latency_steps, "
             "max_size_px, min_neighbors, min_size_px, new_target_scans, pyramid_level, "
-            "realtime_thread, "
-            "region_pyramid_level, "
+            "realtime_thread, recheck_every, region_pyramid_level, region_size_factor, "
             "reject_cats, require_eyes, "
             "scale_factor, track_region_scale)");
   EXPECT_EQ(message("vision.camshift", json::object()),

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <iostream>
+#include <optional>
 #include <string>
 
 #include "portraits.h"
@@ -85,10 +86,90 @@ TEST(FaceDetector, AReducedLevelAndARegionFindTheSameFace) {
     const std::vector<cv::Rect> inside = accepted_on_her(full.Detect(*image, {around}));
     ASSERT_EQ(inside.size(), 1u);
     EXPECT_TRUE(near_reference(inside[0], 4.0)) << inside[0] << " vs " << reference[0];
-    EXPECT_TRUE(full.Detect(*image, {}).empty());
+    EXPECT_TRUE(full.Detect(*image, std::vector<cv::Rect>{}).empty());
     const cv::Rect elsewhere(0, 0, 200, 200);
     ASSERT_EQ((elsewhere & picture).area(), 0);
     EXPECT_TRUE(accepted_on_her(full.Detect(*image, {elsewhere})).empty());
+  }
+}
+
+// A tracker knows the face's size to within a factor: a region search bounded to sizes around
+// it finds the same box as without bounds; bounds that leave her size out find nothing; bounds that
+// cross find nothing either (and search nothing).
+TEST(FaceDetector, ASearchBoundedToTheFacesSizeFindsTheSameBox) {
+  const StereoFrame frame = RenderFixating(FaceCentreWorld("astronaut"));
+  FaceDetector detector;
+  const cv::Rect picture = TruthBox(frame.left_truth, "astronaut");
+  std::optional<cv::Rect> her;
+  for (const FaceDetection& face : detector.Detect(frame.left)) {
+    if (!face.rejected && Overlap(face.box, picture) == 1.0) her = face.box;
+  }
+  ASSERT_TRUE(her);
+  FaceDetector::Search search;
+  search.regions = {
+      cv::Rect(her->x - her->width, her->y - her->height, 3 * her->width, 3 * her->height)};
+  const auto boxes = [&](int min_px, int max_px) {
+    search.min_size_px = min_px;
+    search.max_size_px = max_px;
+    std::vector<cv::Rect> out;
+    for (const FaceDetection& face : detector.Detect(frame.left, search)) {
+      if (!face.rejected) out.push_back(face.box);
+    }
+    return out;
+  };
+  const std::vector<cv::Rect> unbounded = boxes(0, 0);
+  ASSERT_EQ(unbounded.size(), 1u);
+  // The region's box: the mean of the cascade's hits on her, which the region cuts a few of.
+  EXPECT_NEAR(unbounded[0].x, her->x, 0.05 * her->width);
+  EXPECT_NEAR(unbounded[0].width, her->width, 0.05 * her->width);
+  const std::vector<cv::Rect> bounded = boxes(her->width / 2, her->width * 2);
+  ASSERT_EQ(bounded.size(), 1u);
+  EXPECT_EQ(bounded[0], unbounded[0]);            // the same hits: none lay outside the bounds
+  EXPECT_TRUE(boxes(her->width * 2, 0).empty());  // only larger faces
+  EXPECT_TRUE(boxes(0, her->width / 2).empty());  // only smaller faces
+  EXPECT_TRUE(boxes(her->width, her->width / 2).empty());
+}
+
+// A box that overlaps one checked on an earlier frame takes its verdict instead of running the
+// cat and eye cascades: a made-up verdict on her box shows which was used. A checked box
+// elsewhere changes nothing.
+TEST(FaceDetector, ABoxCheckedBeforeKeepsItsVerdict) {
+  const StereoFrame frame = RenderFixating(FaceCentreWorld("astronaut"));
+  FaceDetector detector;
+  const cv::Rect picture = TruthBox(frame.left_truth, "astronaut");
+  std::optional<FaceDetection> her;
+  for (const FaceDetection& face : detector.Detect(frame.left)) {
+    if (!face.rejected && Overlap(face.box, picture) == 1.0) her = face;
+  }
+  ASSERT_TRUE(her);
+  EXPECT_EQ(her->verdict_from, -1);  // checked on this frame
+  FaceDetector::Search search;
+  search.regions = {cv::Rect(0, 0, frame.left.width(), frame.left.height())};
+  FaceDetection elsewhere;
+  elsewhere.box = cv::Rect(0, 0, her->box.width, her->box.height);
+  elsewhere.rejected = true;
+  elsewhere.reason = "made up";
+  FaceDetection before = elsewhere;  // her box a pixel off, as a tracked face moves
+  before.box = her->box + cv::Point(1, 1);
+  search.checked = {elsewhere, before};
+  bool found = false;
+  for (const FaceDetection& face : detector.Detect(frame.left, search)) {
+    if (face.box != her->box) {
+      EXPECT_NE(face.verdict_from, 0) << face.box;  // nothing overlaps the box elsewhere
+      continue;
+    }
+    found = true;
+    EXPECT_EQ(face.verdict_from, 1);
+    EXPECT_TRUE(face.rejected);
+    EXPECT_EQ(face.reason, "made up");
+  }
+  EXPECT_TRUE(found);
+  search.checked = {elsewhere};
+  for (const FaceDetection& face : detector.Detect(frame.left, search)) {
+    if (face.box == her->box) {
+      EXPECT_EQ(face.verdict_from, -1);
+      EXPECT_FALSE(face.rejected) << face.reason;
+    }
   }
 }
 

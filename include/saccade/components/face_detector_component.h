@@ -12,7 +12,11 @@
 // first `new_target_scans` detections of a new target (the track's target_id changed): the
 // saccade to it blurs the images and a tracker may slip onto another face meanwhile; a region
 // around that face would keep finding it, and the two eyes' faces would not pair again until
-// the next whole scan.
+// the next whole scan. Around the track it searches only faces of the track window's size
+// to within `region_size_factor`. The cat and eye checks are most of a search around a face:
+// a face seen again at about the same place keeps its verdict for `recheck_every` - 1
+// searches (the eyes move little between frames while they fixate or pursue; a new target,
+// and the saccade to it, forgets every verdict).
 // Parameters: declared in the constructor (docs/components.md lists them).
 //
 // Detect slowly, track fast: with latency_steps N > 0 the detector works on a thread of its
@@ -47,9 +51,14 @@ class FaceDetectorComponent : public runtime::Component {
   struct Search {
     bool whole = true;
     std::optional<cv::Rect> region;
+    int min_size_px = 0;  // the region's face sides (0: the parameters' bounds)
+    int max_size_px = 0;
+    std::vector<vision::FaceDetection> checked;  // verdicts to reuse (recheck_every)
+    std::vector<int> checked_reuses;             // how often each was reused in a row
   };
   Search NextSearch(const Image& image);
   FacesMessage Detect(std::shared_ptr<const Image> image, const Search& search);
+  void Remember(const std::vector<vision::FaceDetection>& found, const Search& search);
 
   vision::FaceDetector::Options options_;
   std::string cascade_ = "haar";
@@ -61,6 +70,17 @@ class FaceDetectorComponent : public runtime::Component {
   int full_scan_every_ = 5;
   int region_pyramid_level_ = 0;
   int new_target_scans_ = 5;
+  double region_size_factor_ = 2.0;
+  int recheck_every_ = 5;
+  // The faces seen lately and their verdicts: `reuses` searches in a row took the verdict
+  // without checking again; `age` searches have not seen the face since. Written by Detect (on
+  // the detection's thread when it has one; NextSearch reads them once it has been collected).
+  struct Verdict {
+    vision::FaceDetection face;
+    int reuses = 0;
+    int age = 0;
+  };
+  std::vector<Verdict> verdicts_;
   int64_t detections_ = 0;       // started so far
   int64_t last_target_id_ = -1;  // the track's target at the last detection
   int whole_scans_left_ = 0;     // of new_target_scans

@@ -21,6 +21,9 @@ struct FaceDetection {
   int neighbors = 0;  ///< raw cascade hits merged into this box: the detector's confidence
   bool rejected = false;
   std::string reason;  ///< why it was rejected ("" when not)
+  /// The index in FaceDetector::Search::checked of the box, checked on an earlier frame, whose
+  /// verdict (rejected, reason) this one took; -1: the cat and eye cascades ran on this one.
+  int verdict_from = -1;
   cv::Point2d Center() const {
     return {box.x + (box.width - 1) / 2.0, box.y + (box.height - 1) / 2.0};
   }
@@ -81,10 +84,27 @@ class FaceDetector {
   /// list searches nothing. Boxes found in overlapping regions are merged.
   std::vector<FaceDetection> Detect(const Image& image, const std::vector<cv::Rect>& regions);
 
+  /// What one call searches, for a caller that knows more than the options: a tracker's
+  /// window gives where the face is, its size to within a factor, and its verdict.
+  struct Search {
+    /// Image pixels, clipped to it; an empty list searches nothing.
+    std::vector<cv::Rect> regions;
+    /// Face sides searched (image pixels), within the options' min_size_px and max_size_px;
+    /// 0: the options' bound alone.
+    int min_size_px = 0;
+    int max_size_px = 0;
+    /// Candidates checked on an earlier frame: a box that overlaps one of them by at least
+    /// kVerdictOverlap of their union takes its verdict instead of running the cat and eye
+    /// cascades again (they are most of the cost of a search around a tracked face).
+    std::vector<FaceDetection> checked;
+  };
+  static constexpr double kVerdictOverlap = 0.7;
+  std::vector<FaceDetection> Detect(const Image& image, const Search& search);
+
   const Options& options() const { return options_; }
 
  private:
-  std::vector<FaceDetection> DetectIn(const cv::Mat& gray, const std::vector<cv::Rect>& regions);
+  std::vector<FaceDetection> DetectIn(const cv::Mat& gray, const Search& search);
 
   Options options_;
   cv::CascadeClassifier face_;
