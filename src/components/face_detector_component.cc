@@ -21,6 +21,7 @@ using internal::FrameOf;
 FaceDetectorComponent::FaceDetectorComponent()
     : image_(AddInput<runtime::ImageMessage>("image", /*required=*/true)),
       track_(AddInput<TrackMessage>("track")),
+      selection_(AddInput<SelectionMessage>("selection")),
       faces_(AddOutput<FacesMessage>("faces")) {
   DeclareParam("cascade", &cascade_,
                "the face cascade: haar (alt2) or lbp (frontalface_improved; on "
@@ -48,8 +49,9 @@ FaceDetectorComponent::FaceDetectorComponent()
                "with a track region: search the whole image every N-th detection")
       .Range(1, 1000000);
   DeclareParam("new_target_scans", &new_target_scans_,
-               "with a track region: search the whole image too on the first N detections of a "
-               "new target (a saccade's blur may carry a tracker onto another face)")
+               "with a track region: on the first N detections of a new target (a saccade's "
+               "blur may carry a tracker onto another face) search also around where the "
+               "selection input puts it or, without one, the whole image")
       .Range(0, 1000000);
   DeclareParam("region_size_factor", &region_size_factor_,
                "with a track region: search faces from the track window's side / F to its side x "
@@ -105,22 +107,74 @@ FaceDetectorComponent::Search FaceDetectorComponent::NextSearch(const Image& ima
       search.checked_reuses.push_back(v.reuses);
     }
   }
-  if (!track.tracking || track.window.area() <= 0) return search;
-  const double w = track_region_scale_ * track.window.width;
-  const double h = track_region_scale_ * track.window.height;
-  const cv::Rect region(static_cast<int>(std::floor(track.center.x - 0.5 * w)),
-                        static_cast<int>(std::floor(track.center.y - 0.5 * h)),
-                        static_cast<int>(std::ceil(w)), static_cast<int>(std::ceil(h)));
-  search.region = region & cv::Rect(0, 0, image.width(), image.height());
-  if (region_size_factor_ > 0.0) {
-    const int small = std::min(track.window.width, track.window.height);
-    const int large = std::max(track.window.width, track.window.height);
-    search.min_size_px = static_cast<int>(std::floor(small / region_size_factor_));
-    search.max_size_px = static_cast<int>(std::ceil(large * region_size_factor_));
+  const bool tracking = track.tracking && track.window.area() > 0;
+  if (tracking) {
+    const double w = track_region_scale_ * track.window.width;
+    const double h = track_region_scale_ * track.window.height;
+    const cv::Rect region(static_cast<int>(std::floor(track.center.x - 0.5 * w)),
+                          static_cast<int>(std::floor(track.center.y - 0.5 * h)),
+                          static_cast<int>(std::ceil(w)), static_cast<int>(std::ceil(h)));
+    search.region = region & cv::Rect(0, 0, image.width(), image.height());
+    SizesAround(track.window.size(), &search);
   }
-  search.whole = n % full_scan_every_ == 0 || whole_scans_left_ > 0;
-  if (whole_scans_left_ > 0) --whole_scans_left_;
+  // Without a track, the whole image (searching around where the selection puts a lost target
+  // instead left the eyes less steady: bench/baselines/loop-issue14-2core.md).
+  search.whole = !tracking || n % full_scan_every_ == 0;
+  // A new target: around where the selection puts it, or else the whole image.
+  if (tracking && whole_scans_left_ > 0) {
+    --whole_scans_left_;
+    cv::Size face;
+    search.predicted = PredictedRegion(image, track.target_id, &face);
+    if (search.predicted) {
+      SizesAround(face, &search);
+    } else {
+      search.whole = true;
+    }
+  }
   return search;
+}
+
+void FaceDetectorComponent::SizesAround(const cv::Size& face, Search* search) const {
+  if (!(region_size_factor_ > 0.0)) return;
+  const int low =
+      static_cast<int>(std::floor(std::min(face.width, face.height) / region_size_factor_));
+  const int high =
+      static_cast<int>(std::ceil(std::max(face.width, face.height) * region_size_factor_));
+  const bool first = search->max_size_px == 0;  // no bounds yet
+  search->min_size_px = first ? low : std::min(search->min_size_px, low);
+  search->max_size_px = first ? high : std::max(search->max_size_px, high);
+}
+
+std::optional<cv::Rect> FaceDetectorComponent::PredictedRegion(const Image& image,
+                                                               int64_t target_id, cv::Size* face) {
+  if (!selection_.has_value()) return std::nullopt;
+  const SelectionMessage& selection = selection_.value();
+  if (!selection.valid || selection.exploring || selection.target_id != target_id) {
+    return std::nullopt;
+  }
+  if (selection.boxes_fresh) {
+    target_size_id_ = target_id;
+    target_size_ = cv::Size(std::max(selection.left_box.width, selection.right_box.width),
+                            std::max(selection.left_box.height, selection.right_box.height));
+  }
+  if (target_size_id_ != target_id || target_size_.area() <= 0) return std::nullopt;
+  std::optional<Eigen::Vector2d> at;
+  try {
+    at =
+        vision::CameraModelOf(image).Project(vision::CameraPoseOf(image).inverse() * selection.p_W);
+  } catch (const InvalidArgument&) {
+    return std::nullopt;  // an image without its camera (a source that does not say)
+  }
+  if (!at) return std::nullopt;
+  const double w = track_region_scale_ * target_size_.width;
+  const double h = track_region_scale_ * target_size_.height;
+  const cv::Rect region = cv::Rect(static_cast<int>(std::floor(at->x() - 0.5 * w)),
+                                   static_cast<int>(std::floor(at->y() - 0.5 * h)),
+                                   static_cast<int>(std::ceil(w)), static_cast<int>(std::ceil(h))) &
+                          cv::Rect(0, 0, image.width(), image.height());
+  if (region.area() <= 0) return std::nullopt;
+  *face = target_size_;
+  return region;
 }
 
 FacesMessage FaceDetectorComponent::Detect(std::shared_ptr<const Image> image,
@@ -134,11 +188,14 @@ FacesMessage FaceDetectorComponent::Detect(std::shared_ptr<const Image> image,
     whole.checked = search.checked;
     found = detector_->Detect(*out.image, whole);
   }
-  if (search.region) {
-    // The tracked face from the region, at the region's pyramid level: it replaces the whole
+  std::vector<cv::Rect> regions;
+  if (search.region) regions.push_back(*search.region);
+  if (search.predicted) regions.push_back(*search.predicted);
+  if (!regions.empty()) {
+    // The tracked face from the regions, at the region's pyramid level: it replaces the whole
     // image's boxes that overlap it.
     vision::FaceDetector::Search around;
-    around.regions = {*search.region};
+    around.regions = regions;
     around.min_size_px = search.min_size_px;
     around.max_size_px = search.max_size_px;
     around.checked = search.checked;

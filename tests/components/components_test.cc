@@ -365,6 +365,63 @@ TEST(FaceDetectorComponent, SearchesTheWholeImageOnTheFirstDetectionsOfANewTarge
   EXPECT_EQ(detect(1), 0u);
 }
 
+// With attention's selection connected, a new target's first detections search around where
+// its 3D point projects in the image, not the whole image: the astronaut is found where the
+// selection puts her, nothing where it puts a point of the sky (the whole image would have
+// found her), and without a selection of that target the whole image is searched again.
+TEST(FaceDetectorComponent, SearchesANewTargetWhereTheSelectionPutsIt) {
+  const std::shared_ptr<const Image> image = LeftEyeOnTheAstronaut();
+  ASSERT_TRUE(image);
+  const std::optional<cv::Rect> face = AcceptedBox(DetectWhole(image));
+  ASSERT_TRUE(face);
+  const Eigen::Vector3d her = FaceCentreAt(Scene(), Astronaut(), 0.0);
+  // A point of the sky, up and left of her in this image, out of reach of a box around her.
+  const geometry::Pose X_WC = vision::CameraPoseOf(*image);
+  const Eigen::Vector3d sky = X_WC * Eigen::Vector3d(-0.5, -0.4, 2.5);
+  const std::optional<Eigen::Vector2d> sky_px =
+      vision::CameraModelOf(*image).Project(X_WC.inverse() * sky);
+  ASSERT_TRUE(sky_px);
+  ASSERT_TRUE(
+      cv::Rect(0, 0, image->width(), image->height())
+          .contains(cv::Point(static_cast<int>(sky_px->x()), static_cast<int>(sky_px->y()))));
+  ASSERT_GT(cv::norm(cv::Point2d(sky_px->x(), sky_px->y()) -
+                     cv::Point2d(face->x + 0.5 * face->width, face->y + 0.5 * face->height)),
+            3.0 * face->width);
+
+  auto detector =
+      Make("vision.face_detector",
+           {{"track_region_scale", 2.0}, {"full_scan_every", 1000}, {"new_target_scans", 2}});
+  auto faces = Capture<FacesMessage>(*detector, "faces");
+  int64_t step = 1;  // not a multiple of full_scan_every's
+  const auto detect = [&](int64_t target_id, const std::optional<Eigen::Vector3d>& p_W) {
+    TrackMessage track;  // on the sky, far from every face
+    track.tracking = true;
+    track.target_id = target_id;
+    track.window = cv::Rect(20, 20, 80, 80);
+    track.center = {60.0, 60.0};
+    In<TrackMessage>(*detector, "track").Deliver(track);
+    SelectionMessage selection;
+    selection.valid = p_W.has_value();
+    selection.target_id = target_id;
+    selection.p_W = p_W.value_or(Eigen::Vector3d::Zero());
+    selection.boxes_fresh = true;
+    selection.left_box = selection.right_box = *face;
+    In<SelectionMessage>(*detector, "selection").Deliver(selection);
+    In<runtime::ImageMessage>(*detector, "image").Deliver(runtime::ImageMessage{image});
+    detector->Step(At(step++));
+    return AcceptedBox(**faces);
+  };
+  const std::optional<cv::Rect> found = detect(0, her);  // target 0: her face
+  ASSERT_TRUE(found);
+  EXPECT_LT(cv::norm((found->tl() + found->br()) - (face->tl() + face->br())) / 2.0,
+            0.05 * face->width);
+  EXPECT_FALSE(detect(1, sky));  // target 1: the sky; the whole image would find her
+  EXPECT_FALSE(detect(1, sky));
+  EXPECT_TRUE(detect(2, std::nullopt));  // no selection: the whole image
+  EXPECT_TRUE(detect(2, std::nullopt));
+  EXPECT_FALSE(detect(2, std::nullopt));  // then around the track only
+}
+
 // Around a tracked face the detector searches only sizes near the track window's and, between
 // the rechecks, keeps the face's verdict instead of running the cat and eye cascades again
 // (FaceDetector's own tests show both): on the same frames it gives the same faces as checking

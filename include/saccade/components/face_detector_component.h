@@ -2,8 +2,9 @@
 // vision.face_detector -- Haar or LBP faces with the cat and eye checks
 // (vision/face_detector.h).
 //   inputs: image (runtime.image, required); track (vision.track, optional: this eye's
-//           CamShift track, connect it with delay 1); outputs: faces (vision.faces), with the
-//           image they were found in (its time is their capture time).
+//           CamShift track, connect it with delay 1); selection (vision.selection, optional:
+//           attention's, with delay 1); outputs: faces (vision.faces), with the image they
+//           were found in (its time is their capture time).
 //
 // While the track input (when connected) follows a target and `track_region_scale` > 0 (2.5
 // by default), the detector searches a box that many times the track's window around it (at
@@ -12,12 +13,16 @@
 // first `new_target_scans` detections of a new target (the track's target_id changed): the
 // saccade to it blurs the images and a tracker may slip onto another face meanwhile; a region
 // around that face would keep finding it, and the two eyes' faces would not pair again until
-// the next whole scan. Around the track it searches only faces of the track window's size
-// to within `region_size_factor`. The cat and eye checks are most of a search around a face:
-// a face seen again at about the same place keeps its verdict for `recheck_every` - 1
-// searches (the eyes move little between frames while they fixate or pursue; a new target,
-// and the saccade to it, forgets every verdict).
-// Parameters: declared in the constructor (docs/components.md lists them).
+// the next whole scan. With the selection input, those detections search instead a box
+// `track_region_scale` times the target's face (its boxes when attention selected it) around
+// where the selection's 3D point projects in the image (its camera and pose, from the
+// image's metadata): the target's face whatever the tracker did, at a fraction of the cost
+// of the whole image (which they still search when the image carries no camera). Around the track
+// it searches only faces of the track window's size to within `region_size_factor`. The cat and eye
+// checks are most of a search around a face: a face seen again at about the same place keeps its
+// verdict for `recheck_every` - 1 searches (the eyes move little between frames while they fixate
+// or pursue; a new target, and the saccade to it, forgets every verdict). Parameters: declared in
+// the constructor (docs/components.md lists them).
 //
 // Detect slowly, track fast: with latency_steps N > 0 the detector works on a thread of its
 // own, on the newest image it can take, while the loop goes on; its faces are emitted N steps
@@ -51,12 +56,18 @@ class FaceDetectorComponent : public runtime::Component {
   struct Search {
     bool whole = true;
     std::optional<cv::Rect> region;
-    int min_size_px = 0;  // the region's face sides (0: the parameters' bounds)
+    std::optional<cv::Rect> predicted;  // around where the selection puts a new target
+    int min_size_px = 0;                // the region's face sides (0: the parameters' bounds)
     int max_size_px = 0;
     std::vector<vision::FaceDetection> checked;  // verdicts to reuse (recheck_every)
     std::vector<int> checked_reuses;             // how often each was reused in a row
   };
   Search NextSearch(const Image& image);
+  // A box track_region_scale times the target's size around where the selection's point
+  // projects in `image`; none without a selection of that target, a known size, or a camera.
+  // Widens search's face sides to cover `face`'s size to within region_size_factor.
+  void SizesAround(const cv::Size& face, Search* search) const;
+  std::optional<cv::Rect> PredictedRegion(const Image& image, int64_t target_id, cv::Size* face);
   FacesMessage Detect(std::shared_ptr<const Image> image, const Search& search);
   void Remember(const std::vector<vision::FaceDetection>& found, const Search& search);
 
@@ -67,7 +78,7 @@ class FaceDetectorComponent : public runtime::Component {
   int latency_steps_ = 0;
   bool realtime_thread_ = true;
   double track_region_scale_ = 2.5;
-  int full_scan_every_ = 5;
+  int full_scan_every_ = 10;
   int region_pyramid_level_ = 0;
   int new_target_scans_ = 5;
   double region_size_factor_ = 2.0;
@@ -90,6 +101,9 @@ class FaceDetectorComponent : public runtime::Component {
   std::shared_ptr<const Image> last_;  // the image detected last
   runtime::Input<runtime::ImageMessage>& image_;
   runtime::Input<TrackMessage>& track_;
+  runtime::Input<SelectionMessage>& selection_;
+  int64_t target_size_id_ = -1;  // the target whose face size is known
+  cv::Size target_size_;         // its boxes' size when last detected
   runtime::Output<FacesMessage>& faces_;
   std::unique_ptr<vision::FaceDetector> detector_;         // the whole image
   std::unique_ptr<vision::FaceDetector> region_detector_;  // around the track
