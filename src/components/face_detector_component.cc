@@ -18,6 +18,15 @@ namespace saccade::components {
 using internal::Centre;
 using internal::FrameOf;
 
+namespace {
+
+// Two boxes of one face: they overlap by more than half the smaller one.
+bool SameFace(const cv::Rect& a, const cv::Rect& b) {
+  return (a & b).area() > 0.5 * std::min(a.area(), b.area());
+}
+
+}  // namespace
+
 FaceDetectorComponent::FaceDetectorComponent()
     : image_(AddInput<runtime::ImageMessage>("image", /*required=*/true)),
       track_(AddInput<TrackMessage>("track")),
@@ -201,9 +210,8 @@ FacesMessage FaceDetectorComponent::Detect(std::shared_ptr<const Image> image,
     around.checked = search.checked;
     const std::vector<vision::FaceDetection> near = region_detector_->Detect(*out.image, around);
     std::erase_if(found, [&near](const vision::FaceDetection& d) {
-      return std::any_of(near.begin(), near.end(), [&d](const vision::FaceDetection& r) {
-        return (d.box & r.box).area() > 0.5 * std::min(d.box.area(), r.box.area());
-      });
+      return std::any_of(near.begin(), near.end(),
+                         [&d](const vision::FaceDetection& r) { return SameFace(d.box, r.box); });
     });
     found.insert(found.end(), near.begin(), near.end());
     std::stable_sort(found.begin(), found.end(),
@@ -225,10 +233,8 @@ void FaceDetectorComponent::Remember(const std::vector<vision::FaceDetection>& f
   // The faces this search did not see (outside the region) are kept until the next whole scan.
   for (const Verdict& v : verdicts_) {
     if (v.age + 1 >= full_scan_every_) continue;
-    const bool again = std::any_of(found.begin(), found.end(), [&v](const auto& d) {
-      const double common = (v.face.box & d.box).area();
-      return common > 0.5 * std::min(v.face.box.area(), d.box.area());
-    });
+    const bool again = std::any_of(found.begin(), found.end(),
+                                   [&v](const auto& d) { return SameFace(v.face.box, d.box); });
     if (!again) seen.push_back({v.face, v.reuses, v.age + 1});
   }
   verdicts_ = std::move(seen);

@@ -106,8 +106,9 @@ std::vector<FaceDetection> FaceDetector::DetectIn(const cv::Mat& gray_image, con
   };
   const int min_px = std::max(options_.min_size_px, search.min_size_px);
   int max_px = options_.max_size_px;
-  if (search.max_size_px > 0)
+  if (search.max_size_px > 0) {
     max_px = max_px > 0 ? std::min(max_px, search.max_size_px) : search.max_size_px;
+  }
   if (max_px > 0 && max_px < min_px) return {};  // no size left to search
   const cv::Size min_size(reduced(min_px), reduced(min_px));
   const cv::Size max_size = max_px > 0 ? cv::Size(reduced(max_px), reduced(max_px)) : cv::Size();

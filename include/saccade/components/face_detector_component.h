@@ -15,14 +15,16 @@
 // around that face would keep finding it, and the two eyes' faces would not pair again until
 // the next whole scan. With the selection input, those detections search instead a box
 // `track_region_scale` times the target's face (its boxes when attention selected it) around
-// where the selection's 3D point projects in the image (its camera and pose, from the
-// image's metadata): the target's face whatever the tracker did, at a fraction of the cost
-// of the whole image (which they still search when the image carries no camera). Around the track
-// it searches only faces of the track window's size to within `region_size_factor`. The cat and eye
-// checks are most of a search around a face: a face seen again at about the same place keeps its
-// verdict for `recheck_every` - 1 searches (the eyes move little between frames while they fixate
-// or pursue; a new target, and the saccade to it, forgets every verdict). Parameters: declared in
-// the constructor (docs/components.md lists them).
+// where the selection's 3D point projects in the image (its camera and pose, from the image's
+// metadata): the target's face whatever the tracker did, at a fraction of the cost of the
+// whole image (which they still search when the image carries no camera).
+//
+// Around the track it searches only faces of the track window's size to within
+// `region_size_factor`. The cat and eye checks are most of a search around a face: a face
+// seen again at about the same place keeps its verdict for `recheck_every` - 1 searches (the
+// eyes move little between frames while they fixate or pursue; a new target, and the saccade
+// to it, forgets every verdict).
+// Parameters: declared in the constructor (docs/components.md lists them).
 //
 // Detect slowly, track fast: with latency_steps N > 0 the detector works on a thread of its
 // own, on the newest image it can take, while the loop goes on; its faces are emitted N steps
@@ -63,10 +65,11 @@ class FaceDetectorComponent : public runtime::Component {
     std::vector<int> checked_reuses;             // how often each was reused in a row
   };
   Search NextSearch(const Image& image);
-  // A box track_region_scale times the target's size around where the selection's point
-  // projects in `image`; none without a selection of that target, a known size, or a camera.
   // Widens search's face sides to cover `face`'s size to within region_size_factor.
   void SizesAround(const cv::Size& face, Search* search) const;
+  // A box track_region_scale times the target's size around where the selection's point
+  // projects in `image` (the size in `face`); none without a selection of that target, a
+  // known size, or a camera.
   std::optional<cv::Rect> PredictedRegion(const Image& image, int64_t target_id, cv::Size* face);
   FacesMessage Detect(std::shared_ptr<const Image> image, const Search& search);
   void Remember(const std::vector<vision::FaceDetection>& found, const Search& search);
