@@ -76,9 +76,13 @@ void TriangulateComponent::Step(const runtime::StepContext& context) {
   }
   const bool detection_now =
       selection->boxes_fresh && (!tracked || selection->frame_index == FrameOf(l->image));
-  if (tracked && (prefer_tracks_ || !detection_now)) {
+  // Without an offset for this target (the tracks started after the frame of its last
+  // detection, as when a late detection reseeds them), the detection's point stands: the
+  // tracks' own point can be centimetres off.
+  const bool anchored = offset_target_ == selection->target_id;
+  if (tracked && (prefer_tracks_ || (!detection_now && anchored))) {
     out.p_W = tracked->p_W;
-    if (!prefer_tracks_ && offset_target_ == selection->target_id) out.p_W += offset_;
+    if (!prefer_tracks_) out.p_W += offset_;
     out.source = "tracks";
     out.reprojection_px = tracked->reprojection_px;
     out.gap_m = tracked->gap_m;

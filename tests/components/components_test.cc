@@ -465,6 +465,77 @@ TEST(FaceDetectorComponent, KeepingVerdictsAndBoundingSizesGivesTheSameFaces) {
   }
 }
 
+// A late detection (the real-time clock, latency_steps) can reseed the tracks after the frame
+// it came from: the tracks then have no point in that frame to anchor them to it, and the
+// detection's point stands rather than theirs (a CamShift window is not the face's box); once
+// a detection comes in a frame the tracks have, the tracks carry the target from there.
+TEST(TriangulateComponent, UntilTheTracksAreAnchoredToADetectionItsPointStands) {
+  const scene::Scene& scene = Scene();
+  const Eigen::Vector3d face = FaceCentreAt(scene, Astronaut(), 0.0);
+  const head::IkResult look = head::SolveFixation(scene.robot()->head, face);
+  ASSERT_TRUE(look.reachable());
+  const auto at_frame = [](const std::shared_ptr<const Image>& image, int64_t frame) {
+    auto copy = std::make_shared<Image>(*image);
+    copy->metadata().frame_index = frame;
+    return std::shared_ptr<const Image>(copy);
+  };
+  const std::shared_ptr<const Image> left = RenderOne(kScene, "left", look.joints, {});
+  const std::shared_ptr<const Image> right = RenderOne(kScene, "right", look.joints, {});
+  const std::optional<cv::Rect> left_box = AcceptedBox(DetectWhole(left));
+  const std::optional<cv::Rect> right_box = AcceptedBox(DetectWhole(right));
+  ASSERT_TRUE(left_box && right_box);
+
+  const auto track = [](const std::shared_ptr<const Image>& image, const cv::Rect& box) {
+    TrackMessage t;  // a window slid down the face, as CamShift's does onto the neck
+    t.image = image;
+    t.target_id = 0;
+    t.tracking = true;
+    t.window = box + cv::Point(0, box.height / 4);
+    t.center = {t.window.x + 0.5 * t.window.width, t.window.y + 0.5 * t.window.height};
+    return t;
+  };
+  const auto selection = [&](int64_t frame, bool fresh) {
+    SelectionMessage s;
+    s.valid = true;
+    s.target_id = 0;
+    s.p_W = face;  // the detections' point
+    s.frame_index = frame;
+    s.boxes_fresh = fresh;
+    s.left_box = *left_box;
+    s.right_box = *right_box;
+    return s;
+  };
+  const auto step = [&](runtime::Component& c, int64_t k, int64_t track_frame,
+                        const SelectionMessage& s) {
+    auto target = Capture<TargetMessage>(c, "target");
+    In<TrackMessage>(c, "left").Deliver(track(at_frame(left, track_frame), *left_box));
+    In<TrackMessage>(c, "right").Deliver(track(at_frame(right, track_frame), *right_box));
+    In<SelectionMessage>(c, "selection").Deliver(s);
+    c.Step(At(k));
+    EXPECT_TRUE(target->has_value());
+    return target->value_or(TargetMessage{});
+  };
+  // The tracks' own point, for scale: centimetres from the face centre.
+  auto raw = Make("vision.triangulate", {{"prefer", "tracks"}});
+  const TargetMessage tracks_alone = step(*raw, 0, 8, selection(6, true));
+  ASSERT_EQ(tracks_alone.source, "tracks");
+  EXPECT_GT((tracks_alone.p_W - face).norm(), 0.01);
+
+  auto triangulate = Make("vision.triangulate", json::object());
+  // A detection of frame 6 arrives while the tracks, reseeded from it, are at frame 8.
+  const TargetMessage late = step(*triangulate, 0, 8, selection(6, true));
+  EXPECT_EQ(late.source, "selection");
+  EXPECT_LT((late.p_W - face).norm(), 1e-9);
+  const TargetMessage between = step(*triangulate, 1, 9, selection(9, false));
+  EXPECT_EQ(between.source, "selection");  // still no anchor
+  EXPECT_LT((between.p_W - face).norm(), 1e-9);
+  // A detection of frame 9, a frame the tracks have: anchored from then on.
+  EXPECT_EQ(step(*triangulate, 2, 10, selection(9, true)).source, "tracks");
+  const TargetMessage anchored = step(*triangulate, 3, 11, selection(11, false));
+  EXPECT_EQ(anchored.source, "tracks");
+  EXPECT_LT((anchored.p_W - face).norm(), 1e-6);  // the tracks moved by the detection's offset
+}
+
 // The track follows the selected face, and nothing else: when attention moves to a place it
 // has no detection of yet, or explores (its home point, not a face), the last face's track
 // ends, so that neither triangulation nor the detectors keep following a face attention left.

@@ -9,7 +9,9 @@
 //   steps), the tracks' point is moved by the offset between the last detection of the target
 //   and the tracks' point in that detection's frame: between detections the target moves as
 //   the tracks move, from where the detection put it. A late detection (vision.face_detector's
-//   latency_steps) is anchored in the frame it came from the same way.
+//   latency_steps, and the real-time clock) is anchored in the frame it came from the same
+//   way; until the tracks have a point in the frame of a detection of the target (they
+//   started after it), the detection's point stands instead of theirs.
 //   inputs: left, right (vision.track, required), selection (vision.selection, required)
 //   outputs: target (vision.target)
 // Parameters: declared in the constructor (docs/components.md lists them).
