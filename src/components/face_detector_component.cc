@@ -25,6 +25,16 @@ bool SameFace(const cv::Rect& a, const cv::Rect& b) {
   return (a & b).area() > 0.5 * std::min(a.area(), b.area());
 }
 
+// A box `scale` times `size` centred on (cx, cy), clipped to `image`.
+cv::Rect BoxAround(double cx, double cy, const cv::Size& size, double scale, const Image& image) {
+  const double w = scale * size.width;
+  const double h = scale * size.height;
+  return cv::Rect(static_cast<int>(std::floor(cx - 0.5 * w)),
+                  static_cast<int>(std::floor(cy - 0.5 * h)), static_cast<int>(std::ceil(w)),
+                  static_cast<int>(std::ceil(h))) &
+         cv::Rect(0, 0, image.width(), image.height());
+}
+
 }  // namespace
 
 FaceDetectorComponent::FaceDetectorComponent()
@@ -118,12 +128,8 @@ FaceDetectorComponent::Search FaceDetectorComponent::NextSearch(const Image& ima
   }
   const bool tracking = track.tracking && track.window.area() > 0;
   if (tracking) {
-    const double w = track_region_scale_ * track.window.width;
-    const double h = track_region_scale_ * track.window.height;
-    const cv::Rect region(static_cast<int>(std::floor(track.center.x - 0.5 * w)),
-                          static_cast<int>(std::floor(track.center.y - 0.5 * h)),
-                          static_cast<int>(std::ceil(w)), static_cast<int>(std::ceil(h)));
-    search.region = region & cv::Rect(0, 0, image.width(), image.height());
+    search.region =
+        BoxAround(track.center.x, track.center.y, track.window.size(), track_region_scale_, image);
     SizesAround(track.window.size(), &search);
   }
   // Without a track, the whole image (searching around where the selection puts a lost target
@@ -175,12 +181,7 @@ std::optional<cv::Rect> FaceDetectorComponent::PredictedRegion(const Image& imag
     return std::nullopt;  // an image without its camera (a source that does not say)
   }
   if (!at) return std::nullopt;
-  const double w = track_region_scale_ * target_size_.width;
-  const double h = track_region_scale_ * target_size_.height;
-  const cv::Rect region = cv::Rect(static_cast<int>(std::floor(at->x() - 0.5 * w)),
-                                   static_cast<int>(std::floor(at->y() - 0.5 * h)),
-                                   static_cast<int>(std::ceil(w)), static_cast<int>(std::ceil(h))) &
-                          cv::Rect(0, 0, image.width(), image.height());
+  const cv::Rect region = BoxAround(at->x(), at->y(), target_size_, track_region_scale_, image);
   if (region.area() <= 0) return std::nullopt;
   *face = target_size_;
   return region;
