@@ -27,11 +27,17 @@ bool SameFace(const cv::Rect& a, const cv::Rect& b) {
 
 // A box `scale` times `size` centred on (cx, cy), clipped to `image`.
 cv::Rect BoxAround(double cx, double cy, const cv::Size& size, double scale, const Image& image) {
+  // A point the head fixates projects onto the principal point, often (width - 1) / 2 exactly
+  // in one process and within 1e-13 px of it in another (the poses cross DDS as quaternions):
+  // rounded at exactly an integer, those would give boxes a pixel apart and the runs would part.
+  // Values within kSnapPx of an integer count as that integer.
+  constexpr double kSnapPx = 1e-6;
   const double w = scale * size.width;
   const double h = scale * size.height;
-  return cv::Rect(static_cast<int>(std::floor(cx - 0.5 * w)),
-                  static_cast<int>(std::floor(cy - 0.5 * h)), static_cast<int>(std::ceil(w)),
-                  static_cast<int>(std::ceil(h))) &
+  return cv::Rect(static_cast<int>(std::floor(cx - 0.5 * w + kSnapPx)),
+                  static_cast<int>(std::floor(cy - 0.5 * h + kSnapPx)),
+                  static_cast<int>(std::ceil(w - kSnapPx)),
+                  static_cast<int>(std::ceil(h - kSnapPx))) &
          cv::Rect(0, 0, image.width(), image.height());
 }
 
