@@ -96,6 +96,11 @@ FaceDetectorComponent::FaceDetectorComponent()
       .Range(0, 1000);
   DeclareParam("scale_factor", &options_.scale_factor, "size step between pyramid levels")
       .Range(1.0001, 4.0);
+  DeclareParam("discovery_scale_factor", &discovery_scale_factor_,
+               "with a track region: the size step of the whole-image searches, which look for "
+               "the other faces (the tracked face's box comes from the search around it, at "
+               "scale_factor); scale_factor's value: one step everywhere")
+      .Range(1.0001, 4.0);
   DeclareParam("min_size_px", &options_.min_size_px, "smallest face side")
       .Range(1, 100000)
       .Unit("px");
@@ -106,20 +111,32 @@ FaceDetectorComponent::FaceDetectorComponent()
   DeclareParam("require_eyes", &require_eyes_, "reject boxes without an eye inside");
 }
 
-void FaceDetectorComponent::Configured() {
+vision::FaceDetector::Options FaceDetectorComponent::DetectorOptions() const {
   vision::FaceDetector::Options options = options_;
   options.cascade_path = cascade_ == "lbp" ? vision::kLbpFaceCascade : vision::kHaarFaceCascade;
   if (!reject_cats_) options.cat_cascade_path = "";
   if (!require_eyes_) options.eye_cascade_path = "";
+  return options;
+}
+
+void FaceDetectorComponent::Configured() {
+  vision::FaceDetector::Options options = DetectorOptions();
   detector_ = std::make_unique<vision::FaceDetector>(options);
   options.pyramid_level = region_pyramid_level_;
   region_detector_ = std::make_unique<vision::FaceDetector>(options);
+  discovery_detector_.reset();
+  if (discovery_scale_factor_ != options_.scale_factor) {
+    options = DetectorOptions();
+    options.scale_factor = discovery_scale_factor_;
+    discovery_detector_ = std::make_unique<vision::FaceDetector>(options);
+  }
 }
 
 FaceDetectorComponent::Search FaceDetectorComponent::NextSearch(const Image& image) {
   Search search;
   const int64_t n = detections_++;
   if (!(track_region_scale_ > 0.0) || !track_.has_value()) return search;
+  search.tracked = true;
   const TrackMessage& track = track_.value();
   if (track.target_id != last_target_id_) {
     last_target_id_ = track.target_id;
@@ -202,7 +219,9 @@ FacesMessage FaceDetectorComponent::Detect(std::shared_ptr<const Image> image,
     vision::FaceDetector::Search whole;
     whole.regions = {cv::Rect(0, 0, out.image->width(), out.image->height())};
     whole.checked = search.checked;
-    found = detector_->Detect(*out.image, whole);
+    // With a track, the whole image is searched for the other faces (discovery_scale_factor).
+    const bool discovery = search.tracked && discovery_detector_;
+    found = (discovery ? discovery_detector_ : detector_)->Detect(*out.image, whole);
   }
   std::vector<cv::Rect> regions;
   if (search.region) regions.push_back(*search.region);

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstring>
@@ -272,9 +273,10 @@ std::shared_ptr<const Image> LeftEyeOnTheAstronaut() {
   return RenderOne(kScene, "left", look.joints, {});
 }
 
-// The faces a default detector finds in the whole image.
-FacesMessage DetectWhole(const std::shared_ptr<const Image>& image) {
-  auto detector = Make("vision.face_detector", json::object());
+// The faces a detector (default parameters, or `params`) finds in the whole image.
+FacesMessage DetectWhole(const std::shared_ptr<const Image>& image,
+                         const json& params = json::object()) {
+  auto detector = Make("vision.face_detector", params);
   auto faces = Capture<FacesMessage>(*detector, "faces");
   In<runtime::ImageMessage>(*detector, "image").Deliver(runtime::ImageMessage{image});
   detector->Step(At(0));
@@ -330,6 +332,46 @@ TEST(FaceDetectorComponent, SearchesAroundTheTrackAndTheWholeImageEveryNthTime) 
   EXPECT_NEAR(near[0].box.y + 0.5 * near[0].box.height, face->y + 0.5 * face->height,
               kBoxTolerancePx);
   EXPECT_NEAR(near[0].box.width, face->width, kBoxTolerancePx);
+}
+
+// With a track, the whole-image searches look for the other faces, at discovery_scale_factor
+// (the tracked face's box comes from the search around it, at scale_factor): their faces are
+// those of a detector searching the whole image at that step.
+TEST(FaceDetectorComponent, WithATrackSearchesTheWholeImageAtTheDiscoveryStep) {
+  const std::shared_ptr<const Image> image = LeftEyeOnTheAstronaut();
+  ASSERT_TRUE(image);
+  const auto boxes = [](const FacesMessage& faces) {
+    std::vector<std::array<int, 5>> out;
+    for (const FacesMessage::Face& f : faces.faces) {
+      out.push_back({f.box.x, f.box.y, f.box.width, f.box.height, f.rejected ? 1 : 0});
+    }
+    return out;
+  };
+  const auto fine = boxes(DetectWhole(image));  // scale_factor 1.1
+  const auto coarse = boxes(DetectWhole(image, {{"scale_factor", 1.3}}));
+  ASSERT_FALSE(coarse.empty());
+  ASSERT_NE(fine, coarse);  // else this test could not tell them apart
+
+  auto detector = Make("vision.face_detector", {{"track_region_scale", 2.0},
+                                                {"full_scan_every", 1},
+                                                {"new_target_scans", 0},
+                                                {"discovery_scale_factor", 1.3}});
+  auto faces = Capture<FacesMessage>(*detector, "faces");
+  const auto detect = [&](bool with_track, int64_t step) {
+    if (with_track) {
+      TrackMessage track;  // on the sky, top left: the search around it finds nothing
+      track.tracking = true;
+      track.window = cv::Rect(20, 20, 80, 80);
+      track.center = {60.0, 60.0};
+      In<TrackMessage>(*detector, "track").Deliver(track);
+    }
+    In<runtime::ImageMessage>(*detector, "image").Deliver(runtime::ImageMessage{image});
+    detector->Step(At(step));
+    return boxes(**faces);
+  };
+  EXPECT_EQ(detect(false, 0), fine);  // no track yet: the whole image at scale_factor
+  EXPECT_EQ(detect(true, 1), coarse);
+  EXPECT_EQ(detect(true, 2), coarse);
 }
 
 // A new target (the track's target_id changes, as when attention moves on and the eyes make

@@ -9,7 +9,9 @@
 // While the track input (when connected) follows a target and `track_region_scale` > 0 (2.5
 // by default), the detector searches a box that many times the track's window around it (at
 // `region_pyramid_level`), and the whole image too (at `pyramid_level`) every
-// `full_scan_every`-th detection, so that attention still sees the other faces, and on the
+// `full_scan_every`-th detection, so that attention still sees the other faces (a discovery
+// search: at `discovery_scale_factor`, a coarser step between sizes than the search around the
+// track's `scale_factor`; the tracked face's box comes from the latter), and on the
 // first `new_target_scans` detections of a new target (the track's target_id changed): the
 // saccade to it blurs the images and a tracker may slip onto another face meanwhile; a region
 // around that face would keep finding it, and the two eyes' faces would not pair again until
@@ -57,6 +59,7 @@ class FaceDetectorComponent : public runtime::Component {
   // (at region_pyramid_level), or both (the region's faces replace the whole image's there).
   struct Search {
     bool whole = true;
+    bool tracked = false;  // a track region is in use: the whole image is a discovery search
     std::optional<cv::Rect> region;
     std::optional<cv::Rect> predicted;  // around where the selection puts a new target
     int min_size_px = 0;                // the region's face sides (0: the parameters' bounds)
@@ -64,6 +67,8 @@ class FaceDetectorComponent : public runtime::Component {
     std::vector<vision::FaceDetection> checked;  // verdicts to reuse (recheck_every)
     std::vector<int> checked_reuses;             // how often each was reused in a row
   };
+  // options_ with the cascades the parameters choose.
+  vision::FaceDetector::Options DetectorOptions() const;
   Search NextSearch(const Image& image);
   // Widens search's face sides to cover `face`'s size to within region_size_factor.
   void SizesAround(const cv::Size& face, Search* search) const;
@@ -86,6 +91,7 @@ class FaceDetectorComponent : public runtime::Component {
   int new_target_scans_ = 5;
   double region_size_factor_ = 2.0;
   int recheck_every_ = 5;
+  double discovery_scale_factor_ = 1.2;
   // The faces seen lately and their verdicts: `reuses` searches in a row took the verdict
   // without checking again; `age` searches have not seen the face since. Written by Detect (on
   // the detection's thread when it has one; NextSearch reads them once it has been collected).
@@ -110,6 +116,9 @@ class FaceDetectorComponent : public runtime::Component {
   runtime::Output<FacesMessage>& faces_;
   std::unique_ptr<vision::FaceDetector> detector_;         // the whole image
   std::unique_ptr<vision::FaceDetector> region_detector_;  // around the track
+  // The whole image once a track came (discovery_scale_factor), when it differs from
+  // scale_factor.
+  std::unique_ptr<vision::FaceDetector> discovery_detector_;
 };
 
 }  // namespace saccade::components
