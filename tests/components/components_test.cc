@@ -847,10 +847,10 @@ TEST(ComponentParams, UnknownMissingAndOutOfRangeParametersAreNamed) {
     return std::string("accepted");
   };
   EXPECT_EQ(message("vision.face_detector", {{"min_neighbours", 3}}),
-            "unknown parameter 'min_neighbours' (known: cascade, full_scan_every, latency_steps, "
-            "max_size_px, min_neighbors, min_size_px, new_target_scans, pyramid_level, "
-            "realtime_thread, recheck_every, region_pyramid_level, region_size_factor, "
-            "reject_cats, require_eyes, "
+            "unknown parameter 'min_neighbours' (known: cascade, discovery_scale_factor, "
+            "full_scan_every, latency_steps, max_size_px, min_neighbors, min_size_px, "
+            "new_target_scans, pyramid_level, realtime_thread, recheck_every, "
+            "region_pyramid_level, region_size_factor, reject_cats, require_eyes, "
             "scale_factor, track_region_scale)");
   EXPECT_EQ(message("vision.camshift", json::object()),
             "parameter 'eye' is required: one of left, right (the eye whose image and box it "
