@@ -264,20 +264,21 @@ TEST(MotionBlurTest, MovingObjectSmearsOverItsPathDuringTheExposure) {
   EXPECT_NEAR(blur_width, 0.8 * path_px, 2 * kEdgeTolerancePx) << Keep(blurred, "blur");
 }
 
-TEST(MotionBlurTest, RedrawingOnlyWhatMovesGivesTheMeanOfTheInstants) {
-  // A still camera with a lens, a checkered floor and a still ball, and a small box crossing
-  // at 2 m/s: the blur redraws only the box's sweep after the first sub-frame. The frame must
-  // be the mean of its sub-frames' instants, each drawn whole without blur.
+// A still camera with a lens, a checkered floor and a still ball, and `mover` (an object's
+// YAML, without its name) crossing at 2 m/s at 2.5 m: the blur redraws only the mover's sweep
+// after the first sub-frame. The frame must be the mean of its sub-frames' instants, each
+// drawn whole without blur.
+void ExpectRedrawingOnlyWhatMovesGivesTheMeanOfTheInstants(const std::string& mover,
+                                                           const std::string& label) {
+  SCOPED_TRACE(label);
   const scene::Scene world = SceneFrom(R"(
 background: [0.3, 0.4, 0.5]
 lights: [{type: ambient, intensity: 0.5}, {type: directional, direction: [1, 0.5, -1]}]
 ground: {pattern: checker, cell: 0.25}
 objects:
   - {name: ball, kind: sphere, radius: 0.2, pose: {position: [3, -0.6, 0.5]}, color: [0.9, 0.2, 0.1, 1]}
-  - name: box
-    kind: box
-    size: [0.1, 0.1, 0.1]
-    color: [1, 1, 1, 1]
+  - name: mover
+    )" + mover + R"(
     motion: {type: constant_velocity, linear: [0, 2, 0]}
     pose: {position: [2.5, 0, 0.8]}
 cameras:
@@ -318,9 +319,19 @@ cameras:
   // values here). A sub-frame missing from part of the box's sweep would be off by tens of DN.
   constexpr int kMaxDifferenceDn = 1;
   constexpr double kMeanDifferenceDn = 0.05;
-  EXPECT_LE(worst, kMaxDifferenceDn) << Keep(*blurred, "region_blur");
-  EXPECT_LT(sum / mean.size(), kMeanDifferenceDn) << Keep(*blurred, "region_blur");
-  EXPECT_FALSE(SamePixels(*blurred, *first));  // the box did smear
+  EXPECT_LE(worst, kMaxDifferenceDn) << Keep(*blurred, "region_blur_" + label);
+  EXPECT_LT(sum / mean.size(), kMeanDifferenceDn) << Keep(*blurred, "region_blur_" + label);
+  EXPECT_FALSE(SamePixels(*blurred, *first));  // the mover did smear
+}
+
+TEST(MotionBlurTest, RedrawingOnlyWhatMovesGivesTheMeanOfTheInstants) {
+  ExpectRedrawingOnlyWhatMovesGivesTheMeanOfTheInstants(
+      "kind: box\n    size: [0.1, 0.1, 0.1]\n    color: [1, 1, 1, 1]", "box");
+  // A sphere's region is bounded by its radius, not its box's half diagonal (sqrt(3) times
+  // as large): a region short of its silhouette would leave its edge unblurred (with half
+  // the radius: 75 DN off).
+  ExpectRedrawingOnlyWhatMovesGivesTheMeanOfTheInstants(
+      "kind: sphere\n    radius: 0.08\n    color: [1, 1, 1, 1]", "sphere");
 }
 
 // The POPEYE head 1.2 m high before a checker floor and a red ball 2 m ahead, its eyes

@@ -264,8 +264,18 @@ void GlRenderer::AddItem(const scene::Model& model, const Eigen::Vector3d& scale
   item.part = part;
   item.scale = scale;
   if (!model.bounds.isEmpty()) {
+    // The bounding sphere about the box's centre reaches the farthest vertex: for a sphere,
+    // its radius, where the box's half diagonal is sqrt(3) times that (the moving regions of
+    // motion blur, four times the area).
     item.center_model = model.bounds.center().cast<double>();
-    item.radius_model = 0.5 * model.bounds.diagonal().cast<double>().cwiseProduct(scale).norm();
+    double radius2 = 0.0;
+    for (const scene::Mesh& mesh : model.meshes) {
+      for (const Eigen::Vector3f& p : mesh.positions) {
+        radius2 = std::max(
+            radius2, (p.cast<double>() - item.center_model).cwiseProduct(scale).squaredNorm());
+      }
+    }
+    item.radius_model = std::sqrt(radius2);
   }
   // Compile (and let the driver build) every program variant this model may use now, not in
   // the first frame.

@@ -97,7 +97,7 @@ struct DrawItem {
   int part = -1;    // index into robot.parts
   Eigen::Vector3d scale{1.0, 1.0, 1.0};
   Eigen::Vector3d center_model = Eigen::Vector3d::Zero();  // bounds centre (model frame)
-  double radius_model = 0.0;                               // bounds half diagonal, scaled
+  double radius_model = 0.0;  // about center_model to the farthest vertex, scaled
 };
 
 // Column-major float copy of a double matrix, for glUniformMatrix*.
