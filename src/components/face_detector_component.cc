@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <tuple>
+#include <utility>
 #include <vector>
 
 #include "components/internal_frames.h"
@@ -47,6 +49,7 @@ FaceDetectorComponent::FaceDetectorComponent()
     : image_(AddInput<runtime::ImageMessage>("image", /*required=*/true)),
       track_(AddInput<TrackMessage>("track")),
       selection_(AddInput<SelectionMessage>("selection")),
+      partner_(AddInput<FacesMessage>("partner")),
       faces_(AddOutput<FacesMessage>("faces")) {
   DeclareParam("cascade", &cascade_,
                "the face cascade: haar (alt2) or lbp (frontalface_improved; on "
@@ -88,6 +91,16 @@ FaceDetectorComponent::FaceDetectorComponent()
                "searches, then is checked again; a new target forgets them all (1: check every "
                "face every time)")
       .Range(1, 1000000);
+  DeclareParam("partner_min_depth_m", &partner_min_depth_m_,
+               "with a partner input: the nearest depth of a face along its ray from the other "
+               "eye (the near end of the band searched)")
+      .Range(1e-3, 1e6)
+      .Unit("m");
+  DeclareParam("partner_max_depth_m", &partner_max_depth_m_,
+               "with a partner input: the farthest depth of a face along its ray from the other "
+               "eye (the band's far end)")
+      .Range(1e-3, 1e6)
+      .Unit("m");
   DeclareParam("region_pyramid_level", &region_pyramid_level_,
                "the pyramid level of the search around the track (the whole image's is "
                "pyramid_level)")
@@ -120,6 +133,11 @@ vision::FaceDetector::Options FaceDetectorComponent::DetectorOptions() const {
 }
 
 void FaceDetectorComponent::Configured() {
+  if (!(partner_min_depth_m_ < partner_max_depth_m_)) {
+    throw InvalidArgument(
+        fmt::format("partner_min_depth_m ({}) must be less than partner_max_depth_m ({})",
+                    partner_min_depth_m_, partner_max_depth_m_));
+  }
   vision::FaceDetector::Options options = DetectorOptions();
   detector_ = std::make_unique<vision::FaceDetector>(options);
   options.pyramid_level = region_pyramid_level_;
@@ -135,7 +153,21 @@ void FaceDetectorComponent::Configured() {
 FaceDetectorComponent::Search FaceDetectorComponent::NextSearch(const Image& image) {
   Search search;
   const int64_t n = detections_++;
-  if (!(track_region_scale_ > 0.0) || !track_.has_value()) return search;
+  if (track_region_scale_ > 0.0 && track_.has_value()) AroundTrack(image, n, &search);
+  // A face that one eye alone sees cannot be triangulated: with the other eye's faces of this
+  // same capture (the partner input), their epipolar bands instead of the whole image.
+  if (search.whole && partner_.has_value()) {
+    std::optional<std::vector<std::pair<cv::Rect, cv::Size>>> bands = PartnerBands(image);
+    if (bands) {
+      search.whole = false;
+      search.bands = std::move(*bands);
+    }
+  }
+  return search;
+}
+
+void FaceDetectorComponent::AroundTrack(const Image& image, int64_t n, Search* out) {
+  Search& search = *out;
   search.tracked = true;
   const TrackMessage& track = track_.value();
   if (track.target_id != last_target_id_) {
@@ -169,15 +201,17 @@ FaceDetectorComponent::Search FaceDetectorComponent::NextSearch(const Image& ima
       search.whole = true;
     }
   }
-  return search;
+}
+
+std::pair<int, int> FaceDetectorComponent::SizeBounds(const cv::Size& face) const {
+  if (!(region_size_factor_ > 0.0)) return {0, 0};
+  return {static_cast<int>(std::floor(std::min(face.width, face.height) / region_size_factor_)),
+          static_cast<int>(std::ceil(std::max(face.width, face.height) * region_size_factor_))};
 }
 
 void FaceDetectorComponent::SizesAround(const cv::Size& face, Search* search) const {
   if (!(region_size_factor_ > 0.0)) return;
-  const int low =
-      static_cast<int>(std::floor(std::min(face.width, face.height) / region_size_factor_));
-  const int high =
-      static_cast<int>(std::ceil(std::max(face.width, face.height) * region_size_factor_));
+  const auto [low, high] = SizeBounds(face);
   const bool first = search->max_size_px == 0;  // no bounds yet
   search->min_size_px = first ? low : std::min(search->min_size_px, low);
   search->max_size_px = first ? high : std::max(search->max_size_px, high);
@@ -210,6 +244,45 @@ std::optional<cv::Rect> FaceDetectorComponent::PredictedRegion(const Image& imag
   return region;
 }
 
+std::optional<std::vector<std::pair<cv::Rect, cv::Size>>> FaceDetectorComponent::PartnerBands(
+    const Image& image) {
+  if (!partner_.has_value() || !partner_.value().image) return std::nullopt;
+  const FacesMessage& partner = partner_.value();
+  const Image& other = *partner.image;
+  if (other.metadata().time != image.metadata().time) return std::nullopt;  // not this capture
+  std::vector<std::pair<cv::Rect, cv::Size>> bands;
+  try {
+    const geometry::CameraModel other_model = vision::CameraModelOf(other);
+    const geometry::Pose X_WO = vision::CameraPoseOf(other);
+    const geometry::CameraModel model = vision::CameraModelOf(image);
+    const geometry::Pose X_CW = vision::CameraPoseOf(image).inverse();
+    // Points of each face's ray at depths evenly spaced in inverse depth (evenly spaced in
+    // disparity): the boxes around their images overlap, and their union holds the band.
+    constexpr int kSamples = 8;
+    for (const FacesMessage::Face& face : partner.faces) {
+      const cv::Rect& box = face.box;
+      const std::optional<Eigen::Vector3d> ray =
+          other_model.Unproject({box.x + 0.5 * (box.width - 1), box.y + 0.5 * (box.height - 1)});
+      if (!ray || !(ray->z() > 1e-6)) return std::nullopt;  // not a ray this search can follow
+      cv::Rect band;
+      for (int k = 0; k < kSamples; ++k) {
+        const double inverse =
+            1.0 / partner_min_depth_m_ +
+            (1.0 / partner_max_depth_m_ - 1.0 / partner_min_depth_m_) * k / (kSamples - 1);
+        const Eigen::Vector3d p_W = X_WO * (*ray / (ray->z() * inverse));
+        const std::optional<Eigen::Vector2d> at = model.Project(X_CW * p_W);
+        if (!at) continue;  // behind this eye: no face there for it to see
+        const cv::Rect around = BoxAround(at->x(), at->y(), box.size(), track_region_scale_, image);
+        band = band.area() > 0 ? (band | around) : around;
+      }
+      if (band.area() > 0) bands.emplace_back(band, box.size());
+    }
+  } catch (const InvalidArgument&) {
+    return std::nullopt;  // an image without its camera (a source that does not say)
+  }
+  return bands;
+}
+
 FacesMessage FaceDetectorComponent::Detect(std::shared_ptr<const Image> image,
                                            const Search& search) {
   FacesMessage out;
@@ -222,6 +295,21 @@ FacesMessage FaceDetectorComponent::Detect(std::shared_ptr<const Image> image,
     // With a track, the whole image is searched for the other faces (discovery_scale_factor).
     const bool discovery = search.tracked && discovery_detector_;
     found = (discovery ? discovery_detector_ : detector_)->Detect(*out.image, whole);
+  }
+  for (const auto& [band, face] : search.bands) {
+    // As the whole image would be searched, around each of the partner's faces' bands.
+    vision::FaceDetector::Search along;
+    along.regions = {band};
+    std::tie(along.min_size_px, along.max_size_px) = SizeBounds(face);
+    along.checked = search.checked;
+    const bool discovery = search.tracked && discovery_detector_;
+    for (const vision::FaceDetection& d :
+         (discovery ? discovery_detector_ : detector_)->Detect(*out.image, along)) {
+      const bool again = std::any_of(found.begin(), found.end(), [&d](const auto& f) {
+        return SameFace(f.box, d.box);
+      });  // two bands that overlap
+      if (!again) found.push_back(d);
+    }
   }
   std::vector<cv::Rect> regions;
   if (search.region) regions.push_back(*search.region);
@@ -240,9 +328,9 @@ FacesMessage FaceDetectorComponent::Detect(std::shared_ptr<const Image> image,
                          [&d](const vision::FaceDetection& r) { return SameFace(d.box, r.box); });
     });
     found.insert(found.end(), near.begin(), near.end());
-    std::stable_sort(found.begin(), found.end(),
-                     [](const auto& a, const auto& b) { return a.box.area() > b.box.area(); });
   }
+  std::stable_sort(found.begin(), found.end(),
+                   [](const auto& a, const auto& b) { return a.box.area() > b.box.area(); });
   for (const vision::FaceDetection& d : found) {
     out.faces.push_back({d.box, d.neighbors, d.rejected, d.reason});
   }

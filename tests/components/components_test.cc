@@ -374,6 +374,54 @@ TEST(FaceDetectorComponent, WithATrackSearchesTheWholeImageAtTheDiscoveryStep) {
   EXPECT_EQ(detect(true, 2), coarse);
 }
 
+// A face that one eye alone sees cannot be triangulated: with the other eye's faces of the
+// same capture (the partner input), the detector searches their epipolar bands instead of the
+// whole image, and finds there what the whole image holds of them.
+TEST(FaceDetectorComponent, WithThePartnersFacesSearchesTheirEpipolarBandsNotTheWholeImage) {
+  // The eyes verge on a point 5 m beyond her, so that her face lies well apart in the two
+  // images (crossed disparity): a band in the wrong place would miss it.
+  const scene::Scene& scene = Scene();
+  const Eigen::Vector3d her_W = FaceCentreAt(scene, Astronaut(), 0.0);
+  const Eigen::Vector3d base_W =
+      head::ForwardKinematics(scene.robot()->head, scene.robot()->initial_joints)
+          .X_WC.translation();
+  const head::IkResult look =
+      head::SolveFixation(scene.robot()->head, her_W + 5.0 * (her_W - base_W).normalized());
+  ASSERT_TRUE(look.reachable());
+  const std::shared_ptr<const Image> left = RenderOne(kScene, "left", look.joints, {});
+  const std::shared_ptr<const Image> right = RenderOne(kScene, "right", look.joints, {});
+  ASSERT_EQ(left->metadata().time, right->metadata().time);
+  const FacesMessage partner = DetectWhole(left);
+  const std::optional<cv::Rect> her_left = AcceptedBox(partner);
+  const std::optional<cv::Rect> her = AcceptedBox(DetectWhole(right));
+  ASSERT_TRUE(her_left);
+  ASSERT_TRUE(her);
+
+  auto detector = Make("vision.face_detector", json::object());
+  auto faces = Capture<FacesMessage>(*detector, "faces");
+  int64_t step = 0;
+  const auto detect = [&](const FacesMessage& other) {
+    In<FacesMessage>(*detector, "partner").Deliver(other);
+    In<runtime::ImageMessage>(*detector, "image").Deliver(runtime::ImageMessage{right});
+    detector->Step(At(step++));
+    return AcceptedBox(**faces);
+  };
+  const std::optional<cv::Rect> found = detect(partner);
+  ASSERT_TRUE(found);
+  EXPECT_LT(cv::norm((found->tl() + found->br()) - (her->tl() + her->br())) / 2.0,
+            0.05 * her->width);
+  EXPECT_NEAR(found->width, her->width, 0.05 * her->width);
+  // The left eye saw nothing: nothing is searched for, where the whole image would find her.
+  FacesMessage none = partner;
+  none.faces.clear();
+  EXPECT_FALSE(detect(none));
+  // Faces of another capture say nothing of this one: the whole image.
+  auto later = std::make_shared<Image>(*left);
+  later->metadata().time += 0.04;
+  none.image = later;
+  EXPECT_TRUE(detect(none));
+}
+
 // A new target (the track's target_id changes, as when attention moves on and the eyes make
 // a saccade): its first new_target_scans detections search the whole image as well, so that a
 // tracker the saccade carried onto another face is corrected by the next pairing.
@@ -849,9 +897,13 @@ TEST(ComponentParams, UnknownMissingAndOutOfRangeParametersAreNamed) {
   EXPECT_EQ(message("vision.face_detector", {{"min_neighbours", 3}}),
             "unknown parameter 'min_neighbours' (known: cascade, discovery_scale_factor, "
             "full_scan_every, latency_steps, max_size_px, min_neighbors, min_size_px, "
-            "new_target_scans, pyramid_level, realtime_thread, recheck_every, "
-            "region_pyramid_level, region_size_factor, reject_cats, require_eyes, "
+            "new_target_scans, partner_max_depth_m, partner_min_depth_m, pyramid_level, "
+            "realtime_thread, recheck_every, region_pyramid_level, region_size_factor, "
+            "reject_cats, require_eyes, "
             "scale_factor, track_region_scale)");
+  EXPECT_EQ(
+      message("vision.face_detector", {{"partner_min_depth_m", 5}, {"partner_max_depth_m", 2}}),
+      "partner_min_depth_m (5) must be less than partner_max_depth_m (2)");
   EXPECT_EQ(message("vision.camshift", json::object()),
             "parameter 'eye' is required: one of left, right (the eye whose image and box it "
             "tracks)");

@@ -3,8 +3,18 @@
 // (vision/face_detector.h).
 //   inputs: image (runtime.image, required); track (vision.track, optional: this eye's
 //           CamShift track, connect it with delay 1); selection (vision.selection, optional:
-//           attention's, with delay 1); outputs: faces (vision.faces), with the image they
+//           attention's, with delay 1); partner (vision.faces, optional: the other eye's
+//           detector's faces, no delay); outputs: faces (vision.faces), with the image they
 //           were found in (its time is their capture time).
+//
+// With the partner's faces of an image captured at the same time as this one (the other eye
+// of the same stereo pair, the cameras' models and poses in both images' metadata), a search
+// that would take the whole image takes instead each partner face's epipolar band: the boxes
+// `track_region_scale` times the face around where its ray from the other eye, between
+// `partner_min_depth_m` and `partner_max_depth_m`, projects in this image, at face sizes within
+// `region_size_factor` of it. A face that one eye alone sees cannot be triangulated, so the
+// stereo loop loses nothing; the other eye's faces of another capture (a detector on a thread
+// of its own), or an image without its camera, leave the whole image searched.
 //
 // While the track input (when connected) follows a target and `track_region_scale` > 0 (2.5
 // by default), the detector searches a box that many times the track's window around it (at
@@ -37,6 +47,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "saccade/components/messages.h"
@@ -62,7 +73,10 @@ class FaceDetectorComponent : public runtime::Component {
     bool tracked = false;  // a track region is in use: the whole image is a discovery search
     std::optional<cv::Rect> region;
     std::optional<cv::Rect> predicted;  // around where the selection puts a new target
-    int min_size_px = 0;                // the region's face sides (0: the parameters' bounds)
+    // Instead of the whole image, around each of the partner's faces' epipolar bands: the band
+    // and the face's size there.
+    std::vector<std::pair<cv::Rect, cv::Size>> bands;
+    int min_size_px = 0;  // the region's face sides (0: the parameters' bounds)
     int max_size_px = 0;
     std::vector<vision::FaceDetection> checked;  // verdicts to reuse (recheck_every)
     std::vector<int> checked_reuses;             // how often each was reused in a row
@@ -70,12 +84,23 @@ class FaceDetectorComponent : public runtime::Component {
   // options_ with the cascades the parameters choose.
   vision::FaceDetector::Options DetectorOptions() const;
   Search NextSearch(const Image& image);
+  // Around the track (the n-th detection): the region, the new target's, and whether the
+  // whole image too.
+  void AroundTrack(const Image& image, int64_t n, Search* search);
+  // The face sides searched around a face of this size (region_size_factor); {0, 0}: the
+  // parameters' bounds.
+  std::pair<int, int> SizeBounds(const cv::Size& face) const;
   // Widens search's face sides to cover `face`'s size to within region_size_factor.
   void SizesAround(const cv::Size& face, Search* search) const;
   // A box track_region_scale times the target's size around where the selection's point
   // projects in `image` (the size in `face`); none without a selection of that target, a
   // known size, or a camera.
   std::optional<cv::Rect> PredictedRegion(const Image& image, int64_t target_id, cv::Size* face);
+  // The partner's faces' epipolar bands in `image` (their rays from the other eye between
+  // partner_min_depth_m and partner_max_depth_m, projected, each widened as a track region is);
+  // none when the partner's faces are not of an image captured with this one or a camera is
+  // unknown (then the whole image is searched).
+  std::optional<std::vector<std::pair<cv::Rect, cv::Size>>> PartnerBands(const Image& image);
   FacesMessage Detect(std::shared_ptr<const Image> image, const Search& search);
   void Remember(const std::vector<vision::FaceDetection>& found, const Search& search);
 
@@ -92,6 +117,8 @@ class FaceDetectorComponent : public runtime::Component {
   double region_size_factor_ = 2.0;
   int recheck_every_ = 5;
   double discovery_scale_factor_ = 1.2;
+  double partner_min_depth_m_ = 0.3;
+  double partner_max_depth_m_ = 20.0;
   // The faces seen lately and their verdicts: `reuses` searches in a row took the verdict
   // without checking again; `age` searches have not seen the face since. Written by Detect (on
   // the detection's thread when it has one; NextSearch reads them once it has been collected).
@@ -111,6 +138,7 @@ class FaceDetectorComponent : public runtime::Component {
   runtime::Input<runtime::ImageMessage>& image_;
   runtime::Input<TrackMessage>& track_;
   runtime::Input<SelectionMessage>& selection_;
+  runtime::Input<FacesMessage>& partner_;
   int64_t target_size_id_ = -1;  // the target whose face size is known
   cv::Size target_size_;         // its boxes' size when last detected
   runtime::Output<FacesMessage>& faces_;
