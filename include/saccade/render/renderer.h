@@ -55,6 +55,12 @@ struct RendererOptions {
   bool distortion = true;
   /// Sensor noise (SensorSpec: read and shot noise, seeded per camera and frame).
   bool noise = true;
+  /// Where the noise is added when nothing else is left for the final pass (no lens, no float
+  /// accumulation, no ground truth): on the CPU, into the pixels read back, so that the pass is
+  /// skipped (true), or in the pass (false); unset: on the CPU on a software rasteriser
+  /// (llvmpipe, softpipe), where a full-screen pass costs milliseconds. The same formula, table
+  /// and hash either way (kFinalFragmentSource).
+  std::optional<bool> noise_on_cpu;
   /// Motion blur over the exposure (SensorSpec::exposure, blur_samples).
   bool motion_blur = true;
   /// Motion blur of a turning camera (a saccade): the exposure is cut into the fewest

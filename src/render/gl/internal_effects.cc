@@ -742,6 +742,21 @@ void EffectTarget::BindTruthForDrawing(int view) const {
   glClearBufferfv(GL_DEPTH, 0, &far_depth);
 }
 
+bool EffectTarget::can_read_source() const {
+  return lens_.kind == geometry::LensMap::Kind::kIdentity && !truth_ && layers_ == 1 &&
+         source_width_ == lens_.width && source_height_ == lens_.height;
+}
+
+void EffectTarget::ReadSource(int slot) const {
+  // The source layer is resolved (FinishView) and, as the final pass's output, row 0 at the
+  // top: the draw (or resolve) framebuffer on it reads it as the pass would have copied it.
+  glBindFramebuffer(GL_FRAMEBUFFER, samples_ > 0 ? resolve_framebuffer_ : draw_framebuffer_);
+  glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, source_, 0, 0);
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, samples_ > 0 ? resolve_framebuffer_ : draw_framebuffer_);
+  glReadBuffer(GL_COLOR_ATTACHMENT0);
+  color_buffers_.Read(slot, GL_RGBA, GL_UNSIGNED_BYTE);
+}
+
 void EffectTarget::Finish(EffectPrograms& programs, bool accumulated, const NoiseParams* noise,
                           int slot, const TurnSamples* turn) const {
   const bool identity = lens_.kind == geometry::LensMap::Kind::kIdentity;

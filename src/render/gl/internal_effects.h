@@ -233,6 +233,14 @@ class EffectTarget {
   void Finish(EffectPrograms& programs, bool accumulated, const NoiseParams* noise, int slot,
               const TurnSamples* turn = nullptr) const;
 
+  /// Whether the final pass would only copy the source view (plus noise): an identity lens of
+  /// the camera's size, no truth. Then ReadSource may replace Finish when nothing was
+  /// accumulated.
+  bool can_read_source() const;
+  /// Starts the readback of the source view into `slot` as Finish's would of the final pass's
+  /// image (the same pixels without noise), the pass skipped.
+  void ReadSource(int slot) const;
+
   /// After the slot's fence: the camera-size RGBA8 pixels, ids (uint32) and depth (float),
   /// row 0 at the top; nullptr on failure. Unmap each after use.
   const PixelBuffers& color_buffers() const { return color_buffers_; }

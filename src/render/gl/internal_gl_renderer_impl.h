@@ -178,6 +178,8 @@ class GlRenderer final : public Renderer {
     int64_t frame_index = 0;
     std::vector<geometry::Pose> X_WC;   // per camera
     std::vector<int> exposure_samples;  // per camera: sub-frames drawn (1: an instant)
+    // Per camera: the noise Retrieve adds to the pixels read back (the final pass skipped).
+    std::vector<std::optional<NoiseParams>> cpu_noise;
     GLsync fence = nullptr;
   };
 
@@ -258,6 +260,10 @@ class GlRenderer final : public Renderer {
   bool draw_ground_ = false;
   bool draw_robot_ = false;
   double turn_blur_max_error_px_ = -1.0;  // RendererOptions::turn_blur*; < 0: off
+  bool noise_on_cpu_ = false;             // RendererOptions::noise_on_cpu, resolved
+  std::vector<uint32_t> gauss_table_;     // PackGaussianTable(GaussianTable()), for it
+  // NoiseLevels by (read sigma, gain), made as cameras need them.
+  std::map<std::pair<float, float>, std::vector<uint8_t>> noise_levels_;
   std::vector<DrawItem> items_;
   std::vector<Eigen::Isometry3d> item_poses_;  // X_WO (X_WLink X_LinkPart) per item, this state
   std::vector<std::pair<double, int>> order_;  // per view: depth, item

@@ -1,11 +1,16 @@
 #include "render/gl/internal_pixels.h"
 
+#include <algorithm>
+#include <array>
 #include <bit>
+#include <cmath>
 #include <cstring>
 
 #if defined(__x86_64__)
 #include <immintrin.h>
 #endif
+
+#include "render/gl/internal_effects.h"
 
 namespace saccade::render::gl {
 namespace {
@@ -54,6 +59,51 @@ void RgbaToRgb(const uint8_t* rgba, uint8_t* rgb, std::size_t pixels) {
   if (ssse3) return RgbaToRgbSsse3(rgba, rgb, pixels);
 #endif
   RgbaToRgbPortable(rgba, rgb, pixels);
+}
+
+namespace {
+
+// lowbias32 (C. Wellons), as kFinalFragmentSource's Hash.
+inline uint32_t Hash(uint32_t x) {
+  x ^= x >> 16;
+  x *= 0x7feb352du;
+  x ^= x >> 15;
+  x *= 0x846ca68bu;
+  x ^= x >> 16;
+  return x;
+}
+
+}  // namespace
+
+std::vector<uint8_t> NoiseLevels(float read_sigma_dn, float gain_dn_per_e) {
+  const float step = static_cast<float>(kGaussianStep);
+  const float range = static_cast<float>(kGaussianRange);
+  std::vector<uint8_t> levels(256 * 1024);
+  for (int dn = 0; dn < 256; ++dn) {
+    const float value = static_cast<float>(dn);
+    const float sigma = std::sqrt(read_sigma_dn * read_sigma_dn + gain_dn_per_e * value);
+    for (int code = 0; code < 1024; ++code) {
+      const float z = static_cast<float>(code) * step - range;
+      const float noisy = std::floor(value + sigma * z + 0.5f);
+      levels[(dn << 10) | code] = static_cast<uint8_t>(std::clamp(noisy, 0.0f, 255.0f));
+    }
+  }
+  return levels;
+}
+
+void RgbaToRgbWithNoise(const uint8_t* rgba, uint8_t* rgb, int width, int height, uint32_t key,
+                        const uint32_t* table, const uint8_t* levels) {
+  for (int y = 0; y < height; ++y) {
+    const uint32_t row = Hash(static_cast<uint32_t>(y) ^ key);
+    const uint8_t* in = rgba + static_cast<std::size_t>(y) * width * 4;
+    uint8_t* out = rgb + static_cast<std::size_t>(y) * width * 3;
+    for (int x = 0; x < width; ++x, in += 4, out += 3) {
+      const uint32_t g = table[Hash(static_cast<uint32_t>(x) ^ row) & 0xFFFFu];
+      out[0] = levels[(static_cast<uint32_t>(in[0]) << 10) | (g & 1023u)];
+      out[1] = levels[(static_cast<uint32_t>(in[1]) << 10) | ((g >> 10) & 1023u)];
+      out[2] = levels[(static_cast<uint32_t>(in[2]) << 10) | ((g >> 20) & 1023u)];
+    }
+  }
 }
 
 }  // namespace saccade::render::gl

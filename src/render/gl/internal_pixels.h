@@ -2,10 +2,23 @@
 // Pixel conversion of the readback.
 #include <cstddef>
 #include <cstdint>
+#include <vector>
 
 namespace saccade::render::gl {
 
 /// RGBA rows to tightly packed RGB (alpha dropped); SSSE3 where the CPU has it.
 void RgbaToRgb(const uint8_t* rgba, uint8_t* rgb, std::size_t pixels);
+
+/// The final pass's sensor noise (kFinalFragmentSource, NOISE) as a table: entry (DN << 10) |
+/// code is DN plus sqrt(read_sigma^2 + gain * DN) times the deviate of 10-bit `code`
+/// (PackGaussianTable's), rounded and clamped to 8 bits, in the pass's float arithmetic.
+std::vector<uint8_t> NoiseLevels(float read_sigma_dn, float gain_dn_per_e);
+
+/// That noise on the CPU: `rgba` rows of `width` pixels, row 0 at the top (the pass's
+/// gl_FragCoord.y), to tightly packed RGB, each channel through `levels` (NoiseLevels) with
+/// the code of the entry of `table` (PackGaussianTable) that the pass's hash of the pixel and
+/// `key` picks.
+void RgbaToRgbWithNoise(const uint8_t* rgba, uint8_t* rgb, int width, int height, uint32_t key,
+                        const uint32_t* table, const uint8_t* levels);
 
 }  // namespace saccade::render::gl

@@ -61,7 +61,12 @@ std::vector<Frame> GlRenderer::Retrieve() {
     const uint8_t* pixels = setup.effects ? MapOrThrow(setup.effects->color_buffers(), slot, "")
                                           : MapOrThrow(*targets_[i], slot, "");
     const int row_bytes = setup.effects ? 4 * image->width() : targets_[i]->row_bytes();
-    if (row_bytes == static_cast<int>(image->stride())) {
+    if (const std::optional<NoiseParams>& noise = pending.cpu_noise[i]; noise.has_value()) {
+      std::vector<uint8_t>& levels = noise_levels_[{noise->read_sigma_dn, noise->gain_dn_per_e}];
+      if (levels.empty()) levels = NoiseLevels(noise->read_sigma_dn, noise->gain_dn_per_e);
+      RgbaToRgbWithNoise(pixels, image->data(), image->width(), image->height(), noise->key,
+                         gauss_table_.data(), levels.data());
+    } else if (row_bytes == static_cast<int>(image->stride())) {
       std::memcpy(image->data(), pixels, image->size_bytes());
     } else {
       RgbaToRgb(pixels, image->data(), pixel_count);
