@@ -288,13 +288,15 @@ FacesMessage FaceDetectorComponent::Detect(std::shared_ptr<const Image> image,
   FacesMessage out;
   out.image = std::move(image);
   std::vector<vision::FaceDetection> found;
+  // With a track, the whole image (or the partner's bands) is searched for the other faces
+  // (discovery_scale_factor).
+  vision::FaceDetector& wide =
+      search.tracked && discovery_detector_ ? *discovery_detector_ : *detector_;
   if (search.whole) {
     vision::FaceDetector::Search whole;
     whole.regions = {cv::Rect(0, 0, out.image->width(), out.image->height())};
     whole.checked = search.checked;
-    // With a track, the whole image is searched for the other faces (discovery_scale_factor).
-    const bool discovery = search.tracked && discovery_detector_;
-    found = (discovery ? discovery_detector_ : detector_)->Detect(*out.image, whole);
+    found = wide.Detect(*out.image, whole);
   }
   for (const auto& [band, face] : search.bands) {
     // As the whole image would be searched, around each of the partner's faces' bands.
@@ -302,9 +304,7 @@ FacesMessage FaceDetectorComponent::Detect(std::shared_ptr<const Image> image,
     along.regions = {band};
     std::tie(along.min_size_px, along.max_size_px) = SizeBounds(face);
     along.checked = search.checked;
-    const bool discovery = search.tracked && discovery_detector_;
-    for (const vision::FaceDetection& d :
-         (discovery ? discovery_detector_ : detector_)->Detect(*out.image, along)) {
+    for (const vision::FaceDetection& d : wide.Detect(*out.image, along)) {
       const bool again = std::any_of(found.begin(), found.end(), [&d](const auto& f) {
         return SameFace(f.box, d.box);
       });  // two bands that overlap

@@ -26,9 +26,10 @@ using ::testing::HasSubstr;
 
 const std::string kSource = SACCADE_SOURCE_DIR;
 const std::string kTwoPictures = kSource + "/scenes/astronaut_and_cat.yaml";
-// Three faces to fixate in turn: the loop runs its whole --duration (about 10 s of wall time
-// per simulated second on llvmpipe), long enough for a fault timed in wall seconds from the
-// emulator's start to strike mid-run whatever the machine's load at start-up.
+// Three faces to fixate in turn: the loop runs until the third fixation (about 3.4 s of
+// simulated time, 86 steps: 6 s of wall time on the 2-core development machine, at most 3.4 s
+// at camera rate), long enough for a fault timed 1.5 s after the host's first instruction
+// (the emulator's clock for faults, whatever the start-up took) to strike mid-run.
 const std::string kPortraits = kSource + "/scenes/portraits.yaml";
 
 fs::path TempDir(const std::string& name) {
@@ -132,7 +133,7 @@ TEST(HardwareCli, InMirrorModeTheServosFollowTheVirtualHead) {
 
 TEST(HardwareCli, AServoOverloadIsReportedAndTheLoopGoesOnWithTheHeadHeld) {
   const fs::path dir = TempDir("overload");
-  Emulator emulator(dir / "bus", {"--overload", "2@12"});
+  Emulator emulator(dir / "bus", {"--overload", "2@1.5"});
   const CommandRun run =
       Saccade("demo --hardware " + ServoHardware(dir, dir / "bus", false, kPortraits).string() +
               " --duration 4 --record " + (dir / "rec").string());
@@ -147,7 +148,7 @@ TEST(HardwareCli, AServoOverloadIsReportedAndTheLoopGoesOnWithTheHeadHeld) {
 
 TEST(HardwareCli, AServoThatStopsAnsweringIsReported) {
   const fs::path dir = TempDir("silent");
-  Emulator emulator(dir / "bus", {"--silent", "3@12"});
+  Emulator emulator(dir / "bus", {"--silent", "3@1.5"});
   const CommandRun run =
       Saccade("demo --hardware " + ServoHardware(dir, dir / "bus", false, kPortraits).string() +
               " --duration 4 --record " + (dir / "rec").string());

@@ -204,7 +204,10 @@ TEST(ServoEmulatorCliTest, TimedFaultsHappenOnSchedule) {
                "--status-every", "0.1"});
   ASSERT_TRUE(child.ReadLine().has_value());
   DynamixelBus bus(link, kBaud, {milliseconds(20), 1});
-  EXPECT_EQ(bus.Ping(2), 1020);  // before 0.3 s
+  // The faults' delays count from the host's first instruction, not from the emulator's
+  // start: a host that takes its time to start up still sees them mid-run.
+  std::this_thread::sleep_for(milliseconds(500));
+  EXPECT_EQ(bus.Ping(2), 1020);  // the first instruction: 0.3 s to go
   EXPECT_EQ(bus.ReadU8(1, tbl::kHardwareErrorStatus.address), 0);
   std::this_thread::sleep_for(milliseconds(500));
   EXPECT_THROW(bus.Ping(2), BusError);

@@ -14,6 +14,7 @@
 #include <cmath>
 #include <cstdio>
 #include <functional>
+#include <optional>
 #include <set>
 #include <string>
 #include <vector>
@@ -73,7 +74,7 @@ uint8_t ParseId(const std::string& option, const std::string& text) {
 // "ID" or "ID@SECONDS".
 struct TimedFault {
   uint8_t id = 0;
-  double at = 0.0;  // seconds after the start
+  double at = 0.0;  // seconds after the host's first instruction
 };
 
 TimedFault ParseTimedFault(const std::string& option, const std::string& text,
@@ -148,16 +149,17 @@ int Run(int argc, char** argv) {
       ->check(CLI::Range(0.0, 1.0))
       ->capture_default_str();
   app.add_option("--silent", silent_specs,
-                 "The servo stops answering (as if unplugged), at once or after "
-                 "SECONDS; repeatable")
+                 "The servo stops answering (as if unplugged), at once or SECONDS after the "
+                 "host's first instruction; repeatable")
       ->type_name("ID[@SECONDS]");
   app.add_option("--overload", overload_specs,
-                 "The servo raises an overload error (torque off, alert bit) "
-                 "after SECONDS; repeatable")
+                 "The servo raises an overload error (torque off, alert bit) SECONDS after the "
+                 "host's first instruction; repeatable")
       ->type_name("ID[@SECONDS]");
   app.add_option("--overheat", overheat_specs,
                  "The servo's temperature rises to 101 C, above its limit "
-                 "(overheating error: torque off, alert bit), after SECONDS; repeatable")
+                 "(overheating error: torque off, alert bit), SECONDS after the host's first "
+                 "instruction; repeatable")
       ->type_name("ID[@SECONDS]");
   app.add_option("--seed", seed, "Seed of the random faults")->capture_default_str();
   app.add_option("--duration", duration, "Stop after SECONDS (0: until SIGINT/SIGTERM)")
@@ -272,9 +274,19 @@ int Run(int argc, char** argv) {
   size_t next_event = 0;
   double next_status = status_every > 0 ? status_every : -1.0;
   int stop_signal = 0;
+  // The faults' clock starts at the host's first instruction (its start-up, however long,
+  // does not eat into their delays); the emulator polls for it every kPollS until then. A
+  // fault without a delay is there from the start.
+  constexpr double kPollS = 0.005;
+  std::optional<double> first_instruction;
   while (true) {
     const double now = elapsed();
-    while (next_event < events.size() && events[next_event].at <= now) {
+    if (!first_instruction && emulator.counters().instructions_received > 0) {
+      first_instruction = now;
+    }
+    while (next_event < events.size() &&
+           (events[next_event].at <= 0.0 ||
+            (first_instruction && events[next_event].at <= now - *first_instruction))) {
       events[next_event++].run();
     }
     if (next_status >= 0 && next_status <= now) {
@@ -286,7 +298,10 @@ int Run(int argc, char** argv) {
     }
     if (duration > 0 && now >= duration) break;
     double wake = 3600.0;  // seconds from now
-    if (next_event < events.size()) wake = std::min(wake, events[next_event].at - now);
+    if (next_event < events.size()) {
+      wake = std::min(
+          wake, first_instruction ? events[next_event].at - (now - *first_instruction) : kPollS);
+    }
     if (next_status >= 0) wake = std::min(wake, next_status - now);
     if (duration > 0) wake = std::min(wake, duration - now);
     wake = std::max(wake, 0.0);
