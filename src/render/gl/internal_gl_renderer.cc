@@ -121,7 +121,6 @@ GlRenderer::GlRenderer(const scene::Scene& scene, const RendererOptions& options
   for (Pending& pending : pending_) {
     pending.X_WC.resize(cameras_.size());
     pending.exposure_samples.assign(cameras_.size(), 1);
-    pending.cpu_noise.assign(cameras_.size(), std::nullopt);
   }
   image_pools_.resize(cameras_.size());
 
