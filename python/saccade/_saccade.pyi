@@ -229,7 +229,7 @@ class render:
                      msaa_samples: int = 0, draw_robot: bool = True, distortion: bool = True,
                      noise: bool = True, motion_blur: bool = True, truth_depth: bool = False,
                      truth_ids: bool = False, truth_objects: bool = False,
-                     lod_max_error_px: float = 0.25) -> None: ...
+                     lod_max_error_px: float = 0.25, batch_contexts: int = 0) -> None: ...
         camera_names: List[str]
         device: str
         stats: "render.RenderStats"

@@ -116,7 +116,7 @@ void BindRender(py::module_& m) {
                        const std::optional<std::vector<std::string>>& cameras, int msaa_samples,
                        bool draw_robot, bool distortion, bool noise, bool motion_blur,
                        bool truth_depth, bool truth_ids, bool truth_objects,
-                       double lod_max_error_px) {
+                       double lod_max_error_px, int batch_contexts) {
              RendererOptions options;
              if (cameras) options.cameras = *cameras;
              options.msaa_samples = msaa_samples;
@@ -128,6 +128,7 @@ void BindRender(py::module_& m) {
              options.truth_ids = truth_ids;
              options.truth_objects = truth_objects;
              options.lod_max_error_px = lod_max_error_px;
+             options.batch_contexts = batch_contexts;
              auto result = std::make_unique<PyRenderer>();
              result->scene = scene;
              {
@@ -143,8 +144,11 @@ void BindRender(py::module_& m) {
            "scene"_a, "cameras"_a = py::none(), "msaa_samples"_a = 0, "draw_robot"_a = true,
            "distortion"_a = true, "noise"_a = true, "motion_blur"_a = true, "truth_depth"_a = false,
            "truth_ids"_a = false, "truth_objects"_a = false, "lod_max_error_px"_a = 0.25,
+           "batch_contexts"_a = 0,
            "Opens a surfaceless EGL context and uploads the scene. `cameras`: names, default "
-           "all. Raises InvalidArgument naming a bad option or an unknown camera.")
+           "all. `batch_contexts`: GL contexts that draw a render_batch, each on a thread of its "
+           "own (1 or 2; 0: 2 on a software rasteriser with 2 cores or more; the images are the "
+           "same to the bit). Raises InvalidArgument naming a bad option or an unknown camera.")
       .def_property_readonly("camera_names",
                              [](const PyRenderer& r) { return r.renderer->camera_names(); })
       .def_property_readonly("device",

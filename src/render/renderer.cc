@@ -21,6 +21,8 @@ bool RendererOptions::IsValid(std::string* error) const {
   } else if (!std::isfinite(turn_blur_max_error_px) || turn_blur_max_error_px < 0.0) {
     message = fmt::format("turn_blur_max_error_px must be finite and >= 0, got {}",
                           turn_blur_max_error_px);
+  } else if (batch_contexts < 0 || batch_contexts > 2) {
+    message = fmt::format("batch_contexts must be 0 (automatic), 1 or 2, got {}", batch_contexts);
   } else {
     std::set<std::string> seen;
     for (const std::string& name : cameras) {

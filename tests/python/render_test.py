@@ -110,6 +110,19 @@ def test_batch_equals_single_renders_of_each_head(scene):
     assert not np.array_equal(batch[0, 0], batch[1, 0])
 
 
+def test_batch_contexts_one_and_two_give_the_same_images(scene):
+    states = [saccade.scene.SceneState(0.0, [0.04 * i, -0.05, 0.02, -0.02]) for i in range(3)]
+    images = []
+    for contexts in (1, 2):
+        r = saccade.render.Renderer(scene, cameras=["left", "right"], distortion=False,
+                                    noise=False, motion_blur=False, batch_contexts=contexts)
+        images.append(r.render_batch([saccade.render.BatchHead(s) for s in states]))
+    assert np.array_equal(images[0], images[1])
+    assert not np.array_equal(images[1][0, 1], images[1][2, 1])  # the second context's half drew
+    with pytest.raises(saccade.InvalidArgument, match="batch_contexts must be 0 .automatic., 1 or 2, got 3"):
+        saccade.render.Renderer(scene, batch_contexts=3)
+
+
 def test_batch_heads_have_their_own_objects(scene):
     r = saccade.render.Renderer(scene, cameras=["left"], distortion=False, noise=False,
                                 motion_blur=False, draw_robot=False)

@@ -4,9 +4,13 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <cstring>
 #include <random>
+#include <set>
+#include <string>
+#include <vector>
 
 #include "saccade/core/error.h"
 #include "saccade/render/renderer.h"
@@ -90,6 +94,55 @@ TEST(RenderBatch, HiddenAndMovedObjectsChangeOnlyTheirHead) {
   std::vector<uint8_t> again(bytes);
   renderer->RenderBatch({heads[0]}, again.data(), again.size());
   EXPECT_EQ(0, std::memcmp(out.data(), again.data(), bytes));
+}
+
+TEST(RenderBatch, TwoContextsGiveTheSameImagesToTheBitAsOne) {
+  // Tall, narrow cameras (48 x 4096): the framebuffer holds 4 tiles a strip (16384 pixels a
+  // side on llvmpipe), so 3 heads x 2 cameras lie in two strips and the second context's half
+  // (tiles 3 to 5) starts in the first strip and ends in the second.
+  std::string yaml = R"(
+background: [0.62, 0.72, 0.82]
+lights:
+  - {type: ambient, intensity: 0.35}
+  - {type: directional, direction: [0.4, -0.6, -1.0], intensity: 0.8}
+ground: {size: 16, pattern: checker, cell: 0.5}
+robot:
+  head: )" SACCADE_SOURCE_DIR R"(/robots/popeye.yaml
+  visible: false
+  cameras:
+    left: {calibration: {width: 48, height: 4096, fx: 600, fy: 600}}
+    right: {calibration: {width: 48, height: 4096, fx: 600, fy: 600}}
+objects:
+  - {name: ball, kind: sphere, radius: 0.3, color: [0.8, 0.3, 0.2], pose: {position: [2, 0, 1.1]}}
+  - {name: box, kind: box, size: 0.4, color: [0.2, 0.3, 0.9], pose: {position: [3, 0.1, 0.3]}}
+)";
+  const scene::Scene scene =
+      scene::Scene::FromYamlString(yaml, "<tall cameras>", SACCADE_SOURCE_DIR);
+  std::vector<BatchHead> heads(3);
+  for (std::size_t i = 0; i < heads.size(); ++i) {
+    heads[i].state = scene.InitialState();
+    heads[i].state.joints = {0.01 * static_cast<double>(i), -0.1, 0.02, -0.02};
+  }
+  const std::size_t tile_bytes = 48 * 4096 * 3;
+  std::vector<uint8_t> images[2], again[2];
+  for (int contexts : {1, 2}) {
+    RendererOptions options = PinholeOptions();
+    options.batch_contexts = contexts;
+    auto renderer = MakeRenderer(scene, options);
+    images[contexts - 1].assign(heads.size() * 2 * tile_bytes, 0);
+    renderer->RenderBatch(heads, images[contexts - 1].data(), images[contexts - 1].size());
+    // A second, smaller batch on the same renderers (their framebuffers already larger).
+    again[contexts - 1].assign(2 * tile_bytes, 0);
+    renderer->RenderBatch({heads[2]}, again[contexts - 1].data(), again[contexts - 1].size());
+  }
+  EXPECT_TRUE(images[0] == images[1]);
+  EXPECT_TRUE(again[0] == again[1]);
+  // Not blank: every tile shows the ball or the box against the sky and the ground.
+  for (std::size_t tile = 0; tile < 6; ++tile) {
+    const uint8_t* first = images[1].data() + tile * tile_bytes;
+    const std::set<uint8_t> values(first, first + tile_bytes);
+    EXPECT_GE(values.size(), 20u) << "tile " << tile;
+  }
 }
 
 TEST(RenderBatch, RefusesBadBatchesNamingWhatIsWrong) {

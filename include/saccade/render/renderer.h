@@ -82,6 +82,15 @@ struct RendererOptions {
   /// ids too).
   bool truth_objects = false;
 
+  /// GL contexts that draw a batch (RenderBatch), each on a thread of its own with half of its
+  /// images: 1 or 2; 0 (the default): 2 on a software rasteriser (llvmpipe, softpipe) when
+  /// the machine has at least 2 cores, else 1. On a software rasteriser the thread that issues
+  /// the draw calls (vertex work, triangle setup and binning) and the rasteriser's threads take
+  /// turns, so a second issuing thread fills the cores the first leaves idle. The images are
+  /// the same to the bit either way; the second context holds a copy of the scene's meshes and
+  /// textures.
+  int batch_contexts = 0;
+
   bool IsValid(std::string* error) const;
 };
 

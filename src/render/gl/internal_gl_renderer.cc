@@ -7,6 +7,7 @@
 #include <atomic>
 #include <cmath>
 #include <optional>
+#include <thread>
 #include <utility>
 
 #include "render/gl/internal_effect_shaders.h"
@@ -95,6 +96,9 @@ GlRenderer::GlRenderer(const scene::Scene& scene, const RendererOptions& options
   // ~4 ms on llvmpipe), more than the same noise added on the CPU to the pixels read back.
   noise_on_cpu_ = options_.noise_on_cpu.value_or(software);
   if (noise_on_cpu_) gauss_table_ = PackGaussianTable(GaussianTable());
+  batch_contexts_ = options_.batch_contexts != 0
+                        ? options_.batch_contexts
+                        : (software && std::thread::hardware_concurrency() >= 2 ? 2 : 1);
 
   for (std::size_t i = 0; i < scene_.objects().size(); ++i) {
     const scene::Object& object = scene_.objects()[i];

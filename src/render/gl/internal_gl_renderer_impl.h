@@ -287,6 +287,18 @@ class GlRenderer final : public Renderer {
   };
   BatchTarget batch_;
   std::vector<ViewSetup> batch_views_;  // per camera: the pinhole of its K
+  // Draws tiles [first, last) of a batch laid out as `columns` strips of `rows` tiles and
+  // reads them back into their place in `out` (internal_batch.cc).
+  void DrawBatchTiles(const std::vector<BatchHead>& heads, std::size_t first, std::size_t last,
+                      int rows, int columns, uint8_t* out);
+  // The second context of RenderBatch (RendererOptions::batch_contexts): a renderer of the
+  // same scene on a thread of its own, made on the first batch of two images or more.
+  class BatchHelper;
+  struct BatchHelperDeleter {
+    void operator()(BatchHelper* helper) const;
+  };
+  int batch_contexts_ = 1;  // RendererOptions::batch_contexts, resolved
+  std::unique_ptr<BatchHelper, BatchHelperDeleter> batch_helper_;  // last: destroyed first
 };
 
 }  // namespace saccade::render::gl
