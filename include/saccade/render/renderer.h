@@ -88,7 +88,8 @@ struct RendererOptions {
   /// the draw calls (vertex work, triangle setup and binning) and the rasteriser's threads take
   /// turns, so a second issuing thread fills the cores the first leaves idle. The images are
   /// the same to the bit either way; the second context holds a copy of the scene's meshes and
-  /// textures.
+  /// textures and is made at the first batch of at least four 128 x 128 images' pixels
+  /// (smaller batches stay on one context: the hand-off costs more than it saves).
   int batch_contexts = 0;
 
   bool IsValid(std::string* error) const;
