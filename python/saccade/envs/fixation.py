@@ -163,6 +163,7 @@ class _Heads:
         self.target = np.zeros((n, 3))
         self.target_index = np.zeros(n, dtype=np.int64)
         self.axis_error = np.zeros((n, 2))
+        self._bounds_tolerant: Optional[Tuple[np.ndarray, np.ndarray]] = None  # check_actions
 
     # -- spaces ---------------------------------------------------------------------------
     def observation_space(self):
@@ -244,8 +245,11 @@ class _Heads:
                 f"{who}: the action must have shape {shape} ({', '.join(JOINTS)}"
                 f"{' per env' if len(shape) == 2 else ''}), got {a.shape}")
         low, high = self.action_bounds()
-        bad = ~((a >= low - 1e-6) & (a <= high + 1e-6))  # NaN fails both comparisons
-        if bad.any():
+        if self._bounds_tolerant is None:
+            self._bounds_tolerant = (low - 1e-6, high + 1e-6)
+        ok = (a >= self._bounds_tolerant[0]) & (a <= self._bounds_tolerant[1])  # NaN fails both
+        if not ok.all():
+            bad = ~ok
             if not np.all(np.isfinite(a)):
                 raise saccade.InvalidArgument(f"{who}: the action has a non-finite value: {actions}")
             index = np.argwhere(bad)[0]
@@ -256,8 +260,9 @@ class _Heads:
                 f"expected [{low[joint]:.6g}, {high[joint]:.6g}] ({self.action_mode} mode)")
         return a.reshape(-1, 4)
 
-    def apply(self, rows: np.ndarray, actions: np.ndarray):
-        """Moves heads `rows` by their actions over dt (joint limits, velocity limits)."""
+    def apply(self, rows, actions: np.ndarray):
+        """Moves heads `rows` (an index array, or one index) by their actions over dt (joint
+        limits, velocity limits)."""
         q = self.joints[rows]
         if self.action_mode == "velocity":
             q = q + actions * self.dt
@@ -294,7 +299,8 @@ class _Heads:
             "target_W": self.target[i].copy(),
             "target_index": int(self.target_index[i]),
             "target_kind": self.pool.kinds[int(self.target_index[i])],
-            "is_success": bool(np.all(self.axis_error[i] < self.success)),
+            "is_success": bool(self.axis_error[i, 0] < self.success and
+                               self.axis_error[i, 1] < self.success),
         }
 
 
@@ -375,7 +381,7 @@ class FixationEnv:
         if self._needs_reset:
             raise saccade.Error("FixationEnv.step: call reset() before the first step")
         a = self._heads.check_actions(action, "FixationEnv.step")
-        self._heads.apply(np.array([0]), a)
+        self._heads.apply(0, a[0])  # an index, not an array of one: numpy's views are cheaper
         reward, terminated, truncated = self._heads.outcome(0)
         return self._observation(), reward, terminated, truncated, self._heads.info(0)
 
