@@ -102,14 +102,16 @@ def cpp_step_ms(size: int, binary: str) -> float:
 
 
 def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--sizes", type=int, nargs="*", default=[1, 4, 16, 64])
-    parser.add_argument("--image", type=int, default=128)
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--sizes", type=int, nargs="*", default=[1, 4, 16, 64],
+                        help="batch sizes N (1 4 16 64)")
+    parser.add_argument("--image", type=int, default=128, help="image side in pixels (128)")
     parser.add_argument("--scenes", type=int, default=64,
                         help="scenes (seeds 0 .. N-1) every batch size covers: a multiple of each size")
     parser.add_argument("--steps", type=int, default=100, help="steps from each reset, timed")
     parser.add_argument("--rounds", type=int, default=2, help="alternating rounds (the best is kept)")
-    parser.add_argument("--cpp", default=os.path.join(saccade.source_dir(), "build", "bin", "env_step_bench"))
+    parser.add_argument("--cpp", default=os.path.join(saccade.source_dir(), "build", "bin", "env_step_bench"),
+                        help="the C++ step bench (build/bin/env_step_bench)")
     args = parser.parse_args()
     for n in args.sizes:
         if n < 1 or args.scenes % n:

@@ -24,9 +24,10 @@ def axis_error(head, joints, p_W):
 
 
 def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--pipeline", default=os.path.join(saccade.source_dir(), "pipelines", "demo.yaml"))
-    parser.add_argument("--steps", type=int, default=50)
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--pipeline", default=os.path.join(saccade.source_dir(), "pipelines", "demo.yaml"),
+                        help="pipeline YAML (pipelines/demo.yaml)")
+    parser.add_argument("--steps", type=int, default=50, help="steps to run (50)")
     args = parser.parse_args()
 
     scene = saccade.scene.Scene.load(os.path.join(saccade.source_dir(), "scenes", "portraits.yaml"))

@@ -15,8 +15,9 @@ import saccade
 
 
 def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--scene", default=os.path.join(saccade.source_dir(), "scenes", "portraits.yaml"))
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--scene", default=os.path.join(saccade.source_dir(), "scenes", "portraits.yaml"),
+                        help="scene YAML (scenes/portraits.yaml)")
     parser.add_argument("--object", default=None, help="object to fixate (default: the first)")
     parser.add_argument("--save", default=None, help="save both eyes side by side as .npy")
     args = parser.parse_args()

@@ -1,6 +1,5 @@
 #!/usr/bin/python3
-"""A random-policy rollout of the vector env: steps per second and stereo observations per
-second.
+"""A random-policy rollout of the vector env: vector steps and stereo observations per second.
 
     PYTHONPATH=build/python /usr/bin/python3 examples/python/vector_rollout.py --num-envs 16
 """
@@ -14,10 +13,10 @@ from saccade.envs import VectorFixationEnv
 
 
 def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--num-envs", type=int, default=16)
-    parser.add_argument("--size", type=int, default=128)
-    parser.add_argument("--steps", type=int, default=100)
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--num-envs", type=int, default=16, help="heads stepped together (16)")
+    parser.add_argument("--size", type=int, default=128, help="image side in pixels (128)")
+    parser.add_argument("--steps", type=int, default=100, help="vector steps timed (100)")
     args = parser.parse_args()
     env = VectorFixationEnv(num_envs=args.num_envs, image_size=args.size)
     env.reset(seed=0)
