@@ -590,8 +590,14 @@ std::vector<std::optional<GlRenderer::Region>> GlRenderer::MovingRegions(
       frames[k] = head::ForwardKinematics(scene_.robot()->head, subs[k].joints);
     }
   }
-  // The bounding spheres of the items that move, at every sub-frame (world frame).
-  std::vector<std::pair<Eigen::Vector3d, double>> spheres;
+  // The items that move, at every sub-frame: their bounding spheres and poses (world frame).
+  struct Moving {
+    Eigen::Vector3d centre_W;
+    double radius;
+    geometry::Pose X_WO;
+    const DrawItem* item;
+  };
+  std::vector<Moving> moving;
   for (std::size_t i = 0; i < items_.size(); ++i) {
     // Under a pixel over the exposure, an item is as still as the camera (no ghost step).
     if (item_px[i] < 1.0) continue;
@@ -605,36 +611,66 @@ std::vector<std::optional<GlRenderer::Region>> GlRenderer::MovingRegions(
       return X.matrix() != poses.front().matrix();
     });
     if (!moves) continue;
-    for (const geometry::Pose& X_WO : poses) spheres.emplace_back(X_WO * centre, item.radius_model);
+    for (const geometry::Pose& X_WO : poses) {
+      moving.push_back({X_WO * centre, item.radius_model, X_WO, &item});
+    }
   }
   std::vector<std::optional<Region>> regions(views);
   for (int v = 0; v < views; ++v) {
     const geometry::Intrinsics& k = setup.effects->lens().views[v].intrinsics;
     const Eigen::Isometry3d X_EW = EyeFromWorld(view_pose(X_WC, v));
     const Eigen::Matrix4d& P = setup.views[v].projection;
-    double x0 = 1e300, y0 = 1e300, x1 = -1e300, y1 = -1e300;
-    bool all = false;
-    // The corners of the cube around each sphere, projected as the rasteriser does: their
-    // hull holds the sphere's image while every corner lies in front of the eye.
-    for (const auto& [c_W, r] : spheres) {
-      const Eigen::Vector3d c_E = X_EW * c_W;
-      for (int corner = 0; corner < 8 && !all; ++corner) {
-        const Eigen::Vector4d p(c_E.x() + ((corner & 1) ? r : -r),
-                                c_E.y() + ((corner & 2) ? r : -r),
-                                c_E.z() + ((corner & 4) ? r : -r), 1.0);
-        const Eigen::Vector4d clip = P * p;
-        if (clip.w() <= 1e-9) {
-          all = true;
-          break;
-        }
+    // The rectangle that holds the projections of `points` (eye frame), as the rasteriser
+    // projects them; none when one lies behind the eye.
+    using Rect = std::array<double, 4>;  // x0, y0, x1, y1
+    const auto hull = [&](const auto& points) -> std::optional<Rect> {
+      Rect r{1e300, 1e300, -1e300, -1e300};
+      for (const Eigen::Vector3d& p_E : points) {
+        const Eigen::Vector4d clip = P * Eigen::Vector4d(p_E.x(), p_E.y(), p_E.z(), 1.0);
+        if (clip.w() <= 1e-9) return std::nullopt;
         const double x = 0.5 * (clip.x() / clip.w() + 1.0) * k.width();
         const double y = 0.5 * (clip.y() / clip.w() + 1.0) * k.height();
-        x0 = std::min(x0, x);
-        x1 = std::max(x1, x);
-        y0 = std::min(y0, y);
-        y1 = std::max(y1, y);
+        r = {std::min(r[0], x), std::min(r[1], y), std::max(r[2], x), std::max(r[3], y)};
       }
-      if (all) break;
+      return r;
+    };
+    double x0 = 1e300, y0 = 1e300, x1 = -1e300, y1 = -1e300;
+    bool all = false;
+    // Each moving item's image lies within two hulls: of the corners of the cube around its
+    // bounding sphere, and of the corners of its model's box (far tighter for a flat picture,
+    // whose sphere reaches past it on every side). Their intersection holds it while every
+    // corner of one of them lies in front of the eye.
+    for (const Moving& m : moving) {
+      std::array<Eigen::Vector3d, 8> corners;
+      const Eigen::Vector3d c_E = X_EW * m.centre_W;
+      for (int corner = 0; corner < 8; ++corner) {
+        corners[corner] = c_E + Eigen::Vector3d((corner & 1) ? m.radius : -m.radius,
+                                                (corner & 2) ? m.radius : -m.radius,
+                                                (corner & 4) ? m.radius : -m.radius);
+      }
+      std::optional<Rect> rect = hull(corners);
+      const DrawItem& item = *m.item;
+      if (item.model != nullptr && !item.model->bounds.isEmpty()) {
+        for (int corner = 0; corner < 8; ++corner) {
+          const Eigen::Vector3d c =
+              item.model->bounds.corner(static_cast<Eigen::AlignedBox3f::CornerType>(corner))
+                  .cast<double>();
+          corners[corner] = X_EW * (m.X_WO * c.cwiseProduct(item.scale));
+        }
+        if (const std::optional<Rect> box = hull(corners)) {
+          rect = rect ? Rect{std::max((*rect)[0], (*box)[0]), std::max((*rect)[1], (*box)[1]),
+                             std::min((*rect)[2], (*box)[2]), std::min((*rect)[3], (*box)[3])}
+                      : *box;
+        }
+      }
+      if (!rect) {
+        all = true;
+        break;
+      }
+      x0 = std::min(x0, (*rect)[0]);
+      y0 = std::min(y0, (*rect)[1]);
+      x1 = std::max(x1, (*rect)[2]);
+      y1 = std::max(y1, (*rect)[3]);
     }
     if (all) continue;
     // Margin: two pixels for rasterisation and multisampling, one for the camera's own motion
