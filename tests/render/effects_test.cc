@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "image_camera_helpers.h"
+#include "render/gl/internal_pixels.h"
 #include "saccade/core/error.h"
 #include "saccade/core/image.h"
 #include "saccade/core/image_io.h"
@@ -167,6 +168,9 @@ cameras:
   }());
   options.noise_on_cpu = true;
   std::unique_ptr<Renderer> cpu = MakeRenderer(world, options);
+  // Large enough to be converted in two halves on two threads: each half's rows keep their
+  // place in the pass's hash.
+  EXPECT_GE(320u * 240u, gl::kMinSplitNoisePixels);
   const scene::SceneState state = world.InitialState();
   const std::shared_ptr<const Image> a = pass->Render(state, 3)[0].color;
   const std::shared_ptr<const Image> b = cpu->Render(state, 3)[0].color;

@@ -93,7 +93,12 @@ std::vector<uint8_t> NoiseLevels(float read_sigma_dn, float gain_dn_per_e) {
 
 void RgbaToRgbWithNoise(const uint8_t* rgba, uint8_t* rgb, int width, int height, uint32_t key,
                         const uint32_t* table, const uint8_t* levels) {
-  for (int y = 0; y < height; ++y) {
+  RgbaToRgbWithNoise(rgba, rgb, width, 0, height, key, table, levels);
+}
+
+void RgbaToRgbWithNoise(const uint8_t* rgba, uint8_t* rgb, int width, int first_row, int end_row,
+                        uint32_t key, const uint32_t* table, const uint8_t* levels) {
+  for (int y = first_row; y < end_row; ++y) {
     const uint32_t row = Hash(static_cast<uint32_t>(y) ^ key);
     const uint8_t* in = rgba + static_cast<std::size_t>(y) * width * 4;
     uint8_t* out = rgb + static_cast<std::size_t>(y) * width * 3;

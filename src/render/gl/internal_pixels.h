@@ -6,6 +6,10 @@
 
 namespace saccade::render::gl {
 
+/// Images of at least this many pixels get their CPU noise in two halves on two threads
+/// (Retrieve); smaller ones in one piece, where a thread costs more than it saves.
+constexpr std::size_t kMinSplitNoisePixels = 256 * 256;
+
 /// RGBA rows to tightly packed RGB (alpha dropped); SSSE3 where the CPU has it.
 void RgbaToRgb(const uint8_t* rgba, uint8_t* rgb, std::size_t pixels);
 
@@ -20,5 +24,10 @@ std::vector<uint8_t> NoiseLevels(float read_sigma_dn, float gain_dn_per_e);
 /// `key` picks.
 void RgbaToRgbWithNoise(const uint8_t* rgba, uint8_t* rgb, int width, int height, uint32_t key,
                         const uint32_t* table, const uint8_t* levels);
+
+/// The same for rows [first_row, end_row) of the image only (`rgba` and `rgb` still point at
+/// row 0), so that parts of one image can be converted at the same time.
+void RgbaToRgbWithNoise(const uint8_t* rgba, uint8_t* rgb, int width, int first_row, int end_row,
+                        uint32_t key, const uint32_t* table, const uint8_t* levels);
 
 }  // namespace saccade::render::gl
