@@ -14,7 +14,9 @@ import argparse
 import json
 import math
 import os
+import statistics
 import subprocess
+import sys
 import tempfile
 import time
 
@@ -112,7 +114,15 @@ def main() -> None:
     parser.add_argument("--rounds", type=int, default=2, help="alternating rounds (the best is kept)")
     parser.add_argument("--cpp", default=os.path.join(saccade.source_dir(), "build", "bin", "env_step_bench"),
                         help="the C++ step bench (build/bin/env_step_bench)")
+    parser.add_argument("--step-rounds", type=int, default=5,
+                        help="rounds of the Python / C++ step comparison, each a fresh process a side (5)")
+    parser.add_argument("--python-step", type=int, metavar="SIZE",
+                        help="only time one FixationEnv step of SIZE x SIZE eyes in this process and "
+                             "print its ms (what each round of the comparison runs)")
     args = parser.parse_args()
+    if args.python_step is not None:
+        print(f"{python_step_ms(args.python_step):.4f}")
+        return
     for n in args.sizes:
         if n < 1 or args.scenes % n:
             parser.error(f"--scenes {args.scenes} is not a multiple of the batch size {n}")
@@ -135,14 +145,23 @@ def main() -> None:
         print(f"| {n} | {steps:.1f} | {obs:.0f} | {1000.0 / obs:.2f} | {1000.0 / obs / base:.2f} | {obs_median:.0f} |")
 
     if os.path.exists(args.cpp):
-        py, cpp = [], []
-        for _ in range(args.rounds):
-            py.append(python_step_ms(args.image))
-            cpp.append(cpp_step_ms(args.image, args.cpp))
-        p, c = min(py), min(cpp)
-        print(f"\nFixationEnv.step, {args.image}x{args.image} stereo, same scene and objects "
-              f"(least disturbed of 30 x 0.1 s, {args.rounds} rounds): Python {p:.3f} ms, C++ {c:.3f} ms, "
-              f"Python overhead {100.0 * (p - c) / c:+.1f} %")
+        # Each side in a process of its own, in turn: a process's renderer is a little faster or
+        # slower than the next one's (0.12-0.16 ms for the same batch render), so one process
+        # a side would compare two draws of that lottery; pairs of fresh ones compare its spread.
+        print(f"\nFixationEnv.step, {args.image}x{args.image} stereo, same scene and objects, "
+              f"a fresh process each side and round (least disturbed of 30 x 0.1 s each):")
+        print("| round | Python ms | C++ ms | Python overhead |")
+        print("|---|---|---|---|")
+        overheads = []
+        for round_ in range(args.step_rounds):
+            p = float(subprocess.run(
+                [sys.executable, os.path.abspath(__file__), "--python-step", str(args.image)],
+                check=True, capture_output=True, text=True).stdout.split()[-1])
+            c = cpp_step_ms(args.image, args.cpp)
+            overheads.append(100.0 * (p - c) / c)
+            print(f"| {round_ + 1} | {p:.3f} | {c:.3f} | {overheads[-1]:+.1f} % |")
+        print(f"Python overhead: median {statistics.median(overheads):+.1f} % "
+              f"({min(overheads):+.1f} to {max(overheads):+.1f} %, {len(overheads)} rounds)")
     else:
         print(f"\n{args.cpp} not built: no C++ comparison (cmake --build build --target env_step_bench)")
 
