@@ -391,9 +391,10 @@ TEST(MotionBlurTest, RedrawingOnlyWhatMovesGivesTheMeanOfTheInstants) {
       "kind: sphere\n    radius: 0.08\n    color: [1, 1, 1, 1]", "sphere");
   // Flat items: the region is also bounded by the hull of their model's box, far inside their
   // sphere's (a picture's sphere reaches half its diagonal in front of it and behind). A box
-  // hull taken without the item's pose or scale would cut the smear: a picture, a thin slab,
-  // and the mug (an OBJ in centimetres, scaled by unit_scale). Their spheres' motion bound
-  // asks for a sub-frame more than the small movers'.
+  // hull short of the drawn item would cut the smear (shrunk to 0.7 of its size: the picture
+  // 95 DN off, the slab 77): a picture, a thin slab, and the mug (an OBJ in centimetres, its box
+  // scaled by unit_scale as it is drawn). Their spheres' motion bound asks for a sub-frame more
+  // than the small movers'.
   ExpectRedrawingOnlyWhatMovesGivesTheMeanOfTheInstants(
       "kind: picture\n    image: ../assets/astronaut.png\n    height: 0.4", "picture", 10, 2);
   ExpectRedrawingOnlyWhatMovesGivesTheMeanOfTheInstants(

@@ -72,7 +72,8 @@ std::vector<Frame> GlRenderer::Retrieve() {
       // A large image in two halves at once: the fence above waited for every camera's
       // passes, so a software rasteriser's threads are idle while this runs (1024 x 768:
       // about 2.2 ms a camera in one piece on the 2-core development machine).
-      if (pixel_count >= kMinSplitNoisePixels && std::thread::hardware_concurrency() >= 2) {
+      static const bool cores = std::thread::hardware_concurrency() >= 2;  // asked once
+      if (pixel_count >= kMinSplitNoisePixels && cores) {
         const int half = image->height() / 2;
         std::thread other(convert, half, image->height());
         convert(0, half);
