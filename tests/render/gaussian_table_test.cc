@@ -80,5 +80,13 @@ TEST(GaussianTableTest, PackedEntriesDecodeWithinHalfAStepKeepingMeanAndVariance
   EXPECT_THROW(PackGaussianTable(wide), Error);
 }
 
+// Every renderer of a process shares one packed table, made at the first call: it is the table
+// packed above, entry for entry, and later calls return that same one.
+TEST(GaussianTableTest, TheSharedPackedTableIsThePackedTableMadeOnce) {
+  const std::vector<uint32_t>& shared = PackedGaussianTable();
+  EXPECT_EQ(shared, PackGaussianTable(GaussianTable()));
+  EXPECT_EQ(&PackedGaussianTable(), &shared);
+}
+
 }  // namespace
 }  // namespace saccade::render::gl

@@ -285,6 +285,11 @@ std::vector<float> GaussianTable() {
   return table;
 }
 
+const std::vector<uint32_t>& PackedGaussianTable() {
+  static const std::vector<uint32_t> packed = PackGaussianTable(GaussianTable());
+  return packed;
+}
+
 std::vector<uint32_t> PackGaussianTable(const std::vector<float>& table) {
   std::vector<uint32_t> packed(table.size() / 3);
   for (std::size_t i = 0; i < packed.size(); ++i) {
@@ -396,7 +401,7 @@ EffectPrograms::EffectPrograms() {
   truth_.depth_axis = Uniform(truth_.program, "u_depth_axis");
   truth_.id = Uniform(truth_.program, "u_id");
   glUseProgram(0);
-  const std::vector<uint32_t> gauss = PackGaussianTable(GaussianTable());
+  const std::vector<uint32_t>& gauss = PackedGaussianTable();
   gauss_ = MakeTexture2d(GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, kGaussianTableSide,
                          kGaussianTableSide, gauss.data());
   CheckGlError("MakeRenderer: building the effect programs");

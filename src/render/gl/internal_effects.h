@@ -91,6 +91,10 @@ std::vector<float> GaussianTable();
 inline constexpr double kGaussianRange = 4.6;  // the quantiles reach 4.36 (unit variance)
 inline constexpr double kGaussianStep = 2.0 * kGaussianRange / 1023.0;
 std::vector<uint32_t> PackGaussianTable(const std::vector<float>& table);
+/// PackGaussianTable(GaussianTable()), made once a process (about 40 ms of erfc on the 2-core
+/// development machine) and shared by every renderer after: the effect programs' texture and
+/// the CPU noise.
+const std::vector<uint32_t>& PackedGaussianTable();
 
 /// Programs and the empty vertex array shared by every camera's effect passes.
 class EffectPrograms {
