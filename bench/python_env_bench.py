@@ -5,7 +5,9 @@
    64 heads (one batch render per step), and the cost per stereo observation;
 2. one FixationEnv step through Python against the same step in C++ (build/bin/env_step_bench:
    the action checked, joints moved, forward kinematics, both eyes drawn through
-   RenderBatch), on the same scene and the same objects.
+   RenderBatch), on the same scene and the same objects: each side in a fresh process,
+   --step-rounds rounds in turn, every round printed and the median of their overheads (the
+   same render costs 0.12-0.16 ms from one process to the next).
 
     PYTHONPATH=build/python /usr/bin/python3 bench/python_env_bench.py [--sizes 1 4 16 64]
 """
