@@ -590,19 +590,12 @@ std::vector<std::optional<GlRenderer::Region>> GlRenderer::MovingRegions(
       frames[k] = head::ForwardKinematics(scene_.robot()->head, subs[k].joints);
     }
   }
-  // The items that move, at every sub-frame: their bounding spheres and poses (world frame).
-  struct Moving {
-    Eigen::Vector3d centre_W;
-    double radius;
-    geometry::Pose X_WO;
-    const DrawItem* item;
-  };
-  std::vector<Moving> moving;
+  // The items that move, with their pose at every sub-frame (world frame).
+  std::vector<std::pair<const DrawItem*, geometry::Pose>> moving;
   for (std::size_t i = 0; i < items_.size(); ++i) {
     // Under a pixel over the exposure, an item is as still as the camera (no ghost step).
     if (item_px[i] < 1.0) continue;
     const DrawItem& item = items_[i];
-    const Eigen::Vector3d centre = item.center_model.cwiseProduct(item.scale);
     std::vector<geometry::Pose> poses;
     for (std::size_t k = 0; k < subs.size(); ++k) {
       poses.push_back(ItemPose(item, subs[k], frames[k]));
@@ -611,9 +604,7 @@ std::vector<std::optional<GlRenderer::Region>> GlRenderer::MovingRegions(
       return X.matrix() != poses.front().matrix();
     });
     if (!moves) continue;
-    for (const geometry::Pose& X_WO : poses) {
-      moving.push_back({X_WO * centre, item.radius_model, X_WO, &item});
-    }
+    for (const geometry::Pose& X_WO : poses) moving.emplace_back(&item, X_WO);
   }
   std::vector<std::optional<Region>> regions(views);
   for (int v = 0; v < views; ++v) {
@@ -640,22 +631,22 @@ std::vector<std::optional<GlRenderer::Region>> GlRenderer::MovingRegions(
     // bounding sphere, and of the corners of its model's box (far tighter for a flat picture,
     // whose sphere reaches past it on every side). Their intersection holds it while every
     // corner of one of them lies in front of the eye.
-    for (const Moving& m : moving) {
+    for (const auto& [item_ptr, X_WO] : moving) {
+      const DrawItem& item = *item_ptr;
+      const double r = item.radius_model;
+      const Eigen::Vector3d c_E = X_EW * (X_WO * item.center_model.cwiseProduct(item.scale));
       std::array<Eigen::Vector3d, 8> corners;
-      const Eigen::Vector3d c_E = X_EW * m.centre_W;
       for (int corner = 0; corner < 8; ++corner) {
-        corners[corner] = c_E + Eigen::Vector3d((corner & 1) ? m.radius : -m.radius,
-                                                (corner & 2) ? m.radius : -m.radius,
-                                                (corner & 4) ? m.radius : -m.radius);
+        corners[corner] = c_E + Eigen::Vector3d((corner & 1) ? r : -r, (corner & 2) ? r : -r,
+                                                (corner & 4) ? r : -r);
       }
       std::optional<Rect> rect = hull(corners);
-      const DrawItem& item = *m.item;
       if (item.model != nullptr && !item.model->bounds.isEmpty()) {
         for (int corner = 0; corner < 8; ++corner) {
           const Eigen::Vector3d c =
               item.model->bounds.corner(static_cast<Eigen::AlignedBox3f::CornerType>(corner))
                   .cast<double>();
-          corners[corner] = X_EW * (m.X_WO * c.cwiseProduct(item.scale));
+          corners[corner] = X_EW * (X_WO * c.cwiseProduct(item.scale));
         }
         if (const std::optional<Rect> box = hull(corners)) {
           rect = rect ? Rect{std::max((*rect)[0], (*box)[0]), std::max((*rect)[1], (*box)[1]),
