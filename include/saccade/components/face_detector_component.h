@@ -16,7 +16,7 @@
 // stereo loop loses nothing; the other eye's faces of another capture (a detector on a thread
 // of its own), or an image without its camera, leave the whole image searched.
 //
-// While the track input (when connected) follows a target and `track_region_scale` > 0 (2.5
+// While the track input (when connected) follows a target and `track_region_scale` > 0 (1.8
 // by default), the detector searches a box that many times the track's window around it (at
 // `region_pyramid_level`), and the whole image too (at `pyramid_level`) every
 // `full_scan_every`-th detection, so that attention still sees the other faces (a discovery
@@ -110,12 +110,12 @@ class FaceDetectorComponent : public runtime::Component {
   bool require_eyes_ = true;
   int latency_steps_ = 0;
   bool realtime_thread_ = true;
-  double track_region_scale_ = 2.5;
+  double track_region_scale_ = 1.8;
   int full_scan_every_ = 10;
   int region_pyramid_level_ = 0;
   int new_target_scans_ = 5;
-  double region_size_factor_ = 2.0;
-  int recheck_every_ = 5;
+  double region_size_factor_ = 1.5;
+  int recheck_every_ = 10;
   double discovery_scale_factor_ = 1.2;
   double partner_min_depth_m_ = 0.3;
   double partner_max_depth_m_ = 20.0;
