@@ -74,7 +74,8 @@ FaceDetectorComponent::FaceDetectorComponent()
                "connected)")
       .Range(0.0, 100.0);
   DeclareParam("full_scan_every", &full_scan_every_,
-               "with a track region: search the whole image every N-th detection")
+               "with a track region: search the whole image every N-th detection (a face that "
+               "comes into view is found within N frames)")
       .Range(1, 1000000);
   DeclareParam("new_target_scans", &new_target_scans_,
                "with a track region: on the first N detections of a new target (a saccade's "

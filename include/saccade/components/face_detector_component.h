@@ -111,7 +111,7 @@ class FaceDetectorComponent : public runtime::Component {
   int latency_steps_ = 0;
   bool realtime_thread_ = true;
   double track_region_scale_ = 1.8;
-  int full_scan_every_ = 10;
+  int full_scan_every_ = 20;
   int region_pyramid_level_ = 0;
   int new_target_scans_ = 5;
   double region_size_factor_ = 1.5;
