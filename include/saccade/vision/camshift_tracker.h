@@ -6,6 +6,7 @@
 // back-projection mass inside it falls below a fraction of the mass at the seed; the caller
 // then re-detects (e.g. FaceDetector near window()) and calls Start again.
 #include <opencv2/core.hpp>
+#include <optional>
 #include <string>
 
 #include "saccade/core/image.h"
@@ -59,7 +60,9 @@ class CamShiftTracker {
   bool Start(const Image& image, const cv::Rect& box);
 
   /// Moves the track to `image` (same camera, next frame). After loss, returns kLost until
-  /// Start is called again; before any Start, kNotStarted.
+  /// Start is called again; before any Start, kNotStarted. The colour model is back-projected
+  /// around the window only (a window's size each side); a result that reaches that region's
+  /// edge inside the image is computed again over the whole image.
   TrackState Update(const Image& image);
 
   bool tracking() const { return state_.status == TrackState::Status::kTracking; }
@@ -68,7 +71,17 @@ class CamShiftTracker {
   const Options& options() const { return options_; }
 
  private:
-  cv::Mat BackProject(const Image& image, const char* who) const;
+  // The back projection of `region` of `image` (the whole image by default).
+  cv::Mat BackProject(const Image& image, const char* who,
+                      const std::optional<cv::Rect>& region = std::nullopt) const;
+  // CamShift from `window` over `region` of `image`: the state's box and window in the image's
+  // pixels, and the back projection's mass in the new window.
+  struct Shift {
+    cv::RotatedRect box;
+    cv::Rect window;
+    double mass = 0.0;
+  };
+  Shift ShiftIn(const Image& image, const cv::Rect& window, const cv::Rect& region) const;
 
   Options options_;
   cv::Mat histogram_;  // hue x saturation, normalised to 0 .. 255
