@@ -43,12 +43,20 @@ FaceDetection DetectAstronaut(const Image& image) {
   return {};
 }
 
-TEST(CamShiftTracker, KeepsTheFaceWhileTheHeadPans) {
-  const Eigen::Vector3d face = FaceCentreWorld("astronaut");
-  const head::IkResult ik = head::SolveFixation(Portraits().robot()->head, face);
-  ASSERT_TRUE(ik.reachable());
+// The scene's initial state, the head fixating the astronaut's face.
+scene::SceneState FixatingTheAstronaut() {
+  const head::IkResult ik =
+      head::SolveFixation(Portraits().robot()->head, FaceCentreWorld("astronaut"));
+  EXPECT_TRUE(ik.reachable());
   scene::SceneState state = Portraits().InitialState();
   state.joints = ik.joints;
+  return state;
+}
+
+TEST(CamShiftTracker, KeepsTheFaceWhileTheHeadPans) {
+  const Eigen::Vector3d face = FaceCentreWorld("astronaut");
+  scene::SceneState state = FixatingTheAstronaut();
+  const head::JointState start = state.joints;
   StereoFrame frame = RenderState(state, 0);
   const FaceDetection seed = DetectAstronaut(frame.left);
   CamShiftTracker tracker;
@@ -57,8 +65,8 @@ TEST(CamShiftTracker, KeepsTheFaceWhileTheHeadPans) {
   // in all) and tilting 0.2 degrees a frame.
   for (int i = 1; i <= 10; ++i) {
     state.time = i / 30.0;
-    state.joints.pan = ik.joints.pan + 0.6 * kDeg * i;
-    state.joints.tilt = ik.joints.tilt + 0.2 * kDeg * i;
+    state.joints.pan = start.pan + 0.6 * kDeg * i;
+    state.joints.tilt = start.tilt + 0.2 * kDeg * i;
     frame = RenderState(state, i);
     const TrackState track = tracker.Update(frame.left);
     const cv::Point2d truth = ProjectTruth(frame.left, face);
@@ -130,11 +138,8 @@ class WholeImageCamShift {
 };
 
 TEST(CamShiftTracker, TracksAsOpenCvsCamShiftOverTheWholeImage) {
-  const Eigen::Vector3d face = FaceCentreWorld("astronaut");
-  const head::IkResult ik = head::SolveFixation(Portraits().robot()->head, face);
-  ASSERT_TRUE(ik.reachable());
-  scene::SceneState state = Portraits().InitialState();
-  state.joints = ik.joints;
+  scene::SceneState state = FixatingTheAstronaut();
+  const head::JointState start = state.joints;
   StereoFrame frame = RenderState(state, 0);
   ASSERT_EQ(frame.left.format(), PixelFormat::kRgb8);
   const cv::Rect seed = DetectAstronaut(frame.left).box;
@@ -144,7 +149,7 @@ TEST(CamShiftTracker, TracksAsOpenCvsCamShiftOverTheWholeImage) {
   // The head panning: the face ~13 px a frame, once ~50.
   for (int i = 1; i <= 6; ++i) {
     state.time = i / 30.0;
-    state.joints.pan = ik.joints.pan + (i + (i >= 4 ? 3 : 0)) * 0.6 * kDeg;
+    state.joints.pan = start.pan + (i + (i >= 4 ? 3 : 0)) * 0.6 * kDeg;
     frame = RenderState(state, i);
     const TrackState track = tracker.Update(frame.left);
     const auto [centre, window, mass] = reference.Update(frame.left);
@@ -190,15 +195,13 @@ TEST(CamShiftTracker, AResultPastTheRegionIsTheWholeImages) {
 }
 
 TEST(CamShiftTracker, ReportsTheLossWhenTheFaceLeavesTheView) {
-  const Eigen::Vector3d face = FaceCentreWorld("astronaut");
-  const head::IkResult ik = head::SolveFixation(Portraits().robot()->head, face);
-  scene::SceneState state = Portraits().InitialState();
-  state.joints = ik.joints;
+  scene::SceneState state = FixatingTheAstronaut();
+  const head::JointState start = state.joints;
   StereoFrame frame = RenderState(state, 0);
   CamShiftTracker tracker;
   ASSERT_TRUE(tracker.Start(frame.left, DetectAstronaut(frame.left).box));
   // A saccade far up: the face is out of the image (the sky fills it).
-  state.joints.tilt = ik.joints.tilt + 30 * kDeg;
+  state.joints.tilt = start.tilt + 30 * kDeg;
   frame = RenderState(state, 1);
   const TrackState track = tracker.Update(frame.left);
   std::cout << "after the saccade: " << track.reason << "\n";
