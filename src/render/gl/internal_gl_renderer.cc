@@ -95,7 +95,6 @@ GlRenderer::GlRenderer(const scene::Scene& scene, const RendererOptions& options
   // On a software rasteriser a full-screen pass costs milliseconds an eye (a 1024 x 768 copy:
   // ~4 ms on llvmpipe), more than the same noise added on the CPU to the pixels read back.
   noise_on_cpu_ = options_.noise_on_cpu.value_or(software);
-  if (noise_on_cpu_) gauss_table_ = PackedGaussianTable();
   batch_contexts_ = options_.batch_contexts != 0
                         ? options_.batch_contexts
                         : (software && std::thread::hardware_concurrency() >= 2 ? 2 : 1);

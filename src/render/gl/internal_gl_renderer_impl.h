@@ -261,7 +261,6 @@ class GlRenderer final : public Renderer {
   bool draw_robot_ = false;
   double turn_blur_max_error_px_ = -1.0;  // RendererOptions::turn_blur*; < 0: off
   bool noise_on_cpu_ = false;             // RendererOptions::noise_on_cpu, resolved
-  std::vector<uint32_t> gauss_table_;     // PackedGaussianTable(), for it
   // NoiseLevels by (read sigma, gain), made as cameras need them.
   std::map<std::pair<float, float>, std::vector<uint8_t>> noise_levels_;
   std::vector<DrawItem> items_;

@@ -67,7 +67,7 @@ std::vector<Frame> GlRenderer::Retrieve() {
       if (levels.empty()) levels = NoiseLevels(noise->read_sigma_dn, noise->gain_dn_per_e);
       const auto convert = [&](int first_row, int end_row) {
         RgbaToRgbWithNoise(pixels, image->data(), image->width(), first_row, end_row, noise->key,
-                           gauss_table_.data(), levels.data());
+                           PackedGaussianTable().data(), levels.data());
       };
       // A large image in two halves at once: the fence above waited for every camera's
       // passes, so a software rasteriser's threads are idle while this runs (1024 x 768:
