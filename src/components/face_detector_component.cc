@@ -64,6 +64,18 @@ FaceDetectorComponent::FaceDetectorComponent()
                "0: detect within the step; N: detect on a thread of its own, the faces emitted N "
                "steps after their image (simulated clock; real time: once ready)")
       .Range(0, 100);
+  DeclareParam("discovery_latency_steps", &discovery_latency_steps_,
+               "with a track input and latency_steps 0: 0: the whole-image searches for the "
+               "other faces run within the step; D: on a thread of their own, the faces they "
+               "find searched again D steps later around where they were, in that step's image "
+               "(simulated clock: exactly D; real time: once done), so that they never hold up "
+               "the loop")
+      .Range(0, 100);
+  DeclareParam("discovery_pyramid_level", &discovery_pyramid_level_,
+               "with discovery_latency_steps: the pyramid level of the lane's whole-image "
+               "searches (the faces they find are searched again around where they were, at "
+               "pyramid_level)")
+      .Range(0, 4);
   DeclareParam("realtime_thread", &realtime_thread_,
                "on the real-time clock (saccade demo --realtime, the GUI), detect on a thread of "
                "its own whatever latency_steps says, the faces emitted once ready, so that the "
@@ -92,6 +104,11 @@ FaceDetectorComponent::FaceDetectorComponent()
                "searches, then is checked again; a new target forgets them all (1: check every "
                "face every time)")
       .Range(1, 1000000);
+  DeclareParam("recheck_phase", &recheck_phase_,
+               "with recheck_every: a face checked for the first time keeps its verdict N "
+               "searches fewer before its first check again (the two eyes' detectors at phases "
+               "recheck_every / 2 apart check one face on different steps)")
+      .Range(0, 1000000);
   DeclareParam("partner_min_depth_m", &partner_min_depth_m_,
                "with a partner input: the nearest depth of a face along its ray from the other "
                "eye (the near end of the band searched)")
@@ -134,6 +151,9 @@ vision::FaceDetector::Options FaceDetectorComponent::DetectorOptions() const {
 }
 
 void FaceDetectorComponent::Configured() {
+  // A search on a thread of its own uses the detectors replaced below.
+  if (running_.valid()) running_.wait();
+  if (discovery_.valid()) discovery_.wait();
   if (!(partner_min_depth_m_ < partner_max_depth_m_)) {
     throw InvalidArgument(
         fmt::format("partner_min_depth_m ({}) must be less than partner_max_depth_m ({})",
@@ -144,10 +164,15 @@ void FaceDetectorComponent::Configured() {
   options.pyramid_level = region_pyramid_level_;
   region_detector_ = std::make_unique<vision::FaceDetector>(options);
   discovery_detector_.reset();
+  options = DetectorOptions();
+  options.scale_factor = discovery_scale_factor_;
   if (discovery_scale_factor_ != options_.scale_factor) {
-    options = DetectorOptions();
-    options.scale_factor = discovery_scale_factor_;
     discovery_detector_ = std::make_unique<vision::FaceDetector>(options);
+  }
+  lane_detector_.reset();
+  if (discovery_latency_steps_ > 0 && latency_steps_ == 0) {
+    options.pyramid_level = discovery_pyramid_level_;
+    lane_detector_ = std::make_unique<vision::FaceDetector>(options);
   }
 }
 
@@ -157,7 +182,9 @@ FaceDetectorComponent::Search FaceDetectorComponent::NextSearch(const Image& ima
   if (track_region_scale_ > 0.0 && track_.has_value()) AroundTrack(image, n, &search);
   // A face that one eye alone sees cannot be triangulated: with the other eye's faces of this
   // same capture (the partner input), their epipolar bands instead of the whole image.
-  if (search.whole && partner_.has_value()) {
+  // Not with the discovery lane while tracking: the partner's faces of this capture are then
+  // only those around its track.
+  if (search.whole && partner_.has_value() && !(lane_detector_ && search.tracked)) {
     std::optional<std::vector<std::pair<cv::Rect, cv::Size>>> bands = PartnerBands(image);
     if (bands) {
       search.whole = false;
@@ -189,8 +216,23 @@ void FaceDetectorComponent::AroundTrack(const Image& image, int64_t n, Search* o
     SizesAround(track.window.size(), &search);
   }
   // Without a track, the whole image (searching around where the selection puts a lost target
-  // instead left the eyes less steady: bench/baselines/loop-issue14-2core.md).
-  search.whole = !tracking || n % full_scan_every_ == 0;
+  // instead left the eyes less steady: bench/baselines/loop-issue14-2core.md); with the
+  // discovery lane, the whole image on its thread and around where the selection puts the
+  // target at once.
+  search.discovery = n % full_scan_every_ == 0;
+  search.whole = !tracking || search.discovery;
+  if (!tracking && lane_detector_) {
+    // No target (attention has none, or looks around): the whole image on the lane. A lost
+    // target: around where the selection puts it, now.
+    const bool target =
+        selection_.has_value() && selection_.value().valid && !selection_.value().exploring;
+    cv::Size face;
+    search.predicted =
+        target ? PredictedRegion(image, track.target_id, &face) : std::optional<cv::Rect>();
+    if (search.predicted) SizesAround(face, &search);
+    if (!target) search.discovery = true;
+    if (search.predicted) search.whole = search.discovery;
+  }
   // A new target: around where the selection puts it, or else the whole image.
   if (tracking && whole_scans_left_ > 0) {
     --whole_scans_left_;
@@ -286,18 +328,24 @@ std::optional<std::vector<std::pair<cv::Rect, cv::Size>>> FaceDetectorComponent:
 
 FacesMessage FaceDetectorComponent::Detect(std::shared_ptr<const Image> image,
                                            const Search& search) {
-  FacesMessage out;
-  out.image = std::move(image);
-  std::vector<vision::FaceDetection> found;
   // With a track, the whole image (or the partner's bands) is searched for the other faces
   // (discovery_scale_factor).
   vision::FaceDetector& wide =
       search.tracked && discovery_detector_ ? *discovery_detector_ : *detector_;
+  const std::vector<vision::FaceDetection> found = Find(*image, search, wide);
+  if (track_region_scale_ > 0.0 && track_.has_value()) Remember(found, search);
+  return Message(std::move(image), found);
+}
+
+std::vector<vision::FaceDetection> FaceDetectorComponent::Find(const Image& image,
+                                                               const Search& search,
+                                                               vision::FaceDetector& wide) const {
+  std::vector<vision::FaceDetection> found;
   if (search.whole) {
     vision::FaceDetector::Search whole;
-    whole.regions = {cv::Rect(0, 0, out.image->width(), out.image->height())};
+    whole.regions = {cv::Rect(0, 0, image.width(), image.height())};
     whole.checked = search.checked;
-    found = wide.Detect(*out.image, whole);
+    found = wide.Detect(image, whole);
   }
   for (const auto& [band, face] : search.bands) {
     // As the whole image would be searched, around each of the partner's faces' bands.
@@ -305,7 +353,7 @@ FacesMessage FaceDetectorComponent::Detect(std::shared_ptr<const Image> image,
     along.regions = {band};
     std::tie(along.min_size_px, along.max_size_px) = SizeBounds(face);
     along.checked = search.checked;
-    for (const vision::FaceDetection& d : wide.Detect(*out.image, along)) {
+    for (const vision::FaceDetection& d : wide.Detect(image, along)) {
       const bool again = std::any_of(found.begin(), found.end(), [&d](const auto& f) {
         return SameFace(f.box, d.box);
       });  // two bands that overlap
@@ -315,27 +363,38 @@ FacesMessage FaceDetectorComponent::Detect(std::shared_ptr<const Image> image,
   std::vector<cv::Rect> regions;
   if (search.region) regions.push_back(*search.region);
   if (search.predicted) regions.push_back(*search.predicted);
+  std::vector<vision::FaceDetection> near;
   if (!regions.empty()) {
-    // The tracked face from the regions, at the region's pyramid level: it replaces the whole
-    // image's boxes that overlap it.
+    // The tracked face from the regions, at the region's pyramid level.
     vision::FaceDetector::Search around;
     around.regions = regions;
     around.min_size_px = search.min_size_px;
     around.max_size_px = search.max_size_px;
     around.checked = search.checked;
-    const std::vector<vision::FaceDetection> near = region_detector_->Detect(*out.image, around);
-    std::erase_if(found, [&near](const vision::FaceDetection& d) {
-      return std::any_of(near.begin(), near.end(),
-                         [&d](const vision::FaceDetection& r) { return SameFace(d.box, r.box); });
-    });
-    found.insert(found.end(), near.begin(), near.end());
+    near = region_detector_->Detect(image, around);
   }
-  std::stable_sort(found.begin(), found.end(),
+  return Merge(std::move(found), near);
+}
+
+std::vector<vision::FaceDetection> FaceDetectorComponent::Merge(
+    std::vector<vision::FaceDetection> whole, const std::vector<vision::FaceDetection>& near) {
+  std::erase_if(whole, [&near](const vision::FaceDetection& d) {
+    return std::any_of(near.begin(), near.end(),
+                       [&d](const vision::FaceDetection& r) { return SameFace(d.box, r.box); });
+  });
+  whole.insert(whole.end(), near.begin(), near.end());
+  std::stable_sort(whole.begin(), whole.end(),
                    [](const auto& a, const auto& b) { return a.box.area() > b.box.area(); });
+  return whole;
+}
+
+FacesMessage FaceDetectorComponent::Message(std::shared_ptr<const Image> image,
+                                            const std::vector<vision::FaceDetection>& found) const {
+  FacesMessage out;
+  out.image = std::move(image);
   for (const vision::FaceDetection& d : found) {
     out.faces.push_back({d.box, d.neighbors, d.rejected, d.reason});
   }
-  if (track_region_scale_ > 0.0 && track_.has_value()) Remember(found, search);
   return out;
 }
 
@@ -343,7 +402,14 @@ void FaceDetectorComponent::Remember(const std::vector<vision::FaceDetection>& f
                                      const Search& search) {
   std::vector<Verdict> seen;
   for (const vision::FaceDetection& d : found) {
-    seen.push_back({d, d.verdict_from >= 0 ? search.checked_reuses[d.verdict_from] + 1 : 0, 0});
+    int reuses = 0;
+    if (d.verdict_from >= 0) {
+      reuses = search.checked_reuses[d.verdict_from] + 1;
+    } else if (std::none_of(verdicts_.begin(), verdicts_.end(),
+                            [&d](const Verdict& v) { return SameFace(v.face.box, d.box); })) {
+      reuses = recheck_phase_;  // checked for the first time
+    }
+    seen.push_back({d, reuses, 0});
   }
   // The faces this search did not see (outside the region) are kept until the next whole scan.
   for (const Verdict& v : verdicts_) {
@@ -355,12 +421,71 @@ void FaceDetectorComponent::Remember(const std::vector<vision::FaceDetection>& f
   verdicts_ = std::move(seen);
 }
 
+bool FaceDetectorComponent::StartDiscovery(const runtime::StepContext& context,
+                                           const std::shared_ptr<const Image>& image,
+                                           const Search& search) {
+  if (!lane_detector_ || !search.tracked || !search.discovery) return false;
+  Search around = search;  // the track's region (or the target's) now, on this thread
+  around.whole = false;
+  std::vector<vision::FaceDetection> near = Find(*image, around, *detector_);
+  if (discovery_.valid()) {
+    // One is in flight (both eyes start theirs at the same steps: on the same count of
+    // detections, or when attention has no target).
+    Remember(near, search);
+    faces_.Emit(Message(image, near));
+    return true;
+  }
+  discovery_search_ = search;
+  discovery_near_ = near;
+  discovery_target_ = last_target_id_;
+  Search wide = search;  // the whole image on the lane's thread, with its own cascades
+  wide.region.reset();
+  wide.predicted.reset();
+  discovery_due_ = context.step + discovery_latency_steps_;
+  discovery_ = std::async(std::launch::async, [this, image, wide = std::move(wide)] {
+    return Find(*image, wide, *lane_detector_);
+  });
+  Remember(near, search);
+  faces_.Emit(Message(image, near));
+  return true;
+}
+
+void FaceDetectorComponent::Revisit(const std::vector<vision::FaceDetection>& discovered,
+                                    const Image& image, Search* search) const {
+  search->whole = false;
+  search->discovery = false;
+  for (const vision::FaceDetection& d : discovered) {
+    const cv::Rect box =
+        BoxAround(d.box.x + 0.5 * (d.box.width - 1), d.box.y + 0.5 * (d.box.height - 1),
+                  d.box.size(), track_region_scale_, image);
+    const bool tracked = search->region && SameFace(*search->region, box);
+    if (box.area() > 0 && !tracked) search->bands.emplace_back(box, d.box.size());
+  }
+}
+
+bool FaceDetectorComponent::DiscoveryDue(const runtime::StepContext& context) const {
+  if (!discovery_.valid()) return false;
+  return context.realtime
+             ? discovery_.wait_for(std::chrono::seconds(0)) == std::future_status::ready
+             : context.step >= discovery_due_;
+}
+
 void FaceDetectorComponent::Step(const runtime::StepContext& context) {
   const bool own_thread = latency_steps_ > 0 || (context.realtime && realtime_thread_);
   if (!own_thread) {
+    // The discovery's faces (of an image D steps old): searched again, each around where it
+    // was, in this step's image (waits, in simulated time, for as long as the search takes).
+    std::vector<vision::FaceDetection> discovered;
+    if (DiscoveryDue(context)) {
+      discovered = Merge(discovery_.get(), discovery_near_);
+      // A new target meanwhile forgot every verdict (the eyes jumped): these are of before.
+      if (last_target_id_ == discovery_target_) Remember(discovered, discovery_search_);
+    }
     if (image_.fresh() && image_.value().image) {
       const std::shared_ptr<const Image>& image = image_.value().image;
-      faces_.Emit(Detect(image, NextSearch(*image)));
+      Search search = NextSearch(*image);
+      if (!discovered.empty()) Revisit(discovered, *image, &search);
+      if (!StartDiscovery(context, image, search)) faces_.Emit(Detect(image, search));
     }
     return;
   }
@@ -384,6 +509,7 @@ void FaceDetectorComponent::Step(const runtime::StepContext& context) {
 
 void FaceDetectorComponent::Stop() {
   if (running_.valid()) running_.wait();
+  if (discovery_.valid()) discovery_.wait();
 }
 
 }  // namespace saccade::components

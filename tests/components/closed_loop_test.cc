@@ -55,6 +55,7 @@ struct LoopRun {
   std::vector<Visit> visits;             // in the order attention chose them
   std::vector<head::JointState> joints;  // per step
   std::vector<double> face_ages_s;       // per faces message: step time less the image's time
+  std::vector<int> left_faces;           // per step: faces_left's accepted faces (-1: none sent)
   runtime::RunSummary summary;
 };
 
@@ -77,6 +78,7 @@ LoopRun RunLoop(const std::string& scene_file, double seconds, bool stop_when_al
   std::optional<SelectionMessage> selection;
   std::optional<TargetMessage> target;
   std::vector<double> face_times;  // this step's faces messages: their images' times
+  int left_faces = -1;             // this step's faces_left message's accepted faces
   for (const auto& c : pipeline.components()) {
     for (const auto& o : c->outputs()) {
       if (auto* i = dynamic_cast<runtime::Output<runtime::ImageMessage>*>(o.get())) {
@@ -87,8 +89,14 @@ LoopRun RunLoop(const std::string& scene_file, double seconds, bool stop_when_al
       } else if (auto* t = dynamic_cast<runtime::Output<TargetMessage>*>(o.get())) {
         t->signal().Connect([&](const TargetMessage& m) { target = m; });
       } else if (auto* f = dynamic_cast<runtime::Output<FacesMessage>*>(o.get())) {
-        f->signal().Connect(
-            [&](const FacesMessage& m) { face_times.push_back(m.image->metadata().time); });
+        const bool left = c->name() == "faces_left";
+        f->signal().Connect([&, left](const FacesMessage& m) {
+          face_times.push_back(m.image->metadata().time);
+          if (left) {
+            left_faces = static_cast<int>(std::count_if(m.faces.begin(), m.faces.end(),
+                                                        [](const auto& f) { return !f.rejected; }));
+          }
+        });
       } else if (auto* j = dynamic_cast<runtime::Output<JointStateMessage>*>(o.get())) {
         j->signal().Connect([&](const JointStateMessage& m) { out.joints.push_back(m.positions); });
       }
@@ -101,6 +109,8 @@ LoopRun RunLoop(const std::string& scene_file, double seconds, bool stop_when_al
   options.after_step = [&](const runtime::StepContext& context) {
     for (const double t : face_times) out.face_ages_s.push_back(context.time - t);
     face_times.clear();
+    out.left_faces.push_back(left_faces);
+    left_faces = -1;
     if (!selection) return;
     int done = 0, faces = 0;
     for (const PictureFace& p : pictures) {
@@ -259,6 +269,43 @@ TEST(ClosedLoop, AsynchronousDetectionKeepsItsModelledLatencyAndRepeats) {
   EXPECT_EQ(a.visits.front().object, "astronaut_near");
   EXPECT_GE(a.visits.front().fixated_at, 0.0);
   EXPECT_LT(a.visits.front().error_3d_m, Max3dErrorM(a.visits.front().distance_m));
+}
+
+// The discovery lane (pipelines/demo.yaml's discovery_latency_steps): while a face is
+// tracked, the whole-image search for the other faces leaves the step. On the step a search
+// within the step would have found another portrait, the lane's step reports the tracked face
+// alone; discovery_latency_steps later, the other too, searched again around where the lane
+// found it, in that step's own image: every faces message is of its step's image. The run
+// repeats bit for bit.
+TEST(ClosedLoop, TheDiscoveryLaneFindsTheOtherFacesLaterInTheirOwnStep) {
+  const std::string scene = kSource + "/scenes/portraits.yaml";
+  int lane_steps = 0;
+  const auto within = [&lane_steps](runtime::PipelineSpec& spec) {
+    for (runtime::ComponentSpec& c : spec.components) {
+      if (c.type != "vision.face_detector") continue;
+      ASSERT_TRUE(c.params.contains("discovery_latency_steps")) << "demo.yaml has no lane";
+      lane_steps = c.params["discovery_latency_steps"].get<int>();
+      c.params["discovery_latency_steps"] = 0;
+    }
+  };
+  const LoopRun sync = RunLoop(scene, 1.6, false, within);
+  ASSERT_GT(lane_steps, 0);
+  const LoopRun lane = RunLoop(scene, 1.6, false);
+  const LoopRun again = RunLoop(scene, 1.6, false);
+  EXPECT_EQ(lane.joints, again.joints);
+  for (const double age : lane.face_ages_s) EXPECT_EQ(age, 0.0);
+  // The first whole-image search while tracking (the loop has found the portraits at the start
+  // and tracks the nearest): the synchronous loop reports another portrait on that step, the
+  // lane only the tracked one, and the other D steps later.
+  ASSERT_EQ(sync.left_faces.size(), lane.left_faces.size());
+  std::size_t first = 0;
+  for (std::size_t k = 5; k < sync.left_faces.size() && first == 0; ++k) {
+    if (sync.left_faces[k] >= 2) first = k;
+  }
+  ASSERT_GT(first, 0u) << "no whole-image search while tracking in 1.6 s";
+  ASSERT_LT(first + lane_steps, lane.left_faces.size());
+  EXPECT_LE(lane.left_faces[first], 1) << "step " << first;
+  EXPECT_GE(lane.left_faces[first + lane_steps], 2) << "step " << first + lane_steps;
 }
 
 }  // namespace

@@ -895,12 +895,12 @@ TEST(ComponentParams, UnknownMissingAndOutOfRangeParametersAreNamed) {
     return std::string("accepted");
   };
   EXPECT_EQ(message("vision.face_detector", {{"min_neighbours", 3}}),
-            "unknown parameter 'min_neighbours' (known: cascade, discovery_scale_factor, "
-            "full_scan_every, latency_steps, max_size_px, min_neighbors, min_size_px, "
-            "new_target_scans, partner_max_depth_m, partner_min_depth_m, pyramid_level, "
-            "realtime_thread, recheck_every, region_pyramid_level, region_size_factor, "
-            "reject_cats, require_eyes, "
-            "scale_factor, track_region_scale)");
+            "unknown parameter 'min_neighbours' (known: cascade, discovery_latency_steps, "
+            "discovery_pyramid_level, discovery_scale_factor, full_scan_every, latency_steps, "
+            "max_size_px, min_neighbors, min_size_px, new_target_scans, partner_max_depth_m, "
+            "partner_min_depth_m, pyramid_level, realtime_thread, recheck_every, "
+            "recheck_phase, region_pyramid_level, region_size_factor, reject_cats, "
+            "require_eyes, scale_factor, track_region_scale)");
   EXPECT_EQ(
       message("vision.face_detector", {{"partner_min_depth_m", 5}, {"partner_max_depth_m", 2}}),
       "partner_min_depth_m (5) must be less than partner_max_depth_m (2)");

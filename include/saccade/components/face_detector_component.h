@@ -38,6 +38,21 @@
 // to it, forgets every verdict).
 // Parameters: declared in the constructor (docs/components.md lists them).
 //
+// The discovery lane: with discovery_latency_steps D > 0 (and latency_steps 0), the whole-image
+// searches that look for the other faces while the track input is connected leave the step:
+// every full_scan_every-th detection, and every detection while attention has no target (the
+// selection is invalid or looks around), searches at once only around the track (or nothing),
+// and the whole image on a thread of its own (its own cascades, at discovery_pyramid_level).
+// D steps later (simulated clock: exactly D, so that a run repeats bit for bit; real time: the
+// first step after it is done) the faces it found are searched again around where they were
+// (boxes track_region_scale times each, at its size), in that step's own image: every faces
+// message is of its own step's image, and a whole-image search never holds up the loop. Both
+// eyes start theirs on the same steps, so that the stereo pairs hold. The right eye's lane
+// searches the whole image, not the left faces' bands (the partner has, on that step, only the
+// faces around its track). A lost target (the track input not tracking while attention has
+// one) is searched for around where the selection's point projects (as a new target is), the
+// whole image only when the selection cannot say.
+//
 // Detect slowly, track fast: with latency_steps N > 0 the detector works on a thread of its
 // own, on the newest image it can take, while the loop goes on; its faces are emitted N steps
 // after that image arrived (simulated clock: exactly N, so that a run repeats bit for bit) or
@@ -71,6 +86,9 @@ class FaceDetectorComponent : public runtime::Component {
   struct Search {
     bool whole = true;
     bool tracked = false;  // a track region is in use: the whole image is a discovery search
+    // With a track input: the full_scan_every-th search, or one while attention has no target
+    // (the discovery lane takes those whole-image searches).
+    bool discovery = false;
     std::optional<cv::Rect> region;
     std::optional<cv::Rect> predicted;  // around where the selection puts a new target
     // Instead of the whole image, around each of the partner's faces' epipolar bands: the band
@@ -102,7 +120,28 @@ class FaceDetectorComponent : public runtime::Component {
   // unknown (then the whole image is searched).
   std::optional<std::vector<std::pair<cv::Rect, cv::Size>>> PartnerBands(const Image& image);
   FacesMessage Detect(std::shared_ptr<const Image> image, const Search& search);
+  // The faces of `image`: the whole image's (or the bands') with `wide`, then the regions',
+  // which replace the boxes they overlap; largest first. Touches no member but the detectors.
+  std::vector<vision::FaceDetection> Find(const Image& image, const Search& search,
+                                          vision::FaceDetector& wide) const;
+  // The regions' faces merged into the whole image's (the regions' replace those they overlap),
+  // largest first.
+  static std::vector<vision::FaceDetection> Merge(std::vector<vision::FaceDetection> whole,
+                                                  const std::vector<vision::FaceDetection>& near);
+  FacesMessage Message(std::shared_ptr<const Image> image,
+                       const std::vector<vision::FaceDetection>& found) const;
   void Remember(const std::vector<vision::FaceDetection>& found, const Search& search);
+  // When `search` is a discovery search and the lane is on: searches around the track now,
+  // emits those faces and starts the whole image on the lane (unless a search is in flight
+  // there). False when it is not one: the caller searches.
+  bool StartDiscovery(const runtime::StepContext& context,
+                      const std::shared_ptr<const Image>& image, const Search& search);
+  // Turns `search` of this step's image into one around each of the discovered faces (boxes
+  // track_region_scale times each, at its size), the track's region kept.
+  void Revisit(const std::vector<vision::FaceDetection>& discovered, const Image& image,
+               Search* search) const;
+  // The discovery in flight is due (or, in real time, ready).
+  bool DiscoveryDue(const runtime::StepContext& context) const;
 
   vision::FaceDetector::Options options_;
   std::string cascade_ = "haar";
@@ -116,6 +155,9 @@ class FaceDetectorComponent : public runtime::Component {
   int new_target_scans_ = 5;
   double region_size_factor_ = 1.5;
   int recheck_every_ = 10;
+  int recheck_phase_ = 0;
+  int discovery_latency_steps_ = 0;
+  int discovery_pyramid_level_ = 0;
   double discovery_scale_factor_ = 1.2;
   double partner_min_depth_m_ = 0.3;
   double partner_max_depth_m_ = 20.0;
@@ -135,6 +177,13 @@ class FaceDetectorComponent : public runtime::Component {
   std::future<FacesMessage> running_;
   int64_t due_step_ = 0;
   std::shared_ptr<const Image> last_;  // the image detected last
+  // The discovery lane's search in flight: the whole image's faces; the search it is part of
+  // and that search's faces around the track (found at once); the step they are due.
+  std::future<std::vector<vision::FaceDetection>> discovery_;
+  Search discovery_search_;
+  std::vector<vision::FaceDetection> discovery_near_;
+  int64_t discovery_due_ = 0;
+  int64_t discovery_target_ = -1;  // the track's target when it started
   runtime::Input<runtime::ImageMessage>& image_;
   runtime::Input<TrackMessage>& track_;
   runtime::Input<SelectionMessage>& selection_;
@@ -147,6 +196,8 @@ class FaceDetectorComponent : public runtime::Component {
   // The whole image once a track came (discovery_scale_factor), when it differs from
   // scale_factor.
   std::unique_ptr<vision::FaceDetector> discovery_detector_;
+  // The discovery lane's (discovery_latency_steps > 0): its thread's own cascades.
+  std::unique_ptr<vision::FaceDetector> lane_detector_;
 };
 
 }  // namespace saccade::components
