@@ -427,24 +427,21 @@ bool FaceDetectorComponent::StartDiscovery(const runtime::StepContext& context,
   if (!lane_detector_ || !search.tracked || !search.discovery) return false;
   Search around = search;  // the track's region (or the target's) now, on this thread
   around.whole = false;
-  std::vector<vision::FaceDetection> near = Find(*image, around, *detector_);
-  if (discovery_.valid()) {
-    // One is in flight (both eyes start theirs at the same steps: on the same count of
-    // detections, or when attention has no target).
-    Remember(near, search);
-    faces_.Emit(Message(image, near));
-    return true;
+  const std::vector<vision::FaceDetection> near = Find(*image, around, *detector_);
+  // Unless one is in flight (both eyes start theirs at the same steps: on the same count of
+  // detections, or when attention has no target), the whole image on the lane's thread.
+  if (!discovery_.valid()) {
+    discovery_search_ = search;
+    discovery_near_ = near;
+    discovery_target_ = last_target_id_;
+    discovery_due_ = context.step + discovery_latency_steps_;
+    Search wide = search;
+    wide.region.reset();
+    wide.predicted.reset();
+    discovery_ = std::async(std::launch::async, [this, image, wide = std::move(wide)] {
+      return Find(*image, wide, *lane_detector_);
+    });
   }
-  discovery_search_ = search;
-  discovery_near_ = near;
-  discovery_target_ = last_target_id_;
-  Search wide = search;  // the whole image on the lane's thread, with its own cascades
-  wide.region.reset();
-  wide.predicted.reset();
-  discovery_due_ = context.step + discovery_latency_steps_;
-  discovery_ = std::async(std::launch::async, [this, image, wide = std::move(wide)] {
-    return Find(*image, wide, *lane_detector_);
-  });
   Remember(near, search);
   faces_.Emit(Message(image, near));
   return true;
