@@ -52,6 +52,11 @@ AttentionComponent::AttentionComponent()
                "the head fixates a target when its fixation point is this close")
       .Range(1e-6, 1e6)
       .Unit("m");
+  DeclareParam("onset_tolerance_deg", &onset_tolerance_deg_,
+               "a fixation begins once the target, as this step's images put it, is this close to "
+               "where the eyes point, seen from the head (180: as soon as the head arrives)")
+      .Range(0.0, 180.0)
+      .Unit("deg");
   DeclareParam("explore_after_s", &explore_after_s_,
                "with nothing to look at this long, the head goes home")
       .Range(0.0, 1e6)
@@ -76,21 +81,11 @@ void AttentionComponent::Step(const runtime::StepContext& context) {
   const head::HeadFrames frames = head::ForwardKinematics(head, joints);
   const Eigen::Vector3d viewer = frames.X_WC.translation();
 
-  // The head fixates the target when it is at rest with its fixation point on it.
-  bool fixating = false;
-  if (current_.valid && !current_.exploring && joints_.has_value() && joints_.value().arrived &&
-      frames.p_WFixation) {
-    fixating = (*frames.p_WFixation - current_.p_W).norm() <= fixation_tolerance_m_;
-  }
-
   std::vector<Eigen::Vector3d> points;
   const CandidatesMessage* candidates = candidates_.fresh() ? &candidates_.value() : nullptr;
   if (candidates != nullptr) {
     for (const FaceCandidate& c : candidates->candidates) points.push_back(c.p_W);
   }
-  const std::optional<std::size_t> closest =
-      ior_->Select(context.time, points, viewer,
-                   fixating ? std::optional<Eigen::Vector3d>(current_.p_W) : std::nullopt);
 
   // The candidate that is the current target: the nearest within radius_m of it.
   std::optional<std::size_t> same;
@@ -104,6 +99,25 @@ void AttentionComponent::Step(const runtime::StepContext& context) {
       }
     }
   }
+
+  // The head fixates the target when it is at rest with its fixation point on it. A fixation
+  // begins only where this step's sighting of the target agrees with where the eyes point
+  // (onset_tolerance_deg, seen from the head): a saccade lands where the sightings during it
+  // put the target, and the first sharp image may call for a corrective one.
+  bool fixating = false;
+  if (current_.valid && !current_.exploring && joints_.has_value() && joints_.value().arrived &&
+      frames.p_WFixation) {
+    fixating = (*frames.p_WFixation - current_.p_W).norm() <= fixation_tolerance_m_;
+    if (fixating && !current_.fixating) {
+      const Eigen::Vector3d to_fixation = *frames.p_WFixation - viewer;
+      fixating = same.has_value() && std::atan2(to_fixation.cross(points[*same] - viewer).norm(),
+                                                to_fixation.dot(points[*same] - viewer)) <=
+                                         onset_tolerance_deg_ * M_PI / 180.0;
+    }
+  }
+  const std::optional<std::size_t> closest =
+      ior_->Select(context.time, points, viewer,
+                   fixating ? std::optional<Eigen::Vector3d>(current_.p_W) : std::nullopt);
 
   SelectionMessage out = current_;
   out.time = context.time;

@@ -795,6 +795,53 @@ TEST(AttentionComponent, VisitsTheClosestFirstThenTheNextThenGoesHome) {
   EXPECT_EQ((*selection)->suppressed_W.size(), 2u);
 }
 
+// A saccade lands where the sightings during it put the face; the fixation (and its dwell)
+// begins only once this step's sighting agrees with where the eyes point, within
+// onset_tolerance_deg. Once begun, a sighting's jitter does not end it.
+TEST(AttentionComponent, AFixationBeginsWhereThisStepsSightingAgreesWithTheEyes) {
+  const scene::Scene& scene = Scene();
+  const Eigen::Vector3d face(2.0, 0.2, 1.2);
+  // A point `deg` degrees beside the face, seen from the head (a turn about the vertical).
+  const auto beside = [&](double deg) {
+    const Eigen::Vector3d viewer =
+        head::ForwardKinematics(scene.robot()->head, scene.robot()->initial_joints)
+            .X_WC.translation();
+    return Eigen::Vector3d(
+        viewer + Eigen::AngleAxisd(deg * M_PI / 180.0, Eigen::Vector3d::UnitZ()) * (face - viewer));
+  };
+  // The head on `on`, at rest; the step's sighting at `seen`. Returns whether it fixates.
+  const auto run = [&](double onset_deg,
+                       const std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>>& steps) {
+    auto attention =
+        Make("vision.attention", {{"scene", kScene}, {"onset_tolerance_deg", onset_deg}});
+    auto selection = Capture<SelectionMessage>(*attention, "selection");
+    std::vector<bool> fixating;
+    for (std::size_t step = 0; step < steps.size(); ++step) {
+      JointStateMessage joints;
+      joints.positions = head::SolveFixation(scene.robot()->head, steps[step].first).joints;
+      joints.arrived = true;
+      In<JointStateMessage>(*attention, "joints").Deliver(joints);
+      In<CandidatesMessage>(*attention, "candidates")
+          .Deliver(Candidates(At(step).time, {steps[step].second}));
+      attention->Step(At(step));
+      attention->inputs()[0]->MarkSeen();
+      fixating.push_back((*selection)->fixating);
+    }
+    return fixating;
+  };
+  // Step 0 selects the face as seen in the saccade (0.4 deg off, 14 mm at 2 m); at step 1 the
+  // head has landed there and sees the face where it is; at step 2 the head is on it; at
+  // steps 3 and 4 the sightings jitter by 0.3 deg.
+  const std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>> steps = {{face, beside(0.4)},
+                                                                          {beside(0.4), face},
+                                                                          {face, face},
+                                                                          {face, beside(0.3)},
+                                                                          {beside(0.3), face}};
+  EXPECT_EQ(run(0.1, steps), std::vector<bool>({false, false, true, true, true}));
+  // Without the onset check the landing counts as a fixation.
+  EXPECT_EQ(run(180.0, steps), std::vector<bool>({false, true, true, true, true}));
+}
+
 TEST(SimHead, CommandsBeyondTheLimitsAreClampedAndCountedNeverExceeded) {
   const scene::Scene& scene = Scene();
   auto head_component = Make("sim.head", {{"scene", kScene}});

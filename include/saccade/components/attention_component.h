@@ -3,7 +3,10 @@
 //   (seed 7.2) does not suppress; sticks to it until it has been fixated for fixation_time_s
 //   (then it is suppressed for suppression_time_s) or unseen for lost_after_s. With nothing to
 //   look at for explore_after_s, it sends the head home (a point home_distance_m straight
-//   ahead of its base), from where it looks for faces again.
+//   ahead of its base), from where it looks for faces again. A fixation (and its dwell) begins
+//   when the head is at rest on the target and this step's sighting of it is within
+//   onset_tolerance_deg of where the eyes point; a saccade that landed off gets its correction
+//   first.
 //   inputs: candidates (vision.candidates, required), joints (head.joints, delay 1)
 //   outputs: selection (vision.selection)
 //   methods: reset (runtime.empty -> runtime.text): forgets the target and every suppressed
@@ -39,6 +42,7 @@ class AttentionComponent : public runtime::Component {
   std::optional<vision::InhibitionOfReturn> ior_;
   double lost_after_s_ = 1.5;
   double fixation_tolerance_m_ = 0.05;
+  double onset_tolerance_deg_ = 0.1;
   double explore_after_s_ = 0.5;
   double home_distance_m_ = 3.0;
   double idle_since_ = 0.0;
