@@ -27,6 +27,10 @@ bool SameFace(const cv::Rect& a, const cv::Rect& b) {
   return (a & b).area() > 0.5 * std::min(a.area(), b.area());
 }
 
+// The overlap (of the union) at which a face found around one the discovery lane found takes
+// its verdict: a box of the same size, moved by half its side.
+constexpr double kRevisitVerdictOverlap = 1.0 / 3.0;
+
 // A box `scale` times `size` centred on (cx, cy), clipped to `image`.
 cv::Rect BoxAround(double cx, double cy, const cv::Size& size, double scale, const Image& image) {
   // A point the head fixates projects onto the principal point, often (width - 1) / 2 exactly
@@ -347,19 +351,28 @@ std::vector<vision::FaceDetection> FaceDetectorComponent::Find(const Image& imag
     whole.checked = search.checked;
     found = wide.Detect(image, whole);
   }
-  for (const auto& [band, face] : search.bands) {
-    // As the whole image would be searched, around each of the partner's faces' bands.
-    vision::FaceDetector::Search along;
-    along.regions = {band};
-    std::tie(along.min_size_px, along.max_size_px) = SizeBounds(face);
-    along.checked = search.checked;
-    for (const vision::FaceDetection& d : wide.Detect(image, along)) {
-      const bool again = std::any_of(found.begin(), found.end(), [&d](const auto& f) {
-        return SameFace(f.box, d.box);
-      });  // two bands that overlap
-      if (!again) found.push_back(d);
+  // As the whole image would be searched, around each of the partner's faces' bands, and
+  // around each of the lane's faces. A face found in a revisit's box is the one the lane found
+  // there, moved by what it moved since: it keeps that face's verdict at a third of their union
+  // (a box of the same size half its side away), where faces that merely overlap need 70 %.
+  const auto search_around = [&](const std::vector<std::pair<cv::Rect, cv::Size>>& boxes,
+                                 double verdict_overlap) {
+    for (const auto& [band, face] : boxes) {
+      vision::FaceDetector::Search along;
+      along.regions = {band};
+      std::tie(along.min_size_px, along.max_size_px) = SizeBounds(face);
+      along.checked = search.checked;
+      along.verdict_overlap = verdict_overlap;
+      for (const vision::FaceDetection& d : wide.Detect(image, along)) {
+        const bool again = std::any_of(found.begin(), found.end(), [&d](const auto& f) {
+          return SameFace(f.box, d.box);
+        });  // two bands that overlap
+        if (!again) found.push_back(d);
+      }
     }
-  }
+  };
+  search_around(search.bands, vision::FaceDetector::kVerdictOverlap);
+  search_around(search.revisits, kRevisitVerdictOverlap);
   std::vector<cv::Rect> regions;
   if (search.region) regions.push_back(*search.region);
   if (search.predicted) regions.push_back(*search.predicted);
@@ -456,7 +469,7 @@ void FaceDetectorComponent::Revisit(const std::vector<vision::FaceDetection>& di
         BoxAround(d.box.x + 0.5 * (d.box.width - 1), d.box.y + 0.5 * (d.box.height - 1),
                   d.box.size(), track_region_scale_, image);
     const bool tracked = search->region && SameFace(*search->region, box);
-    if (box.area() > 0 && !tracked) search->bands.emplace_back(box, d.box.size());
+    if (box.area() > 0 && !tracked) search->revisits.emplace_back(box, d.box.size());
   }
 }
 
@@ -481,7 +494,11 @@ void FaceDetectorComponent::Step(const runtime::StepContext& context) {
     if (image_.fresh() && image_.value().image) {
       const std::shared_ptr<const Image>& image = image_.value().image;
       Search search = NextSearch(*image);
-      if (!discovered.empty()) Revisit(discovered, *image, &search);
+      // Where the lane found its faces is where they were before the eyes jumped to a new
+      // target (since, or at this step): not where this image shows them.
+      if (!discovered.empty() && last_target_id_ == discovery_target_) {
+        Revisit(discovered, *image, &search);
+      }
       if (!StartDiscovery(context, image, search)) faces_.Emit(Detect(image, search));
     }
     return;

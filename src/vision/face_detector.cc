@@ -166,12 +166,16 @@ std::vector<FaceDetection> FaceDetector::DetectIn(const cv::Mat& gray_image, con
     FaceDetection& d = out[i];
     d.box = boxes[i];
     d.neighbors = i < neighbors.size() ? neighbors[i] : 0;
-    const auto same =
-        std::find_if(search.checked.begin(), search.checked.end(), [&d](const FaceDetection& c) {
-          const double common = (c.box & d.box).area();
-          const double all = c.box.area() + d.box.area() - common;
-          return all > 0 && common >= kVerdictOverlap * all;
-        });
+    auto same = search.checked.end();
+    double most = 0.0;
+    for (auto c = search.checked.begin(); c != search.checked.end(); ++c) {
+      const double common = (c->box & d.box).area();
+      const double all = c->box.area() + d.box.area() - common;
+      if (all > 0 && common >= search.verdict_overlap * all && common / all > most) {
+        most = common / all;
+        same = c;
+      }
+    }
     if (same != search.checked.end()) {
       d.rejected = same->rejected;
       d.reason = same->reason;

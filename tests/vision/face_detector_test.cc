@@ -173,6 +173,56 @@ TEST(FaceDetector, ABoxCheckedBeforeKeepsItsVerdict) {
   }
 }
 
+// Of several checked boxes a face overlaps enough, it takes the verdict of the one it overlaps
+// most; a search may lower the overlap it needs (the discovery lane's faces, searched again
+// around where they were after moving).
+TEST(FaceDetector, AVerdictComesFromTheCheckedBoxOverlappedMost) {
+  const StereoFrame frame = RenderFixating(FaceCentreWorld("astronaut"));
+  FaceDetector detector;
+  const cv::Rect picture = TruthBox(frame.left_truth, "astronaut");
+  std::optional<FaceDetection> her;
+  for (const FaceDetection& face : detector.Detect(frame.left)) {
+    if (!face.rejected && Overlap(face.box, picture) == 1.0) her = face;
+  }
+  ASSERT_TRUE(her);
+  const auto checked = [&](int dx, const std::string& reason) {
+    FaceDetection c;
+    c.box = her->box + cv::Point(dx, 0);
+    c.rejected = true;
+    c.reason = reason;
+    return c;
+  };
+  const auto verdict = [&](const FaceDetector::Search& search) {
+    for (const FaceDetection& face : detector.Detect(frame.left, search)) {
+      if (face.box == her->box) return face;
+    }
+    ADD_FAILURE() << "her face not found";
+    return FaceDetection{};
+  };
+  FaceDetector::Search search;
+  search.regions = {cv::Rect(0, 0, frame.left.width(), frame.left.height())};
+  // Both overlap her box by more than 70 % of their union: the nearer one's verdict.
+  search.checked = {checked(3, "three pixels off"), checked(1, "a pixel off")};
+  FaceDetection face = verdict(search);
+  EXPECT_EQ(face.verdict_from, 1);
+  EXPECT_EQ(face.reason, "a pixel off");
+  // Moved by 40 % of its side (a third of their union and more, under 70 %): checked again,
+  // unless the search takes a third.
+  const int moved = her->box.width * 2 / 5;
+  search.checked = {checked(moved, "moved")};
+  const double common = (search.checked[0].box & her->box).area();
+  const double iou = common / (2.0 * her->box.area() - common);
+  ASSERT_GT(iou, 1.0 / 3.0);
+  ASSERT_LT(iou, FaceDetector::kVerdictOverlap);
+  face = verdict(search);
+  EXPECT_EQ(face.verdict_from, -1);
+  EXPECT_FALSE(face.rejected) << face.reason;
+  search.verdict_overlap = 1.0 / 3.0;
+  face = verdict(search);
+  EXPECT_EQ(face.verdict_from, 0);
+  EXPECT_EQ(face.reason, "moved");
+}
+
 // Measured: with the head on the astronaut, the cat's picture is cut by the right image's edge,
 // and alt2 fires on it (a 72 px box straddling its left border); with the head on the cat,
 // alt2 at min_neighbors 2 fires at its left border. Every such candidate must be rejected.

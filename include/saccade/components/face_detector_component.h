@@ -46,7 +46,11 @@
 // D steps later (simulated clock: exactly D, so that a run repeats bit for bit; real time: the
 // first step after it is done) the faces it found are searched again around where they were
 // (boxes track_region_scale times each, at its size), in that step's own image: every faces
-// message is of its own step's image, and a whole-image search never holds up the loop. Both
+// message is of its own step's image, and a whole-image search never holds up the loop. A face
+// found there keeps the verdict the lane gave it if their boxes overlap by a third of their
+// union (it moved, or was found at another size, since). When the eyes have jumped to a new
+// target since the lane began, its faces are not searched again: they are no longer where it
+// found them in the image, and the next discovery finds them. Both
 // eyes start theirs on the same steps, so that the stereo pairs hold. The right eye's lane
 // searches the whole image, not the left faces' bands (the partner has, on that step, only the
 // faces around its track). A lost target (the track input not tracking while attention has
@@ -94,6 +98,9 @@ class FaceDetectorComponent : public runtime::Component {
     // Instead of the whole image, around each of the partner's faces' epipolar bands: the band
     // and the face's size there.
     std::vector<std::pair<cv::Rect, cv::Size>> bands;
+    // The discovery lane's faces, each searched again around where it was (Revisit): the box
+    // and the face's size there.
+    std::vector<std::pair<cv::Rect, cv::Size>> revisits;
     int min_size_px = 0;  // the region's face sides (0: the parameters' bounds)
     int max_size_px = 0;
     std::vector<vision::FaceDetection> checked;  // verdicts to reuse (recheck_every)

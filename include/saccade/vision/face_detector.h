@@ -97,6 +97,9 @@ class FaceDetector {
     /// kVerdictOverlap of their union takes its verdict instead of running the cat and eye
     /// cascades again (they are most of the cost of a search around a tracked face).
     std::vector<FaceDetection> checked;
+    /// The overlap (of the union) at which a box takes a checked candidate's verdict; of
+    /// several, the one it overlaps most.
+    double verdict_overlap = kVerdictOverlap;
   };
   static constexpr double kVerdictOverlap = 0.7;
   std::vector<FaceDetection> Detect(const Image& image, const Search& search);
