@@ -78,7 +78,8 @@ FaceDetectorComponent::FaceDetectorComponent()
   DeclareParam("discovery_pyramid_level", &discovery_pyramid_level_,
                "with discovery_latency_steps: the pyramid level of the lane's whole-image "
                "searches (the faces they find are searched again around where they were, at "
-               "pyramid_level)")
+               "pyramid_level), and of the whole-image searches for the other faces of a "
+               "detector on its own thread in real time (realtime_thread)")
       .Range(0, 4);
   DeclareParam("realtime_thread", &realtime_thread_,
                "on the real-time clock (saccade demo --realtime, the GUI), detect on a thread of "
@@ -330,12 +331,15 @@ std::optional<std::vector<std::pair<cv::Rect, cv::Size>>> FaceDetectorComponent:
   return bands;
 }
 
-FacesMessage FaceDetectorComponent::Detect(std::shared_ptr<const Image> image,
-                                           const Search& search) {
+FacesMessage FaceDetectorComponent::Detect(std::shared_ptr<const Image> image, const Search& search,
+                                           bool own_thread) {
   // With a track, the whole image (or the partner's bands) is searched for the other faces
-  // (discovery_scale_factor).
-  vision::FaceDetector& wide =
-      search.tracked && discovery_detector_ ? *discovery_detector_ : *detector_;
+  // (discovery_scale_factor); on a thread of its own, where the discovery lane is not used, at
+  // the lane's pyramid level.
+  vision::FaceDetector& wide = !search.tracked                ? *detector_
+                               : own_thread && lane_detector_ ? *lane_detector_
+                               : discovery_detector_          ? *discovery_detector_
+                                                              : *detector_;
   const std::vector<vision::FaceDetection> found = Find(*image, search, wide);
   if (track_region_scale_ > 0.0 && track_.has_value()) Remember(found, search);
   return Message(std::move(image), found);
@@ -518,7 +522,7 @@ void FaceDetectorComponent::Step(const runtime::StepContext& context) {
   due_step_ = context.step + latency_steps_;
   const Search search = NextSearch(*image);
   running_ =
-      std::async(std::launch::async, [this, image, search] { return Detect(image, search); });
+      std::async(std::launch::async, [this, image, search] { return Detect(image, search, true); });
 }
 
 void FaceDetectorComponent::Stop() {

@@ -706,6 +706,58 @@ TEST(FaceDetectorComponent, OnTheRealTimeClockDetectsOnAThreadOfItsOwn) {
   threaded->Stop();
 }
 
+// On its own thread in real time (the GUI, demo --realtime) the detector does not use the
+// discovery lane, but its whole-image searches for the other faces take the lane's pyramid
+// level (discovery_pyramid_level) as the lane's would.
+TEST(FaceDetectorComponent, OnItsOwnThreadSearchesTheWholeImageAtTheLanesLevel) {
+  const std::shared_ptr<const Image> image = LeftEyeOnTheAstronaut();
+  ASSERT_TRUE(image);
+  const auto boxes = [](const FacesMessage& faces) {
+    std::vector<std::array<int, 5>> out;
+    for (const FacesMessage::Face& f : faces.faces) {
+      out.push_back({f.box.x, f.box.y, f.box.width, f.box.height, f.rejected ? 1 : 0});
+    }
+    return out;
+  };
+  const auto full = boxes(DetectWhole(image, {{"scale_factor", 1.2}}));
+  const auto half = boxes(DetectWhole(image, {{"scale_factor", 1.2}, {"pyramid_level", 1}}));
+  ASSERT_FALSE(half.empty());
+  ASSERT_NE(full, half);  // else this test could not tell them apart
+
+  const auto realtime = [](int64_t step) {
+    runtime::StepContext context = At(step);
+    context.realtime = true;
+    return context;
+  };
+  const auto threaded = [&](int lane_latency) {
+    auto detector = Make("vision.face_detector", {{"track_region_scale", 2.0},
+                                                  {"full_scan_every", 1},
+                                                  {"new_target_scans", 0},
+                                                  {"discovery_scale_factor", 1.2},
+                                                  {"discovery_latency_steps", lane_latency},
+                                                  {"discovery_pyramid_level", 1}});
+    auto faces = Capture<FacesMessage>(*detector, "faces");
+    TrackMessage track;  // on the sky, top left: the search around it finds nothing
+    track.tracking = true;
+    track.window = cv::Rect(20, 20, 80, 80);
+    track.center = {60.0, 60.0};
+    In<TrackMessage>(*detector, "track").Deliver(track);
+    In<runtime::ImageMessage>(*detector, "image").Deliver(runtime::ImageMessage{image});
+    detector->Step(realtime(0));
+    int64_t step = 1;
+    const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+    while (!faces->has_value() && std::chrono::steady_clock::now() < give_up) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+      detector->Step(realtime(step++));  // no new image: only collects
+    }
+    detector->Stop();
+    EXPECT_TRUE(faces->has_value());
+    return boxes(faces->value_or(FacesMessage{}));
+  };
+  EXPECT_EQ(threaded(4), half);  // the lane's level
+  EXPECT_EQ(threaded(0), full);  // no lane: pyramid_level
+}
+
 TEST(SimCameras, TheHeadsMotionBlursTheEyeImages) {
   const std::string portraits = std::string(SACCADE_SOURCE_DIR) + "/scenes/portraits.yaml";
   const head::JointState still{0.0, 0.0, 0.0, 0.0};

@@ -62,6 +62,9 @@
 // after that image arrived (simulated clock: exactly N, so that a run repeats bit for bit) or
 // as soon as they are ready (real time), and it then takes the newest image again. Tracking
 // and triangulation use the image the faces carry, so late faces are placed where they were.
+// On the real-time clock (realtime_thread) the discovery lane is not used, as all detection is
+// off the loop's thread; with discovery_latency_steps > 0 the whole-image searches for the
+// other faces then take the lane's discovery_pyramid_level.
 #include <future>
 #include <memory>
 #include <optional>
@@ -126,7 +129,10 @@ class FaceDetectorComponent : public runtime::Component {
   // none when the partner's faces are not of an image captured with this one or a camera is
   // unknown (then the whole image is searched).
   std::optional<std::vector<std::pair<cv::Rect, cv::Size>>> PartnerBands(const Image& image);
-  FacesMessage Detect(std::shared_ptr<const Image> image, const Search& search);
+  // The faces of `image` (own_thread: on the detector's thread, latency_steps or
+  // realtime_thread), remembered for the next search.
+  FacesMessage Detect(std::shared_ptr<const Image> image, const Search& search,
+                      bool own_thread = false);
   // The faces of `image`: the whole image's (or the bands') with `wide`, then the regions',
   // which replace the boxes they overlap; largest first. Touches no member but the detectors.
   std::vector<vision::FaceDetection> Find(const Image& image, const Search& search,
