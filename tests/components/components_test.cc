@@ -284,6 +284,24 @@ FacesMessage DetectWhole(const std::shared_ptr<const Image>& image,
   return faces->value_or(FacesMessage{});
 }
 
+// Each face's box and verdict, to compare two searches.
+std::vector<std::array<int, 5>> Boxes(const FacesMessage& faces) {
+  std::vector<std::array<int, 5>> out;
+  for (const FacesMessage::Face& f : faces.faces) {
+    out.push_back({f.box.x, f.box.y, f.box.width, f.box.height, f.rejected ? 1 : 0});
+  }
+  return out;
+}
+
+// A track on the sky, top left of an eye on the astronaut: the search around it finds nothing.
+TrackMessage TrackOnTheSky() {
+  TrackMessage track;
+  track.tracking = true;
+  track.window = cv::Rect(20, 20, 80, 80);
+  track.center = {60.0, 60.0};
+  return track;
+}
+
 // The box of the last face not rejected, if any.
 std::optional<cv::Rect> AcceptedBox(const FacesMessage& faces) {
   std::optional<cv::Rect> box;
@@ -340,15 +358,8 @@ TEST(FaceDetectorComponent, SearchesAroundTheTrackAndTheWholeImageEveryNthTime) 
 TEST(FaceDetectorComponent, WithATrackSearchesTheWholeImageAtTheDiscoveryStep) {
   const std::shared_ptr<const Image> image = LeftEyeOnTheAstronaut();
   ASSERT_TRUE(image);
-  const auto boxes = [](const FacesMessage& faces) {
-    std::vector<std::array<int, 5>> out;
-    for (const FacesMessage::Face& f : faces.faces) {
-      out.push_back({f.box.x, f.box.y, f.box.width, f.box.height, f.rejected ? 1 : 0});
-    }
-    return out;
-  };
-  const auto fine = boxes(DetectWhole(image));  // scale_factor 1.1
-  const auto coarse = boxes(DetectWhole(image, {{"scale_factor", 1.3}}));
+  const auto fine = Boxes(DetectWhole(image));  // scale_factor 1.1
+  const auto coarse = Boxes(DetectWhole(image, {{"scale_factor", 1.3}}));
   ASSERT_FALSE(coarse.empty());
   ASSERT_NE(fine, coarse);  // else this test could not tell them apart
 
@@ -359,15 +370,11 @@ TEST(FaceDetectorComponent, WithATrackSearchesTheWholeImageAtTheDiscoveryStep) {
   auto faces = Capture<FacesMessage>(*detector, "faces");
   const auto detect = [&](bool with_track, int64_t step) {
     if (with_track) {
-      TrackMessage track;  // on the sky, top left: the search around it finds nothing
-      track.tracking = true;
-      track.window = cv::Rect(20, 20, 80, 80);
-      track.center = {60.0, 60.0};
-      In<TrackMessage>(*detector, "track").Deliver(track);
+      In<TrackMessage>(*detector, "track").Deliver(TrackOnTheSky());
     }
     In<runtime::ImageMessage>(*detector, "image").Deliver(runtime::ImageMessage{image});
     detector->Step(At(step));
-    return boxes(**faces);
+    return Boxes(**faces);
   };
   EXPECT_EQ(detect(false, 0), fine);  // no track yet: the whole image at scale_factor
   EXPECT_EQ(detect(true, 1), coarse);
@@ -712,15 +719,8 @@ TEST(FaceDetectorComponent, OnTheRealTimeClockDetectsOnAThreadOfItsOwn) {
 TEST(FaceDetectorComponent, OnItsOwnThreadSearchesTheWholeImageAtTheLanesLevel) {
   const std::shared_ptr<const Image> image = LeftEyeOnTheAstronaut();
   ASSERT_TRUE(image);
-  const auto boxes = [](const FacesMessage& faces) {
-    std::vector<std::array<int, 5>> out;
-    for (const FacesMessage::Face& f : faces.faces) {
-      out.push_back({f.box.x, f.box.y, f.box.width, f.box.height, f.rejected ? 1 : 0});
-    }
-    return out;
-  };
-  const auto full = boxes(DetectWhole(image, {{"scale_factor", 1.2}}));
-  const auto half = boxes(DetectWhole(image, {{"scale_factor", 1.2}, {"pyramid_level", 1}}));
+  const auto full = Boxes(DetectWhole(image, {{"scale_factor", 1.2}}));
+  const auto half = Boxes(DetectWhole(image, {{"scale_factor", 1.2}, {"pyramid_level", 1}}));
   ASSERT_FALSE(half.empty());
   ASSERT_NE(full, half);  // else this test could not tell them apart
 
@@ -737,11 +737,7 @@ TEST(FaceDetectorComponent, OnItsOwnThreadSearchesTheWholeImageAtTheLanesLevel) 
                                                   {"discovery_latency_steps", lane_latency},
                                                   {"discovery_pyramid_level", 1}});
     auto faces = Capture<FacesMessage>(*detector, "faces");
-    TrackMessage track;  // on the sky, top left: the search around it finds nothing
-    track.tracking = true;
-    track.window = cv::Rect(20, 20, 80, 80);
-    track.center = {60.0, 60.0};
-    In<TrackMessage>(*detector, "track").Deliver(track);
+    In<TrackMessage>(*detector, "track").Deliver(TrackOnTheSky());
     In<runtime::ImageMessage>(*detector, "image").Deliver(runtime::ImageMessage{image});
     detector->Step(realtime(0));
     int64_t step = 1;
@@ -752,7 +748,7 @@ TEST(FaceDetectorComponent, OnItsOwnThreadSearchesTheWholeImageAtTheLanesLevel) 
     }
     detector->Stop();
     EXPECT_TRUE(faces->has_value());
-    return boxes(faces->value_or(FacesMessage{}));
+    return Boxes(faces->value_or(FacesMessage{}));
   };
   EXPECT_EQ(threaded(4), half);  // the lane's level
   EXPECT_EQ(threaded(0), full);  // no lane: pyramid_level

@@ -130,17 +130,23 @@ TEST(FaceDetector, ASearchBoundedToTheFacesSizeFindsTheSameBox) {
   EXPECT_TRUE(boxes(her->width, her->width / 2).empty());
 }
 
+// The astronaut's face the detector accepts in the left eye, checked on this frame.
+std::optional<FaceDetection> HerFace(FaceDetector& detector, const StereoFrame& frame) {
+  const cv::Rect picture = TruthBox(frame.left_truth, "astronaut");
+  std::optional<FaceDetection> her;
+  for (const FaceDetection& face : detector.Detect(frame.left)) {
+    if (!face.rejected && Overlap(face.box, picture) == 1.0) her = face;
+  }
+  return her;
+}
+
 // A box that overlaps one checked on an earlier frame takes its verdict instead of running the
 // cat and eye cascades: a made-up verdict on her box shows which was used. A checked box
 // elsewhere changes nothing.
 TEST(FaceDetector, ABoxCheckedBeforeKeepsItsVerdict) {
   const StereoFrame frame = RenderFixating(FaceCentreWorld("astronaut"));
   FaceDetector detector;
-  const cv::Rect picture = TruthBox(frame.left_truth, "astronaut");
-  std::optional<FaceDetection> her;
-  for (const FaceDetection& face : detector.Detect(frame.left)) {
-    if (!face.rejected && Overlap(face.box, picture) == 1.0) her = face;
-  }
+  const std::optional<FaceDetection> her = HerFace(detector, frame);
   ASSERT_TRUE(her);
   EXPECT_EQ(her->verdict_from, -1);  // checked on this frame
   FaceDetector::Search search;
@@ -179,11 +185,7 @@ TEST(FaceDetector, ABoxCheckedBeforeKeepsItsVerdict) {
 TEST(FaceDetector, AVerdictComesFromTheCheckedBoxOverlappedMost) {
   const StereoFrame frame = RenderFixating(FaceCentreWorld("astronaut"));
   FaceDetector detector;
-  const cv::Rect picture = TruthBox(frame.left_truth, "astronaut");
-  std::optional<FaceDetection> her;
-  for (const FaceDetection& face : detector.Detect(frame.left)) {
-    if (!face.rejected && Overlap(face.box, picture) == 1.0) her = face;
-  }
+  const std::optional<FaceDetection> her = HerFace(detector, frame);
   ASSERT_TRUE(her);
   const auto checked = [&](int dx, const std::string& reason) {
     FaceDetection c;
