@@ -303,7 +303,8 @@ Runner AddDemoCommand(CLI::App& app) {
       "the faces on the scene's portraits (rejecting the cat), tracks each with CamShift, "
       "triangulates it and fixates it, closest first, moving on once inhibition of return "
       "suppresses it. Prints each fixation's object, 3D error against the true face centre, "
-      "each eye's angular error and the time it took, then the latency of every stage. "
+      "each eye's angular error as it began and the time it took; at the end each eye's "
+      "largest error over each fixation, then the latency of every stage. "
       "Exit status: 0 when at least one face was fixated, 3 when none was, 1 on an error.");
   demo->add_option("--pipeline", o->pipeline, "Pipeline YAML (components and connections)")
       ->check(CLI::ExistingFile)

@@ -136,6 +136,17 @@ std::string DemoReport::Text(const std::string& record) const {
   }
   out += fmt::format("{:.1f} steps per second, real-time factor {:.2f} (simulated s per wall s)\n",
                      steps_per_second(), real_time_factor());
+  // The lines above give each fixation's errors as it began; over the whole fixation (pursuit
+  // of a moving face included), the largest:
+  std::string dwell;
+  for (const Fixation& f : scorer->fixations()) {
+    if (!f.has_truth || f.dwell_samples == 0) continue;
+    dwell += fmt::format("  {:<16} L {:.3f} R {:.3f} deg  (mean {:.3f} / {:.3f} over {} steps)\n",
+                         f.object, f.dwell_max_deg[0], f.dwell_max_deg[1],
+                         f.dwell_sum_deg[0] / f.dwell_samples, f.dwell_sum_deg[1] / f.dwell_samples,
+                         f.dwell_samples);
+  }
+  if (!dwell.empty()) out += "eye axis error over each fixation, largest:\n" + dwell;
   if (realtime) {
     // A step that ends after the next tick was due: the loop skips the missed ticks (no
     // backlog, no burst), so this counts the camera periods it could not keep.

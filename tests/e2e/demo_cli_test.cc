@@ -8,6 +8,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <opencv2/videoio.hpp>
+#include <regex>
 #include <sstream>
 #include <string>
 
@@ -150,6 +151,15 @@ TEST(DemoCli, AFailingComponentIsNamedAndTheRecordingIsKept) {
                                    " --scene " + kTwoPictures + " --duration 4 --keep-going");
   EXPECT_EQ(going.status, 0) << going.output;
   EXPECT_THAT(going.output, HasSubstr("1 of 1 faces fixated"));
+  // Over the fixation, each eye's largest error from the true face centre.
+  std::smatch dwell;
+  ASSERT_TRUE(std::regex_search(
+      going.output, dwell,
+      std::regex(
+          R"(eye axis error over each fixation, largest:\n  astronaut +L ([0-9.]+) R ([0-9.]+) deg)")))
+      << going.output;
+  EXPECT_LT(std::stod(dwell[1]), 0.5);
+  EXPECT_LT(std::stod(dwell[2]), 0.5);
   fs::remove_all(dir.parent_path());
 }
 
