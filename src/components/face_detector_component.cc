@@ -31,6 +31,15 @@ bool SameFace(const cv::Rect& a, const cv::Rect& b) {
 // its verdict: a box of the same size, moved by half its side.
 constexpr double kRevisitVerdictOverlap = 1.0 / 3.0;
 
+// A search on a thread of its own is taken at its due step on the simulated clock (exactly,
+// so that runs repeat; get() then waits for as long as it takes), in real time once done.
+template <typename T>
+bool Due(const std::future<T>& search, const runtime::StepContext& context, int64_t due_step) {
+  if (!search.valid()) return false;
+  return context.realtime ? search.wait_for(std::chrono::seconds(0)) == std::future_status::ready
+                          : context.step >= due_step;
+}
+
 // A box `scale` times `size` centred on (cx, cy), clipped to `image`.
 cv::Rect BoxAround(double cx, double cy, const cv::Size& size, double scale, const Image& image) {
   // A point the head fixates projects onto the principal point, often (width - 1) / 2 exactly
@@ -477,20 +486,13 @@ void FaceDetectorComponent::Revisit(const std::vector<vision::FaceDetection>& di
   }
 }
 
-bool FaceDetectorComponent::DiscoveryDue(const runtime::StepContext& context) const {
-  if (!discovery_.valid()) return false;
-  return context.realtime
-             ? discovery_.wait_for(std::chrono::seconds(0)) == std::future_status::ready
-             : context.step >= discovery_due_;
-}
-
 void FaceDetectorComponent::Step(const runtime::StepContext& context) {
   const bool own_thread = latency_steps_ > 0 || (context.realtime && realtime_thread_);
   if (!own_thread) {
     // The discovery's faces (of an image D steps old): searched again, each around where it
     // was, in this step's image (waits, in simulated time, for as long as the search takes).
     std::vector<vision::FaceDetection> discovered;
-    if (DiscoveryDue(context)) {
+    if (Due(discovery_, context, discovery_due_)) {
       discovered = Merge(discovery_.get(), discovery_near_);
       // A new target meanwhile forgot every verdict (the eyes jumped): these are of before.
       if (last_target_id_ == discovery_target_) Remember(discovered, discovery_search_);
@@ -508,10 +510,7 @@ void FaceDetectorComponent::Step(const runtime::StepContext& context) {
     return;
   }
   if (running_.valid()) {
-    const bool done = context.realtime
-                          ? running_.wait_for(std::chrono::seconds(0)) == std::future_status::ready
-                          : context.step >= due_step_;
-    if (!done) return;
+    if (!Due(running_, context, due_step_)) return;
     faces_.Emit(running_.get());  // waits, in simulated time, for as long as it takes
   }
   // The newest image: the one this step brought, or a later one than the last detected.

@@ -153,8 +153,6 @@ class FaceDetectorComponent : public runtime::Component {
   // track_region_scale times each, at its size), the track's region kept.
   void Revisit(const std::vector<vision::FaceDetection>& discovered, const Image& image,
                Search* search) const;
-  // The discovery in flight is due (or, in real time, ready).
-  bool DiscoveryDue(const runtime::StepContext& context) const;
 
   vision::FaceDetector::Options options_;
   std::string cascade_ = "haar";
