@@ -19,6 +19,8 @@
 #include <vector>
 
 #include "image_camera_helpers.h"
+#include "render/gl/internal_cpu_lens.h"
+#include "render/gl/internal_effects.h"
 #include "render/gl/internal_pixels.h"
 #include "saccade/core/error.h"
 #include "saccade/core/image.h"
@@ -142,24 +144,33 @@ TEST_P(NoiseTest, MatchesTheConfiguredSigmaWithin2Percent) {
   }
 }
 
+// A lit, textured scene (a ball, a portrait, the checker ground: every DN) seen by one noisy
+// camera of `calibration`.
+std::string LitScene(const std::string& calibration) {
+  return R"(
+background: [0.6, 0.7, 0.8]
+lights: [{type: ambient, intensity: 0.3}, {type: directional, direction: [1, 0.5, -1]}]
+ground: {pattern: checker, cell: 0.25}
+objects:
+  - {name: ball, kind: sphere, radius: 0.3, pose: {position: [3, 0, 0.5]}, color: [0.9, 0.5, 0.1, 1]}
+  - {name: face, kind: picture, image: ../assets/astronaut.png, height: 0.8,
+     pose: {position: [3, 0.8, 1.0], rpy_deg: [0, 0, 180]}}
+cameras:
+  - name: cam
+    calibration: )" +
+         calibration + R"(
+    look_at: {eye: [0, 0, 1.2], target: [3, 0.3, 0.8]}
+    sensor: {read_noise_dn: 2, gain_dn_per_e: 0.3, seed: 5}
+)";
+}
+
 // The noise added on the CPU after readback is the final pass's: the same hash of the pixel
 // and frame, the same table entry, the same variance for each DN. On a lit, textured scene
 // (every DN, shot noise growing with it) the two images agree to the bit on llvmpipe; a
 // device's float rounding of a DN (255 x its texel / 255) may put a rare value on the other
 // side of a half.
 TEST(NoiseOnCpuTest, AddsTheFinalPassesNoise) {
-  const scene::Scene world = SceneFrom(R"(
-background: [0.6, 0.7, 0.8]
-lights: [{type: ambient, intensity: 0.3}, {type: directional, direction: [1, 0.5, -1]}]
-ground: {pattern: checker, cell: 0.25}
-objects:
-  - {name: ball, kind: sphere, radius: 0.3, pose: {position: [3, 0, 0.5]}, color: [0.9, 0.5, 0.1, 1]}
-cameras:
-  - name: cam
-    calibration: {width: 320, height: 240, fx: 300, fy: 300}
-    look_at: {eye: [0, 0, 1.2], target: [3, 0, 0.5]}
-    sensor: {read_noise_dn: 2, gain_dn_per_e: 0.3, seed: 5}
-)");
+  const scene::Scene world = SceneFrom(LitScene("{width: 320, height: 240, fx: 300, fy: 300}"));
   RendererOptions options;
   std::unique_ptr<Renderer> pass = MakeRenderer(world, [&] {
     RendererOptions o = options;
@@ -187,6 +198,96 @@ cameras:
   RendererOptions clean = options;
   clean.noise = false;
   EXPECT_FALSE(SamePixels(*b, *MakeRenderer(world, clean)->Render(state, 3)[0].color));
+}
+
+// The lens remapped on the CPU after the source view is read back (a software rasteriser's
+// way) is the final pass's: the same bilinear samples of the same map, within one DN (the pass
+// rounds each of a pixel's footprint samples to 8 bits, the CPU their mean once), with and
+// without noise. Two lenses of one source view: the bench scene's barrel (one sample a pixel)
+// and a barrel so strong that it folds before the corners, so that the image's rim takes
+// several samples a pixel and its corners have no ray (black).
+TEST(LensOnCpuTest, RemapsAsTheFinalPassDoes) {
+  const std::string cameras[] = {
+      "{width: 320, height: 240, fx: 300, fy: 300, distortion: {model: radtan, coefficients: "
+      "[-0.2, 0.1, 0.0005, -0.0003, 0.0]}}",
+      "{width: 320, height: 240, fx: 200, fy: 200, distortion: {model: radtan, coefficients: "
+      "[-0.45, 0.0, 0.0, 0.0, 0.0]}}"};
+  for (const std::string& calibration : cameras) {
+    SCOPED_TRACE(calibration);
+    const scene::Scene world = SceneFrom(LitScene(calibration));
+    const geometry::LensMap lens = geometry::MakeLensMap(world.cameras()[0].model);
+    ASSERT_EQ(lens.kind, geometry::LensMap::Kind::kPinhole);
+    const gl::RemapTable table = gl::MakeRemapTable(lens);
+    const scene::SceneState state = world.InitialState();
+    for (const bool noise : {false, true}) {
+      SCOPED_TRACE(noise ? "with noise" : "without noise");
+      RendererOptions options;
+      options.noise = noise;
+      options.lens_on_cpu = false;
+      const std::shared_ptr<const Image> pass = RenderOnce(world, options, &state, 3)[0].color;
+      options.lens_on_cpu = true;
+      const std::shared_ptr<const Image> cpu = RenderOnce(world, options, &state, 3)[0].color;
+      ASSERT_EQ(pass->size_bytes(), cpu->size_bytes());
+      std::size_t differ = 0;
+      int worst = 0;
+      int64_t sum = 0;
+      for (std::size_t i = 0; i < pass->size_bytes(); ++i) {
+        const int d = cpu->data()[i] - pass->data()[i];
+        differ += d != 0;
+        worst = std::max(worst, std::abs(d));
+        sum += d;
+      }
+      // A sample's rounding differs here and there (the rasteriser truncates its weights and
+      // each stage of the blend), by one DN, two where two roundings meet on an edge (a
+      // misplaced sample, a half-pixel or a row's shift, would differ by tens on every edge);
+      // noise adds no more (the same deviate on neighbouring DNs); and no bias.
+      EXPECT_LE(worst, 2) << Keep(*pass, "lens_pass") << " " << Keep(*cpu, "lens_cpu");
+      EXPECT_LT(static_cast<double>(differ) / pass->size_bytes(), 0.05) << differ << " differ";
+      EXPECT_LT(std::abs(static_cast<double>(sum) / pass->size_bytes()), 0.02) << sum;
+      // The lens is applied: not the pinhole's image.
+      options.distortion = false;
+      EXPECT_FALSE(SamePixels(*cpu, *RenderOnce(world, options, &state, 3)[0].color));
+    }
+    if (lens.invalid_pixels > 0) {  // the folding lens: several samples a pixel, and no ray
+      EXPECT_GT(table.multi_tap_pixels, 1000);
+      EXPECT_GT(lens.invalid_pixels, 0);
+      gl::CpuLens cpu_lens(table, lens.width, lens.height, lens.views[0].intrinsics.width(),
+                           lens.views[0].intrinsics.height());
+      EXPECT_GT(cpu_lens.special_pixels(), static_cast<std::size_t>(table.multi_tap_pixels));
+    }
+  }
+}
+
+// The remap's and the noise's AVX2 loops and their portable ones give the same rows to the
+// bit (the same integer arithmetic and lookups), on a random source through the barrel lens;
+// rows of a width that leaves a tail for the portable loop.
+TEST(LensOnCpuTest, TheVectorLoopsEqualThePortableOnes) {
+  const double coefficients[] = {-0.2, 0.1, 0.0005, -0.0003, 0.0};
+  const geometry::CameraModel model(geometry::Intrinsics(317, 240, 300, 300, 158, 119.5),
+                                    geometry::Distortion::RadialTangential(coefficients));
+  const geometry::LensMap lens = geometry::MakeLensMap(model);
+  const int w = lens.views[0].intrinsics.width(), h = lens.views[0].intrinsics.height();
+  std::vector<uint8_t> source(4 * static_cast<std::size_t>(w) * h);
+  uint32_t state = 12345;
+  for (uint8_t& b : source)
+    b = static_cast<uint8_t>((state = state * 1664525u + 1013904223u) >> 24);
+  const gl::CpuLens cpu_lens(gl::MakeRemapTable(lens), lens.width, lens.height, w, h);
+  const std::vector<uint8_t> levels = gl::NoiseLevels(2.0f, 0.3f);
+  std::vector<uint8_t> fast(4 * lens.width), portable(4 * lens.width);
+  std::vector<uint8_t> fast_rgb(3 * lens.width), portable_rgb(3 * lens.width);
+  std::size_t noisy = 0;
+  for (int y = 0; y < lens.height; ++y) {
+    cpu_lens.RemapRow(source.data(), y, fast.data());
+    cpu_lens.RemapRow(source.data(), y, portable.data(), /*simd=*/false);
+    ASSERT_EQ(fast, portable) << "row " << y;
+    gl::RgbaRowToRgbWithNoise(fast.data(), fast_rgb.data(), lens.width, y, 77,
+                              gl::PackedGaussianTable().data(), levels.data());
+    gl::RgbaRowToRgbWithNoise(fast.data(), portable_rgb.data(), lens.width, y, 77,
+                              gl::PackedGaussianTable().data(), levels.data(), /*simd=*/false);
+    ASSERT_EQ(fast_rgb, portable_rgb) << "row " << y;
+    for (int x = 0; x < lens.width; ++x) noisy += fast_rgb[3 * x] != fast[4 * x];
+  }
+  EXPECT_GT(noisy, static_cast<std::size_t>(lens.width) * lens.height / 2);  // noise was added
 }
 
 INSTANTIATE_TEST_SUITE_P(Sensor, NoiseTest,

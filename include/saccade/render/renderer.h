@@ -8,13 +8,15 @@
 // frames come back with row 0 at the top; pixels come back through pixel buffer objects,
 // asynchronously and double buffered.
 //
-// Effects (seed section 4.3), all on the GPU and each switchable: a camera with lens
-// distortion is drawn as one wider pinhole view, or as cube faces for lenses beyond 120
-// degrees, and remapped per pixel (geometry/lens_map.h) so that points land where
-// cv::projectPoints / cv::fisheye::projectPoints put them; motion blur averages sub-frames
-// over the exposure; read and shot noise are added in digital numbers, seeded per camera and
-// frame; one final pass does remap, noise and quantisation. Cameras without any effect take
-// the direct path (no extra pass). Ground truth (depth, ids, boxes) goes through the same
+// Effects (seed section 4.3), each switchable: a camera with lens distortion is drawn as one
+// wider pinhole view, or as cube faces for lenses beyond 120 degrees, and remapped per pixel
+// (geometry/lens_map.h) so that points land where cv::projectPoints /
+// cv::fisheye::projectPoints put them; motion blur averages sub-frames over the exposure;
+// read and shot noise are added in digital numbers, seeded per camera and frame; one final
+// pass on the GPU does remap, noise and quantisation, or, on a software rasteriser, the CPU
+// does the remap of one source view and the noise to the pixels read back
+// (RendererOptions::lens_on_cpu, noise_on_cpu). Cameras without any effect take the direct
+// path (no extra pass). Ground truth (depth, ids, boxes) goes through the same
 // remap, so it matches the distorted colour image pixel for pixel.
 
 #include <Eigen/Core>
@@ -48,7 +50,8 @@ struct RendererOptions {
 
   // Effects (seed section 4.3), each applied where the camera's description asks for it and
   // switched off here for every camera at once. They run on the GPU in one remap pass after
-  // the scene is drawn (plus the extra scene passes motion blur needs).
+  // the scene is drawn (plus the extra scene passes motion blur needs), or on the CPU after
+  // readback (lens_on_cpu, noise_on_cpu).
   /// Lens distortion of the cameras' calibrations (geometry/lens_map.h: a wider pinhole view,
   /// or a cube for lenses beyond 120 degrees, remapped). Off: every camera renders as the
   /// pinhole of its K, and the frames' metadata says distortion "none".
@@ -61,6 +64,13 @@ struct RendererOptions {
   /// (llvmpipe, softpipe), where a full-screen pass costs milliseconds. The same formula, table
   /// and hash either way (kFinalFragmentSource).
   std::optional<bool> noise_on_cpu;
+  /// Where the lens remap is done when the camera's lens needs one source view (not a cube)
+  /// and nothing was accumulated in float (the head still, or blur off) and no ground truth is
+  /// drawn: on the CPU, after the source view is read back, with the noise (true), or in the
+  /// final pass (false); unset: on the CPU on a software rasteriser, where the pass costs
+  /// 7-10 ms an eye at 1024 x 768. The same samples either way (render/gl/internal_cpu_lens.h:
+  /// within one DN of the pass).
+  std::optional<bool> lens_on_cpu;
   /// Motion blur over the exposure (SensorSpec::exposure, blur_samples).
   bool motion_blur = true;
   /// Motion blur of a turning camera (a saccade): the exposure is cut into the fewest

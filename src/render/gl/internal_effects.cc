@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "render/gl/internal_cpu_lens.h"
 #include "render/gl/internal_effect_shaders.h"
 #include "render/gl/internal_gl_util.h"
 #include "saccade/core/error.h"
@@ -504,7 +505,8 @@ void PixelBuffers::Unmap() const {
 
 // --- EffectTarget -------------------------------------------------------------------------
 
-EffectTarget::EffectTarget(const geometry::LensMap& lens, int samples, bool blur, bool truth)
+EffectTarget::EffectTarget(const geometry::LensMap& lens, int samples, bool blur, bool truth,
+                           bool lens_on_cpu)
     : lens_(lens),
       samples_(samples),
       blur_(blur),
@@ -544,6 +546,10 @@ EffectTarget::EffectTarget(const geometry::LensMap& lens, int samples, bool blur
   if (blur_) EnableBlur();
   if (lens_.kind != geometry::LensMap::Kind::kIdentity) {
     const RemapTable table = MakeRemapTable(lens_);
+    if (lens_on_cpu && layers_ == 1 && !truth_) {
+      cpu_lens_ = std::make_unique<CpuLens>(table, lens_.width, lens_.height, w, h);
+      source_buffers_ = std::make_unique<PixelBuffers>(w, h, 4);
+    }
     map_ =
         MakeTexture2d(GL_RGBA32F, GL_RGBA, GL_FLOAT, lens_.width, lens_.height, table.map.data());
     footprint_ = MakeTexture2d(GL_RGBA32F, GL_RGBA, GL_FLOAT, lens_.width, lens_.height,
@@ -748,6 +754,7 @@ void EffectTarget::BindTruthForDrawing(int view) const {
 }
 
 bool EffectTarget::can_read_source() const {
+  if (cpu_lens_) return true;
   return lens_.kind == geometry::LensMap::Kind::kIdentity && !truth_ && layers_ == 1 &&
          source_width_ == lens_.width && source_height_ == lens_.height;
 }
@@ -759,7 +766,7 @@ void EffectTarget::ReadSource(int slot) const {
   glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, source_, 0, 0);
   glBindFramebuffer(GL_READ_FRAMEBUFFER, samples_ > 0 ? resolve_framebuffer_ : draw_framebuffer_);
   glReadBuffer(GL_COLOR_ATTACHMENT0);
-  color_buffers_.Read(slot, GL_RGBA, GL_UNSIGNED_BYTE);
+  (cpu_lens_ ? *source_buffers_ : color_buffers_).Read(slot, GL_RGBA, GL_UNSIGNED_BYTE);
 }
 
 void EffectTarget::Finish(EffectPrograms& programs, bool accumulated, const NoiseParams* noise,

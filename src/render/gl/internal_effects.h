@@ -14,6 +14,10 @@
 //      sensor noise (a hashed table of normal deviates, GaussianTable), quantisation to 8
 //      bits (internal_effect_shaders.h)
 //   -> readback through pixel buffer objects, one per in-flight slot.
+// On a software rasteriser (RendererOptions::lens_on_cpu, noise_on_cpu), when nothing was
+// accumulated in float, no ground truth is drawn and the lens has one source view, the final
+// pass is skipped: the source view is read back and Retrieve remaps it and adds the noise on
+// the CPU (internal_cpu_lens.h, internal_pixels.h).
 //
 // Ground truth, when asked: one more scene pass per view into an R32UI id array and an RG32F
 // depth array (the camera's z and the view's depth; no MSAA: ids are not blended), remapped
@@ -164,6 +168,8 @@ struct TurnSamples {
   std::vector<float> layers;
 };
 
+class CpuLens;  // internal_cpu_lens.h
+
 /// Pixel buffer objects, one per in-flight slot, for one image of fixed size and format.
 class PixelBuffers {
  public:
@@ -186,8 +192,11 @@ class PixelBuffers {
 class EffectTarget {
  public:
   /// `samples` 0 for no MSAA; `blur`: allocate the accumulation array; `truth`: the id and
-  /// depth arrays and outputs. Throws saccade::Error naming the sizes when the device refuses.
-  EffectTarget(const geometry::LensMap& lens, int samples, bool blur, bool truth);
+  /// depth arrays and outputs; `lens_on_cpu`: a lens of one source view without truth is
+  /// remapped on the CPU (cpu_lens) when nothing was accumulated. Throws saccade::Error naming
+  /// the sizes when the device refuses.
+  EffectTarget(const geometry::LensMap& lens, int samples, bool blur, bool truth,
+               bool lens_on_cpu = false);
   ~EffectTarget();
   EffectTarget(const EffectTarget&) = delete;
   EffectTarget& operator=(const EffectTarget&) = delete;
@@ -238,12 +247,17 @@ class EffectTarget {
               const TurnSamples* turn = nullptr) const;
 
   /// Whether the final pass would only copy the source view (plus noise): an identity lens of
-  /// the camera's size, no truth. Then ReadSource may replace Finish when nothing was
-  /// accumulated.
+  /// the camera's size, no truth; or remap it where the CPU does that (cpu_lens). Then
+  /// ReadSource may replace Finish when nothing was accumulated.
   bool can_read_source() const;
-  /// Starts the readback of the source view into `slot` as Finish's would of the final pass's
-  /// image (the same pixels without noise), the pass skipped.
+  /// Starts the readback of the source view into `slot`, the pass skipped: an identity lens's
+  /// into color_buffers (Finish's pixels without noise), a lens remapped on the CPU's into
+  /// source_buffers.
   void ReadSource(int slot) const;
+  /// The lens remap on the CPU (RendererOptions::lens_on_cpu); null when the pass remaps.
+  const CpuLens* cpu_lens() const { return cpu_lens_.get(); }
+  /// With cpu_lens: the source view's RGBA8 pixels after the slot's fence, row 0 first.
+  const PixelBuffers& source_buffers() const { return *source_buffers_; }
 
   /// After the slot's fence: the camera-size RGBA8 pixels, ids (uint32) and depth (float),
   /// row 0 at the top; nullptr on failure. Unmap each after use.
@@ -285,6 +299,8 @@ class EffectTarget {
   GLuint output_ids_ = 0, output_z_ = 0, output_truth_framebuffer_ = 0;
   PixelBuffers color_buffers_;
   std::unique_ptr<PixelBuffers> id_buffers_, depth_buffers_;
+  std::unique_ptr<CpuLens> cpu_lens_;
+  std::unique_ptr<PixelBuffers> source_buffers_;  // with cpu_lens_
 };
 
 }  // namespace saccade::render::gl

@@ -93,8 +93,10 @@ GlRenderer::GlRenderer(const scene::Scene& scene, const RendererOptions& options
                         renderer.find("softpipe") != std::string::npos;
   resources_ = std::make_unique<GpuResources>(/*anisotropic=*/!software);
   // On a software rasteriser a full-screen pass costs milliseconds an eye (a 1024 x 768 copy:
-  // ~4 ms on llvmpipe), more than the same noise added on the CPU to the pixels read back.
+  // ~4 ms on llvmpipe), more than the same noise, and the lens remap, done on the CPU to the
+  // pixels read back.
   noise_on_cpu_ = options_.noise_on_cpu.value_or(software);
+  lens_on_cpu_ = options_.lens_on_cpu.value_or(software);
   batch_contexts_ = options_.batch_contexts != 0
                         ? options_.batch_contexts
                         : (software && std::thread::hardware_concurrency() >= 2 ? 2 : 1);
@@ -209,7 +211,8 @@ void GlRenderer::BuildCameraSetups(std::vector<CameraSetup> reuse, bool reuse_di
     }
     if (setup.distorted || setup.noise || setup.blur || truth_) {
       if (!effect_programs_) effect_programs_ = std::make_unique<EffectPrograms>();
-      setup.effects = std::make_unique<EffectTarget>(lens, samples_, setup.blur, truth_);
+      setup.effects =
+          std::make_unique<EffectTarget>(lens, samples_, setup.blur, truth_, lens_on_cpu_);
       PrebuildFinal(setup);
       if (truth_) effect_programs_->GetTruthRemap(!setup.distorted);
       targets_.push_back(nullptr);
@@ -425,7 +428,8 @@ void GlRenderer::Submit(const scene::SceneState& state, int64_t frame_index) {
   const int slot = (oldest_ + in_flight_) % CameraTarget::kSlots;
   Pending& pending = pending_[slot];
   pending.state = state;
-  pending.cpu_noise.assign(cameras_.size(), std::nullopt);  // DrawEffects sets it
+  pending.cpu_noise.assign(cameras_.size(), std::nullopt);  // DrawEffects sets them
+  pending.cpu_lens.assign(cameras_.size(), false);
   pending.frame_index = frame_index;
   UpdatePoses(state);
   for (std::size_t i = 0; i < cameras_.size(); ++i) {
@@ -856,10 +860,13 @@ void GlRenderer::DrawEffects(int camera, const scene::SceneState& state, int64_t
   noise.gain_dn_per_e = static_cast<float>(spec.sensor.gain_dn_per_e);
   noise.key = NoiseKey(spec.sensor.seed, spec.name, frame_index);
   // Nothing for the final pass to do but copy the source view and add noise: skipped, the
-  // noise added to the pixels read back (Retrieve) when it goes on the CPU.
+  // noise added to the pixels read back (Retrieve) when it goes on the CPU. The same with a
+  // lens remapped on the CPU, which takes the noise with it.
   const bool copy_only = effects.can_read_source() && !accumulated && !fused;
-  if (copy_only && (!setup.noise || noise_on_cpu_)) {
+  const bool cpu_lens = effects.cpu_lens() != nullptr;
+  if (copy_only && (!setup.noise || noise_on_cpu_ || cpu_lens)) {
     if (setup.noise) pending_[slot].cpu_noise[camera] = noise;
+    pending_[slot].cpu_lens[camera] = cpu_lens;
     effects.ReadSource(slot);
     return;
   }

@@ -180,6 +180,9 @@ class GlRenderer final : public Renderer {
     std::vector<int> exposure_samples;  // per camera: sub-frames drawn (1: an instant)
     // Per camera: the noise Retrieve adds to the pixels read back (the final pass skipped).
     std::vector<std::optional<NoiseParams>> cpu_noise;
+    // Per camera: its source view was read back for the lens remap on the CPU (the pass
+    // skipped; EffectTarget::cpu_lens).
+    std::vector<bool> cpu_lens;
     GLsync fence = nullptr;
   };
 
@@ -242,6 +245,12 @@ class GlRenderer final : public Renderer {
   uint32_t ItemId(const DrawItem& item) const;
   void SetLights(const LightUniforms& uniforms, const Eigen::Isometry3d& X_EW) const;
   std::shared_ptr<Image> NewImage(int camera);
+  // The CPU's share of Retrieve (internal_readback.cc): NoiseLevels for a sensor, made once;
+  // rows [first_row, end_row) of a camera's image from the pixels read back, remapped through
+  // its lens (Pending::cpu_lens) and with its noise (`levels` null: none).
+  const uint8_t* LevelsFor(const NoiseParams& noise);
+  void ConvertRows(int camera, const Pending& pending, const uint8_t* pixels, const uint8_t* levels,
+                   Image* image, int first_row, int end_row) const;
 
   EglContext context_;  // first: destroyed last
   scene::Scene scene_;
@@ -261,6 +270,7 @@ class GlRenderer final : public Renderer {
   bool draw_robot_ = false;
   double turn_blur_max_error_px_ = -1.0;  // RendererOptions::turn_blur*; < 0: off
   bool noise_on_cpu_ = false;             // RendererOptions::noise_on_cpu, resolved
+  bool lens_on_cpu_ = false;              // RendererOptions::lens_on_cpu, resolved
   // NoiseLevels by (read sigma, gain), made as cameras need them.
   std::map<std::pair<float, float>, std::vector<uint8_t>> noise_levels_;
   std::vector<DrawItem> items_;

@@ -15,7 +15,8 @@ void RgbaToRgb(const uint8_t* rgba, uint8_t* rgb, std::size_t pixels);
 
 /// The final pass's sensor noise (kFinalFragmentSource, NOISE) as a table: entry (DN << 10) |
 /// code is DN plus sqrt(read_sigma^2 + gain * DN) times the deviate of 10-bit `code`
-/// (PackGaussianTable's), rounded and clamped to 8 bits, in the pass's float arithmetic.
+/// (PackGaussianTable's), rounded and clamped to 8 bits, in the pass's float arithmetic; then 3
+/// bytes of padding (the vector loop's gathers read 4 bytes an entry).
 std::vector<uint8_t> NoiseLevels(float read_sigma_dn, float gain_dn_per_e);
 
 /// That noise on the CPU: `rgba` rows of `width` pixels, row 0 at the top (the pass's
@@ -29,5 +30,12 @@ void RgbaToRgbWithNoise(const uint8_t* rgba, uint8_t* rgb, int width, int height
 /// row 0), so that parts of one image can be converted at the same time.
 void RgbaToRgbWithNoise(const uint8_t* rgba, uint8_t* rgb, int width, int first_row, int end_row,
                         uint32_t key, const uint32_t* table, const uint8_t* levels);
+
+/// One row: row `y` of the image (its place in the hash) from `rgba_row` into `rgb_row`;
+/// eight pixels at a time with AVX2 where the CPU has it (`simd` false: the portable loop, for
+/// tests: the two give the same bytes).
+void RgbaRowToRgbWithNoise(const uint8_t* rgba_row, uint8_t* rgb_row, int width, int y,
+                           uint32_t key, const uint32_t* table, const uint8_t* levels,
+                           bool simd = true);
 
 }  // namespace saccade::render::gl

@@ -6,6 +6,7 @@
 #include <cstring>
 #include <thread>
 
+#include "render/gl/internal_cpu_lens.h"
 #include "render/gl/internal_gl_renderer_impl.h"
 #include "render/gl/internal_pixels.h"
 #include "saccade/core/error.h"
@@ -57,21 +58,27 @@ std::vector<Frame> GlRenderer::Retrieve() {
     Describe(static_cast<int>(i), pending, &image->metadata());
     const std::size_t pixel_count =
         static_cast<std::size_t>(image->width()) * static_cast<std::size_t>(image->height());
-    // One path for every camera: the effect target's colour buffers when effects run, else
-    // the plain target; a tightly packed RGB row is copied as it is.
-    const uint8_t* pixels = setup.effects ? MapOrThrow(setup.effects->color_buffers(), slot, "")
-                                          : MapOrThrow(*targets_[i], slot, "");
+    // One path for every camera: the effect target's colour buffers when effects run (its
+    // source view's when the CPU remaps the lens), else the plain target; a tightly packed
+    // RGB row is copied as it is.
+    const bool cpu_lens = pending.cpu_lens[i];
+    const PixelBuffers* effect_buffers =
+        !setup.effects
+            ? nullptr
+            : (cpu_lens ? &setup.effects->source_buffers() : &setup.effects->color_buffers());
+    const uint8_t* pixels = effect_buffers != nullptr ? MapOrThrow(*effect_buffers, slot, "")
+                                                      : MapOrThrow(*targets_[i], slot, "");
     const int row_bytes = setup.effects ? 4 * image->width() : targets_[i]->row_bytes();
-    if (const std::optional<NoiseParams>& noise = pending.cpu_noise[i]; noise.has_value()) {
-      std::vector<uint8_t>& levels = noise_levels_[{noise->read_sigma_dn, noise->gain_dn_per_e}];
-      if (levels.empty()) levels = NoiseLevels(noise->read_sigma_dn, noise->gain_dn_per_e);
+    const std::optional<NoiseParams>& noise = pending.cpu_noise[i];
+    if (cpu_lens || noise.has_value()) {
+      const uint8_t* levels = noise.has_value() ? LevelsFor(*noise) : nullptr;
       const auto convert = [&](int first_row, int end_row) {
-        RgbaToRgbWithNoise(pixels, image->data(), image->width(), first_row, end_row, noise->key,
-                           PackedGaussianTable().data(), levels.data());
+        ConvertRows(static_cast<int>(i), pending, pixels, levels, image.get(), first_row, end_row);
       };
       // A large image in two halves at once: the fence above waited for every camera's
-      // passes, so a software rasteriser's threads are idle while this runs (1024 x 768:
-      // about 2.2 ms a camera in one piece on the 2-core development machine).
+      // passes, so a software rasteriser's threads are idle while this runs (the bench
+      // scene's 1024 x 768 eyes, lens and noise: 3 to 5 ms a camera in two halves on the
+      // 2-core development machine).
       static const bool cores = std::thread::hardware_concurrency() >= 2;  // asked once
       if (pixel_count >= kMinSplitNoisePixels && cores) {
         const int half = image->height() / 2;
@@ -86,8 +93,8 @@ std::vector<Frame> GlRenderer::Retrieve() {
     } else {
       RgbaToRgb(pixels, image->data(), pixel_count);
     }
-    if (setup.effects) {
-      setup.effects->color_buffers().Unmap();
+    if (effect_buffers != nullptr) {
+      effect_buffers->Unmap();
     } else {
       targets_[i]->Unmap();
     }
@@ -100,6 +107,37 @@ std::vector<Frame> GlRenderer::Retrieve() {
   stats_.readback_ms += Milliseconds(start, end);
   stats_.total_ms += Milliseconds(start, end);
   return frames;
+}
+
+const uint8_t* GlRenderer::LevelsFor(const NoiseParams& noise) {
+  std::vector<uint8_t>& levels = noise_levels_[{noise.read_sigma_dn, noise.gain_dn_per_e}];
+  if (levels.empty()) levels = NoiseLevels(noise.read_sigma_dn, noise.gain_dn_per_e);
+  return levels.data();
+}
+
+void GlRenderer::ConvertRows(int camera, const Pending& pending, const uint8_t* pixels,
+                             const uint8_t* levels, Image* image, int first_row,
+                             int end_row) const {
+  const std::size_t i = static_cast<std::size_t>(camera);
+  const std::optional<NoiseParams>& noise = pending.cpu_noise[i];
+  const int width = image->width();
+  if (!pending.cpu_lens[i]) {
+    RgbaToRgbWithNoise(pixels, image->data(), width, first_row, end_row, noise->key,
+                       PackedGaussianTable().data(), levels);
+    return;
+  }
+  const CpuLens& lens = *setups_[i].effects->cpu_lens();
+  std::vector<uint8_t> row(4 * static_cast<std::size_t>(width));
+  for (int y = first_row; y < end_row; ++y) {
+    lens.RemapRow(pixels, y, row.data());
+    uint8_t* out = image->data() + static_cast<std::size_t>(y) * image->stride();
+    if (levels != nullptr) {
+      RgbaRowToRgbWithNoise(row.data(), out, width, y, noise->key, PackedGaussianTable().data(),
+                            levels);
+    } else {
+      RgbaToRgb(row.data(), out, static_cast<std::size_t>(width));
+    }
+  }
 }
 
 void GlRenderer::Describe(int camera_index, const Pending& pending, ImageMetadata* out) const {
