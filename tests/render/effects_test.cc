@@ -259,8 +259,10 @@ TEST(LensOnCpuTest, RemapsAsTheFinalPassDoes) {
 }
 
 // The remap's and the noise's AVX2 loops and their portable ones give the same rows to the
-// bit (the same integer arithmetic and lookups), on a random source through the barrel lens;
-// rows of a width that leaves a tail for the portable loop.
+// bit, on a random source through the barrel lens, in rows of a width that leaves a tail for
+// the portable loop: the remap's integer arithmetic, and the noise's levels (a table) against
+// the vector loop's float arithmetic, for read noise alone, shot noise alone, both, and noise
+// wide enough to clip at 0 and 255.
 TEST(LensOnCpuTest, TheVectorLoopsEqualThePortableOnes) {
   const double coefficients[] = {-0.2, 0.1, 0.0005, -0.0003, 0.0};
   const geometry::CameraModel model(geometry::Intrinsics(317, 240, 300, 300, 158, 119.5),
@@ -269,25 +271,34 @@ TEST(LensOnCpuTest, TheVectorLoopsEqualThePortableOnes) {
   const int w = lens.views[0].intrinsics.width(), h = lens.views[0].intrinsics.height();
   std::vector<uint8_t> source(4 * static_cast<std::size_t>(w) * h);
   uint32_t state = 12345;
-  for (uint8_t& b : source)
+  for (uint8_t& b : source) {
     b = static_cast<uint8_t>((state = state * 1664525u + 1013904223u) >> 24);
+  }
   const gl::CpuLens cpu_lens(gl::MakeRemapTable(lens), lens.width, lens.height, w, h);
-  const std::vector<uint8_t> levels = gl::NoiseLevels(2.0f, 0.3f);
   std::vector<uint8_t> fast(4 * lens.width), portable(4 * lens.width);
-  std::vector<uint8_t> fast_rgb(3 * lens.width), portable_rgb(3 * lens.width);
-  std::size_t noisy = 0;
   for (int y = 0; y < lens.height; ++y) {
     cpu_lens.RemapRow(source.data(), y, fast.data());
     cpu_lens.RemapRow(source.data(), y, portable.data(), /*simd=*/false);
     ASSERT_EQ(fast, portable) << "row " << y;
-    gl::RgbaRowToRgbWithNoise(fast.data(), fast_rgb.data(), lens.width, y, 77,
-                              gl::PackedGaussianTable().data(), levels.data());
-    gl::RgbaRowToRgbWithNoise(fast.data(), portable_rgb.data(), lens.width, y, 77,
-                              gl::PackedGaussianTable().data(), levels.data(), /*simd=*/false);
-    ASSERT_EQ(fast_rgb, portable_rgb) << "row " << y;
-    for (int x = 0; x < lens.width; ++x) noisy += fast_rgb[3 * x] != fast[4 * x];
   }
-  EXPECT_GT(noisy, static_cast<std::size_t>(lens.width) * lens.height / 2);  // noise was added
+  const std::pair<float, float> sensors[] = {
+      {5.0f, 0.0f}, {0.0f, 0.2f}, {2.0f, 0.3f}, {1.5f, 0.1f}, {20.0f, 1.7f}};
+  for (const auto& [read, gain] : sensors) {
+    SCOPED_TRACE(::testing::Message() << "read " << read << " DN, gain " << gain);
+    const std::vector<uint8_t> levels = gl::NoiseLevels(read, gain);
+    const gl::CpuNoise noise{77, read, gain, gl::PackedGaussianTable().data(), levels.data()};
+    std::vector<uint8_t> fast_rgb(3 * lens.width), portable_rgb(3 * lens.width);
+    std::size_t noisy = 0;
+    for (int y = 0; y < lens.height; ++y) {
+      cpu_lens.RemapRow(source.data(), y, fast.data());
+      gl::RgbaRowToRgbWithNoise(fast.data(), fast_rgb.data(), lens.width, y, noise);
+      gl::RgbaRowToRgbWithNoise(fast.data(), portable_rgb.data(), lens.width, y, noise,
+                                /*simd=*/false);
+      ASSERT_EQ(fast_rgb, portable_rgb) << "row " << y;
+      for (int x = 0; x < lens.width; ++x) noisy += fast_rgb[3 * x] != fast[4 * x];
+    }
+    EXPECT_GT(noisy, static_cast<std::size_t>(lens.width) * lens.height / 2);  // noise added
+  }
 }
 
 INSTANTIATE_TEST_SUITE_P(Sensor, NoiseTest,

@@ -22,6 +22,7 @@
 #include "render/gl/internal_egl_context.h"
 #include "render/gl/internal_gl_util.h"
 #include "render/gl/internal_gpu_resources.h"
+#include "render/gl/internal_pixels.h"
 #include "saccade/core/error.h"
 #include "saccade/head/kinematics.h"
 #include "saccade/render/renderer.h"
@@ -247,9 +248,9 @@ class GlRenderer final : public Renderer {
   std::shared_ptr<Image> NewImage(int camera);
   // The CPU's share of Retrieve (internal_readback.cc): NoiseLevels for a sensor, made once;
   // rows [first_row, end_row) of a camera's image from the pixels read back, remapped through
-  // its lens (Pending::cpu_lens) and with its noise (`levels` null: none).
+  // its lens (`lens`: Pending::cpu_lens) and with its noise (null: none; one of the two).
   const uint8_t* LevelsFor(const NoiseParams& noise);
-  void ConvertRows(int camera, const Pending& pending, const uint8_t* pixels, const uint8_t* levels,
+  void ConvertRows(int camera, bool lens, const uint8_t* pixels, const CpuNoise* noise,
                    Image* image, int first_row, int end_row) const;
 
   EglContext context_;  // first: destroyed last

@@ -15,27 +15,30 @@ void RgbaToRgb(const uint8_t* rgba, uint8_t* rgb, std::size_t pixels);
 
 /// The final pass's sensor noise (kFinalFragmentSource, NOISE) as a table: entry (DN << 10) |
 /// code is DN plus sqrt(read_sigma^2 + gain * DN) times the deviate of 10-bit `code`
-/// (PackGaussianTable's), rounded and clamped to 8 bits, in the pass's float arithmetic; then 3
-/// bytes of padding (the vector loop's gathers read 4 bytes an entry).
+/// (PackGaussianTable's), rounded and clamped to 8 bits, in the pass's float arithmetic.
 std::vector<uint8_t> NoiseLevels(float read_sigma_dn, float gain_dn_per_e);
 
-/// That noise on the CPU: `rgba` rows of `width` pixels, row 0 at the top (the pass's
-/// gl_FragCoord.y), to tightly packed RGB, each channel through `levels` (NoiseLevels) with
-/// the code of the entry of `table` (PackGaussianTable) that the pass's hash of the pixel and
-/// `key` picks.
-void RgbaToRgbWithNoise(const uint8_t* rgba, uint8_t* rgb, int width, int height, uint32_t key,
-                        const uint32_t* table, const uint8_t* levels);
+/// One camera's noise in one frame, as the CPU adds it: the pass's hash of the pixel and `key`
+/// picks an entry of `table` (PackGaussianTable), whose codes give each channel's deviate;
+/// `levels` is NoiseLevels(read_sigma_dn, gain_dn_per_e), the vector loop computes the same.
+struct CpuNoise {
+  uint32_t key = 0;
+  float read_sigma_dn = 0.0f;
+  float gain_dn_per_e = 0.0f;
+  const uint32_t* table = nullptr;
+  const uint8_t* levels = nullptr;
+};
 
-/// The same for rows [first_row, end_row) of the image only (`rgba` and `rgb` still point at
-/// row 0), so that parts of one image can be converted at the same time.
+/// That noise on the CPU: rows [first_row, end_row) of `rgba` (rows of `width` pixels, row 0
+/// at the top: the pass's gl_FragCoord.y) to tightly packed RGB in `rgb` (`rgba` and `rgb`
+/// point at row 0, so that parts of one image can be converted at the same time).
 void RgbaToRgbWithNoise(const uint8_t* rgba, uint8_t* rgb, int width, int first_row, int end_row,
-                        uint32_t key, const uint32_t* table, const uint8_t* levels);
+                        const CpuNoise& noise);
 
 /// One row: row `y` of the image (its place in the hash) from `rgba_row` into `rgb_row`;
-/// eight pixels at a time with AVX2 where the CPU has it (`simd` false: the portable loop, for
-/// tests: the two give the same bytes).
+/// eight pixels at a time with AVX2 where the CPU has it (`simd` false: the portable loop
+/// through the levels, for tests: the two give the same bytes).
 void RgbaRowToRgbWithNoise(const uint8_t* rgba_row, uint8_t* rgb_row, int width, int y,
-                           uint32_t key, const uint32_t* table, const uint8_t* levels,
-                           bool simd = true);
+                           const CpuNoise& noise, bool simd = true);
 
 }  // namespace saccade::render::gl

@@ -71,9 +71,14 @@ std::vector<Frame> GlRenderer::Retrieve() {
     const int row_bytes = setup.effects ? 4 * image->width() : targets_[i]->row_bytes();
     const std::optional<NoiseParams>& noise = pending.cpu_noise[i];
     if (cpu_lens || noise.has_value()) {
-      const uint8_t* levels = noise.has_value() ? LevelsFor(*noise) : nullptr;
+      std::optional<CpuNoise> cpu_noise;
+      if (noise.has_value()) {
+        cpu_noise = CpuNoise{noise->key, noise->read_sigma_dn, noise->gain_dn_per_e,
+                             PackedGaussianTable().data(), LevelsFor(*noise)};
+      }
       const auto convert = [&](int first_row, int end_row) {
-        ConvertRows(static_cast<int>(i), pending, pixels, levels, image.get(), first_row, end_row);
+        ConvertRows(static_cast<int>(i), cpu_lens, pixels, cpu_noise ? &*cpu_noise : nullptr,
+                    image.get(), first_row, end_row);
       };
       // A large image in two halves at once: the fence above waited for every camera's
       // passes, so a software rasteriser's threads are idle while this runs (the bench
@@ -115,25 +120,20 @@ const uint8_t* GlRenderer::LevelsFor(const NoiseParams& noise) {
   return levels.data();
 }
 
-void GlRenderer::ConvertRows(int camera, const Pending& pending, const uint8_t* pixels,
-                             const uint8_t* levels, Image* image, int first_row,
-                             int end_row) const {
-  const std::size_t i = static_cast<std::size_t>(camera);
-  const std::optional<NoiseParams>& noise = pending.cpu_noise[i];
+void GlRenderer::ConvertRows(int camera, bool lens, const uint8_t* pixels, const CpuNoise* noise,
+                             Image* image, int first_row, int end_row) const {
   const int width = image->width();
-  if (!pending.cpu_lens[i]) {
-    RgbaToRgbWithNoise(pixels, image->data(), width, first_row, end_row, noise->key,
-                       PackedGaussianTable().data(), levels);
+  if (!lens) {
+    RgbaToRgbWithNoise(pixels, image->data(), width, first_row, end_row, *noise);
     return;
   }
-  const CpuLens& lens = *setups_[i].effects->cpu_lens();
+  const CpuLens& cpu_lens = *setups_[static_cast<std::size_t>(camera)].effects->cpu_lens();
   std::vector<uint8_t> row(4 * static_cast<std::size_t>(width));
   for (int y = first_row; y < end_row; ++y) {
-    lens.RemapRow(pixels, y, row.data());
+    cpu_lens.RemapRow(pixels, y, row.data());
     uint8_t* out = image->data() + static_cast<std::size_t>(y) * image->stride();
-    if (levels != nullptr) {
-      RgbaRowToRgbWithNoise(row.data(), out, width, y, noise->key, PackedGaussianTable().data(),
-                            levels);
+    if (noise != nullptr) {
+      RgbaRowToRgbWithNoise(row.data(), out, width, y, *noise);
     } else {
       RgbaToRgb(row.data(), out, static_cast<std::size_t>(width));
     }
