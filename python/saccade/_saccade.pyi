@@ -218,6 +218,7 @@ class render:
         draw_ms: float
         effects_ms: float
         readback_ms: float
+        cpu_effects_ms: float
         total_ms: float
     class BatchHead:
         def __init__(self, state: "scene.SceneState",

@@ -83,6 +83,9 @@ void BindRender(py::module_& m) {
       .def_readonly("draw_ms", &RenderStats::draw_ms)
       .def_readonly("effects_ms", &RenderStats::effects_ms)
       .def_readonly("readback_ms", &RenderStats::readback_ms)
+      .def_readonly("cpu_effects_ms", &RenderStats::cpu_effects_ms,
+                    "Of readback_ms: the lens remap and the noise done on the CPU (a software "
+                    "rasteriser's way).")
       .def_readonly("total_ms", &RenderStats::total_ms);
 
   py::class_<BatchHead>(m, "BatchHead",

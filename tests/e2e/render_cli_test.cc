@@ -176,6 +176,17 @@ TEST(BenchCli, ReportsFramesPerSecondAndStages) {
   EXPECT_EQ(out["cameras"].size(), 2u);
   EXPECT_GT(out["ms_per_frame"]["draw"].get<double>(), 0.0);
   EXPECT_TRUE(out["ms_per_frame"].contains("effects"));
+  // Of the readback, what the CPU did of the effects: on a software rasteriser (llvmpipe here)
+  // the lens remap and the noise; on a GPU nothing.
+  const double cpu = out["ms_per_frame"]["cpu_effects"].get<double>();
+  EXPECT_LE(cpu, out["ms_per_frame"]["readback"].get<double>());
+  const std::string device = out["device"].get<std::string>();
+  if (device.find("llvmpipe") != std::string::npos ||
+      device.find("softpipe") != std::string::npos) {
+    EXPECT_GT(cpu, 0.0) << device;
+  } else {
+    EXPECT_EQ(cpu, 0.0) << device;
+  }
   // The default: every effect the scene describes is on.
   EXPECT_TRUE(out["distortion"].get<bool>());
   EXPECT_TRUE(out["noise"].get<bool>());

@@ -205,3 +205,21 @@ def test_set_effects_gives_the_frames_of_a_renderer_made_with_them():
         assert np.array_equal(got.color, made.color), (distortion, noise, blur)
         images.append(got.color.copy())
     assert not np.array_equal(images[0], images[1]) and not np.array_equal(images[1], images[2])
+
+
+def test_stats_say_what_the_cpu_did_of_the_effects():
+    # The bench scene's eyes, head still: on a software rasteriser (llvmpipe here) the lens
+    # remap and the noise run on the CPU after readback, and the stats count them within
+    # readback; a GPU does them in its final pass.
+    bench = saccade.scene.Scene.load(path("scenes", "bench.yaml"))
+    r = saccade.render.Renderer(bench, cameras=["left"])
+    r.render(bench.initial_state(), 0)
+    stats = r.stats
+    assert stats.frames == 1
+    if "llvmpipe" in r.device or "softpipe" in r.device:
+        assert 0.0 < stats.cpu_effects_ms <= stats.readback_ms
+    else:
+        assert stats.cpu_effects_ms == 0.0
+    plain = saccade.render.Renderer(bench, cameras=["left"], distortion=False, noise=False)
+    plain.render(bench.initial_state(), 0)
+    assert plain.stats.cpu_effects_ms == 0.0

@@ -28,6 +28,7 @@ struct Measurement {
   int64_t pixels = 0;
   // Per frame, milliseconds (RenderStats).
   double update_ms = 0.0, draw_ms = 0.0, effects_ms = 0.0, readback_ms = 0.0;
+  double cpu_effects_ms = 0.0;  ///< of readback_ms: the lens remap and noise on the CPU
 
   double fps() const { return frames / std::max(seconds, 1e-9); }
   double ms_per_frame() const { return 1000.0 * seconds / std::max(frames, 1); }

@@ -153,6 +153,9 @@ struct RenderStats {
   double draw_ms = 0;          ///< issuing draw calls (and, on llvmpipe, rasterising)
   double effects_ms = 0;       ///< issuing the remap / noise / truth passes
   double readback_ms = 0;      ///< waiting for and copying pixels out of the PBOs
+  /// Of readback_ms: the lens remap and the noise done on the CPU after readback
+  /// (RendererOptions::lens_on_cpu, noise_on_cpu; a software rasteriser's way).
+  double cpu_effects_ms = 0;
   double total_ms = 0;
 };
 

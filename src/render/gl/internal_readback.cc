@@ -85,6 +85,7 @@ std::vector<Frame> GlRenderer::Retrieve() {
       // scene's 1024 x 768 eyes, lens and noise: 3 to 5 ms a camera in two halves on the
       // 2-core development machine).
       static const bool cores = std::thread::hardware_concurrency() >= 2;  // asked once
+      const Clock::time_point converting = Clock::now();
       if (pixel_count >= kMinSplitNoisePixels && cores) {
         const int half = image->height() / 2;
         std::thread other(convert, half, image->height());
@@ -93,6 +94,7 @@ std::vector<Frame> GlRenderer::Retrieve() {
       } else {
         convert(0, image->height());
       }
+      stats_.cpu_effects_ms += Milliseconds(converting, Clock::now());
     } else if (row_bytes == static_cast<int>(image->stride())) {
       std::memcpy(image->data(), pixels, image->size_bytes());
     } else {
