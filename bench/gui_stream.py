@@ -6,7 +6,11 @@
 Connects to the WebSocket (docs/gui-protocol.md) and measures, over --seconds:
   - frames per second received per camera, states per second, the loop's steps per second;
   - the round trip of `ping` (median, p95) and the latency of a `joints` command until a state
-    shows the new target (median, p95), alternating the pan target between two values;
+    shows the new target (median, p95), alternating the pan target between two values, each
+    command sent as soon as a state shows the one before (so most land while the head turns);
+  - from rest: --commands more, each sent a random 0.1-0.35 s after a state says the head
+    arrived at the one before (at a random phase of the loop's step), timed until a state shows the new target and until a state shows the pan
+    moving towards it (the step the command lands in, or the next);
   - with --slow-clients N (before the commands, which switch perception off): N more clients
     connect and never read; the loop's steps per second with them is reported next to the
     figure without them, and what the server held and skipped for them (/api/status).
@@ -17,6 +21,7 @@ import argparse
 import base64
 import json
 import os
+import random
 import socket
 import statistics
 import struct
@@ -115,11 +120,13 @@ def main():
         return next_id[0]
 
     frames, states, last_state = {}, 0, None
-    ping_ms, joints_ms = [], []
+    ping_ms, joints_ms, rest_ms, motion_ms = [], [], [], []
     pending_ping, pending_joint = {}, None  # id -> sent; (target, sent)
+    # From rest: [target, sent, pan when sent, target shown, motion shown]
+    from_rest = None
 
     def pump(until):
-        nonlocal states, last_state, pending_joint
+        nonlocal states, last_state, pending_joint, from_rest
         while time.monotonic() < until:
             op, data = ws.read()
             now = time.monotonic()
@@ -135,6 +142,18 @@ def main():
                     if pending_joint and m.get("joints") and abs(m["joints"]["targets"]["pan"] - pending_joint[0]) < 1e-9:
                         joints_ms.append(1e3 * (now - pending_joint[1]))
                         pending_joint = None
+                    if from_rest and m.get("joints"):
+                        j = m["joints"]
+                        target, sent, pan0, shown, moving = from_rest
+                        if not shown and abs(j["targets"]["pan"] - target) < 1e-9:
+                            rest_ms.append(1e3 * (now - sent))
+                            from_rest[3] = shown = True
+                        moved = j["positions"]["pan"] - pan0
+                        if not moving and moved * (target - pan0) > 0 and abs(moved) > 1e-4:
+                            motion_ms.append(1e3 * (now - sent))
+                            from_rest[4] = moving = True
+                        if shown and moving and j["arrived"]:
+                            from_rest = None
                 elif m["type"] == "reply" and m["id"] in pending_ping:
                     ping_ms.append(1e3 * (now - pending_ping.pop(m["id"])))
                 elif m["type"] == "error":
@@ -182,6 +201,19 @@ def main():
         deadline = time.monotonic() + 30
         while pending_joint and time.monotonic() < deadline:
             pump(time.monotonic() + 0.01)
+    # From rest: once the head arrived, a random pause (the loop's phase), then the command.
+    rng = random.Random(1)
+    for k in range(args.commands if joints_ms else 0):
+        deadline = time.monotonic() + 30
+        while not (last_state["joints"]["arrived"]) and time.monotonic() < deadline:
+            pump(time.monotonic() + 0.01)
+        pump(time.monotonic() + rng.uniform(0.1, 0.3))
+        time.sleep(rng.uniform(0.0, 0.05))  # not just after a state: a random phase of the step
+        target = 0.1 if k % 2 == 0 else -0.1
+        from_rest = [target, time.monotonic(), last_state["joints"]["positions"]["pan"], False, False]
+        command({"type": "joints", "positions": {"pan": target}})
+        while from_rest and time.monotonic() < deadline:
+            pump(time.monotonic() + 0.01)
 
     result = {
         "seconds": elapsed, "steps_per_s": steps_per_s, "states_per_s": states_per_s,
@@ -189,6 +221,11 @@ def main():
         "ping_ms": {"median": statistics.median(ping_ms), "p95": percentile(ping_ms, 0.95)},
         "joints_to_state_ms": {"median": statistics.median(joints_ms) if joints_ms else None,
                                "p95": percentile(joints_ms, 0.95), "n": len(joints_ms)},
+        "from_rest": {
+            "joints_to_state_ms": {"median": statistics.median(rest_ms) if rest_ms else None,
+                                   "p95": percentile(rest_ms, 0.95), "n": len(rest_ms)},
+            "joints_to_motion_ms": {"median": statistics.median(motion_ms) if motion_ms else None,
+                                    "p95": percentile(motion_ms, 0.95), "n": len(motion_ms)}},
         "slow": slow,
     }
     if args.json:
@@ -200,6 +237,11 @@ def main():
     if joints_ms:
         print(f"joints command to a state with the new target ({len(joints_ms)}): median "
               f"{statistics.median(joints_ms):.1f} ms, p95 {percentile(joints_ms, 0.95):.1f} ms")
+    if rest_ms and motion_ms:
+        print(f"from rest ({len(rest_ms)}): to a state with the new target median "
+              f"{statistics.median(rest_ms):.1f} ms, p95 {percentile(rest_ms, 0.95):.1f} ms; to a "
+              f"state with the pan moving towards it median {statistics.median(motion_ms):.1f} ms, "
+              f"p95 {percentile(motion_ms, 0.95):.1f} ms")
     if slow:
         print(f"with {slow['clients']} clients that never read: {slow['steps_per_s']:.2f} steps/s "
               f"(without: {steps_per_s:.2f}); held for each at most {slow['queued_bytes_max'] / 1e6:.2f} MB, "

@@ -147,6 +147,8 @@ int RunDemo(Options o) {
   run.on_error = [&](const runtime::StepError& error) {
     fmt::print(stderr, "saccade: error: {}\n", error.ToString());
   };
+  // While a step waits for its frames, the GUI takes the commands that came meanwhile.
+  if (gui) run.while_waiting = [&] { gui->WhileWaiting(); };
   run.step_timing = [&](const runtime::StepContext&, const runtime::StepTiming& timing) {
     latency.Add(timing);
   };

@@ -4,8 +4,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
+#include <utility>
 #include <vector>
 
+#include "components/internal_render_thread.h"
 #include "components/internal_scene.h"
 #include "saccade/core/error.h"
 
@@ -54,7 +57,17 @@ void SimCameras::Configured() {
   }
 }
 
-void SimCameras::Start() { renderer_ = render::MakeRenderer(*scene_, options_); }
+SimCameras::~SimCameras() { Stop(); }
+
+void SimCameras::Start() {
+  thread_ = std::make_unique<internal::RenderThread>();
+  try {
+    thread_->Post([this] { renderer_ = render::MakeRenderer(*scene_, options_); }).get();
+  } catch (...) {
+    thread_.reset();
+    throw;
+  }
+}
 
 void SimCameras::SetEffects(bool distortion, bool noise, bool motion_blur) {
   if (options_.distortion == distortion && options_.noise == noise &&
@@ -68,11 +81,20 @@ void SimCameras::SetEffects(bool distortion, bool noise, bool motion_blur) {
 }
 
 void SimCameras::Step(const runtime::StepContext& context) {
+  const std::function<void()>* while_waiting = context.while_waiting;
   std::vector<render::Frame> frames;
-  if (options_changed_ && renderer_) {
-    // The frames in flight were drawn with the old effects: they go out with this step's.
-    if (renderer_->InFlight() > 0) frames = renderer_->Retrieve();
-    renderer_->SetEffects(options_.distortion, options_.noise, options_.motion_blur);
+  if (in_flight_) {
+    // The previous step's frames (pipelined): this step emits them.
+    std::future<std::vector<render::Frame>> previous = std::move(*in_flight_);
+    in_flight_.reset();
+    frames = internal::Await(std::move(previous), while_waiting);
+  }
+  if (options_changed_) {
+    // Nothing is in flight now: the frames above were drawn with the old effects and go out
+    // with this step's.
+    const bool d = options_.distortion, n = options_.noise, b = options_.motion_blur;
+    internal::Await(thread_->Post([this, d, n, b] { renderer_->SetEffects(d, n, b); }),
+                    while_waiting);
     options_changed_ = false;
   }
   scene::SceneState state = scene_->InitialState();
@@ -81,18 +103,29 @@ void SimCameras::Step(const runtime::StepContext& context) {
     state.joints = joints->positions;
     state.joint_velocities = joints->velocities;
   }
+  const int64_t frame_index = context.step;
+  auto render = [this, state = std::move(state), frame_index] {
+    return renderer_->Render(state, frame_index);
+  };
   const bool pipelined = pipelined_ == "always" || (pipelined_ == "auto" && context.realtime);
   if (pipelined) {
-    if (renderer_->InFlight() > 0) frames = renderer_->Retrieve();
-    renderer_->Submit(state, context.step);
+    in_flight_ = thread_->Post(std::move(render));
   } else {
-    frames = renderer_->Render(state, context.step);
+    frames = internal::Await(thread_->Post(std::move(render)), while_waiting);
   }
   for (std::size_t i = 0; i < frames.size() && i < outputs_.size(); ++i) {
     outputs_[i]->Emit(runtime::ImageMessage{frames[i].color});
   }
 }
 
-void SimCameras::Stop() { renderer_.reset(); }
+void SimCameras::Stop() {
+  if (!thread_) return;
+  if (in_flight_) {
+    in_flight_->wait();  // a frame nobody will take (its error too)
+    in_flight_.reset();
+  }
+  thread_->Post([this] { renderer_.reset(); }).wait();
+  thread_.reset();
+}
 
 }  // namespace saccade::components

@@ -456,6 +456,9 @@ void GuiSession::AfterStep(const runtime::StepContext& context, const Latest& la
   sim_time_ = context.time + context.dt;
 
   commanded_.reset();  // this step's joints are the newest
+  last_context_ = context;
+  last_context_->while_waiting = nullptr;
+  last_latest_ = &latest;
   ApplyQueued();
   server_->PublishState(StateJson(context, latest));
 
@@ -496,6 +499,12 @@ void GuiSession::AfterStep(const runtime::StepContext& context, const Latest& la
     }
   });
   last_return_wall_ = WallNow();
+}
+
+void GuiSession::WhileWaiting() {
+  if (ApplyQueued() > 0 && last_context_ && last_latest_ != nullptr) {
+    server_->PublishState(StateJson(*last_context_, *last_latest_));
+  }
 }
 
 void GuiSession::EncodeLoop() {

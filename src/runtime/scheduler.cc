@@ -220,6 +220,9 @@ RunSummary RunPipeline(Pipeline& pipeline, const RunOptions& options) {
               stepped[i] = 1;
               StepContext own_context = context;
               own_context.seed = component.seed();
+              if (!parallel && options.while_waiting) {
+                own_context.while_waiting = &options.while_waiting;
+              }
               DeferredEmits*& deferred = DeferredEmits::Current();
               if (parallel) {
                 deferred = &held[i];

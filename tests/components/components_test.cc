@@ -7,6 +7,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstring>
+#include <functional>
 #include <memory>
 #include <opencv2/imgproc.hpp>
 #include <optional>
@@ -261,6 +262,38 @@ TEST(SimCameras, PipelinedCaptureEmitsThePreviousStepsFrameUnchanged) {
   }
   pipelined->Stop();
   plain->Stop();
+}
+
+// The renderer draws on a thread of its own: while a step waits for its frames it calls
+// StepContext::while_waiting, on the step's thread (where a GUI applies its commands).
+TEST(SimCameras, WhileWaitingRunsOnTheStepsThreadWhileTheRendererDraws) {
+  for (const char* mode : {"never", "always"}) {
+    auto cameras =
+        Make("sim.cameras", {{"scene", kScene}, {"cameras", {"left"}}, {"pipelined", mode}});
+    auto got = Capture<runtime::ImageMessage>(*cameras, "left");
+    cameras->Start();
+    std::vector<std::thread::id> calls;
+    const std::function<void()> hook = [&] { calls.push_back(std::this_thread::get_id()); };
+    const bool pipelined = std::string(mode) == "always";
+    for (int64_t step = 0; step < 4; ++step) {
+      runtime::StepContext context = At(step);
+      context.while_waiting = &hook;
+      const std::size_t before = calls.size();
+      cameras->Step(context);
+      if (pipelined && step == 0) {
+        EXPECT_FALSE(got->has_value());
+        EXPECT_EQ(calls.size(), before);  // nothing to wait for: the render goes on alone
+        continue;
+      }
+      ASSERT_TRUE(got->has_value()) << mode;
+      EXPECT_EQ((*got)->image->metadata().frame_index, pipelined ? step - 1 : step) << mode;
+      if (!pipelined) {
+        EXPECT_GT(calls.size(), before) << step;  // it waited for a whole render
+      }
+    }
+    cameras->Stop();
+    for (const std::thread::id& id : calls) EXPECT_EQ(id, std::this_thread::get_id()) << mode;
+  }
 }
 
 // The left eye's image with the head fixating the astronaut's face; null when it cannot.

@@ -284,6 +284,45 @@ components:
   EXPECT_EQ(run(1, "serial", 20).first, std::vector<bool>(4, false));
 }
 
+// RunOptions::while_waiting reaches a component only where nothing else runs beside it: every
+// component of a serial run; in a run with threads, a level of one ({alone}), never one of
+// several ({rec_a, rec_b, relay}).
+TEST(SchedulerTest, WhileWaitingIsOfferedOnlyWhereNothingElseRuns) {
+  for (const int threads : {1, 2}) {
+    Pipeline pipeline = Load(fmt::format(R"(clock: {{mode: simulated, step: 1, steps: 3}}
+threads: {}
+components:
+  - {{name: src, type: test.random}}
+  - {{name: rec_a, type: test.recorder, inputs: {{in: src.out}}}}
+  - {{name: rec_b, type: test.recorder, inputs: {{in: src.out}}}}
+  - {{name: relay, type: test.relay, inputs: {{in: src.out}}}}
+  - {{name: alone, type: test.recorder, inputs: {{in: relay.out}}}}
+)",
+                                         threads));
+    RunOptions options;
+    std::vector<std::thread::id> calls;
+    options.while_waiting = [&] { calls.push_back(std::this_thread::get_id()); };
+    RunPipeline(pipeline, options);
+    for (const char* name : {"rec_a", "rec_b", "alone"}) {
+      const auto& records = pipeline.Find<Recorder>(name)->records;
+      ASSERT_EQ(records.size(), 3u) << name;
+      const bool offered = threads == 1 || std::string(name) == "alone";
+      for (const Record& r : records) EXPECT_EQ(r.while_waiting, offered) << name << threads;
+    }
+    // Three steps of three recorders, or of the one alone; on the thread that runs the loop.
+    EXPECT_EQ(calls.size(), threads == 1 ? 9u : 3u);
+    for (const std::thread::id& id : calls) EXPECT_EQ(id, std::this_thread::get_id());
+  }
+  // Without the option, nobody is offered anything.
+  Pipeline pipeline = Load(R"(clock: {mode: simulated, step: 1, steps: 2}
+components:
+  - {name: a, type: test.random}
+  - {name: rec, type: test.recorder, inputs: {in: a.out}}
+)");
+  RunPipeline(pipeline);
+  for (const Record& r : pipeline.Find<Recorder>("rec")->records) EXPECT_FALSE(r.while_waiting);
+}
+
 TEST(SchedulerTest, ThrowingComponentWithContinueCountsErrors) {
   std::string text = WithOnError("continue");
   text.replace(text.find("{at: 2}"), 7, "{at: 2, every: true}");

@@ -80,15 +80,18 @@ struct Record {
   bool has_value = false;
   bool fresh = false;
   double value = 0.0;
+  bool while_waiting = false;  ///< the context offered StepContext::while_waiting
 };
 
-/// Records its Value input each step.
+/// Records its Value input each step; calls StepContext::while_waiting once when offered.
 class Recorder : public Component {
  public:
   Recorder() : in_(AddInput<Value>("in")) {}
   void Step(const StepContext& context) override {
     records.push_back({context.step, context.time, in_.has_value(), in_.fresh(),
-                       in_.has_value() ? in_.value().value : 0.0});
+                       in_.has_value() ? in_.value().value : 0.0,
+                       context.while_waiting != nullptr});
+    if (context.while_waiting != nullptr) (*context.while_waiting)();
   }
   std::vector<Record> records;
 

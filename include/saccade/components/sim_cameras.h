@@ -4,12 +4,15 @@
 //   inputs:  joints (head.joints, optional): the head's state at this step's time; connect
 //            it from sim.head with delay 1. Without it, the scene's initial joints.
 //   outputs: <camera> (runtime.image) per camera, shared; frame index = step.
-//   Pipelined capture (`pipelined`: always, or auto with the real-time clock): each step submits
-//   this step's state to the renderer and emits the frames of the previous step's, which
-//   rendered while the rest of the loop worked (llvmpipe rasterises on threads of its own, a
-//   GPU on its own); the images are one step older (their capture time says so), and the
-//   first step emits none.
+//   The renderer lives on a thread of its own (its GL context current there). Pipelined
+//   capture (`pipelined`: always, or auto with the real-time clock): each step hands this
+//   step's state to that thread and emits the frames of the previous step's, which rendered
+//   while the rest of the loop worked; the images are one step older (their capture time says
+//   so), and the first step emits none. A render's error surfaces in the step that takes its
+//   frames. While a step waits for frames it calls StepContext::while_waiting (a live GUI
+//   takes its commands meanwhile).
 // Parameters: declared in the constructor (docs/components.md lists them).
+#include <future>
 #include <memory>
 #include <optional>
 #include <string>
@@ -23,17 +26,23 @@
 
 namespace saccade::components {
 
+namespace internal {
+class RenderThread;
+}
+
 class SimCameras : public runtime::Component, public EyeCamerasRole {
  public:
   SimCameras();
+  ~SimCameras() override;
   void Start() override;
   void Step(const runtime::StepContext& context) override;
   void Stop() override;
-  bool thread_affine() const override { return true; }  // the renderer's GL context
+  bool thread_affine() const override { return true; }  // while_waiting on the loop's thread
 
   const scene::Scene& scene() const override { return *scene_; }
-  /// Switches the scene's effects (the GUI's toggles); the next Step renders with them (it
-  /// makes a new renderer). Call from the thread that runs the pipeline.
+  /// Switches the scene's effects (the GUI's toggles); the next Step renders with them
+  /// (Renderer::SetEffects). Call from the thread that runs the pipeline (while_waiting
+  /// included).
   void SetEffects(bool distortion, bool noise, bool motion_blur) override;
   void SetPipelined(bool on) override { pipelined_ = on ? "always" : "never"; }
   const render::RendererOptions& options() const { return options_; }
@@ -48,7 +57,9 @@ class SimCameras : public runtime::Component, public EyeCamerasRole {
   std::vector<runtime::Output<runtime::ImageMessage>*> outputs_;
   std::shared_ptr<const scene::Scene> scene_;
   render::RendererOptions options_;
-  std::unique_ptr<render::Renderer> renderer_;
+  std::unique_ptr<internal::RenderThread> thread_;                    // owns renderer_'s GL context
+  std::unique_ptr<render::Renderer> renderer_;                        // used on thread_ only
+  std::optional<std::future<std::vector<render::Frame>>> in_flight_;  // pipelined
   std::string pipelined_ = "auto";
   bool options_changed_ = false;
 };

@@ -7,8 +7,10 @@
 // Threads: commands arrive on the server's I/O thread; they are checked there (joint limits,
 // reachability, well-formed values: a bad one gets an error reply and changes nothing) and
 // queued; AfterStep applies them on the simulation thread, between steps, where the
-// components live. JPEG encoding runs on a thread of its own that always takes the newest
-// images, so that a slow encoder or client costs frames, never simulation steps.
+// components live, and so does WhileWaiting, while a step waits for its camera frames (the
+// state the page then gets shows the command's targets a render sooner). JPEG encoding runs on a
+// thread of its own that always takes the newest images, so that a slow encoder or client costs
+// frames, never simulation steps.
 
 #include <atomic>
 #include <condition_variable>
@@ -61,6 +63,10 @@ class GuiSession {
   void AfterStep(const runtime::StepContext& context, const Latest& latest,
                  const std::atomic<bool>& stop);
 
+  /// On the simulation thread while a step waits on a device (runtime::RunOptions::
+  /// while_waiting): applies the queued commands, and when there were any publishes the state
+  /// (the last step's, with the commands' targets).
+  void WhileWaiting();
   /// One line for the terminal: clients, frames sent and skipped.
   std::string Describe() const;
 
@@ -101,6 +107,9 @@ class GuiSession {
   mutable std::mutex joints_mutex_;
   head::JointState targets_;  // the latest targets, for partial joint commands (joints_mutex_)
 
+  // The last step AfterStep saw (simulation thread), for the states WhileWaiting publishes.
+  std::optional<runtime::StepContext> last_context_;
+  const Latest* last_latest_ = nullptr;
   // Pacing and timing (simulation thread).
   double last_return_wall_ = -1.0;
   double last_step_ms_ = 0.0;

@@ -14,6 +14,7 @@
 // component_registry.h makes components by type name.
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <optional>
@@ -39,6 +40,11 @@ struct StepContext {
   /// the GUI's: RunOptions::live): work may finish when it does. When false, a component that
   /// models a latency must keep to it, for runs to be repeatable.
   bool realtime = false;
+  /// A component that blocks on a device (sim.cameras waiting for its frames) calls this now
+  /// and then while it waits, on its own thread: RunOptions::while_waiting, for the run's owner
+  /// to do its work meanwhile (a live GUI takes commands). Set only where nothing else runs at
+  /// the time (a level stepped one component after the other); null otherwise.
+  const std::function<void()>* while_waiting = nullptr;
 };
 
 /// A component's method without its types: name, message types, and a JSON call.

@@ -107,6 +107,10 @@ struct RunOptions {
   /// Called after each step (before after_step) with its timing (StepTiming). For per-step
   /// latencies; may be empty.
   std::function<void(const StepContext&, const StepTiming&)> step_timing;
+  /// Called while a component waits on a device within a step (StepContext::while_waiting),
+  /// every few milliseconds, on the loop's thread and only while no other component runs:
+  /// e.g. a GUI applying the commands that arrived. May be empty.
+  std::function<void()> while_waiting;
 };
 
 /// The time of simulated step `step`: step * clock.step; with a time source
