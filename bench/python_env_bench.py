@@ -97,7 +97,8 @@ def cpp_step_ms(size: int, binary: str) -> float:
     env.close()
     try:
         result = subprocess.run(
-            [binary, "--benchmark_format=json"], check=True, capture_output=True, text=True,
+            [binary, "--benchmark_format=json", "--benchmark_filter=BM_FixationEnvStep"],
+            check=True, capture_output=True, text=True,
             env=dict(os.environ, SACCADE_ENV_SCENE=scene.name))
     finally:
         os.unlink(scene.name)

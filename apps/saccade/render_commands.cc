@@ -121,22 +121,8 @@ int RunBench(const BenchOptions& o) {
       bar.reset();
     }
   };
-  // The first figure: the options as given, the head still.
-  const Measurement main = Measure(scene, o.renderer, {}, o.frames, o.warmup, progress);
-  std::vector<EffectRun> runs;
-  if (o.effect_table) {
-    runs = EffectRuns(scene, o.renderer, main.cameras);
-    const head::JointState panning{kBenchPanRate, 0.0, 0.0, 0.0};
-    for (EffectRun& run : runs) {
-      if (!run.unconfigured.empty()) continue;
-      run.result = Measure(scene, run.options, run.moving ? panning : head::JointState{}, o.frames,
-                           o.warmup, progress);
-    }
-  }
-  render::BenchReport report{o.scene, o.renderer, o.frames, o.warmup, 0, 0, main, runs};
-  const auto* first = scene.FindCamera(main.cameras.front());
-  report.width = first->model.intrinsics().width();
-  report.height = first->model.intrinsics().height();
+  const render::BenchReport report =
+      render::Bench(o.scene, scene, o.renderer, o.frames, o.warmup, o.effect_table, progress);
   if (o.json) {
     std::cout << report.Json().dump(2) << "\n";
   } else {

@@ -96,6 +96,28 @@ double OffMs(const std::vector<EffectRun>& runs) {
 }
 }  // namespace
 
+BenchReport Bench(const std::string& scene_path, const scene::Scene& scene,
+                  const RendererOptions& options, int frames, int warmup, bool effect_table,
+                  const std::function<void(int done, double fps)>& progress) {
+  // The first figure: the options as given, the head still.
+  const Measurement main = Measure(scene, options, {}, frames, warmup, progress);
+  std::vector<EffectRun> runs;
+  if (effect_table) {
+    runs = EffectRuns(scene, options, main.cameras);
+    const head::JointState panning{kBenchPanRate, 0.0, 0.0, 0.0};
+    for (EffectRun& run : runs) {
+      if (!run.unconfigured.empty()) continue;
+      run.result = Measure(scene, run.options, run.moving ? panning : head::JointState{}, frames,
+                           warmup, progress);
+    }
+  }
+  BenchReport report{scene_path, options, frames, warmup, 0, 0, main, runs};
+  const scene::CameraSpec* first = scene.FindCamera(main.cameras.front());
+  report.width = first->model.intrinsics().width();
+  report.height = first->model.intrinsics().height();
+  return report;
+}
+
 nlohmann::json BenchReport::Json() const {
   using nlohmann::json;
   const double off_ms = OffMs(runs);

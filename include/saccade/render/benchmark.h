@@ -68,4 +68,11 @@ struct BenchReport {
   std::string Text() const;
 };
 
+/// `saccade bench` on a loaded scene (`scene_path` only names it in the report): the first
+/// figure, then with `effect_table` every run of EffectRuns that the scene gives something to
+/// do. `progress` as Measure's, for every run in turn.
+BenchReport Bench(const std::string& scene_path, const scene::Scene& scene,
+                  const RendererOptions& options, int frames, int warmup, bool effect_table,
+                  const std::function<void(int done, double fps)>& progress = {});
+
 }  // namespace saccade::render
