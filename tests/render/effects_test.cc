@@ -258,6 +258,36 @@ TEST(LensOnCpuTest, RemapsAsTheFinalPassDoes) {
   }
 }
 
+// A large batch's readback converts RGBA to RGB in parts on threads (RenderBatch): the same
+// bytes as one pass, whatever the number of parts and wherever a part ends (a pixel count that
+// no part divides, an SSSE3 store of 16 bytes near each part's end).
+TEST(PixelsTest, RgbaToRgbInPartsGivesTheSameBytesAsOnePass) {
+  for (const std::size_t pixels :
+       {std::size_t{5}, gl::kMinConvertPartPixels - 1, 3 * gl::kMinConvertPartPixels + 7}) {
+    std::vector<uint8_t> rgba(4 * pixels);
+    uint32_t x = 12345u;
+    for (uint8_t& b : rgba) {
+      x = x * 1664525u + 1013904223u;
+      b = static_cast<uint8_t>(x >> 24);
+    }
+    std::vector<uint8_t> want(3 * pixels);
+    gl::RgbaToRgb(rgba.data(), want.data(), pixels);
+    for (const unsigned threads : {1u, 2u, 3u, 8u, 64u}) {
+      std::vector<uint8_t> got(3 * pixels + 16, 0xAB);  // a guard past the end
+      gl::RgbaToRgbInParts(rgba.data(), got.data(), pixels, threads);
+      EXPECT_EQ(std::memcmp(got.data(), want.data(), want.size()), 0) << pixels << " " << threads;
+      EXPECT_EQ(got[3 * pixels], 0xAB) << "wrote past the end";
+    }
+  }
+  // Alpha is dropped, channels kept in order.
+  const uint8_t one[4] = {10, 20, 30, 40};
+  uint8_t rgb[3] = {};
+  gl::RgbaToRgbInParts(one, rgb, 1, 4);
+  EXPECT_EQ(rgb[0], 10);
+  EXPECT_EQ(rgb[1], 20);
+  EXPECT_EQ(rgb[2], 30);
+}
+
 // The remap's and the noise's AVX2 loops and their portable ones give the same rows to the
 // bit, on a random source through the barrel lens, in rows of a width that leaves a tail for
 // the portable loop: the remap's integer arithmetic, and the noise's levels (a table) against

@@ -5,6 +5,7 @@
 #include <bit>
 #include <cmath>
 #include <cstring>
+#include <thread>
 
 #if defined(__x86_64__)
 #include <immintrin.h>
@@ -59,6 +60,23 @@ void RgbaToRgb(const uint8_t* rgba, uint8_t* rgb, std::size_t pixels) {
   if (ssse3) return RgbaToRgbSsse3(rgba, rgb, pixels);
 #endif
   RgbaToRgbPortable(rgba, rgb, pixels);
+}
+
+void RgbaToRgbInParts(const uint8_t* rgba, uint8_t* rgb, std::size_t pixels, unsigned threads) {
+  const std::size_t parts =
+      std::min<std::size_t>({std::max(1u, threads), 8, pixels / kMinConvertPartPixels});
+  if (parts <= 1) {
+    RgbaToRgb(rgba, rgb, pixels);
+    return;
+  }
+  // Each part's SSSE3 stores stay inside its own range (RgbaToRgbSsse3).
+  const std::size_t step = (pixels + parts - 1) / parts;
+  std::vector<std::thread> others;
+  for (std::size_t from = step; from < pixels; from += step) {
+    others.emplace_back(RgbaToRgb, rgba + 4 * from, rgb + 3 * from, std::min(step, pixels - from));
+  }
+  RgbaToRgb(rgba, rgb, std::min(step, pixels));
+  for (std::thread& other : others) other.join();
 }
 
 namespace {

@@ -13,6 +13,14 @@ constexpr std::size_t kMinSplitNoisePixels = 256 * 256;
 /// RGBA rows to tightly packed RGB (alpha dropped); SSSE3 where the CPU has it.
 void RgbaToRgb(const uint8_t* rgba, uint8_t* rgb, std::size_t pixels);
 
+/// The fewest pixels of a part of RgbaToRgbInParts: about a millisecond of one thread's work
+/// (reading a mapped pixel buffer), against some 50 us to start a thread.
+constexpr std::size_t kMinConvertPartPixels = std::size_t{1} << 20;
+
+/// RgbaToRgb in parts of at least kMinConvertPartPixels, at most `threads` (and 8) at once,
+/// each on a thread of its own: the same bytes. For a large batch's readback (RenderBatch).
+void RgbaToRgbInParts(const uint8_t* rgba, uint8_t* rgb, std::size_t pixels, unsigned threads);
+
 /// The final pass's sensor noise (kFinalFragmentSource, NOISE) as a table: entry (DN << 10) |
 /// code is DN plus sqrt(read_sigma^2 + gain * DN) times the deviate of 10-bit `code`
 /// (PackGaussianTable's), rounded and clamped to 8 bits, in the pass's float arithmetic.
