@@ -319,6 +319,7 @@ MeshProgram& GlRenderer::GetMeshProgram(int variant) {
   p.shininess = Uniform(p.program, "u_shininess");
   p.lights.Find(p.program);
   glUseProgram(p.program);
+  SetLightColours(p.lights);
   glUniform1i(Uniform(p.program, "u_texture"), 0);
   glUseProgram(0);
   CheckGlError("MakeRenderer: building a mesh program");
@@ -341,6 +342,7 @@ void GlRenderer::BuildGroundProgram() {
   ground_.normal_eye = Uniform(ground_.program, "u_normal_eye");
   ground_.lights.Find(ground_.program);
   glUseProgram(ground_.program);
+  SetLightColours(ground_.lights);
   glUniform1f(Uniform(ground_.program, "u_cell"), static_cast<float>(ground.cell));
   glUniform1f(Uniform(ground_.program, "u_line_fraction"),
               static_cast<float>(ground.line_width / ground.cell));
@@ -350,35 +352,50 @@ void GlRenderer::BuildGroundProgram() {
   CheckGlError("MakeRenderer: building the ground program");
 }
 
-void GlRenderer::SetLights(const LightUniforms& uniforms, const Eigen::Isometry3d& X_EW) const {
-  std::array<float, 3 * kMaxLights> directions{}, directional_colors{}, positions{};
+void GlRenderer::SetLightColours(const LightUniforms& uniforms) const {
+  std::array<float, 3 * kMaxLights> directional_colors{};
   std::array<float, 4 * kMaxLights> point_colors{};
   for (std::size_t i = 0; i < directional_lights_.size(); ++i) {
     const scene::Light& light = *directional_lights_[i];
-    // Towards the light, in the eye frame.
-    const Eigen::Vector3f l = (-(X_EW.linear() * light.direction_W).normalized()).cast<float>();
     const Eigen::Vector3f c = light.color * light.intensity;
-    std::copy(l.data(), l.data() + 3, directions.begin() + 3 * i);
     std::copy(c.data(), c.data() + 3, directional_colors.begin() + 3 * i);
   }
   for (std::size_t i = 0; i < point_lights_.size(); ++i) {
     const scene::Light& light = *point_lights_[i];
-    const Eigen::Vector3f p = (X_EW * light.position_W).cast<float>();
     const Eigen::Vector3f c = light.color * light.intensity;
-    std::copy(p.data(), p.data() + 3, positions.begin() + 3 * i);
     std::copy(c.data(), c.data() + 3, point_colors.begin() + 4 * i);
     point_colors[4 * i + 3] = static_cast<float>(light.attenuation);
   }
   glUniform3fv(uniforms.ambient, 1, ambient_.data());
   if (!directional_lights_.empty()) {
-    const auto n = static_cast<GLsizei>(directional_lights_.size());
-    glUniform3fv(uniforms.directional_direction, n, directions.data());
-    glUniform3fv(uniforms.directional_color, n, directional_colors.data());
+    glUniform3fv(uniforms.directional_color, static_cast<GLsizei>(directional_lights_.size()),
+                 directional_colors.data());
   }
   if (!point_lights_.empty()) {
-    const auto n = static_cast<GLsizei>(point_lights_.size());
-    glUniform3fv(uniforms.point_position, n, positions.data());
-    glUniform4fv(uniforms.point_color, n, point_colors.data());
+    glUniform4fv(uniforms.point_color, static_cast<GLsizei>(point_lights_.size()),
+                 point_colors.data());
+  }
+}
+
+void GlRenderer::SetLights(const LightUniforms& uniforms, const Eigen::Isometry3d& X_EW) const {
+  std::array<float, 3 * kMaxLights> directions{}, positions{};
+  for (std::size_t i = 0; i < directional_lights_.size(); ++i) {
+    // Towards the light, in the eye frame.
+    const Eigen::Vector3f l =
+        (-(X_EW.linear() * directional_lights_[i]->direction_W).normalized()).cast<float>();
+    std::copy(l.data(), l.data() + 3, directions.begin() + 3 * i);
+  }
+  for (std::size_t i = 0; i < point_lights_.size(); ++i) {
+    const Eigen::Vector3f p = (X_EW * point_lights_[i]->position_W).cast<float>();
+    std::copy(p.data(), p.data() + 3, positions.begin() + 3 * i);
+  }
+  if (!directional_lights_.empty()) {
+    glUniform3fv(uniforms.directional_direction, static_cast<GLsizei>(directional_lights_.size()),
+                 directions.data());
+  }
+  if (!point_lights_.empty()) {
+    glUniform3fv(uniforms.point_position, static_cast<GLsizei>(point_lights_.size()),
+                 positions.data());
   }
 }
 

@@ -244,6 +244,10 @@ class GlRenderer final : public Renderer {
   double PixelsPerModelUnit(const DrawItem& item, double depth, double focal, double near) const;
   void FillTruth(int camera, const Pending& pending, int slot, Frame* frame);
   uint32_t ItemId(const DrawItem& item) const;
+  // The lights' colours and the ambient term, once when a program is built (the program in
+  // use); SetLights then sends what moves with the camera, each camera pass: directions and
+  // positions in its eye frame.
+  void SetLightColours(const LightUniforms& uniforms) const;
   void SetLights(const LightUniforms& uniforms, const Eigen::Isometry3d& X_EW) const;
   std::shared_ptr<Image> NewImage(int camera);
   // The CPU's share of Retrieve (internal_readback.cc): NoiseLevels for a sensor, made once;
