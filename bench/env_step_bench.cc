@@ -11,6 +11,8 @@
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
+#include <memory>
+#include <optional>
 #include <sstream>
 #include <vector>
 
@@ -22,21 +24,37 @@ namespace {
 
 using saccade::head::JointState;
 
-void BM_FixationEnvStep(benchmark::State& bench) {
+// The env's scene, from the file SACCADE_ENV_SCENE names; none (the bench skipped) without it.
+std::optional<saccade::scene::Scene> EnvScene(benchmark::State& bench) {
   const char* path = std::getenv("SACCADE_ENV_SCENE");
   if (path == nullptr) {
-    bench.SkipWithError("set SACCADE_ENV_SCENE (bench/python_env_bench.py does)");
-    return;
+    bench.SkipWithError(
+        "set SACCADE_ENV_SCENE to the env's scene (bench/python_env_bench.py "
+        "writes one)");
+    return std::nullopt;
   }
   std::ifstream file(path);
   std::stringstream text;
   text << file.rdbuf();
-  const saccade::scene::Scene scene = saccade::scene::Scene::FromYamlString(text.str(), path, ".");
+  return saccade::scene::Scene::FromYamlString(text.str(), path, ".");
+}
+
+// The env's renderer: both eyes, no robot, no effects.
+std::unique_ptr<saccade::render::Renderer> EnvRenderer(const saccade::scene::Scene& scene,
+                                                       int batch_contexts) {
   saccade::render::RendererOptions options;
   options.cameras = {"left", "right"};
   options.draw_robot = false;
   options.distortion = options.noise = options.motion_blur = false;
-  auto renderer = saccade::render::MakeRenderer(scene, options);
+  options.batch_contexts = batch_contexts;
+  return saccade::render::MakeRenderer(scene, options);
+}
+
+void BM_FixationEnvStep(benchmark::State& bench) {
+  const std::optional<saccade::scene::Scene> env = EnvScene(bench);
+  if (!env) return;
+  const saccade::scene::Scene& scene = *env;
+  auto renderer = EnvRenderer(scene, 0);
   const auto& head = scene.robot()->head;
   const int w = scene.cameras()[0].model.intrinsics().width();
   const int h = scene.cameras()[0].model.intrinsics().height();
@@ -109,23 +127,10 @@ BENCHMARK(BM_FixationEnvStep)
 // `stereo_obs_per_s` is N x calls a second (bench/baselines/python-env-2core.md; on a GPU the
 // figure of issue 17's N = 256).
 void BM_RenderBatch(benchmark::State& bench) {
-  const char* path = std::getenv("SACCADE_ENV_SCENE");
-  if (path == nullptr) {
-    bench.SkipWithError(
-        "set SACCADE_ENV_SCENE to the env's scene (bench/python_env_bench.py "
-        "writes one)");
-    return;
-  }
-  std::ifstream file(path);
-  std::stringstream text;
-  text << file.rdbuf();
-  const saccade::scene::Scene scene = saccade::scene::Scene::FromYamlString(text.str(), path, ".");
-  saccade::render::RendererOptions options;
-  options.cameras = {"left", "right"};
-  options.draw_robot = false;
-  options.distortion = options.noise = options.motion_blur = false;
-  options.batch_contexts = static_cast<int>(bench.range(1));
-  auto renderer = saccade::render::MakeRenderer(scene, options);
+  const std::optional<saccade::scene::Scene> env = EnvScene(bench);
+  if (!env) return;
+  const saccade::scene::Scene& scene = *env;
+  auto renderer = EnvRenderer(scene, static_cast<int>(bench.range(1)));
   const auto& head = scene.robot()->head;
   const int w = scene.cameras()[0].model.intrinsics().width();
   const int h = scene.cameras()[0].model.intrinsics().height();
