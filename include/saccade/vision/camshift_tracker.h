@@ -71,7 +71,8 @@ class CamShiftTracker {
   const Options& options() const { return options_; }
 
  private:
-  // The back projection of `region` of `image` (the whole image by default).
+  // The back projection of `region` of `image` (the whole image by default); before the colour
+  // model is learnt (Start), that region in HSV.
   cv::Mat BackProject(const Image& image, const char* who,
                       const std::optional<cv::Rect>& region = std::nullopt) const;
   // CamShift from `window` over `region` of `image`: the state's box and window in the image's
