@@ -20,6 +20,7 @@
 
 #include "image_camera_helpers.h"
 #include "render/gl/internal_cpu_lens.h"
+#include "render/gl/internal_cpu_turn.h"
 #include "render/gl/internal_effects.h"
 #include "render/gl/internal_pixels.h"
 #include "saccade/core/error.h"
@@ -775,6 +776,92 @@ TEST(MotionBlurTest, ATurningCameraBlursThroughItsTurnAsDrawingEverySubFrameDoes
     EXPECT_LT(mean, 0.25) << i << Keep(a, "lens_turned") << Keep(b, "lens_drawn");
     EXPECT_LT(over, 0.005) << i;
   }
+}
+
+// A turning camera's fetches through the turn on the CPU (RendererOptions::turn_blur_on_cpu,
+// the default on llvmpipe: the stretches read back) give the final pass's image within a DN:
+// the pass weighs each fetch with 8 fractional bits and rounds it, the CPU weighs in float and
+// rounds the mean once. A fetch a pixel off, or a homography applied the wrong way round, would
+// differ by tens of DN on every edge of the checker ground and the ball. With noise, the same
+// deviates: the two differ where the signal rounded differently, by about as much.
+TEST(MotionBlurTest, TheTurnFetchedOnTheCpuIsTheFinalPassWithinADn) {
+  for (const bool noise : {false, true}) {
+    SCOPED_TRACE(noise ? "with noise" : "without noise");
+    std::string yaml = HeadAndBallScene(16);
+    if (noise) {
+      for (std::size_t at = 0; (at = yaml.find("blur_samples: 16}", at)) != std::string::npos;) {
+        yaml.replace(at, 17, "blur_samples: 16, read_noise_dn: 2.0, gain_dn_per_e: 0.1}");
+        ++at;
+      }
+    }
+    const scene::Scene world = SceneFrom(yaml);
+    ASSERT_EQ(world.FindCamera("left")->sensor.read_noise_dn, noise ? 2.0 : 0.0);
+    scene::SceneState turning = world.InitialState();
+    turning.joint_velocities.left = 2.0;
+    turning.joint_velocities.right = -2.0;
+    RendererOptions options;
+    options.noise = noise;
+    options.turn_blur_on_cpu = false;
+    const std::vector<Frame> pass = MakeRenderer(world, options)->Render(turning, 5);
+    options.turn_blur_on_cpu = true;
+    const std::vector<Frame> cpu = MakeRenderer(world, options)->Render(turning, 5);
+    for (int i = 0; i < 2; ++i) {
+      const Image& a = *cpu[i].color;
+      const Image& b = *pass[i].color;
+      EXPECT_EQ(a.metadata().exposure_samples, b.metadata().exposure_samples) << i;
+      EXPECT_GE(a.metadata().exposure_samples, 8) << i;
+      ASSERT_EQ(a.size_bytes(), b.size_bytes());
+      std::size_t differ = 0;
+      int worst = 0;
+      int64_t sum = 0;
+      for (std::size_t k = 0; k < a.size_bytes(); ++k) {
+        const int d = a.data()[k] - b.data()[k];
+        differ += d != 0;
+        worst = std::max(worst, std::abs(d));
+        sum += d;
+      }
+      std::cout << "eye " << i << ": " << differ << " of " << a.size_bytes()
+                << " values differ, by at most " << worst << "\n";
+      EXPECT_GT(differ, 0u) << "the same image: the CPU did not fetch the turn";
+      EXPECT_LE(worst, noise ? 2 : 1) << Keep(a, "turn_cpu") << " " << Keep(b, "turn_pass");
+      EXPECT_LT(static_cast<double>(differ) / a.size_bytes(), 0.05) << differ << " differ";
+      EXPECT_LT(std::abs(static_cast<double>(sum) / a.size_bytes()), 0.02) << sum;
+    }
+  }
+}
+
+// The turn's AVX2 loop and its portable one give the same rows to the bit: random stretches,
+// homographies of a turn with some perspective, fetches past every edge (clamped), and a width
+// that leaves a tail for the portable loop.
+TEST(MotionBlurTest, TheTurnsVectorLoopEqualsThePortableOne) {
+  const int w = 203, h = 61;
+  std::vector<uint8_t> layers(2 * 4 * static_cast<std::size_t>(w) * h);
+  uint32_t state = 4242;
+  for (uint8_t& b : layers)
+    b = static_cast<uint8_t>((state = state * 1664525u + 1013904223u) >> 24);
+  gl::CpuTurn turn;
+  for (int k = 0; k < 7; ++k) {
+    Eigen::Matrix3f m = Eigen::Matrix3f::Identity();
+    m(0, 2) = -30.0f + 11.3f * k;  // shifts past the left and the right edge
+    m(1, 2) = 0.37f * k - 2.0f;
+    m(0, 1) = 0.01f * k;
+    m(2, 0) = 1e-4f * (k - 3);  // perspective
+    turn.homographies.push_back(m);
+    turn.layers.push_back(k % 2);
+  }
+  turn.stretches = 2;
+  std::vector<uint8_t> fast(4 * w), portable(4 * w);
+  std::size_t blurred = 0;
+  for (int y = 0; y < h; ++y) {
+    gl::TurnBlurRow(turn, layers.data(), w, h, y, fast.data());
+    gl::TurnBlurRow(turn, layers.data(), w, h, y, portable.data(), /*simd=*/false);
+    ASSERT_EQ(fast, portable) << "row " << y;
+    for (int x = 0; x < w; ++x) {
+      EXPECT_EQ(fast[4 * x + 3], 255);
+      blurred += fast[4 * x] != layers[4 * (static_cast<std::size_t>(y) * w + x)];
+    }
+  }
+  EXPECT_GT(blurred, static_cast<std::size_t>(w) * h / 2);  // the mean, not a copy
 }
 
 // --- ground truth ----------------------------------------------------------------------------

@@ -83,6 +83,12 @@ struct RendererOptions {
   /// a bound of 0 with anything but a pure turn: every sub-frame drawn.
   bool turn_blur = true;
   double turn_blur_max_error_px = 1.0;  ///< finite, >= 0
+  /// Where a turning camera's sub-frames are fetched through the turn when its lens is a
+  /// pinhole and no ground truth is drawn: on the CPU, from the stretches read back, with the
+  /// noise (true), or in the final pass (false); unset: on the CPU on a software rasteriser,
+  /// where the pass cost 31-43 ms an eye of `saccade demo`. Within one DN of the pass
+  /// (render/gl/internal_cpu_turn.h).
+  std::optional<bool> turn_blur_on_cpu;
 
   /// Ground truth per frame (Frame::depth, ids, objects), consistent with the distortion:
   /// drawn at the frame's time (the middle of the exposure), without blur or noise.

@@ -485,9 +485,13 @@ PixelBuffers::PixelBuffers(int width, int height, int bytes_per_pixel)
 PixelBuffers::~PixelBuffers() { glDeleteBuffers(CameraTarget::kSlots, buffers_); }
 
 void PixelBuffers::Read(int slot, GLenum format, GLenum type) const {
+  Read(slot, format, type, height_, 0);
+}
+
+void PixelBuffers::Read(int slot, GLenum format, GLenum type, int rows, std::size_t offset) const {
   glBindBuffer(GL_PIXEL_PACK_BUFFER, buffers_[slot]);
   glPixelStorei(GL_PACK_ALIGNMENT, 1);
-  glReadPixels(0, 0, width_, height_, format, type, nullptr);
+  glReadPixels(0, 0, width_, rows, format, type, reinterpret_cast<void*>(offset));
   glBindBuffer(GL_PIXEL_PACK_BUFFER, 0);
 }
 
@@ -767,6 +771,29 @@ void EffectTarget::ReadSource(int slot) const {
   glBindFramebuffer(GL_READ_FRAMEBUFFER, samples_ > 0 ? resolve_framebuffer_ : draw_framebuffer_);
   glReadBuffer(GL_COLOR_ATTACHMENT0);
   (cpu_lens_ ? *source_buffers_ : color_buffers_).Read(slot, GL_RGBA, GL_UNSIGNED_BYTE);
+}
+
+void EffectTarget::ReadStretches(int slot, int count) const {
+  if (stretches_ == 0 || count < 1 || count > kMaxTurnStretches) {
+    throw Error(fmt::format("ReadStretches: {} stretches, expected 1 to {}{}", count,
+                            kMaxTurnStretches,
+                            stretches_ == 0 ? " (this target has no stretches)" : ""));
+  }
+  if (stretch_buffers_ == nullptr) {
+    stretch_buffers_ =
+        std::make_unique<PixelBuffers>(source_width_, source_height_ * kMaxTurnStretches, 4);
+  }
+  // As ReadSource: the resolved layer, through the framebuffer the pass would have read.
+  const GLuint framebuffer = samples_ > 0 ? resolve_framebuffer_ : draw_framebuffer_;
+  glBindFramebuffer(GL_FRAMEBUFFER, framebuffer);
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, framebuffer);
+  glReadBuffer(GL_COLOR_ATTACHMENT0);
+  const std::size_t layer_bytes = static_cast<std::size_t>(source_width_) * source_height_ * 4;
+  for (int g = 0; g < count; ++g) {
+    glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, stretches_, 0, g);
+    stretch_buffers_->Read(slot, GL_RGBA, GL_UNSIGNED_BYTE, source_height_,
+                           static_cast<std::size_t>(g) * layer_bytes);
+  }
 }
 
 void EffectTarget::Finish(EffectPrograms& programs, bool accumulated, const NoiseParams* noise,

@@ -179,6 +179,8 @@ class PixelBuffers {
   PixelBuffers& operator=(const PixelBuffers&) = delete;
   /// Starts the copy of the bound read framebuffer's read buffer into the slot's buffer.
   void Read(int slot, GLenum format, GLenum type) const;
+  /// The same for `rows` rows of the read buffer, `offset` bytes into the slot's buffer.
+  void Read(int slot, GLenum format, GLenum type, int rows, std::size_t offset) const;
   /// Maps the slot's buffer (after its fence), nullptr on failure; Unmap after use.
   const void* Map(int slot) const;
   void Unmap() const;
@@ -258,6 +260,11 @@ class EffectTarget {
   const CpuLens* cpu_lens() const { return cpu_lens_.get(); }
   /// With cpu_lens: the source view's RGBA8 pixels after the slot's fence, row 0 first.
   const PixelBuffers& source_buffers() const { return *source_buffers_; }
+  /// Starts the readback of the first `count` stretch layers into `slot`, one after the other,
+  /// the pass skipped: a turn fetched on the CPU (internal_cpu_turn.h). One source view only.
+  void ReadStretches(int slot, int count) const;
+  /// After ReadStretches and the slot's fence: the stretches' RGBA8 pixels, row 0 first.
+  const PixelBuffers& stretch_buffers() const { return *stretch_buffers_; }
 
   /// After the slot's fence: the camera-size RGBA8 pixels, ids (uint32) and depth (float),
   /// row 0 at the top; nullptr on failure. Unmap each after use.
@@ -301,6 +308,8 @@ class EffectTarget {
   std::unique_ptr<PixelBuffers> id_buffers_, depth_buffers_;
   std::unique_ptr<CpuLens> cpu_lens_;
   std::unique_ptr<PixelBuffers> source_buffers_;  // with cpu_lens_
+  // kMaxTurnStretches layers' worth, made by the first ReadStretches.
+  mutable std::unique_ptr<PixelBuffers> stretch_buffers_;
 };
 
 }  // namespace saccade::render::gl

@@ -97,6 +97,7 @@ GlRenderer::GlRenderer(const scene::Scene& scene, const RendererOptions& options
   // pixels read back.
   noise_on_cpu_ = options_.noise_on_cpu.value_or(software);
   lens_on_cpu_ = options_.lens_on_cpu.value_or(software);
+  turn_on_cpu_ = options_.turn_blur_on_cpu.value_or(software);
   batch_contexts_ = options_.batch_contexts != 0
                         ? options_.batch_contexts
                         : (software && std::thread::hardware_concurrency() >= 2 ? 2 : 1);
@@ -447,6 +448,7 @@ void GlRenderer::Submit(const scene::SceneState& state, int64_t frame_index) {
   pending.state = state;
   pending.cpu_noise.assign(cameras_.size(), std::nullopt);  // DrawEffects sets them
   pending.cpu_lens.assign(cameras_.size(), false);
+  pending.cpu_turn.assign(cameras_.size(), std::nullopt);
   pending.frame_index = frame_index;
   UpdatePoses(state);
   for (std::size_t i = 0; i < cameras_.size(); ++i) {
@@ -881,6 +883,19 @@ void GlRenderer::DrawEffects(int camera, const scene::SceneState& state, int64_t
   // lens remapped on the CPU, which takes the noise with it.
   const bool copy_only = effects.can_read_source() && !accumulated && !fused;
   const bool cpu_lens = effects.cpu_lens() != nullptr;
+  // A turn into stretch layers of a pinhole camera, no truth: its fetches on the CPU, with
+  // the noise (RendererOptions::turn_blur_on_cpu).
+  if (fused && turn_on_cpu_ && !effects.has_truth() &&
+      effects.lens().kind == geometry::LensMap::Kind::kIdentity) {
+    CpuTurn cpu_turn;
+    cpu_turn.homographies = std::move(turn.homographies);
+    for (const float layer : turn.layers) cpu_turn.layers.push_back(static_cast<int>(layer));
+    cpu_turn.stretches = stretches;
+    if (setup.noise) pending_[slot].cpu_noise[camera] = noise;
+    pending_[slot].cpu_turn[camera] = std::move(cpu_turn);
+    effects.ReadStretches(slot, stretches);
+    return;
+  }
   if (copy_only && (!setup.noise || noise_on_cpu_ || cpu_lens)) {
     if (setup.noise) pending_[slot].cpu_noise[camera] = noise;
     pending_[slot].cpu_lens[camera] = cpu_lens;

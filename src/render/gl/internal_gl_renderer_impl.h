@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "render/gl/internal_camera_target.h"
+#include "render/gl/internal_cpu_turn.h"
 #include "render/gl/internal_effects.h"
 #include "render/gl/internal_egl_context.h"
 #include "render/gl/internal_gl_util.h"
@@ -184,6 +185,9 @@ class GlRenderer final : public Renderer {
     // Per camera: its source view was read back for the lens remap on the CPU (the pass
     // skipped; EffectTarget::cpu_lens).
     std::vector<bool> cpu_lens;
+    // Per camera: its stretches were read back for the turn's fetches on the CPU (the pass
+    // skipped; RendererOptions::turn_blur_on_cpu).
+    std::vector<std::optional<CpuTurn>> cpu_turn;
     GLsync fence = nullptr;
   };
 
@@ -252,10 +256,11 @@ class GlRenderer final : public Renderer {
   std::shared_ptr<Image> NewImage(int camera);
   // The CPU's share of Retrieve (internal_readback.cc): NoiseLevels for a sensor, made once;
   // rows [first_row, end_row) of a camera's image from the pixels read back, remapped through
-  // its lens (`lens`: Pending::cpu_lens) and with its noise (null: none; one of the two).
+  // its lens (`lens`: Pending::cpu_lens) or through its turn (`turn`: Pending::cpu_turn,
+  // null: none) and with its noise (null: none; one of them at least).
   const uint8_t* LevelsFor(const NoiseParams& noise);
-  void ConvertRows(int camera, bool lens, const uint8_t* pixels, const CpuNoise* noise,
-                   Image* image, int first_row, int end_row) const;
+  void ConvertRows(int camera, bool lens, const CpuTurn* turn, const uint8_t* pixels,
+                   const CpuNoise* noise, Image* image, int first_row, int end_row) const;
 
   EglContext context_;  // first: destroyed last
   scene::Scene scene_;
@@ -276,6 +281,7 @@ class GlRenderer final : public Renderer {
   double turn_blur_max_error_px_ = -1.0;  // RendererOptions::turn_blur*; < 0: off
   bool noise_on_cpu_ = false;             // RendererOptions::noise_on_cpu, resolved
   bool lens_on_cpu_ = false;              // RendererOptions::lens_on_cpu, resolved
+  bool turn_on_cpu_ = false;              // RendererOptions::turn_blur_on_cpu, resolved
   // NoiseLevels by (read sigma, gain), made as cameras need them.
   std::map<std::pair<float, float>, std::vector<uint8_t>> noise_levels_;
   std::vector<DrawItem> items_;

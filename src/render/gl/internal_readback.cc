@@ -59,26 +59,27 @@ std::vector<Frame> GlRenderer::Retrieve() {
     const std::size_t pixel_count =
         static_cast<std::size_t>(image->width()) * static_cast<std::size_t>(image->height());
     // One path for every camera: the effect target's colour buffers when effects run (its
-    // source view's when the CPU remaps the lens), else the plain target; a tightly packed
-    // RGB row is copied as it is.
+    // source view's when the CPU remaps the lens, its stretches' when the CPU fetches a turn),
+    // else the plain target; a tightly packed RGB row is copied as it is.
     const bool cpu_lens = pending.cpu_lens[i];
-    const PixelBuffers* effect_buffers =
-        !setup.effects
-            ? nullptr
-            : (cpu_lens ? &setup.effects->source_buffers() : &setup.effects->color_buffers());
+    const CpuTurn* cpu_turn = pending.cpu_turn[i] ? &*pending.cpu_turn[i] : nullptr;
+    const PixelBuffers* effect_buffers = !setup.effects ? nullptr
+                                         : cpu_turn     ? &setup.effects->stretch_buffers()
+                                         : cpu_lens     ? &setup.effects->source_buffers()
+                                                        : &setup.effects->color_buffers();
     const uint8_t* pixels = effect_buffers != nullptr ? MapOrThrow(*effect_buffers, slot, "")
                                                       : MapOrThrow(*targets_[i], slot, "");
     const int row_bytes = setup.effects ? 4 * image->width() : targets_[i]->row_bytes();
     const std::optional<NoiseParams>& noise = pending.cpu_noise[i];
-    if (cpu_lens || noise.has_value()) {
+    if (cpu_lens || cpu_turn != nullptr || noise.has_value()) {
       std::optional<CpuNoise> cpu_noise;
       if (noise.has_value()) {
         cpu_noise = CpuNoise{noise->key, noise->read_sigma_dn, noise->gain_dn_per_e,
                              PackedGaussianTable().data(), LevelsFor(*noise)};
       }
       const auto convert = [&](int first_row, int end_row) {
-        ConvertRows(static_cast<int>(i), cpu_lens, pixels, cpu_noise ? &*cpu_noise : nullptr,
-                    image.get(), first_row, end_row);
+        ConvertRows(static_cast<int>(i), cpu_lens, cpu_turn, pixels,
+                    cpu_noise ? &*cpu_noise : nullptr, image.get(), first_row, end_row);
       };
       // A large image in two halves at once: the fence above waited for every camera's
       // passes, so a software rasteriser's threads are idle while this runs (the bench
@@ -122,9 +123,23 @@ const uint8_t* GlRenderer::LevelsFor(const NoiseParams& noise) {
   return levels.data();
 }
 
-void GlRenderer::ConvertRows(int camera, bool lens, const uint8_t* pixels, const CpuNoise* noise,
-                             Image* image, int first_row, int end_row) const {
+void GlRenderer::ConvertRows(int camera, bool lens, const CpuTurn* turn, const uint8_t* pixels,
+                             const CpuNoise* noise, Image* image, int first_row,
+                             int end_row) const {
   const int width = image->width();
+  if (turn != nullptr) {
+    std::vector<uint8_t> row(4 * static_cast<std::size_t>(width));
+    for (int y = first_row; y < end_row; ++y) {
+      TurnBlurRow(*turn, pixels, width, image->height(), y, row.data());
+      uint8_t* out = image->data() + static_cast<std::size_t>(y) * image->stride();
+      if (noise != nullptr) {
+        RgbaRowToRgbWithNoise(row.data(), out, width, y, *noise);
+      } else {
+        RgbaToRgb(row.data(), out, static_cast<std::size_t>(width));
+      }
+    }
+    return;
+  }
   if (!lens) {
     RgbaToRgbWithNoise(pixels, image->data(), width, first_row, end_row, *noise);
     return;
