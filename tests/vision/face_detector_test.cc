@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <iostream>
+#include <opencv2/imgproc.hpp>
 #include <optional>
 #include <string>
 
@@ -254,6 +255,55 @@ TEST(FaceDetector, RejectsEveryCandidateOnTheCat) {
   }
   // The cat does fool the face cascade alone: otherwise this test would test nothing.
   EXPECT_GE(candidates_on_cat, 1);
+}
+
+// A colour image is converted to gray only where it is searched and checked (level 0, no
+// equalisation): the same faces, hit counts and verdicts as its whole gray image, which takes
+// the other path. Over the whole image and in a region around each face (so that the cat and
+// eye checks read boxes reaching past the region), on the astronaut and on the cat.
+TEST(FaceDetector, AColourImageGivesItsGrayImagesFacesAndVerdicts) {
+  const Eigen::Vector3d cat = PictureTexelToWorld("chelsea", 225, 150);
+  FaceDetector::Options options;
+  options.min_neighbors = 2;  // the cat passes the face cascade (RejectsEveryCandidateOnTheCat)
+  FaceDetector detector(options);
+  int compared = 0, rejected = 0;
+  for (const Eigen::Vector3d& target : {FaceCentreWorld("astronaut"), cat}) {
+    const StereoFrame frame = RenderFixating(target);
+    for (const Image* eye : {&frame.left, &frame.right}) {
+      const Image& colour = *eye;
+      ASSERT_EQ(colour.format(), PixelFormat::kRgb8);
+      Image gray(colour.width(), colour.height(), PixelFormat::kGray8);
+      const cv::Mat rgb(colour.height(), colour.width(), CV_8UC3,
+                        const_cast<uint8_t*>(colour.data()), colour.stride());
+      cv::Mat gray_mat(gray.height(), gray.width(), CV_8UC1, gray.data(), gray.stride());
+      cv::cvtColor(rgb, gray_mat, cv::COLOR_RGB2GRAY);
+      const auto same = [&](const FaceDetector::Search& search) {
+        const std::vector<FaceDetection> a = detector.Detect(colour, search);
+        const std::vector<FaceDetection> b = detector.Detect(gray, search);
+        ASSERT_EQ(a.size(), b.size());
+        for (std::size_t i = 0; i < a.size(); ++i) {
+          EXPECT_EQ(a[i].box, b[i].box) << i;
+          EXPECT_EQ(a[i].neighbors, b[i].neighbors) << i;
+          EXPECT_EQ(a[i].rejected, b[i].rejected) << i;
+          EXPECT_EQ(a[i].reason, b[i].reason) << i;
+          ++compared;
+          rejected += a[i].rejected ? 1 : 0;
+        }
+      };
+      FaceDetector::Search whole;
+      whole.regions = {cv::Rect(0, 0, colour.width(), colour.height())};
+      same(whole);
+      for (const FaceDetection& face : detector.Detect(gray)) {
+        FaceDetector::Search around;
+        around.regions = {cv::Rect(face.box.x - face.box.width / 4,
+                                   face.box.y - face.box.height / 4, face.box.width * 3 / 2,
+                                   face.box.height * 3 / 2)};
+        same(around);
+      }
+    }
+  }
+  EXPECT_GE(compared, 4);  // faces and the cat's candidates, whole and around
+  EXPECT_GE(rejected, 1);  // a verdict compared, not only boxes
 }
 
 TEST(FaceDetector, WithoutTheRejectionTheCatIsAcceptedAsAFace) {

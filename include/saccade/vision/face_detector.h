@@ -107,7 +107,10 @@ class FaceDetector {
   const Options& options() const { return options_; }
 
  private:
-  std::vector<FaceDetection> DetectIn(const cv::Mat& gray, const Search& search);
+  // `gray`: the whole image in gray; or, with `colour` (a colour image, no equalisation, level
+  // 0), empty, and only the rectangles searched and checked are converted from `colour`.
+  std::vector<FaceDetection> DetectIn(const cv::Mat& gray, const Search& search,
+                                      const cv::Mat* colour = nullptr);
 
   Options options_;
   cv::CascadeClassifier face_;
