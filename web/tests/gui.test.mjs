@@ -205,28 +205,35 @@ describe('saccade gui (portraits.yaml)', () => {
 
   test('the page loads, draws the world and shows both cameras', async () => {
     await waitReady(page);
-    // Both <img> hold a decoded frame (ready counts decoded frames; a newer one may be loading).
-    await page.waitForFunction(() => ['left', 'right'].every(
-      (n) => document.getElementById(`image-${n}`).naturalWidth > 0), null,
-    { timeout: kMoveTimeoutMs, polling: 100 });
-    // Both camera views: images of the cameras' size, not uniform.
-    const views = await page.evaluate(() => ['left', 'right'].map((name) => {
-      const img = document.getElementById(`image-${name}`);
-      const camera = window.saccadeGui.scene.cameras.find((c) => c.name === name);
-      const c = document.createElement('canvas');
-      c.width = 128; c.height = 96;
-      const ctx = c.getContext('2d');
-      ctx.drawImage(img, 0, 0, c.width, c.height);
-      const d = ctx.getImageData(0, 0, c.width, c.height).data;
-      let sum = 0, sum2 = 0, n = 0;
-      for (let i = 0; i < d.length; i += 4) {
-        const g = (d[i] + d[i + 1] + d[i + 2]) / 3;
-        sum += g; sum2 += g * g; n++;
+    // Both camera views: images of the cameras' size, not uniform. Both <img> must hold a
+    // decoded frame when they are read (ready counts decoded frames, and a newer frame may be
+    // loading, with no size, at any moment): the page waits for that and reads them in the same
+    // task, where no frame can come between the check and the reading.
+    const views = await page.evaluate(async (timeoutMs) => {
+      const decoded = () => ['left', 'right'].every(
+        (n) => document.getElementById(`image-${n}`).naturalWidth > 0);
+      const until = performance.now() + timeoutMs;
+      while (!decoded() && performance.now() < until) {
+        await new Promise((resolve) => setTimeout(resolve, 10));
       }
-      const mean = sum / n;
-      return { name, naturalWidth: img.naturalWidth, naturalHeight: img.naturalHeight,
-        width: camera.width, height: camera.height, std: Math.sqrt(sum2 / n - mean * mean) };
-    }));
+      return ['left', 'right'].map((name) => {
+        const img = document.getElementById(`image-${name}`);
+        const camera = window.saccadeGui.scene.cameras.find((c) => c.name === name);
+        const c = document.createElement('canvas');
+        c.width = 128; c.height = 96;
+        const ctx = c.getContext('2d');
+        ctx.drawImage(img, 0, 0, c.width, c.height);
+        const d = ctx.getImageData(0, 0, c.width, c.height).data;
+        let sum = 0, sum2 = 0, n = 0;
+        for (let i = 0; i < d.length; i += 4) {
+          const g = (d[i] + d[i + 1] + d[i + 2]) / 3;
+          sum += g; sum2 += g * g; n++;
+        }
+        const mean = sum / n;
+        return { name, naturalWidth: img.naturalWidth, naturalHeight: img.naturalHeight,
+          width: camera.width, height: camera.height, std: Math.sqrt(sum2 / n - mean * mean) };
+      });
+    }, kMoveTimeoutMs);
     for (const v of views) {
       assert.equal(v.naturalWidth, v.width, `${v.name}: image width`);
       assert.equal(v.naturalHeight, v.height, `${v.name}: image height`);
