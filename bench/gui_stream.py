@@ -11,6 +11,10 @@ Connects to the WebSocket (docs/gui-protocol.md) and measures, over --seconds:
   - from rest: --commands more, each sent a random 0.1-0.35 s after a state says the head
     arrived at the one before (at a random phase of the loop's step), timed until a state shows the new target and until a state shows the pan
     moving towards it (the step the command lands in, or the next);
+  - with --frame-ms MS: the client takes MS to finish with each frame (as a browser that
+    decodes and draws slower than the server renders); with --window W it asks for a frame
+    window of W (`frame_window`) and acknowledges each frame when done (`frame_ack`), which
+    bounds how many frames (and the states and replies behind them) wait for it;
   - with --slow-clients N (before the commands, which switch perception off): N more clients
     connect and never read; the loop's steps per second with them is reported next to the
     figure without them, and what the server held and skipped for them (/api/status).
@@ -103,6 +107,10 @@ def main():
     parser.add_argument("--seconds", type=float, default=20.0, help="how long to count frames")
     parser.add_argument("--commands", type=int, default=10, help="joints commands to time")
     parser.add_argument("--slow-clients", type=int, default=0, help="clients that never read")
+    parser.add_argument("--frame-ms", type=float, default=0.0,
+                        help="milliseconds this client spends on each frame (a slow page)")
+    parser.add_argument("--window", type=int, default=0,
+                        help="frames sent and not acknowledged at most (frame_window; 0: none)")
     parser.add_argument("--json", action="store_true")
     args = parser.parse_args()
     url = urllib.parse.urlparse(args.url)
@@ -120,6 +128,9 @@ def main():
         return next_id[0]
 
     frames, states, last_state = {}, 0, None
+    frames_done = [0]
+    if args.window:
+        command({"type": "frame_window", "frames": args.window})
     ping_ms, joints_ms, rest_ms, motion_ms = [], [], [], []
     pending_ping, pending_joint = {}, None  # id -> sent; (target, sent)
     # From rest: [target, sent, pan when sent, target shown, motion shown]
@@ -134,6 +145,11 @@ def main():
                 n = struct.unpack("<I", data[:4])[0]
                 camera = json.loads(data[4:4 + n])["camera"]
                 frames[camera] = frames.get(camera, 0) + 1
+                if args.frame_ms:
+                    time.sleep(args.frame_ms / 1e3)
+                frames_done[0] += 1
+                if args.window:
+                    command({"type": "frame_ack", "frames": frames_done[0]})
             elif op == 1:
                 m = json.loads(data)
                 if m["type"] == "state":
@@ -226,7 +242,7 @@ def main():
                                    "p95": percentile(rest_ms, 0.95), "n": len(rest_ms)},
             "joints_to_motion_ms": {"median": statistics.median(motion_ms) if motion_ms else None,
                                     "p95": percentile(motion_ms, 0.95), "n": len(motion_ms)}},
-        "slow": slow,
+        "slow": slow, "frame_ms": args.frame_ms, "window": args.window,
     }
     if args.json:
         print(json.dumps(result, indent=2))

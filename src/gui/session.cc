@@ -362,7 +362,7 @@ json GuiSession::Handle(const json& command, int64_t client) {
   }
   throw CommandError("unknown command type '" + type +
                      "' (joints, fixate, perception, effects, pause, resume, step, speed, stop, "
-                     "estop, clear, ping: docs/gui-protocol.md)");
+                     "estop, clear, ping, frame_window, frame_ack: docs/gui-protocol.md)");
 }
 
 json GuiSession::StateJson(const runtime::StepContext& context, const Latest& latest) {

@@ -48,6 +48,8 @@ inline constexpr std::size_t kHttpBodyLimit = 64 * 1024;        // GET/HEAD carr
 // connection with 1009 (message too big).
 inline constexpr std::size_t kHardMessageFactor = 16;
 inline constexpr const char* kServerName = "saccade";
+// The largest `frame_window` a client may ask for (frames sent and not acknowledged).
+inline constexpr int kMaxFrameWindow = 64;
 
 // Beast 1.74 speaks boost::string_view.
 inline std::string_view View(beast::string_view v) { return {v.data(), v.size()}; }
@@ -168,7 +170,9 @@ inline json StatsJson(const ClientStats& s) {
               {"messages_dropped", s.messages_dropped},
               {"commands", s.commands},
               {"errors", s.errors},
-              {"queued_bytes", s.queued_bytes}};
+              {"queued_bytes", s.queued_bytes},
+              {"frame_window", s.frame_window},
+              {"frames_acked", s.frames_acked}};
 }
 
 struct Document {
@@ -185,9 +189,6 @@ struct Frame {
 };
 
 using Text = std::shared_ptr<const std::string>;
-
-class WsSession;
-class HttpSession;
 
 class WsSession;
 class HttpSession;

@@ -1,6 +1,7 @@
 #pragma once
 // A WebSocket client of the GUI server: the handshake, commands read and answered, and the
-// writes of states, frames and texts, newest first, one in flight (gui_server.cc).
+// writes of states, frames and texts, newest first, one in flight, and no more frames
+// unacknowledged than the client's frame window (gui_server.cc, docs/gui-protocol.md).
 #include "server/internal_server_core.h"
 
 namespace saccade::server::internal_gui {
@@ -36,6 +37,13 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
   void OnRead(beast::error_code ec);
 
   void HandleCommand(std::string_view text);
+
+  // I/O thread: `frame_window` and `frame_ack`, which the session answers itself (the
+  // application's handler never sees them). Returns the reply's fields; throws CommandError.
+  json FlowCommand(const std::string& type, const json& command);
+
+  // A frame may be written now: no window, or fewer than it sent and not acknowledged.
+  bool FrameRoomLocked() const;
 
   void SendError(json id, const std::string& message);
 
@@ -75,6 +83,7 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
   std::string last_camera_;
   std::size_t queued_bytes_ = 0;  // texts_, state_, frames_ and the write in flight
   std::size_t in_flight_bytes_ = 0;
+  int64_t frames_written_ = 0;  // frames whose write began (what `frame_ack` counts against)
   bool open_ = false;
   bool closed_ = false;
   bool writing_ = false;

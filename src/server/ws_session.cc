@@ -180,18 +180,21 @@ void WsSession::HandleCommand(std::string_view text) {
   const int64_t id_value = parsed.id;
   last_id_ = id_value;
 
+  // The session answers flow control itself; everything else goes to the application.
+  const std::string& type = command.at("type").get_ref<const std::string&>();
+  const bool flow = type == "frame_window" || type == "frame_ack";
   CommandHandler handler;
-  {
+  if (!flow) {
     std::lock_guard lock(server_->config_mutex);
     handler = server_->handler;
   }
-  if (!handler) {
+  if (!flow && !handler) {
     SendError(id, "this server takes no commands (no command handler)");
     return;
   }
   json reply;
   try {
-    json result = handler(command, stats_.id);
+    json result = flow ? FlowCommand(type, command) : handler(command, stats_.id);
     if (result.is_object()) {
       reply = std::move(result);
     } else {
@@ -209,6 +212,46 @@ void WsSession::HandleCommand(std::string_view text) {
   reply["id"] = id_value;
   reply["ok"] = true;
   QueueOwnText(reply);
+}
+
+json WsSession::FlowCommand(const std::string& type, const json& command) {
+  const auto it = command.find("frames");
+  const bool integer = it != command.end() && it->is_number_integer() &&
+                       !(it->is_number_unsigned() && it->get<uint64_t>() > (uint64_t{1} << 62));
+  std::lock_guard lock(mutex_);
+  if (type == "frame_window") {
+    if (!integer || it->get<int64_t>() < 0 || it->get<int64_t>() > kMaxFrameWindow) {
+      throw CommandError("frame_window: 'frames' must be an integer from 0 (no window) to " +
+                         std::to_string(kMaxFrameWindow) + ", got " +
+                         (it == command.end() ? std::string("nothing") : it->dump()));
+    }
+    stats_.frame_window = it->get<int>();
+  } else {
+    if (!integer) {
+      throw CommandError(
+          "frame_ack: 'frames' must be an integer, the running total of frames this client "
+          "has finished with, got " +
+          (it == command.end() ? std::string("nothing") : it->dump()));
+    }
+    const int64_t total = it->get<int64_t>();
+    if (total < stats_.frames_acked) {
+      throw CommandError("frame_ack: 'frames' " + std::to_string(total) + " is fewer than the " +
+                         std::to_string(stats_.frames_acked) +
+                         " already acknowledged (it is a running total)");
+    }
+    if (total > frames_written_) {
+      throw CommandError("frame_ack: 'frames' " + std::to_string(total) + " is more than the " +
+                         std::to_string(frames_written_) + " frames sent to this client");
+    }
+    stats_.frames_acked = total;
+  }
+  return json{{"window", stats_.frame_window},
+              {"frames_sent", frames_written_},
+              {"frames_acked", stats_.frames_acked}};
+}
+
+bool WsSession::FrameRoomLocked() const {
+  return stats_.frame_window == 0 || frames_written_ - stats_.frames_acked < stats_.frame_window;
 }
 
 void WsSession::SendError(json id, const std::string& message) {
@@ -284,8 +327,9 @@ void WsSession::MaybeWrite() {
       out_text_ = std::move(state_);
       state_.reset();
       in_flight_bytes_ = out_text_->size();
-    } else if (!frames_.empty()) {
+    } else if (!frames_.empty() && FrameRoomLocked()) {
       kind = Kind::kFrame;
+      ++frames_written_;
       auto it = frames_.upper_bound(last_camera_);
       if (it == frames_.end()) it = frames_.begin();
       last_camera_ = it->first;

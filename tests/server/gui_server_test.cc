@@ -400,6 +400,8 @@ TEST(GuiServerHttpTest, StatusListsClients) {
   ASSERT_EQ(body.at("clients").size(), 1u);
   EXPECT_EQ(body["clients"][0]["peer"].get<std::string>().rfind("127.0.0.1:", 0), 0u);
   EXPECT_TRUE(body["clients"][0].contains("frames_skipped"));
+  EXPECT_EQ(body["clients"][0].value("frame_window", -1), 0);
+  EXPECT_EQ(body["clients"][0].value("frames_acked", -1), 0);
 }
 
 TEST(GuiServerHttpTest, WebSocketOnlyAtWs) {
@@ -929,6 +931,120 @@ TEST_F(ServerTest, TextQueueDropsOldestWhenFull) {
   ASSERT_EQ(stats.size(), 1u);
   EXPECT_GT(stats[0].messages_dropped, 0);
   EXPECT_LT(stats[0].queued_bytes, 6u * (filler.size() + 100));
+}
+
+// The next message that is a frame or an answer (states and events skipped): the frame's
+// header, or the reply/error.
+json NextFrameOrAnswer(WsClient& client) {
+  for (;;) {
+    const auto message = client.Read();
+    if (!message) return nullptr;
+    if (!message->text) {
+      json header;
+      std::string payload;
+      if (!ParseFrame(message->data, &header, &payload)) return nullptr;
+      return header;
+    }
+    json parsed = json::parse(message->data);
+    const std::string type = parsed.value("type", "");
+    if (type == "reply" || type == "error") return parsed;
+  }
+}
+
+void PublishFrames(GuiServer& server, const std::string& camera, int first, int last) {
+  const auto payload = std::make_shared<const std::string>(1000, camera[0]);
+  for (int i = first; i <= last; ++i) {
+    server.PublishFrame(camera, {{"type", "frame"}, {"camera", camera}, {"frame", i}}, payload);
+  }
+}
+
+TEST_F(ServerTest, AFrameWindowHoldsFramesUntilAcknowledgedThenSendsTheNewest) {
+  auto client = Connect();
+  client->SendJson({{"type", "frame_window"}, {"id", 1}, {"frames", 1}});
+  const json set = NextFrameOrAnswer(*client);
+  EXPECT_EQ(set.at("type"), "reply");
+  EXPECT_EQ(set.at("window"), 1);
+  EXPECT_EQ(set.at("frames_sent"), 0);
+  EXPECT_EQ(handled_, 0) << "flow control is the session's, not the application's";
+
+  PublishFrames(*server_, "left", 0, 0);
+  EXPECT_EQ(NextFrameOrAnswer(*client).value("frame", -1), 0);
+  // The window is full: newer frames wait, each camera's newest replacing the one before, and
+  // an answer overtakes them.
+  PublishFrames(*server_, "left", 1, 5);
+  PublishFrames(*server_, "right", 1, 2);
+  client->SendJson({{"type", "ping"}, {"id", 2}});
+  const json pong = NextFrameOrAnswer(*client);
+  EXPECT_EQ(pong.value("type", ""), "reply") << pong.dump();
+  EXPECT_EQ(pong.value("id", 0), 2);
+
+  // Each acknowledgement lets one more through: the newest of a camera.
+  client->SendJson({{"type", "frame_ack"}, {"id", 3}, {"frames", 1}});
+  const json ack = NextFrameOrAnswer(*client);
+  EXPECT_EQ(ack.value("type", ""), "reply") << ack.dump();
+  EXPECT_EQ(ack.value("frames_sent", -1), 1);
+  EXPECT_EQ(ack.value("frames_acked", -1), 1);
+  std::map<std::string, int> got;
+  const json first = NextFrameOrAnswer(*client);
+  got[first.value("camera", "")] = first.value("frame", -1);
+  client->SendJson({{"type", "frame_ack"}, {"id", 4}, {"frames", 2}});
+  EXPECT_EQ(NextFrameOrAnswer(*client).value("frames_sent", -1), 2);
+  const json second = NextFrameOrAnswer(*client);
+  got[second.value("camera", "")] = second.value("frame", -1);
+  EXPECT_EQ(got, (std::map<std::string, int>{{"left", 5}, {"right", 2}}));
+
+  const ClientStats stats = server_->clients().at(0);
+  EXPECT_EQ(stats.frame_window, 1);
+  EXPECT_EQ(stats.frames_acked, 2);
+  EXPECT_EQ(stats.frames_skipped, 5);  // left 1-4, right 1
+
+  // Window 0 turns it off: frames flow without acknowledgements.
+  client->SendJson({{"type", "frame_window"}, {"id", 5}, {"frames", 0}});
+  EXPECT_EQ(NextFrameOrAnswer(*client).value("window", -1), 0);
+  for (int i = 6; i < 9; ++i) {
+    PublishFrames(*server_, "left", i, i);
+    EXPECT_EQ(NextFrameOrAnswer(*client).value("frame", -1), i);
+  }
+}
+
+TEST_F(ServerTest, BadFlowCommandsAreErrorsThatNameTheFieldAndChangeNothing) {
+  auto client = Connect();
+  client->SendJson({{"type", "frame_window"}, {"id", 1}, {"frames", 2}});
+  ASSERT_EQ(NextFrameOrAnswer(*client).value("type", ""), "reply");
+  PublishFrames(*server_, "left", 0, 0);
+  ASSERT_EQ(NextFrameOrAnswer(*client).value("frame", -1), 0);
+
+  const std::vector<std::pair<json, std::string>> bad = {
+      {{{"type", "frame_window"}, {"frames", 65}}, "'frames' must be an integer from 0"},
+      {{{"type", "frame_window"}, {"frames", -1}}, "got -1"},
+      {{{"type", "frame_window"}, {"frames", "4"}}, "got \"4\""},
+      {{{"type", "frame_window"}}, "got nothing"},
+      {{{"type", "frame_ack"}, {"frames", 1.5}}, "running total"},
+      {{{"type", "frame_ack"}, {"frames", 2}}, "'frames' 2 is more than the 1 frames sent"},
+  };
+  int64_t id = 2;
+  for (const auto& [fields, expected] : bad) {
+    json command = fields;
+    command["id"] = id;
+    client->SendJson(command);
+    const json answer = NextFrameOrAnswer(*client);
+    EXPECT_EQ(answer.value("type", ""), "error") << command.dump();
+    EXPECT_EQ(answer.value("id", 0), id);
+    const std::string error = answer.value("error", "");
+    EXPECT_EQ(error.rfind(fields.at("type").get<std::string>() + ": ", 0), 0u) << error;
+    EXPECT_NE(error.find(expected), std::string::npos) << error;
+    ++id;
+  }
+  client->SendJson({{"type", "frame_ack"}, {"id", id++}, {"frames", 1}});
+  ASSERT_EQ(NextFrameOrAnswer(*client).value("frames_acked", -1), 1);
+  client->SendJson({{"type", "frame_ack"}, {"id", id++}, {"frames", 0}});
+  EXPECT_NE(NextFrameOrAnswer(*client).value("error", "").find("fewer than the 1 already"),
+            std::string::npos);
+
+  const ClientStats stats = server_->clients().at(0);
+  EXPECT_EQ(stats.frame_window, 2);
+  EXPECT_EQ(stats.frames_acked, 1);
+  EXPECT_EQ(handled_, 0);
 }
 
 TEST_F(ServerTest, ClientsBeyondMaxClientsGet503) {

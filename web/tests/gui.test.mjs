@@ -412,6 +412,19 @@ describe('saccade gui (portraits.yaml)', () => {
       `Chromium headless, SwiftShader, ${os.cpus().length} cores`;
     console.log(line);
     assert.ok(fps.left > 0 && fps.right > 0, line);
+
+    // Flow control: the page asked for a window of frames and acknowledges each frame it is
+    // done with, so the server never has more than the window of them unacknowledged.
+    const flow = await page.evaluate(async () => {
+      const response = await fetch('/api/status' + location.search);
+      const status = await response.json();
+      const me = status.clients.find((c) => c.id === window.saccadeGui.hello.client);
+      return { me, done: window.saccadeGui.framesDone };
+    });
+    assert.ok(flow.me, 'the page is among /api/status clients');
+    assert.equal(flow.me.frame_window, 4, JSON.stringify(flow.me));
+    assert.ok(flow.me.frames_acked > 0 && flow.me.frames_acked <= flow.done, JSON.stringify(flow));
+    assert.ok(flow.me.frames_sent - flow.me.frames_acked <= 4, JSON.stringify(flow.me));
   });
 });
 

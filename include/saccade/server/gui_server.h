@@ -85,6 +85,10 @@ struct ClientStats {
   int64_t commands = 0;          ///< commands received
   int64_t errors = 0;            ///< error replies sent
   std::size_t queued_bytes = 0;  ///< held for this client now
+  /// Flow control (docs/gui-protocol.md, `frame_window`): at most this many frames sent and
+  /// not yet acknowledged; 0 when the client asked for none (frames go as fast as it reads).
+  int frame_window = 0;
+  int64_t frames_acked = 0;  ///< the client's running total from `frame_ack`
 };
 
 /// Called for each well-formed command ({"type": ..., "id": ...}, a JSON object) on the I/O

@@ -21,6 +21,7 @@ const gui = window.saccadeGui = {
   hello: null,
   framesReceived: { left: 0, right: 0 },
   framesShown: { left: 0, right: 0 },
+  framesDone: 0,             // frames the page finished with (acknowledged: frame_ack)
   pageFps: { left: 0, right: 0 },
   lastClick: null,
   errors: [],
@@ -94,6 +95,15 @@ async function start() {
   app.controls = controls;
 
   const controlsPanel = new Controls(document.body, send, (d) => { head.setImageDistance(d); redraw(); });
+  // Flow control (docs/gui-protocol.md, frame_window): the server sends at most kFrameWindow
+  // frames that the page has not finished with (shown, failed or replaced), so that a page
+  // that draws slower than the server renders never lets frames, and the states and replies
+  // behind them, queue up in the socket and the browser.
+  const kFrameWindow = 4;
+  const frameDone = () => {
+    gui.framesDone++;
+    if (connection.open) connection.send('frame_ack', { frames: gui.framesDone });
+  };
   const views = {};
   for (const name of ['left', 'right']) {
     views[name] = new CameraView(images[name], $(`label-${name}`), name, (n) => {
@@ -101,7 +111,7 @@ async function start() {
       head.imageUpdated(n);
       redraw();
       maybeReady();
-    });
+    }, frameDone);
   }
 
   // Plots: joints, fixation error, rates, step time.
@@ -130,6 +140,7 @@ async function start() {
       gui.hello = m;
       $('connection').textContent = `connected · client ${m.client}`;
       $('connection').className = 'badge ok';
+      connection.send('frame_window', { frames: kFrameWindow });
     },
     onState: (state) => {
       latest = state;
@@ -151,7 +162,7 @@ async function start() {
       maybeReady();
     },
     onFrame: (header, blob) => {
-      if (!(header.camera in views)) return;  // world cameras: not shown
+      if (!(header.camera in views)) { frameDone(); return; }  // world cameras: not shown
       gui.framesReceived[header.camera]++;
       views[header.camera].frame(header, blob);
     },

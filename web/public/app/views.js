@@ -4,14 +4,16 @@
 /**
  * One camera's live image: the newest JPEG decoded into an <img> through a Blob URL (the
  * previous URL revoked once the next image has loaded). A frame that arrives while one is
- * decoding waits; a newer one replaces it (only the newest is shown).
+ * decoding waits; a newer one replaces it (only the newest is shown). `onDone()` is called
+ * once for every frame the view is finished with: shown, failed or replaced while waiting.
  */
 export class CameraView {
-  constructor(image, label, name, onImage) {
+  constructor(image, label, name, onImage, onDone) {
     this.image = image;
     this.label = label;
     this.name = name;
     this.onImage = onImage;
+    this.onDone = onDone;
     this.url = null;
     this.decoding = false;
     this.waiting = null;       // [header, blob]
@@ -24,7 +26,11 @@ export class CameraView {
 
   frame(header, blob) {
     this.received++;
-    if (this.decoding) { this.waiting = [header, blob]; return; }
+    if (this.decoding) {
+      if (this.waiting) this.onDone?.();  // replaced: never shown
+      this.waiting = [header, blob];
+      return;
+    }
     this.show(header, blob);
   }
 
@@ -50,6 +56,7 @@ export class CameraView {
     } else {
       this.failed++;
     }
+    this.onDone?.();
     if (this.waiting) {
       const [header, blob] = this.waiting;
       this.waiting = null;
