@@ -99,7 +99,9 @@ async function start() {
   // frames that the page has not finished with (shown, failed or replaced), so that a page
   // that draws slower than the server renders never lets frames, and the states and replies
   // behind them, queue up in the socket and the browser.
-  const kFrameWindow = 4;
+  // The page's address may set another (?frame_window=N, 0 .. 64; 0: none).
+  const asked = new URLSearchParams(location.search).get('frame_window');
+  const kFrameWindow = asked !== null && /^\d+$/.test(asked) && Number(asked) <= 64 ? Number(asked) : 4;
   const frameDone = () => {
     gui.framesDone++;
     if (connection.open) connection.send('frame_ack', { frames: gui.framesDone });
