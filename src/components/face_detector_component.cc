@@ -118,6 +118,12 @@ FaceDetectorComponent::FaceDetectorComponent()
                "searches, then is checked again; a new target forgets them all (1: check every "
                "face every time)")
       .Range(1, 1000000);
+  DeclareParam("keep_target_verdict", &keep_target_verdict_,
+               "with a selection input: on a new target's first new_target_scans searches, the "
+               "face found where the selection puts it (a third of their union) keeps the "
+               "verdict that made it the target (attention chooses only faces both eyes "
+               "accepted) instead of running the cat and eye cascades while the head turns to "
+               "it; it is checked again like any face (recheck_every, recheck_phase)");
   DeclareParam("recheck_phase", &recheck_phase_,
                "with recheck_every: a face checked for the first time keeps its verdict N "
                "searches fewer before its first check again (the two eyes' detectors at phases "
@@ -251,9 +257,20 @@ void FaceDetectorComponent::AroundTrack(const Image& image, int64_t n, Search* o
   if (tracking && whole_scans_left_ > 0) {
     --whole_scans_left_;
     cv::Size face;
-    search.predicted = PredictedRegion(image, track.target_id, &face);
+    cv::Rect face_box;
+    search.predicted = PredictedRegion(image, track.target_id, &face, &face_box);
     if (search.predicted) {
       SizesAround(face, &search);
+      if (keep_target_verdict_ && face_box.area() > 0) {
+        // Attention chooses only faces that both eyes accepted: the face where the selection
+        // puts the target keeps that verdict while the head turns to it (faces move by up to
+        // half their side between frames then, hence a third of their union, as revisits).
+        vision::FaceDetection target;
+        target.box = face_box;
+        search.checked.push_back(target);
+        search.checked_reuses.push_back(recheck_phase_);  // as if checked for the first time
+        search.verdict_overlap = kRevisitVerdictOverlap;
+      }
     } else {
       search.whole = true;
     }
@@ -275,7 +292,8 @@ void FaceDetectorComponent::SizesAround(const cv::Size& face, Search* search) co
 }
 
 std::optional<cv::Rect> FaceDetectorComponent::PredictedRegion(const Image& image,
-                                                               int64_t target_id, cv::Size* face) {
+                                                               int64_t target_id, cv::Size* face,
+                                                               cv::Rect* face_box) {
   if (!selection_.has_value()) return std::nullopt;
   const SelectionMessage& selection = selection_.value();
   if (!selection.valid || selection.exploring || selection.target_id != target_id) {
@@ -298,6 +316,7 @@ std::optional<cv::Rect> FaceDetectorComponent::PredictedRegion(const Image& imag
   const cv::Rect region = BoxAround(at->x(), at->y(), target_size_, track_region_scale_, image);
   if (region.area() <= 0) return std::nullopt;
   *face = target_size_;
+  if (face_box != nullptr) *face_box = BoxAround(at->x(), at->y(), target_size_, 1.0, image);
   return region;
 }
 
@@ -397,6 +416,7 @@ std::vector<vision::FaceDetection> FaceDetectorComponent::Find(const Image& imag
     around.min_size_px = search.min_size_px;
     around.max_size_px = search.max_size_px;
     around.checked = search.checked;
+    around.verdict_overlap = search.verdict_overlap;
     near = region_detector_->Detect(image, around);
   }
   return Merge(std::move(found), near);

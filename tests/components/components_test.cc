@@ -552,6 +552,69 @@ TEST(FaceDetectorComponent, SearchesANewTargetWhereTheSelectionPutsIt) {
   EXPECT_FALSE(detect(2, std::nullopt));  // then around the track only
 }
 
+// A new target keeps the verdict that made it a target (attention chooses only faces that both
+// eyes accepted) while the head turns to it: the face found where the selection puts it takes
+// that verdict instead of the cat and eye cascades', and is checked again like any face
+// (recheck_every). Shown on a box the cascades reject, as if attention had chosen it.
+TEST(FaceDetectorComponent, ANewTargetKeepsItsVerdictUntilItsRecheck) {
+  const std::shared_ptr<const Image> image = LeftEyeOnTheAstronaut();
+  ASSERT_TRUE(image);
+  // Every hit of the face cascade a box (no grouping): boxes on the cat and elsewhere too,
+  // which the cat and eye checks reject.
+  const json hits = {{"min_neighbors", 0}};
+  const geometry::Pose X_WC = vision::CameraPoseOf(*image);
+  // Per detection of a new target on `box`: 1 accepted, 0 rejected, -1 not found.
+  const auto run = [&](const cv::Rect& box, bool keep) {
+    // A point on the box's centre ray (any depth projects there).
+    const Eigen::Vector2d centre(box.x + 0.5 * box.width, box.y + 0.5 * box.height);
+    const std::optional<Eigen::Vector3d> ray = vision::CameraModelOf(*image).Unproject(centre);
+    EXPECT_TRUE(ray);
+    const Eigen::Vector3d p_W = X_WC * (ray.value_or(Eigen::Vector3d::UnitZ()) * 2.0);
+    json params = hits;
+    params.update({{"track_region_scale", 2.0},
+                   {"full_scan_every", 1000},
+                   {"new_target_scans", 3},
+                   {"recheck_every", 4},
+                   {"keep_target_verdict", keep}});
+    auto detector = Make("vision.face_detector", params);
+    auto faces = Capture<FacesMessage>(*detector, "faces");
+    std::vector<int> verdicts;
+    for (int64_t step = 1; step <= 8; ++step) {  // step 0 would search the whole image
+      TrackMessage track;
+      track.tracking = true;
+      track.target_id = 7;
+      track.window = box;
+      track.center = {centre.x(), centre.y()};
+      In<TrackMessage>(*detector, "track").Deliver(track);
+      SelectionMessage selection;
+      selection.valid = true;
+      selection.target_id = 7;
+      selection.p_W = p_W;
+      selection.boxes_fresh = true;
+      selection.left_box = selection.right_box = box;
+      In<SelectionMessage>(*detector, "selection").Deliver(selection);
+      In<runtime::ImageMessage>(*detector, "image").Deliver(runtime::ImageMessage{image});
+      detector->Step(At(step));
+      int verdict = -1;
+      for (const FacesMessage::Face& f : (*faces)->faces) {
+        if ((f.box & box).area() > 0.5 * box.area()) verdict = f.rejected ? 0 : 1;
+      }
+      verdicts.push_back(verdict);
+    }
+    return verdicts;
+  };
+  // A box the cascades reject on every search around it, as if attention had chosen it.
+  const std::vector<int> every_time_rejected(8, 0);
+  std::optional<cv::Rect> rejected;
+  for (const FacesMessage::Face& f : DetectWhole(image, hits).faces) {
+    if (f.rejected && !rejected && run(f.box, false) == every_time_rejected) rejected = f.box;
+  }
+  ASSERT_TRUE(rejected) << "no box that the searches around it find and reject";
+  // Kept: the target's verdict serves recheck_every - 1 = 3 searches, as a face's own verdict
+  // does, then the face is checked and rejected.
+  EXPECT_EQ(run(*rejected, true), (std::vector<int>{1, 1, 1, 0, 0, 0, 0, 0}));
+}
+
 // Around a tracked face the detector searches only sizes near the track window's and, between
 // the rechecks, keeps the face's verdict instead of running the cat and eye cascades again
 // (FaceDetector's own tests show both): on the same frames it gives the same faces as checking
@@ -1024,8 +1087,9 @@ TEST(ComponentParams, UnknownMissingAndOutOfRangeParametersAreNamed) {
   };
   EXPECT_EQ(message("vision.face_detector", {{"min_neighbours", 3}}),
             "unknown parameter 'min_neighbours' (known: cascade, discovery_latency_steps, "
-            "discovery_pyramid_level, discovery_scale_factor, full_scan_every, latency_steps, "
-            "max_size_px, min_neighbors, min_size_px, new_target_scans, partner_max_depth_m, "
+            "discovery_pyramid_level, discovery_scale_factor, full_scan_every, "
+            "keep_target_verdict, latency_steps, max_size_px, min_neighbors, min_size_px, "
+            "new_target_scans, partner_max_depth_m, "
             "partner_min_depth_m, pyramid_level, realtime_thread, recheck_every, "
             "recheck_phase, region_pyramid_level, region_size_factor, reject_cats, "
             "require_eyes, scale_factor, track_region_scale)");

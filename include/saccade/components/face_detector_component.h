@@ -108,6 +108,9 @@ class FaceDetectorComponent : public runtime::Component {
     int max_size_px = 0;
     std::vector<vision::FaceDetection> checked;  // verdicts to reuse (recheck_every)
     std::vector<int> checked_reuses;             // how often each was reused in a row
+    // The overlap (of the union) at which the region's search takes a checked verdict: lower
+    // on a new target's scans, where the target's own verdict is among them.
+    double verdict_overlap = vision::FaceDetector::kVerdictOverlap;
   };
   // options_ with the cascades the parameters choose.
   vision::FaceDetector::Options DetectorOptions() const;
@@ -122,8 +125,9 @@ class FaceDetectorComponent : public runtime::Component {
   void SizesAround(const cv::Size& face, Search* search) const;
   // A box track_region_scale times the target's size around where the selection's point
   // projects in `image` (the size in `face`); none without a selection of that target, a
-  // known size, or a camera.
-  std::optional<cv::Rect> PredictedRegion(const Image& image, int64_t target_id, cv::Size* face);
+  // known size, or a camera. `face_box`, when given: the target's own box there.
+  std::optional<cv::Rect> PredictedRegion(const Image& image, int64_t target_id, cv::Size* face,
+                                          cv::Rect* face_box = nullptr);
   // The partner's faces' epipolar bands in `image` (their rays from the other eye between
   // partner_min_depth_m and partner_max_depth_m, projected, each widened as a track region is);
   // none when the partner's faces are not of an image captured with this one or a camera is
@@ -164,6 +168,7 @@ class FaceDetectorComponent : public runtime::Component {
   int full_scan_every_ = 20;
   int region_pyramid_level_ = 0;
   int new_target_scans_ = 5;
+  bool keep_target_verdict_ = true;
   double region_size_factor_ = 1.5;
   int recheck_every_ = 10;
   int recheck_phase_ = 0;
