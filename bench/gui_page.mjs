@@ -56,7 +56,11 @@ const url = await new Promise((resolve, reject) => {
     const m = out.match(/^gui: .*?(http:\/\/\S+)/m);
     if (m) { server.stdout.resume(); resolve(m[1]); }
   });
+  server.on('error', (e) => reject(new Error(`gui_page: cannot run ${args.binary}: ${e.message}`)));
   server.on('exit', (code) => reject(new Error(`gui_page: saccade gui exited (${code}) before serving`)));
+}).catch((e) => {
+  console.error(e.message);
+  process.exit(1);
 });
 
 const browser = await chromium.launch({
