@@ -5,6 +5,8 @@
 //   - the frames per second each camera view showed;
 //   - the round trip of `ping` sent from the page (median, max): what a command waits for,
 //     behind whatever the page has not yet handled;
+//   - the page's long tasks (over 50 ms of its main thread): how many a second, their share of
+//     the time and the longest: what a click or a key waits for;
 //   - what the server sent, skipped and had acknowledged for the page (/api/status).
 //
 //   node bench/gui_page.mjs [--throttle 4] [--seconds 10] [--pings 10] [--window N]
@@ -77,9 +79,18 @@ try {
   const cdp = await page.context().newCDPSession(page);
   await cdp.send('Emulation.setCPUThrottlingRate', { rate: throttle });
   console.error(`gui_page: page ready; CPU slowed down ${throttle} x, counting frames for ${seconds} s...`);
+  // The page's long tasks (over 50 ms of its main thread, the Long Tasks API): what a click
+  // or a key waits for behind them.
+  await page.evaluate(() => {
+    window.benchLongTasks = [];
+    new PerformanceObserver((list) => {
+      for (const entry of list.getEntries()) window.benchLongTasks.push(entry.duration);
+    }).observe({ type: 'longtask' });
+  });
   const shown0 = await page.evaluate(() => ({ ...window.saccadeGui.framesShown }));
   await page.waitForTimeout(seconds * 1000);
   const shown1 = await page.evaluate(() => ({ ...window.saccadeGui.framesShown }));
+  const longTasks = (await page.evaluate(() => window.benchLongTasks.splice(0))).sort((a, b) => a - b);
   const roundTrips = [];
   for (let i = 0; i < pings; i++) {
     roundTrips.push(await page.evaluate(async () => {
@@ -98,6 +109,11 @@ try {
     throttle, seconds,
     shown_per_s: { left: (shown1.left - shown0.left) / seconds, right: (shown1.right - shown0.right) / seconds },
     ping_ms: { median: roundTrips[Math.floor(roundTrips.length / 2)], max: roundTrips[roundTrips.length - 1] },
+    long_tasks: {
+      per_s: longTasks.length / seconds,
+      busy_share: longTasks.reduce((a, b) => a + b, 0) / (seconds * 1000),
+      max_ms: longTasks.length ? longTasks[longTasks.length - 1] : 0,
+    },
     server: { frames_sent: me.frames_sent, frames_skipped: me.frames_skipped, frame_window: me.frame_window,
       frames_acked: me.frames_acked },
   };
@@ -106,7 +122,9 @@ try {
   } else {
     console.log(`page slowed down ${throttle} x: shown ${result.shown_per_s.left.toFixed(1)} / ` +
       `${result.shown_per_s.right.toFixed(1)} frames/s (left / right); ping round trip median ` +
-      `${result.ping_ms.median.toFixed(1)} ms, max ${result.ping_ms.max.toFixed(1)}; server: ` +
+      `${result.ping_ms.median.toFixed(1)} ms, max ${result.ping_ms.max.toFixed(1)}; long tasks ` +
+      `${result.long_tasks.per_s.toFixed(1)}/s, ${(100 * result.long_tasks.busy_share).toFixed(0)} % of the ` +
+      `time, longest ${result.long_tasks.max_ms.toFixed(0)} ms; server: ` +
       `${me.frames_sent} frames sent, ${me.frames_skipped} skipped, window ${me.frame_window}, ` +
       `${me.frames_acked} acknowledged`);
   }

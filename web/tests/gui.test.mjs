@@ -38,6 +38,7 @@ const kWorldPixelTolerance = 40;
 const kWorldInlierFraction = 0.9;
 const kDragPx = 100;
 const kDragAngleToleranceDeg = 4;  // the mouse lands on whole pixels; the throttle sends the last
+const kImagePlaneTolerance = 3;   // mean grey difference (of 255), image plane against the view
 const kImageChangeThreshold = 8;   // mean absolute grey difference (of 255) after a 50 deg pan
 const kFixationToleranceDeg = 1.0; // each optical axis to the clicked point
 
@@ -253,6 +254,48 @@ describe('saccade gui (portraits.yaml)', () => {
       window.saccadeGui.setView([-1.5, -0.7, 2.1], [1.0, 0.0, 1.0]);
     });
     assert.ok(shown.left > 0 && shown.right > 0);
+    // Each image plane in the world holds its camera view's picture, the right way up: both
+    // scaled to 128 x 96, the mean grey difference is small, and far smaller than against the
+    // picture upside down.
+    const planes = await page.evaluate(async (timeoutMs) => {
+      const settled = () => ['left', 'right'].every((n) => {
+        const img = document.getElementById(`image-${n}`);
+        const plane = window.saccadeGui.imagePlane(n);
+        return img.complete && img.naturalWidth > 0 && plane?.visible && plane.pending === 0;
+      });
+      const until = performance.now() + timeoutMs;
+      while (!settled() && performance.now() < until) {
+        await new Promise((resolve) => setTimeout(resolve, 10));
+      }
+      const grey = (source, flip) => {
+        const c = document.createElement('canvas');
+        c.width = 128; c.height = 96;
+        const ctx = c.getContext('2d');
+        if (flip) ctx.setTransform(1, 0, 0, -1, 0, c.height);
+        ctx.drawImage(source, 0, 0, c.width, c.height);
+        const d = ctx.getImageData(0, 0, c.width, c.height).data;
+        const g = new Float32Array(c.width * c.height);
+        for (let i = 0; i < g.length; i++) g[i] = (d[4 * i] + d[4 * i + 1] + d[4 * i + 2]) / 3;
+        return g;
+      };
+      const meanDiff = (a, b) => a.reduce((sum, v, i) => sum + Math.abs(v - b[i]), 0) / a.length;
+      return ['left', 'right'].map((name) => {
+        const plane = window.saccadeGui.imagePlane(name);
+        const view = grey(document.getElementById(`image-${name}`), false);
+        const flipped = grey(document.getElementById(`image-${name}`), true);
+        const shownInWorld = grey(plane.canvas, false);
+        return { name, settled: settled(), same: meanDiff(shownInWorld, view),
+          upsideDown: meanDiff(shownInWorld, flipped) };
+      });
+    }, kMoveTimeoutMs);
+    for (const p of planes) {
+      const line = `${p.name} image plane against its camera view: mean grey difference ` +
+        `${p.same.toFixed(2)} (against the view upside down ${p.upsideDown.toFixed(2)})`;
+      console.log(line);
+      assert.ok(p.settled, `${p.name}: the image plane never showed the view's picture`);
+      assert.ok(p.same < kImagePlaneTolerance, line);
+      assert.ok(p.upsideDown > 4 * p.same, line);
+    }
     const actual = await page.locator('#world-canvas').screenshot();
     const actualPath = path.join(kOutput, 'world.actual.png');
     fs.writeFileSync(actualPath, actual);

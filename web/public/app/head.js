@@ -40,17 +40,23 @@ function setLine(l, a, b) {
 
 /** One eye camera: frustum lines and the image plane, in the camera's optical frame. */
 class CameraRig {
-  constructor(camera, image) {
+  constructor(camera) {
     this.camera = camera;  // /api/scene.cameras entry
-    this.image = image;    // the camera view's <img>, copied at each new picture
     this.group = new THREE.Group();
     this.group.matrixAutoUpdate = false;
     this.group.name = `camera:${camera.name}`;
     // A half-size copy of the live image: the <img> may already load the next picture when
-    // the world is drawn, and a smaller texture uploads faster.
+    // the world is drawn, and a smaller texture uploads faster. The copy is decoded and scaled
+    // from the frame's JPEG off the page's main thread (createImageBitmap), and the canvas is
+    // a CPU one (willReadFrequently): a GPU canvas made the page wait for the GPU process at
+    // every copy (seconds at a time with a software GPU: bench/gui_page.mjs).
     this.canvas = document.createElement('canvas');
     this.canvas.width = Math.max(1, Math.round(camera.width / 2));
     this.canvas.height = Math.max(1, Math.round(camera.height / 2));
+    this.context = this.canvas.getContext('2d', { willReadFrequently: true });
+    this.requested = 0;  // pictures asked for
+    this.settled = 0;    // of them, drawn, dropped or failed
+    this.drawn = 0;      // the newest of them drawn
     this.texture = new THREE.CanvasTexture(this.canvas);
     this.texture.colorSpace = THREE.NoColorSpace;
     this.texture.minFilter = THREE.LinearFilter;
@@ -107,18 +113,31 @@ class CameraRig {
     this.group.matrixWorldNeedsUpdate = true;
   }
 
-  /** The image element has a new picture. */
-  imageUpdated() {
-    if (!this.image.complete || !this.image.naturalWidth) return;
-    this.canvas.getContext('2d').drawImage(this.image, 0, 0, this.canvas.width, this.canvas.height);
-    this.texture.needsUpdate = true;
-    this.plane.visible = true;
+  /**
+   * The camera view shows a new picture, `blob` its JPEG: the image plane takes it once it is
+   * decoded, and calls `onDrawn()`. A picture decoded after a newer one is dropped; one that
+   * does not decode leaves the plane as it was.
+   */
+  imageUpdated(blob, onDrawn) {
+    const picture = ++this.requested;
+    createImageBitmap(blob, {
+      resizeWidth: this.canvas.width, resizeHeight: this.canvas.height, resizeQuality: 'medium',
+    }).then((bitmap) => {
+      if (picture > this.drawn) {
+        this.drawn = picture;
+        this.context.drawImage(bitmap, 0, 0);
+        this.texture.needsUpdate = true;
+        this.plane.visible = true;
+        onDrawn?.();
+      }
+      bitmap.close();
+    }, () => {}).finally(() => { this.settled++; });
   }
 }
 
 /**
- * The robot and the cameras' drawings. `views` maps camera name -> image element (the live
- * image, shared with the camera views).
+ * The robot and the cameras' drawings. `images` maps camera name -> the camera view's image
+ * element: the cameras with a view get a frustum and an image plane.
  */
 export class Head {
   constructor(scene, doc, models, images) {
@@ -149,7 +168,7 @@ export class Head {
     this.rigs = new Map();
     for (const camera of doc.cameras ?? []) {
       if (!images[camera.name]) continue;
-      const rig = new CameraRig(camera, images[camera.name]);
+      const rig = new CameraRig(camera);
       this.rigs.set(camera.name, rig);
       rig.group.visible = false;
       scene.add(rig.group);
@@ -205,8 +224,18 @@ export class Head {
     for (const rig of this.rigs.values()) rig.setDistance(d);
   }
 
-  imageUpdated(camera) {
-    this.rigs.get(camera)?.imageUpdated();
+  /**
+   * Camera `camera`'s image plane (a test hook): its canvas, whether it is shown and how many
+   * pictures are still being decoded for it.
+   */
+  imagePlane(camera) {
+    const rig = this.rigs.get(camera);
+    return rig && { canvas: rig.canvas, visible: rig.plane.visible, pending: rig.requested - rig.settled };
+  }
+
+  /** Camera `camera`'s view shows a new picture (`blob`: its JPEG); see CameraRig. */
+  imageUpdated(camera, blob, onDrawn) {
+    this.rigs.get(camera)?.imageUpdated(blob, onDrawn);
   }
 
   showClick(p) {

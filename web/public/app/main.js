@@ -108,10 +108,9 @@ async function start() {
   };
   const views = {};
   for (const name of ['left', 'right']) {
-    views[name] = new CameraView(images[name], $(`label-${name}`), name, (n) => {
+    views[name] = new CameraView(images[name], $(`label-${name}`), name, (n, blob) => {
       gui.framesShown[n]++;
-      head.imageUpdated(n);
-      redraw();
+      head.imageUpdated(n, blob, redraw);
       maybeReady();
     }, frameDone);
   }
@@ -293,6 +292,7 @@ async function start() {
     render();
   };
   gui.send = (type, fields) => send(type, fields);
+  gui.imagePlane = (name) => head.imagePlane(name);
   gui.render = render;
   gui.setImageDistance = (d) => {
     const slider = $('plane-distance');

@@ -27,7 +27,9 @@ export class Plot {
       c.width = Math.round(w * dpr);
       c.height = Math.round(h * dpr);
     }
-    const ctx = c.getContext('2d');
+    // A CPU canvas: a GPU one makes the page wait for the GPU process at each drawing (with a
+    // software GPU, for hundreds of ms: bench/gui_page.mjs).
+    const ctx = c.getContext('2d', { willReadFrequently: true });
     ctx.setTransform(dpr, 0, 0, dpr, 0, 0);
     ctx.clearRect(0, 0, w, h);
     const top = 30, bottom = h - 4, left = 34, right = w - 4;

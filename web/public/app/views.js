@@ -4,8 +4,9 @@
 /**
  * One camera's live image: the newest JPEG decoded into an <img> through a Blob URL (the
  * previous URL revoked once the next image has loaded). A frame that arrives while one is
- * decoding waits; a newer one replaces it (only the newest is shown). `onDone()` is called
- * once for every frame the view is finished with: shown, failed or replaced while waiting.
+ * decoding waits; a newer one replaces it (only the newest is shown). `onImage(name, blob)` is
+ * called for every frame shown, `onDone()` once for every frame the view is finished with:
+ * shown, failed or replaced while waiting.
  */
 export class CameraView {
   constructor(image, label, name, onImage, onDone) {
@@ -37,6 +38,7 @@ export class CameraView {
   show(header, blob) {
     this.decoding = true;
     this.header = header;
+    this.blob = blob;
     this.previousUrl = this.url;
     this.url = URL.createObjectURL(blob);
     this.image.src = this.url;
@@ -52,7 +54,7 @@ export class CameraView {
       this.shown++;
       const h = this.header;
       this.label.textContent = `${this.name} camera · ${h.width}×${h.height} · frame ${h.frame} · t ${Number(h.time).toFixed(2)} s`;
-      this.onImage?.(this.name);
+      this.onImage?.(this.name, this.blob);
     } else {
       this.failed++;
     }
