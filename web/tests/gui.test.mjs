@@ -130,11 +130,11 @@ async function moveHead(page, joints) {
 /** A grey 256 x 192 copy of a camera view's current image, as a plain array. */
 function grabGrey(page, camera) {
   return page.evaluate((name) => {
-    const img = document.getElementById(`image-${name}`);
+    const view = document.getElementById(`image-${name}`);
     const c = document.createElement('canvas');
     c.width = 256; c.height = 192;
     const ctx = c.getContext('2d');
-    ctx.drawImage(img, 0, 0, c.width, c.height);
+    ctx.drawImage(view, 0, 0, c.width, c.height);
     const d = ctx.getImageData(0, 0, c.width, c.height).data;
     const grey = [];
     for (let i = 0; i < d.length; i += 4) grey.push((d[i] + d[i + 1] + d[i + 2]) / 3);
@@ -206,24 +206,22 @@ describe('saccade gui (portraits.yaml)', () => {
 
   test('the page loads, draws the world and shows both cameras', async () => {
     await waitReady(page);
-    // Both camera views: images of the cameras' size, not uniform. Both <img> must hold a
-    // decoded frame when they are read (ready counts decoded frames, and a newer frame may be
-    // loading, with no size, at any moment): the page waits for that and reads them in the same
-    // task, where no frame can come between the check and the reading.
+    // Both camera views: images of the cameras' size, not uniform. Both views' canvases must
+    // hold a picture when they are read (0 x 0 until the first): the page waits for that.
     const views = await page.evaluate(async (timeoutMs) => {
       const decoded = () => ['left', 'right'].every(
-        (n) => document.getElementById(`image-${n}`).naturalWidth > 0);
+        (n) => document.getElementById(`image-${n}`).width > 0);
       const until = performance.now() + timeoutMs;
       while (!decoded() && performance.now() < until) {
         await new Promise((resolve) => setTimeout(resolve, 10));
       }
       return ['left', 'right'].map((name) => {
-        const img = document.getElementById(`image-${name}`);
+        const view = document.getElementById(`image-${name}`);
         const camera = window.saccadeGui.scene.cameras.find((c) => c.name === name);
         const c = document.createElement('canvas');
         c.width = 128; c.height = 96;
         const ctx = c.getContext('2d');
-        ctx.drawImage(img, 0, 0, c.width, c.height);
+        ctx.drawImage(view, 0, 0, c.width, c.height);
         const d = ctx.getImageData(0, 0, c.width, c.height).data;
         let sum = 0, sum2 = 0, n = 0;
         for (let i = 0; i < d.length; i += 4) {
@@ -231,13 +229,13 @@ describe('saccade gui (portraits.yaml)', () => {
           sum += g; sum2 += g * g; n++;
         }
         const mean = sum / n;
-        return { name, naturalWidth: img.naturalWidth, naturalHeight: img.naturalHeight,
+        return { name, imageWidth: view.width, imageHeight: view.height,
           width: camera.width, height: camera.height, std: Math.sqrt(sum2 / n - mean * mean) };
       });
     }, kMoveTimeoutMs);
     for (const v of views) {
-      assert.equal(v.naturalWidth, v.width, `${v.name}: image width`);
-      assert.equal(v.naturalHeight, v.height, `${v.name}: image height`);
+      assert.equal(v.imageWidth, v.width, `${v.name}: image width`);
+      assert.equal(v.imageHeight, v.height, `${v.name}: image height`);
       assert.ok(v.std > 10, `${v.name}: the image is uniform (grey standard deviation ${v.std.toFixed(1)})`);
     }
 
@@ -258,11 +256,8 @@ describe('saccade gui (portraits.yaml)', () => {
     // scaled to 128 x 96, the mean grey difference is small, and far smaller than against the
     // picture upside down.
     const planes = await page.evaluate(async (timeoutMs) => {
-      const settled = () => ['left', 'right'].every((n) => {
-        const img = document.getElementById(`image-${n}`);
-        const plane = window.saccadeGui.imagePlane(n);
-        return img.complete && img.naturalWidth > 0 && plane?.visible && plane.pending === 0;
-      });
+      const settled = () => ['left', 'right'].every(
+        (n) => document.getElementById(`image-${n}`).width > 0 && window.saccadeGui.imagePlane(n)?.visible);
       const until = performance.now() + timeoutMs;
       while (!settled() && performance.now() < until) {
         await new Promise((resolve) => setTimeout(resolve, 10));

@@ -45,18 +45,13 @@ class CameraRig {
     this.group = new THREE.Group();
     this.group.matrixAutoUpdate = false;
     this.group.name = `camera:${camera.name}`;
-    // A half-size copy of the live image: the <img> may already load the next picture when
-    // the world is drawn, and a smaller texture uploads faster. The copy is decoded and scaled
-    // from the frame's JPEG off the page's main thread (createImageBitmap), and the canvas is
-    // a CPU one (willReadFrequently): a GPU canvas made the page wait for the GPU process at
-    // every copy (seconds at a time with a software GPU: bench/gui_page.mjs).
+    // A half-size copy of the live image (a smaller texture uploads faster), in a CPU canvas
+    // (willReadFrequently): a GPU canvas made the page wait for the GPU process at every copy
+    // (seconds at a time with a software GPU: bench/gui_page.mjs).
     this.canvas = document.createElement('canvas');
     this.canvas.width = Math.max(1, Math.round(camera.width / 2));
     this.canvas.height = Math.max(1, Math.round(camera.height / 2));
     this.context = this.canvas.getContext('2d', { willReadFrequently: true });
-    this.requested = 0;  // pictures asked for
-    this.settled = 0;    // of them, drawn, dropped or failed
-    this.drawn = 0;      // the newest of them drawn
     this.texture = new THREE.CanvasTexture(this.canvas);
     this.texture.colorSpace = THREE.NoColorSpace;
     this.texture.minFilter = THREE.LinearFilter;
@@ -113,34 +108,20 @@ class CameraRig {
     this.group.matrixWorldNeedsUpdate = true;
   }
 
-  /**
-   * The camera view shows a new picture, `blob` its JPEG: the image plane takes it once it is
-   * decoded, and calls `onDrawn()`. A picture decoded after a newer one is dropped; one that
-   * does not decode leaves the plane as it was.
-   */
-  imageUpdated(blob, onDrawn) {
-    const picture = ++this.requested;
-    createImageBitmap(blob, {
-      resizeWidth: this.canvas.width, resizeHeight: this.canvas.height, resizeQuality: 'medium',
-    }).then((bitmap) => {
-      if (picture > this.drawn) {
-        this.drawn = picture;
-        this.context.drawImage(bitmap, 0, 0);
-        this.texture.needsUpdate = true;
-        this.plane.visible = true;
-        onDrawn?.();
-      }
-      bitmap.close();
-    }, () => {}).finally(() => { this.settled++; });
+  /** The camera view shows a new picture (`bitmap`, decoded): the image plane copies it. */
+  imageUpdated(bitmap) {
+    this.context.drawImage(bitmap, 0, 0, this.canvas.width, this.canvas.height);
+    this.texture.needsUpdate = true;
+    this.plane.visible = true;
   }
 }
 
 /**
- * The robot and the cameras' drawings. `images` maps camera name -> the camera view's image
- * element: the cameras with a view get a frustum and an image plane.
+ * The robot and the cameras' drawings. `views` maps camera name -> the camera view's canvas:
+ * the cameras with a view get a frustum and an image plane.
  */
 export class Head {
-  constructor(scene, doc, models, images) {
+  constructor(scene, doc, models, views) {
     this.scene = scene;
     this.links = new Map();       // link name -> Group posed by state.frames
     this.draggables = [];         // meshes of the links a drag moves
@@ -167,7 +148,7 @@ export class Head {
     // The eye cameras (those with a pose in the state: left and right).
     this.rigs = new Map();
     for (const camera of doc.cameras ?? []) {
-      if (!images[camera.name]) continue;
+      if (!views[camera.name]) continue;
       const rig = new CameraRig(camera);
       this.rigs.set(camera.name, rig);
       rig.group.visible = false;
@@ -224,18 +205,15 @@ export class Head {
     for (const rig of this.rigs.values()) rig.setDistance(d);
   }
 
-  /**
-   * Camera `camera`'s image plane (a test hook): its canvas, whether it is shown and how many
-   * pictures are still being decoded for it.
-   */
+  /** Camera `camera`'s image plane (a test hook): its canvas and whether it is shown. */
   imagePlane(camera) {
     const rig = this.rigs.get(camera);
-    return rig && { canvas: rig.canvas, visible: rig.plane.visible, pending: rig.requested - rig.settled };
+    return rig && { canvas: rig.canvas, visible: rig.plane.visible };
   }
 
-  /** Camera `camera`'s view shows a new picture (`blob`: its JPEG); see CameraRig. */
-  imageUpdated(camera, blob, onDrawn) {
-    this.rigs.get(camera)?.imageUpdated(blob, onDrawn);
+  /** Camera `camera`'s view shows a new picture (`bitmap`, decoded); see CameraRig. */
+  imageUpdated(camera, bitmap) {
+    this.rigs.get(camera)?.imageUpdated(bitmap);
   }
 
   showClick(p) {

@@ -108,9 +108,10 @@ async function start() {
   };
   const views = {};
   for (const name of ['left', 'right']) {
-    views[name] = new CameraView(images[name], $(`label-${name}`), name, (n, blob) => {
+    views[name] = new CameraView(images[name], $(`label-${name}`), name, (n, bitmap) => {
       gui.framesShown[n]++;
-      head.imageUpdated(n, blob, redraw);
+      head.imageUpdated(n, bitmap);
+      redraw();
       maybeReady();
     }, frameDone);
   }

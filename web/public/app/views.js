@@ -2,27 +2,27 @@
 // command the simulation and reflect its state, and the log of errors and events.
 
 /**
- * One camera's live image: the newest JPEG decoded into an <img> through a Blob URL (the
- * previous URL revoked once the next image has loaded). A frame that arrives while one is
- * decoding waits; a newer one replaces it (only the newest is shown). `onImage(name, blob)` is
- * called for every frame shown, `onDone()` once for every frame the view is finished with:
- * shown, failed or replaced while waiting.
+ * One camera's live image: each frame's JPEG decoded once, off the page's main thread
+ * (createImageBitmap), and drawn into the view's canvas (a CPU canvas: a GPU one makes the page
+ * wait for the GPU process at every drawing); `onImage(name, bitmap)` may draw the same picture
+ * elsewhere (the world's image plane) before the bitmap is released. A frame that arrives while
+ * one is decoding waits; a newer one replaces it (only the newest is shown). `onDone()` is called
+ * once for every frame the view is finished with: shown, failed or replaced while waiting. The
+ * canvas is 0 x 0 until the first picture.
  */
 export class CameraView {
-  constructor(image, label, name, onImage, onDone) {
-    this.image = image;
+  constructor(canvas, label, name, onImage, onDone) {
+    this.canvas = canvas;
+    this.context = canvas.getContext('2d', { willReadFrequently: true });
     this.label = label;
     this.name = name;
     this.onImage = onImage;
     this.onDone = onDone;
-    this.url = null;
     this.decoding = false;
     this.waiting = null;       // [header, blob]
     this.received = 0;         // frames received
     this.shown = 0;            // frames decoded and shown
     this.failed = 0;           // frames that did not decode (not shown)
-    this.image.addEventListener('load', () => this.loaded(true));
-    this.image.addEventListener('error', () => this.loaded(false));
   }
 
   frame(header, blob) {
@@ -37,32 +37,31 @@ export class CameraView {
 
   show(header, blob) {
     this.decoding = true;
-    this.header = header;
-    this.blob = blob;
-    this.previousUrl = this.url;
-    this.url = URL.createObjectURL(blob);
-    this.image.src = this.url;
+    createImageBitmap(blob).then((bitmap) => this.decoded(header, bitmap), () => this.decoded(header, null));
   }
 
-  // `ok`: the frame decoded (an <img> whose frame failed shows nothing: naturalWidth 0), so
-  // only those count as shown; either way the next waiting frame goes on.
-  loaded(ok) {
-    if (this.previousUrl) URL.revokeObjectURL(this.previousUrl);
-    this.previousUrl = null;
+  // `bitmap`: the frame decoded, or null when it did not (then nothing is shown); either way
+  // the next waiting frame goes on.
+  decoded(header, bitmap) {
     this.decoding = false;
-    if (ok) {
+    if (bitmap) {
+      if (this.canvas.width !== bitmap.width || this.canvas.height !== bitmap.height) {
+        this.canvas.width = bitmap.width;
+        this.canvas.height = bitmap.height;
+      }
+      this.context.drawImage(bitmap, 0, 0);
       this.shown++;
-      const h = this.header;
-      this.label.textContent = `${this.name} camera · ${h.width}×${h.height} · frame ${h.frame} · t ${Number(h.time).toFixed(2)} s`;
-      this.onImage?.(this.name, this.blob);
+      this.label.textContent = `${this.name} camera · ${header.width}×${header.height} · frame ${header.frame} · t ${Number(header.time).toFixed(2)} s`;
+      this.onImage?.(this.name, bitmap);
+      bitmap.close();
     } else {
       this.failed++;
     }
     this.onDone?.();
     if (this.waiting) {
-      const [header, blob] = this.waiting;
+      const [next, blob] = this.waiting;
       this.waiting = null;
-      this.show(header, blob);
+      this.show(next, blob);
     }
   }
 }
