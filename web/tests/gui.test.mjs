@@ -311,6 +311,32 @@ describe('saccade gui (portraits.yaml)', () => {
     assert.ok(result.inlierFraction > kWorldInlierFraction, report);
   });
 
+  test('a camera view finishes with every frame: shown, undecodable or replaced', async () => {
+    // The frame window (docs/gui-protocol.md) counts on it: a frame the view never finishes
+    // with would hold the server's window shut. A view of its own, in the page.
+    const result = await page.evaluate(async (timeoutMs) => {
+      const { CameraView } = await import('/app/views.js');
+      const canvas = document.createElement('canvas');
+      let shown = 0, done = 0;
+      const view = new CameraView(canvas, document.createElement('span'), 'test',
+        () => shown++, () => done++);
+      const source = document.createElement('canvas');
+      source.width = 8; source.height = 6;
+      source.getContext('2d').fillRect(0, 0, 8, 6);
+      const jpeg = await new Promise((resolve) => source.toBlob(resolve, 'image/jpeg'));
+      const header = (frame) => ({ width: 8, height: 6, frame, time: 0 });
+      view.frame(header(1), new Blob(['not a JPEG'], { type: 'image/jpeg' }));
+      view.frame(header(2), jpeg);  // waits for frame 1, then is replaced by 3
+      view.frame(header(3), jpeg);
+      const until = performance.now() + timeoutMs;
+      while (done < 3 && performance.now() < until) {
+        await new Promise((r) => setTimeout(r, 10));
+      }
+      return { shown, done, failed: view.failed, width: canvas.width, height: canvas.height };
+    }, 10_000);
+    assert.deepEqual(result, { shown: 1, done: 3, failed: 1, width: 8, height: 6 });
+  });
+
   test('a joints command outside the limits is refused and moves nothing', async () => {
     await waitReady(page);
     const before = await page.evaluate(() => window.saccadeGui.state.joints.targets.pan);

@@ -37,31 +37,36 @@ export class CameraView {
 
   show(header, blob) {
     this.decoding = true;
-    createImageBitmap(blob).then((bitmap) => this.decoded(header, bitmap), () => this.decoded(header, null));
+    createImageBitmap(blob).then(
+      (bitmap) => this.decoded(header, bitmap),
+      () => this.decoded(header, null));
   }
 
-  // `bitmap`: the frame decoded, or null when it did not (then nothing is shown); either way
-  // the next waiting frame goes on.
+  // `bitmap`: the frame decoded, or null when it did not (then nothing is shown). Whatever
+  // happens in drawing it, the frame is done with and the next waiting frame goes on.
   decoded(header, bitmap) {
     this.decoding = false;
-    if (bitmap) {
-      if (this.canvas.width !== bitmap.width || this.canvas.height !== bitmap.height) {
-        this.canvas.width = bitmap.width;
-        this.canvas.height = bitmap.height;
+    try {
+      if (bitmap) {
+        if (this.canvas.width !== bitmap.width || this.canvas.height !== bitmap.height) {
+          this.canvas.width = bitmap.width;
+          this.canvas.height = bitmap.height;
+        }
+        this.context.drawImage(bitmap, 0, 0);
+        this.shown++;
+        this.label.textContent = `${this.name} camera · ${header.width}×${header.height} · frame ${header.frame} · t ${Number(header.time).toFixed(2)} s`;
+        this.onImage?.(this.name, bitmap);
+      } else {
+        this.failed++;
       }
-      this.context.drawImage(bitmap, 0, 0);
-      this.shown++;
-      this.label.textContent = `${this.name} camera · ${header.width}×${header.height} · frame ${header.frame} · t ${Number(header.time).toFixed(2)} s`;
-      this.onImage?.(this.name, bitmap);
-      bitmap.close();
-    } else {
-      this.failed++;
-    }
-    this.onDone?.();
-    if (this.waiting) {
-      const [next, blob] = this.waiting;
-      this.waiting = null;
-      this.show(next, blob);
+    } finally {
+      bitmap?.close();
+      this.onDone?.();
+      if (this.waiting) {
+        const [next, blob] = this.waiting;
+        this.waiting = null;
+        this.show(next, blob);
+      }
     }
   }
 }
