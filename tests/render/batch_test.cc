@@ -71,6 +71,34 @@ TEST(RenderBatch, EachHeadEqualsASingleRenderOfItsState) {
   EXPECT_NE(0, std::memcmp(batch.data(), batch.data() + 2 * image_bytes, image_bytes));
 }
 
+TEST(RenderBatch, EachHeadEqualsItselfAloneToTheBitWhateverItsPlace) {
+  // Every tile is drawn at the origin of its own layer, as a batch of one head is: the same
+  // window coordinates, so the same pixels to the bit (the vector env equals single envs).
+  const scene::Scene scene = LoadScene();
+  auto renderer = MakeRenderer(scene, PinholeOptions());
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> angle(-0.2, 0.2);
+  std::vector<BatchHead> heads(5);
+  for (BatchHead& head : heads) {
+    head.state = scene.InitialState();
+    head.state.joints = {angle(rng), angle(rng), angle(rng), angle(rng)};
+  }
+  const int w = scene.FindCamera("left")->model.intrinsics().width();
+  const int h = scene.FindCamera("left")->model.intrinsics().height();
+  const std::size_t pair_bytes = static_cast<std::size_t>(w) * h * 3 * 2;
+  std::vector<uint8_t> batch(heads.size() * pair_bytes);
+  renderer->RenderBatch(heads, batch.data(), batch.size());
+  std::vector<uint8_t> alone(pair_bytes);
+  for (std::size_t i = 0; i < heads.size(); ++i) {
+    renderer->RenderBatch({heads[i]}, alone.data(), alone.size());
+    std::size_t differing = 0;
+    for (std::size_t k = 0; k < pair_bytes; ++k) {
+      differing += batch[i * pair_bytes + k] != alone[k];
+    }
+    EXPECT_EQ(differing, 0u) << "head " << i;
+  }
+}
+
 TEST(RenderBatch, HiddenAndMovedObjectsChangeOnlyTheirHead) {
   const scene::Scene scene = LoadScene();
   RendererOptions options = PinholeOptions();
@@ -97,9 +125,8 @@ TEST(RenderBatch, HiddenAndMovedObjectsChangeOnlyTheirHead) {
 }
 
 TEST(RenderBatch, TwoContextsGiveTheSameImagesToTheBitAsOne) {
-  // Tall, narrow cameras (48 x 4096): the framebuffer holds 4 tiles a strip (16384 pixels a
-  // side on llvmpipe), so 3 heads x 2 cameras lie in two strips and the second context's half
-  // (tiles 3 to 5) starts in the first strip and ends in the second.
+  // Tall, narrow cameras (48 x 4096), 3 heads x 2 cameras: the second context's half (tiles 3
+  // to 5) starts with the second head's right eye.
   std::string yaml = R"(
 background: [0.62, 0.72, 0.82]
 lights:
@@ -137,6 +164,8 @@ objects:
   }
   EXPECT_TRUE(images[0] == images[1]);
   EXPECT_TRUE(again[0] == again[1]);
+  // The third head alone is the third head of the batch.
+  EXPECT_TRUE(std::equal(again[0].begin(), again[0].end(), images[0].begin() + 4 * tile_bytes));
   // Not blank: every tile shows the ball or the box against the sky and the ground.
   for (std::size_t tile = 0; tile < 6; ++tile) {
     const uint8_t* first = images[1].data() + tile * tile_bytes;

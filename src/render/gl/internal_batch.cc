@@ -1,20 +1,24 @@
 // Batch rendering (Renderer::RenderBatch): N heads, each with its own state and its own
-// placement of the scene's objects, drawn through every camera into one framebuffer of tiles
-// and read back at once.
+// placement of the scene's objects, drawn through every camera into one framebuffer and read
+// back at once.
 //
-// Layout: the framebuffer is `columns` strips of tiles, each strip one image wide and `rows`
-// images tall. Tile k = head * cameras + camera lies in strip k / rows, at height k % rows.
-// The projection flips rows (flip_rows, as every camera pass), so a strip's memory order from
-// glReadPixels is its tiles in order, each with row 0 at the top: one glReadPixels per strip
-// into one pixel buffer gives the caller's heads x cameras x height x width layout directly,
-// and one map reads it all. The draw calls are the single renderer's (DrawScene); what a batch
-// saves is the per-call overhead: one framebuffer bind, one synchronisation and one readback
-// for every image of every head, which is what dominates small images on llvmpipe.
+// Layout: tile k = head * cameras + camera is layer k of a colour texture array, drawn at the
+// origin of its layer. Every tile has the same window coordinates as a batch of one head has,
+// so a head's images are the same to the bit whatever its place in the batch: a tile drawn at
+// an offset in one large framebuffer (as before) had window coordinates, and the rasteriser's
+// interpolation from the framebuffer's origin, of other float rounding, and a few thousand
+// pixels of a vector env's 64 x 64 images differed from the same seeds' single envs. The
+// projection flips rows (flip_rows, as every camera pass), so glReadPixels of a layer gives its
+// image with row 0 at the top: one glReadPixels per tile into one pixel buffer gives the
+// caller's heads x cameras x height x width layout directly, and one map reads it all. The draw
+// calls are the single renderer's (DrawScene); what a batch saves is the per-call overhead: one
+// framebuffer, one synchronisation and one readback for every image of every head, which is
+// what dominates small images on llvmpipe.
 //
 // Two contexts (RendererOptions::batch_contexts): the second half of the tiles is drawn by a
 // second renderer of the same scene, on a thread of its own (its context current there for
-// good), into the same places of its own framebuffer of the same layout, and read back into
-// its part of the caller's buffer. On llvmpipe the thread that issues draw calls does the
+// good), into the same layers of its own framebuffer, and read back into its part of the
+// caller's buffer. On llvmpipe the thread that issues draw calls does the
 // vertex work, triangle setup and binning, then waits while the rasteriser's threads draw
 // the scene it binned: with two issuing threads, one bins while the other's scene is drawn.
 #include <fmt/format.h>
@@ -180,19 +184,6 @@ void GlRenderer::RenderBatch(const std::vector<BatchHead>& heads, uint8_t* out,
   if (tiles == 0) return;
 
   context_.MakeCurrent();
-  GLint max_size = 0;
-  glGetIntegerv(GL_MAX_RENDERBUFFER_SIZE, &max_size);
-  const int max_rows = std::max(1, static_cast<int>(max_size) / height);
-  const int max_columns = std::max(1, static_cast<int>(max_size) / width);
-  const int rows = static_cast<int>(std::min<std::size_t>(tiles, max_rows));
-  const int columns = static_cast<int>((tiles + rows - 1) / rows);
-  if (columns > max_columns) {
-    throw InvalidArgument(fmt::format(
-        "Renderer::RenderBatch: {} images of {} x {} do not fit the device's framebuffer ({} "
-        "pixels a side); expected at most {}",
-        tiles, width, height, max_size, static_cast<std::size_t>(max_rows) * max_columns));
-  }
-
   // Small batches stay on one context: handing half of a stereo pair of 128 x 128 images to
   // the other thread cost more than it saved (FixationEnv's step: 0.16 ms on one context,
   // 0.18-0.25 split).
@@ -208,70 +199,78 @@ void GlRenderer::RenderBatch(const std::vector<BatchHead>& heads, uint8_t* out,
     context_.MakeCurrent();
   }
   if (split && batch_helper_ != nullptr) {
-    // The second half of the tiles on the helper's context, the first half here, at the same
-    // places in the same layout (the rasteriser's arithmetic depends on where a tile lies).
+    // The second half of the tiles on the helper's context, the first half here.
     const std::size_t middle = tiles / 2;
-    batch_helper_->Start([&heads, middle, tiles, rows, columns, out](GlRenderer& helper) {
-      helper.DrawBatchTiles(heads, middle, tiles, rows, columns, out);
+    batch_helper_->Start([&heads, middle, tiles, out](GlRenderer& helper) {
+      helper.DrawBatchTiles(heads, middle, tiles, out);
     });
     try {
-      DrawBatchTiles(heads, 0, middle, rows, columns, out);
+      DrawBatchTiles(heads, 0, middle, out);
     } catch (...) {
       batch_helper_->Wait(/*rethrow=*/false);
       throw;
     }
     batch_helper_->Wait(/*rethrow=*/true);
   } else {
-    DrawBatchTiles(heads, 0, tiles, rows, columns, out);
+    DrawBatchTiles(heads, 0, tiles, out);
   }
   stats_.frames += static_cast<int64_t>(heads.size());
   stats_.total_ms += Milliseconds(start, Clock::now());
 }
 
 void GlRenderer::DrawBatchTiles(const std::vector<BatchHead>& heads, std::size_t first,
-                                std::size_t last, int rows, int columns, uint8_t* out) {
+                                std::size_t last, uint8_t* out) {
   const Clock::time_point start = Clock::now();
   context_.MakeCurrent();
   const int width = cameras_[0]->model.intrinsics().width();
   const int height = cameras_[0]->model.intrinsics().height();
   const std::size_t cameras = cameras_.size();
+  const std::size_t count = last - first;
+  const std::size_t tile_rgba = static_cast<std::size_t>(width) * height * 4;
 
-  // The framebuffer of tiles, (re)made when the batch outgrows it.
-  if (batch_.framebuffer == 0 || columns > batch_.columns || rows > batch_.rows) {
+  // The layers and the pixel buffer, (re)made when the batch outgrows them. A batch of more
+  // tiles than the device's layers is drawn in parts, each read back before the next.
+  GLint max_layers = 0;
+  glGetIntegerv(GL_MAX_ARRAY_TEXTURE_LAYERS, &max_layers);
+  const int layers = static_cast<int>(std::min<std::size_t>(count, std::max(1, max_layers)));
+  if (batch_.framebuffer == 0 || layers > batch_.layers || count * tile_rgba > batch_.pixel_bytes) {
     if (batch_.framebuffer != 0) {
       glDeleteFramebuffers(1, &batch_.framebuffer);
-      const GLuint renderbuffers[] = {batch_.color, batch_.depth};
-      glDeleteRenderbuffers(2, renderbuffers);
+      glDeleteTextures(1, &batch_.color);
+      glDeleteRenderbuffers(1, &batch_.depth);
       glDeleteBuffers(1, &batch_.pixels);
     }
-    batch_.columns = std::max(columns, batch_.columns);
-    batch_.rows = std::max(rows, batch_.rows);
-    const int fb_width = batch_.columns * width;
-    const int fb_height = batch_.rows * height;
-    glGenRenderbuffers(1, &batch_.color);
-    glBindRenderbuffer(GL_RENDERBUFFER, batch_.color);
-    glRenderbufferStorage(GL_RENDERBUFFER, GL_RGBA8, fb_width, fb_height);
+    batch_.layers = std::max(layers, batch_.layers);
+    glGenTextures(1, &batch_.color);
+    glBindTexture(GL_TEXTURE_2D_ARRAY, batch_.color);
+    glTexImage3D(GL_TEXTURE_2D_ARRAY, 0, GL_RGBA8, width, height, batch_.layers, 0, GL_RGBA,
+                 GL_UNSIGNED_BYTE, nullptr);
+    glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+    glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MAX_LEVEL, 0);
+    glBindTexture(GL_TEXTURE_2D_ARRAY, 0);
     glGenRenderbuffers(1, &batch_.depth);
     glBindRenderbuffer(GL_RENDERBUFFER, batch_.depth);
-    glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT24, fb_width, fb_height);
+    glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT24, width, height);
+    glBindRenderbuffer(GL_RENDERBUFFER, 0);
     glGenFramebuffers(1, &batch_.framebuffer);
     glBindFramebuffer(GL_FRAMEBUFFER, batch_.framebuffer);
-    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, batch_.color);
+    glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, batch_.color, 0, 0);
     glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, batch_.depth);
     const GLenum status = glCheckFramebufferStatus(GL_FRAMEBUFFER);
     if (status != GL_FRAMEBUFFER_COMPLETE) {
       throw Error(fmt::format(
-          "Renderer::RenderBatch: the {} x {} framebuffer of tiles is incomplete: status 0x{:04X}",
-          fb_width, fb_height, status));
+          "Renderer::RenderBatch: the framebuffer of {} layers of {} x {} is incomplete: status "
+          "0x{:04X}",
+          batch_.layers, width, height, status));
     }
-    batch_.pixel_bytes = static_cast<std::size_t>(fb_width) * fb_height * 4;
+    batch_.pixel_bytes = std::max(batch_.pixel_bytes, count * tile_rgba);
     glGenBuffers(1, &batch_.pixels);
     glBindBuffer(GL_PIXEL_PACK_BUFFER, batch_.pixels);
     glBufferData(GL_PIXEL_PACK_BUFFER, static_cast<GLsizeiptr>(batch_.pixel_bytes), nullptr,
                  GL_STREAM_READ);
     glBindBuffer(GL_PIXEL_PACK_BUFFER, 0);
-    glBindRenderbuffer(GL_RENDERBUFFER, 0);
-    CheckGlError("Renderer::RenderBatch: making the framebuffer of tiles");
+    CheckGlError("Renderer::RenderBatch: making the framebuffer of layers");
   }
   if (batch_views_.empty()) {
     for (const scene::CameraSpec* camera : cameras_) {
@@ -284,57 +283,56 @@ void GlRenderer::DrawBatchTiles(const std::vector<BatchHead>& heads, std::size_t
   }
 
   glBindFramebuffer(GL_FRAMEBUFFER, batch_.framebuffer);
-  glEnable(GL_SCISSOR_TEST);
-  glViewport(0, 0, batch_.columns * width, batch_.rows * height);
-  glScissor(0, 0, batch_.columns * width, batch_.rows * height);
-  glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
-  double pose_ms = 0.0;
-  std::size_t posed = heads.size();  // the head whose poses item_poses_ holds
-  for (std::size_t tile = first; tile < last; ++tile) {
-    const std::size_t h = tile / cameras;
-    const std::size_t c = tile % cameras;
-    const BatchHead& head = heads[h];
-    if (h != posed) {
-      const Clock::time_point pose_start = Clock::now();
-      UpdatePoses(head.state);
-      for (std::size_t i = 0; i < items_.size(); ++i) {
-        const int object = items_[i].object;
-        if (object < 0) continue;
-        if (!head.hidden.empty() && head.hidden[object]) {
-          item_poses_[i] = Eigen::Isometry3d(Eigen::Translation3d(0.0, 0.0, -kHiddenDepth));
-        } else if (!head.object_poses.empty() && head.object_poses[object].has_value()) {
-          item_poses_[i] = *head.object_poses[object];
-        }
-      }
-      posed = h;
-      pose_ms += Milliseconds(pose_start, Clock::now());
-    }
-    const int x = static_cast<int>(tile / rows) * width;
-    const int y = static_cast<int>(tile % rows) * height;
-    glViewport(x, y, width, height);
-    glScissor(x, y, width, height);
-    DrawScene(batch_views_[c], cameras_[c]->clip.near, scene_.CameraPose(*cameras_[c], head.state));
-  }
   glDisable(GL_SCISSOR_TEST);
+  glViewport(0, 0, width, height);
+  glPixelStorei(GL_PACK_ALIGNMENT, 1);
+  double pose_ms = 0.0, read_ms = 0.0;
+  std::size_t posed = heads.size();  // the head whose poses item_poses_ holds
+  for (std::size_t part = first; part < last; part += static_cast<std::size_t>(layers)) {
+    const std::size_t part_end = std::min(last, part + static_cast<std::size_t>(layers));
+    for (std::size_t tile = part; tile < part_end; ++tile) {
+      const std::size_t h = tile / cameras;
+      const std::size_t c = tile % cameras;
+      const BatchHead& head = heads[h];
+      if (h != posed) {
+        const Clock::time_point pose_start = Clock::now();
+        UpdatePoses(head.state);
+        for (std::size_t i = 0; i < items_.size(); ++i) {
+          const int object = items_[i].object;
+          if (object < 0) continue;
+          if (!head.hidden.empty() && head.hidden[object]) {
+            item_poses_[i] = Eigen::Isometry3d(Eigen::Translation3d(0.0, 0.0, -kHiddenDepth));
+          } else if (!head.object_poses.empty() && head.object_poses[object].has_value()) {
+            item_poses_[i] = *head.object_poses[object];
+          }
+        }
+        posed = h;
+        pose_ms += Milliseconds(pose_start, Clock::now());
+      }
+      glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, batch_.color, 0,
+                                static_cast<GLint>(tile - part));
+      glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+      DrawScene(batch_views_[c], cameras_[c]->clip.near,
+                scene_.CameraPose(*cameras_[c], head.state));
+    }
+    // The part's layers into the pixel buffer, each at its tile's place.
+    const Clock::time_point read_start = Clock::now();
+    glBindBuffer(GL_PIXEL_PACK_BUFFER, batch_.pixels);
+    for (std::size_t tile = part; tile < part_end; ++tile) {
+      glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, batch_.color, 0,
+                                static_cast<GLint>(tile - part));
+      glReadPixels(0, 0, width, height, GL_RGBA, GL_UNSIGNED_BYTE,
+                   reinterpret_cast<void*>((tile - first) * tile_rgba));
+    }
+    glBindBuffer(GL_PIXEL_PACK_BUFFER, 0);
+    read_ms += Milliseconds(read_start, Clock::now());
+  }
   const Clock::time_point drawn = Clock::now();
 
-  // Each strip's part of [first, last) into the pixel buffer, then one map for all of them.
-  glBindFramebuffer(GL_READ_FRAMEBUFFER, batch_.framebuffer);
+  // One map for all of [first, last).
   glBindBuffer(GL_PIXEL_PACK_BUFFER, batch_.pixels);
-  glPixelStorei(GL_PACK_ALIGNMENT, 1);
-  const std::size_t tile_rgba = static_cast<std::size_t>(width) * height * 4;
-  for (int column = 0; column < columns; ++column) {
-    const std::size_t strip = static_cast<std::size_t>(column) * rows;
-    const std::size_t from = std::max(first, strip);
-    const std::size_t to = std::min(last, strip + static_cast<std::size_t>(rows));
-    if (from >= to) continue;
-    glReadPixels(column * width, static_cast<int>(from - strip) * height, width,
-                 static_cast<int>(to - from) * height, GL_RGBA, GL_UNSIGNED_BYTE,
-                 reinterpret_cast<void*>(from * tile_rgba));
-  }
-  const auto* rgba = static_cast<const uint8_t*>(
-      glMapBufferRange(GL_PIXEL_PACK_BUFFER, static_cast<GLintptr>(first * tile_rgba),
-                       static_cast<GLsizeiptr>((last - first) * tile_rgba), GL_MAP_READ_BIT));
+  const auto* rgba = static_cast<const uint8_t*>(glMapBufferRange(
+      GL_PIXEL_PACK_BUFFER, 0, static_cast<GLsizeiptr>(count * tile_rgba), GL_MAP_READ_BIT));
   if (rgba == nullptr) {
     const GLenum error = glGetError();
     glBindBuffer(GL_PIXEL_PACK_BUFFER, 0);
@@ -345,8 +343,7 @@ void GlRenderer::DrawBatchTiles(const std::vector<BatchHead>& heads, std::size_t
   // In parts on threads for a large batch (on an H200, N = 256 128 x 128 stereo pairs: the
   // readback 5.2 -> 1.7 ms); each context's threads share the cores with the other's.
   static const unsigned cores = std::thread::hardware_concurrency();  // asked once
-  RgbaToRgbInParts(rgba, out + first * tile_rgb,
-                   (last - first) * static_cast<std::size_t>(width) * height,
+  RgbaToRgbInParts(rgba, out + first * tile_rgb, count * static_cast<std::size_t>(width) * height,
                    cores / static_cast<unsigned>(std::max(1, batch_contexts_)));
   glUnmapBuffer(GL_PIXEL_PACK_BUFFER);
   glBindBuffer(GL_PIXEL_PACK_BUFFER, 0);
@@ -355,8 +352,8 @@ void GlRenderer::DrawBatchTiles(const std::vector<BatchHead>& heads, std::size_t
   const Clock::time_point end = Clock::now();
 
   stats_.scene_update_ms += pose_ms;
-  stats_.draw_ms += Milliseconds(start, drawn) - pose_ms;
-  stats_.readback_ms += Milliseconds(drawn, end);
+  stats_.draw_ms += Milliseconds(start, drawn) - pose_ms - read_ms;
+  stats_.readback_ms += Milliseconds(drawn, end) + read_ms;
 }
 
 void GlRenderer::BatchHelperDeleter::operator()(BatchHelper* helper) const { delete helper; }

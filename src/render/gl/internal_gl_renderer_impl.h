@@ -298,19 +298,21 @@ class GlRenderer final : public Renderer {
   int samples_ = 0;
   std::string description_;
   RenderStats stats_;
-  // The batch's framebuffer of tiles and its pixel buffer (internal_batch.cc), made on the
-  // first RenderBatch and remade when the batch grows; freed with the context.
+  // The batch's framebuffer (internal_batch.cc): a colour texture array of one layer per
+  // tile, every tile drawn at the origin of its layer (as a batch of one head is), a depth
+  // buffer of one tile, and the pixel buffer the tiles are read into; made on the first
+  // RenderBatch and remade when a batch has more tiles; freed with the context.
   struct BatchTarget {
     GLuint framebuffer = 0, color = 0, depth = 0, pixels = 0;
-    int columns = 0, rows = 0;  // tiles
+    int layers = 0;  // of `color`
     std::size_t pixel_bytes = 0;
   };
   BatchTarget batch_;
   std::vector<ViewSetup> batch_views_;  // per camera: the pinhole of its K
-  // Draws tiles [first, last) of a batch laid out as `columns` strips of `rows` tiles and
-  // reads them back into their place in `out` (internal_batch.cc).
+  // Draws tiles [first, last) of a batch (tile = head * cameras + camera) and reads them back
+  // into their place in `out` (internal_batch.cc).
   void DrawBatchTiles(const std::vector<BatchHead>& heads, std::size_t first, std::size_t last,
-                      int rows, int columns, uint8_t* out);
+                      uint8_t* out);
   // The second context of RenderBatch (RendererOptions::batch_contexts): a renderer of the
   // same scene on a thread of its own, made on the first batch of two images or more.
   class BatchHelper;
