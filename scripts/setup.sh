@@ -44,6 +44,9 @@ packages=(
   # the Python package (docs/python.md): pybind11 bindings for Debian's /usr/bin/python3, numpy
   # arrays, its tests under pytest
   pybind11-dev python3-numpy python3-pytest python3-dev
+  # what Gymnasium needs besides numpy (../shared/third_party/gymnasium, for the envs' tests:
+  # tests/python/gymnasium_test.py)
+  python3-cloudpickle python3-typing-extensions
   # the reference of the Python tests for the camera model (cv2.projectPoints)
   python3-opencv
 )

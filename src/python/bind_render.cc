@@ -21,7 +21,7 @@ uint8_t* CheckOut(const py::array& out, const std::vector<py::ssize_t>& shape, c
   for (py::ssize_t i = 0; i < out.ndim(); ++i) {
     got += (got.empty() ? "" : ", ") + std::to_string(out.shape(i));
   }
-  if (!out.dtype().is(py::dtype::of<uint8_t>()) ||
+  if (!out.dtype().equal(py::dtype::of<uint8_t>()) ||
       out.ndim() != static_cast<py::ssize_t>(shape.size()) ||
       !std::equal(shape.begin(), shape.end(), out.shape())) {
     throw InvalidArgument(std::string(who) + ": out must be a uint8 array of shape (" + want +

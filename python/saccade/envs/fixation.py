@@ -1,7 +1,10 @@
 """Fixation: bring a chosen target onto both optical axes of the stereo head.
 
 ``FixationEnv`` (one head) and ``VectorFixationEnv`` (N heads rendered in one batch) follow
-Gymnasium's API contract exactly, without needing gymnasium (docs/python.md):
+Gymnasium's API contract exactly, without needing gymnasium (docs/python.md). When gymnasium
+is importable they are ``gymnasium.Env`` and ``gymnasium.vector.VectorEnv`` (so
+``gymnasium.make``, its wrappers and ``check_env`` take them), and both pickle (rebuilt from
+their constructor arguments, then their state):
 
 - ``reset(*, seed=None, options=None) -> (obs, info)``; ``step(action) -> (obs, reward,
   terminated, truncated, info)``; ``render()``; ``close()``;
@@ -38,7 +41,22 @@ import numpy as np
 import saccade
 from saccade.envs import spaces
 
+try:  # pragma: no cover - exercised only where gymnasium is importable
+    import gymnasium as _gymnasium
+    from gymnasium.vector import VectorEnv as _VectorEnvBase
+
+    _EnvBase = _gymnasium.Env
+except ImportError:
+    _gymnasium = None
+    _EnvBase = object
+    _VectorEnvBase = object
+
 JOINTS = ("pan", "tilt", "left", "right")
+
+
+class EpisodeEnded(saccade.Error, AssertionError):
+    """step() of a vector env in AutoresetMode.DISABLED while a sub-env's episode has ended and
+    was not reset (an AssertionError too, as gymnasium.vector.SyncVectorEnv raises there)."""
 
 
 class AutoresetMode(enum.Enum):
@@ -131,9 +149,11 @@ class _Heads:
         if len(image_size) != 2 or min(image_size) < 8 or max(image_size) > 2048:
             raise saccade.InvalidArgument(
                 f"image_size must be a side or (width, height), each 8..2048, got {image_size}")
-        if not (max_episode_steps >= 1):
+        if max_episode_steps is not None and not (
+                isinstance(max_episode_steps, (int, np.integer)) and max_episode_steps >= 1):
             raise saccade.InvalidArgument(
-                f"max_episode_steps must be >= 1, got {max_episode_steps}")
+                f"max_episode_steps must be an integer >= 1 or None (no limit), got "
+                f"{max_episode_steps!r}")
         if not (0 < success_deg < 90):
             raise saccade.InvalidArgument(f"success_deg must be in (0, 90), got {success_deg}")
         if not (0 < dt <= 1):
@@ -141,7 +161,8 @@ class _Heads:
         self.n = n
         self.width, self.height = image_size
         self.action_mode = action_mode
-        self.max_episode_steps = int(max_episode_steps)
+        self.max_episode_steps = None if max_episode_steps is None else int(max_episode_steps)
+        self.step_limit = math.inf if max_episode_steps is None else int(max_episode_steps)
         self.success = math.radians(success_deg)
         self.dt = float(dt)
         self.pool = _Pool(image_size, fov_deg, scene_seed)
@@ -283,7 +304,7 @@ class _Heads:
         left, right = self.axis_error[i].tolist()  # Python floats: numpy on two values costs more
         success = left < self.success and right < self.success
         reward = -0.5 * (left + right) + (1.0 if success else 0.0)
-        return reward, success, bool(self.steps[i] >= self.max_episode_steps)
+        return reward, success, bool(self.steps[i] >= self.step_limit)
 
     def render(self, rows: Sequence[int], out: np.ndarray) -> np.ndarray:
         heads = []
@@ -292,6 +313,26 @@ class _Heads:
             head.state = saccade.scene.SceneState(float(self.steps[i]) * self.dt, self.joints[i])
             heads.append(head)
         return self.renderer.render_batch(heads, out=out)
+
+    def state(self) -> Dict[str, Any]:
+        """What changes after construction (for pickling; set_state restores it)."""
+        return {
+            "joints": self.joints.copy(), "steps": self.steps.copy(),
+            "object_poses": [list(p) for p in self.object_poses],
+            "hidden": [list(h) for h in self.hidden], "target": self.target.copy(),
+            "target_index": self.target_index.copy(), "axis_error": self.axis_error.copy(),
+        }
+
+    def set_state(self, state: Dict[str, Any]):
+        for key in ("joints", "steps", "target", "target_index", "axis_error"):
+            getattr(self, key)[...] = state[key]
+        self.object_poses = [list(p) for p in state["object_poses"]]
+        self.hidden = [list(h) for h in state["hidden"]]
+        for i in range(self.n):
+            if all(self.hidden[i]):
+                continue  # never reset
+            self.batch[i] = saccade.render.BatchHead(saccade.scene.SceneState(),
+                                                     self.object_poses[i], self.hidden[i])
 
     def info(self, i: int) -> Dict[str, Any]:
         return {
@@ -304,14 +345,16 @@ class _Heads:
         }
 
 
-class FixationEnv:
+class FixationEnv(_EnvBase):
     """One stereo head that must fixate a target (Gymnasium's Env contract; module docstring).
+    A ``gymnasium.Env`` when gymnasium is importable.
 
     Args:
         render_mode: None or "rgb_array" (render() returns both eyes side by side).
         image_size: the eyes' image side, or (width, height), pixels.
         action_mode: "velocity" (rad/s) or "target" (rad).
-        max_episode_steps: steps before ``truncated``.
+        max_episode_steps: steps before ``truncated``; None: no limit of its own (what
+            ``gymnasium.make`` builds: its TimeLimit wrapper holds the registered limit).
         success_deg: both optical axes within this angle of the target ends the episode.
         dt: seconds per step (render_fps = 1 / dt).
         fov_deg: the eyes' horizontal field of view.
@@ -321,12 +364,15 @@ class FixationEnv:
     metadata = {"render_modes": ["rgb_array"], "render_fps": 25}
 
     def __init__(self, render_mode: Optional[str] = None, image_size: Union[int, Tuple[int, int]] = 64,
-                 action_mode: str = "velocity", max_episode_steps: int = 200,
+                 action_mode: str = "velocity", max_episode_steps: Optional[int] = 200,
                  success_deg: float = 1.0, dt: float = 0.04, fov_deg: float = 60.0,
                  scene_seed: int = 0):
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
             raise saccade.InvalidArgument(
                 f"render_mode must be None or one of {self.metadata['render_modes']}, got {render_mode!r}")
+        self._kwargs = dict(render_mode=render_mode, image_size=image_size, action_mode=action_mode,
+                            max_episode_steps=max_episode_steps, success_deg=success_deg, dt=dt,
+                            fov_deg=fov_deg, scene_seed=scene_seed)
         self.render_mode = render_mode
         self._heads = _Heads(1, image_size, action_mode, max_episode_steps, success_deg, dt,
                              fov_deg, scene_seed)
@@ -394,6 +440,29 @@ class FixationEnv:
     def close(self):
         self._heads = None
 
+    def __getstate__(self) -> Dict[str, Any]:
+        # The renderer (a GL context) and the scene do not pickle: the constructor's arguments
+        # rebuild them, then the state (episode, generators, spaces, last images) is restored.
+        return {
+            "kwargs": self._kwargs, "spec": self.spec,
+            "heads": None if self._heads is None else self._heads.state(),
+            "np_random": self._np_random, "np_random_seed": self._np_random_seed,
+            "observation_space": self.observation_space, "action_space": self.action_space,
+            "images": self._images, "needs_reset": self._needs_reset,
+        }
+
+    def __setstate__(self, state: Dict[str, Any]):
+        FixationEnv.__init__(self, **state["kwargs"])
+        self.spec = state["spec"]
+        self._np_random, self._np_random_seed = state["np_random"], state["np_random_seed"]
+        self.observation_space, self.action_space = state["observation_space"], state["action_space"]
+        # A copy: the renderer writes into arrays like it, and unpickled ones may be unaligned.
+        self._images, self._needs_reset = np.array(state["images"]), state["needs_reset"]
+        if state["heads"] is None:
+            self.close()
+        else:
+            self._heads.set_state(state["heads"])
+
     def __enter__(self):
         return self
 
@@ -405,10 +474,13 @@ class FixationEnv:
         return f"<FixationEnv {self._heads.width}x{self._heads.height} {self._heads.action_mode}>"
 
 
-class VectorFixationEnv:
+class VectorFixationEnv(_VectorEnvBase):
     """N FixationEnv heads stepped together and rendered in one batch (one renderer call,
-    one readback per step). Gymnasium's VectorEnv contract: observations and rewards are
-    stacked along a first axis of num_envs; infos are dicts of arrays with "_key" masks.
+    one readback per step). Gymnasium's VectorEnv contract, step for step what
+    ``gymnasium.vector.SyncVectorEnv`` of N FixationEnv gives (docs/python.md): observations and
+    rewards are stacked along a first axis of num_envs; infos are dicts of arrays with "_key"
+    masks, built as SyncVectorEnv builds them. A ``gymnasium.vector.VectorEnv`` when gymnasium
+    is importable.
 
     Args: as FixationEnv, plus
         num_envs: N >= 1.
@@ -421,8 +493,8 @@ class VectorFixationEnv:
 
     def __init__(self, num_envs: int = 4, render_mode: Optional[str] = None,
                  image_size: Union[int, Tuple[int, int]] = 64, action_mode: str = "velocity",
-                 max_episode_steps: int = 200, success_deg: float = 1.0, dt: float = 0.04,
-                 fov_deg: float = 60.0, scene_seed: int = 0,
+                 max_episode_steps: Optional[int] = 200, success_deg: float = 1.0,
+                 dt: float = 0.04, fov_deg: float = 60.0, scene_seed: int = 0,
                  autoreset_mode: Union[AutoresetMode, str] = AutoresetMode.NEXT_STEP):
         if not (isinstance(num_envs, (int, np.integer)) and num_envs >= 1):
             raise saccade.InvalidArgument(f"num_envs must be an integer >= 1, got {num_envs!r}")
@@ -435,6 +507,10 @@ class VectorFixationEnv:
             raise saccade.InvalidArgument(
                 f"autoreset_mode must be one of {[m.value for m in AutoresetMode]}, "
                 f"got {autoreset_mode!r}") from None
+        self._kwargs = dict(num_envs=num_envs, render_mode=render_mode, image_size=image_size,
+                            action_mode=action_mode, max_episode_steps=max_episode_steps,
+                            success_deg=success_deg, dt=dt, fov_deg=fov_deg,
+                            scene_seed=scene_seed, autoreset_mode=mode.value)
         self.num_envs = int(num_envs)
         self.render_mode = render_mode
         self.autoreset_mode = mode
@@ -456,7 +532,7 @@ class VectorFixationEnv:
 
     @property
     def np_random(self) -> np.random.Generator:
-        """The first sub-environment's generator (gymnasium's VectorEnv has one per env)."""
+        """The first sub-environment's generator (each sub-env has its own)."""
         return self._rng(0)
 
     @property
@@ -479,21 +555,39 @@ class VectorFixationEnv:
         return {"left": out[:, 0], "right": out[:, 1],
                 "joints": self._heads.joints.astype(np.float32)}
 
-    def _infos(self, rows) -> Dict[str, Any]:
-        mask = np.zeros(self.num_envs, dtype=bool)
-        mask[list(rows)] = True
+    def _infos(self, rows: np.ndarray) -> Dict[str, Any]:
+        """The infos of sub-envs `rows` (an index array), as SyncVectorEnv batches the single
+        envs' infos: each key an array over all envs (zeros, or None for strings, outside
+        `rows`) and its "_key" mask."""
+        n = self.num_envs
         h = self._heads
+        mask = np.zeros(n, dtype=bool)
+        mask[rows] = True
+        axis_error = np.zeros((n, 2))
+        axis_error[rows] = h.axis_error[rows]
+        target_W = np.zeros((n, 3))
+        target_W[rows] = h.target[rows]
+        target_index = np.zeros(n, dtype=int)
+        target_index[rows] = h.target_index[rows]
+        target_kind = np.full(n, None, dtype=object)
+        for i in rows:
+            target_kind[i] = h.pool.kinds[int(h.target_index[i])]
+        is_success = np.zeros(n, dtype=bool)
+        is_success[rows] = np.all(h.axis_error[rows] < h.success, axis=1)
         return {
-            "axis_error": h.axis_error.copy(), "_axis_error": mask.copy(),
-            "target_W": h.target.copy(), "_target_W": mask.copy(),
-            "target_index": h.target_index.copy(), "_target_index": mask.copy(),
-            "is_success": np.all(h.axis_error < h.success, axis=1), "_is_success": mask.copy(),
+            "axis_error": axis_error, "_axis_error": mask.copy(),
+            "target_W": target_W, "_target_W": mask.copy(),
+            "target_index": target_index, "_target_index": mask.copy(),
+            "target_kind": target_kind, "_target_kind": mask.copy(),
+            "is_success": is_success, "_is_success": mask,
         }
 
     def reset(self, *, seed: Optional[Union[int, Sequence[Optional[int]]]] = None,
               options: Optional[Dict[str, Any]] = None):
-        """Resets every sub-environment (or those of options["reset_mask"]). `seed`: an int
-        (env i gets seed + i), a list of one seed (or None) per env, or None."""
+        """Resets every sub-environment, or those of options["reset_mask"] (a bool array of
+        num_envs, at least one True) as SyncVectorEnv does: the others keep their episode and
+        their generator. `seed`: an int (env i gets seed + i), a list of one seed (or None)
+        per env, or None; a sub-env outside the mask ignores its seed."""
         if seed is None:
             seeds: List[Optional[int]] = [None] * self.num_envs
         elif isinstance(seed, (int, np.integer)):
@@ -505,52 +599,70 @@ class VectorFixationEnv:
                     f"VectorFixationEnv.reset: {len(seeds)} seeds for {self.num_envs} envs")
         mask = np.ones(self.num_envs, dtype=bool)
         if options and "reset_mask" in options:
-            mask = np.asarray(options["reset_mask"], dtype=bool)
-            if mask.shape != (self.num_envs,):
+            options = dict(options)
+            mask = np.asarray(options.pop("reset_mask"))
+            if mask.dtype != np.bool_ or mask.shape != (self.num_envs,):
                 raise saccade.InvalidArgument(
-                    f"VectorFixationEnv.reset: reset_mask must have shape ({self.num_envs},), "
-                    f"got {mask.shape}")
-        for i in range(self.num_envs):
+                    f"VectorFixationEnv.reset: options['reset_mask'] must be a bool array of "
+                    f"shape ({self.num_envs},), got {mask.dtype} {mask.shape}")
+            if not mask.any():
+                raise saccade.InvalidArgument(
+                    "VectorFixationEnv.reset: options['reset_mask'] must hold at least one True "
+                    f"value, got {mask}")
+        rows = np.flatnonzero(mask)
+        for i in rows:
             if seeds[i] is not None:
                 self._rngs[i], _ = spaces.seeding_np_random(seeds[i])
-            if mask[i]:
-                self._heads.randomise(i, self._rng(i), options)
+            self._heads.randomise(int(i), self._rng(int(i)), options)
         if seed is not None:
             self._np_random_seed = tuple(seeds)
         self._autoreset[mask] = False
         self._needs_reset = False
-        return self._observations(), self._infos(np.flatnonzero(mask))
+        return self._observations(), self._infos(rows)
 
     def step(self, actions):
         """Steps every sub-environment; returns (obs, rewards, terminations, truncations, infos)
-        stacked along the first axis."""
+        stacked along the first axis. Raises EpisodeEnded in AutoresetMode.DISABLED when a
+        sub-env's episode ended and was not reset (reset(options={"reset_mask": ...}))."""
         if self._needs_reset:
             raise saccade.Error("VectorFixationEnv.step: call reset() before the first step")
         a = self._heads.check_actions(actions, "VectorFixationEnv.step")
         n = self.num_envs
+        if self.autoreset_mode == AutoresetMode.DISABLED and self._autoreset.any():
+            raise EpisodeEnded(
+                f"VectorFixationEnv.step: the episodes of sub-envs "
+                f"{np.flatnonzero(self._autoreset).tolist()} ended; expected reset(options="
+                f"{{'reset_mask': mask}}) of them before the next step (AutoresetMode.DISABLED)")
         rewards = np.zeros(n, dtype=np.float64)
         terminations = np.zeros(n, dtype=bool)
         truncations = np.zeros(n, dtype=bool)
-        resetting = self._autoreset.copy() if self.autoreset_mode == AutoresetMode.NEXT_STEP else np.zeros(n, bool)
-        for i in np.flatnonzero(resetting):
-            self._heads.randomise(int(i), self._rng(int(i)), None)
-        moving = np.flatnonzero(~resetting)
+        if self.autoreset_mode == AutoresetMode.NEXT_STEP:
+            resetting = self._autoreset
+            for i in np.flatnonzero(resetting):
+                self._heads.randomise(int(i), self._rng(int(i)), None)
+            moving = np.flatnonzero(~resetting)
+        else:
+            moving = np.arange(n)
         if len(moving):
             self._heads.apply(moving, a[moving])
         for i in moving:
             rewards[i], terminations[i], truncations[i] = self._heads.outcome(int(i))
         ended = terminations | truncations
-        infos = self._infos(range(n))
-        if self.autoreset_mode == AutoresetMode.SAME_STEP and np.any(ended):
+        infos: Dict[str, Any] = {}
+        if self.autoreset_mode == AutoresetMode.SAME_STEP and ended.any():
+            # As SyncVectorEnv: final_obs an object array of the ended envs' observations,
+            # final_info their infos batched with masks; then the new episodes' observations
+            # and infos in their place.
             final = self._observations()
-            infos["final_obs"] = np.array([None] * n, dtype=object)
-            infos["final_info"] = np.array([None] * n, dtype=object)
-            for i in np.flatnonzero(ended):
-                infos["final_obs"][i] = {k: v[i].copy() for k, v in final.items()}
-                infos["final_info"][i] = self._heads.info(int(i))
+            rows = np.flatnonzero(ended)
+            final_obs = np.full(n, None, dtype=object)
+            for i in rows:
+                final_obs[i] = {k: v[i].copy() for k, v in final.items()}
+            infos["final_obs"], infos["_final_obs"] = final_obs, ended.copy()
+            infos["final_info"], infos["_final_info"] = self._infos(rows), ended.copy()
+            for i in rows:
                 self._heads.randomise(int(i), self._rng(int(i)), None)
-            infos["_final_obs"] = ended.copy()
-            infos["_final_info"] = ended.copy()
+        infos.update(self._infos(np.arange(n)))
         self._autoreset = ended
         return self._observations(), rewards, terminations, truncations, infos
 
@@ -561,9 +673,34 @@ class VectorFixationEnv:
         return tuple(np.concatenate([self._images[i, 0], self._images[i, 1]], axis=1)
                      for i in range(self.num_envs))
 
-    def close(self):
+    def close(self, **kwargs):
         self._heads = None
         self.closed = True
+
+    def __getstate__(self) -> Dict[str, Any]:
+        # As FixationEnv's: rebuilt from the constructor's arguments, then the state restored.
+        return {
+            "kwargs": self._kwargs, "spec": self.spec,
+            "heads": None if self._heads is None else self._heads.state(),
+            "rngs": list(self._rngs), "np_random_seed": self._np_random_seed,
+            "spaces": (self.single_observation_space, self.single_action_space,
+                       self.observation_space, self.action_space),
+            "images": self._images, "autoreset": self._autoreset,
+            "needs_reset": self._needs_reset,
+        }
+
+    def __setstate__(self, state: Dict[str, Any]):
+        VectorFixationEnv.__init__(self, **state["kwargs"])
+        self.spec = state["spec"]
+        self._rngs, self._np_random_seed = list(state["rngs"]), state["np_random_seed"]
+        (self.single_observation_space, self.single_action_space, self.observation_space,
+         self.action_space) = state["spaces"]
+        self._images, self._autoreset = np.array(state["images"]), np.array(state["autoreset"])
+        self._needs_reset = state["needs_reset"]
+        if state["heads"] is None:
+            self.close()
+        else:
+            self._heads.set_state(state["heads"])
 
     def __enter__(self):
         return self
@@ -574,3 +711,14 @@ class VectorFixationEnv:
 
     def __str__(self):
         return f"<VectorFixationEnv num_envs={self.num_envs}>"
+
+
+def gymnasium_entry_point(**kwargs) -> FixationEnv:
+    """``gymnasium.make``'s entry point of saccade/Fixation-v0: a FixationEnv with no step
+    limit of its own unless `max_episode_steps` is given, since make's TimeLimit wrapper holds
+    the limit (the registered 200, the env's default, or make(..., max_episode_steps=k))."""
+    kwargs.setdefault("max_episode_steps", None)
+    return FixationEnv(**kwargs)
+
+
+gymnasium_entry_point.metadata = FixationEnv.metadata

@@ -17,9 +17,15 @@ except ImportError:
 
 
 def _np_random(seed: Optional[int] = None):
-    # gymnasium.utils.seeding.np_random: a PCG64 generator from a SeedSequence.
+    # gymnasium.utils.seeding.np_random: a PCG64 generator from a SeedSequence. With gymnasium
+    # importable, its own function (a bad seed raises gymnasium.error.Error, as Gymnasium's
+    # envs do); else the same generator, and a bad seed raises saccade.InvalidArgument.
+    if _gymnasium is not None:  # pragma: no cover
+        return _gymnasium.utils.seeding.np_random(seed)
     if seed is not None and not (isinstance(seed, (int, np.integer)) and seed >= 0):
-        raise ValueError(f"seed must be a non-negative integer or None, got {seed!r}")
+        from saccade import InvalidArgument
+
+        raise InvalidArgument(f"seed must be a non-negative integer or None, got {seed!r}")
     seed_seq = np.random.SeedSequence(seed)
     return np.random.Generator(np.random.PCG64(seed_seq)), seed_seq.entropy
 
@@ -160,7 +166,12 @@ def batch_box(space, n: int):
 
 
 def batch_space(space, n: int):
-    """Box -> stacked Box; Dict -> Dict of stacked spaces."""
+    """Box -> stacked Box; Dict -> Dict of stacked spaces (gymnasium.vector.utils.batch_space
+    itself when gymnasium is importable)."""
+    if _gymnasium is not None:  # pragma: no cover
+        from gymnasium.vector.utils import batch_space as gymnasium_batch_space
+
+        return gymnasium_batch_space(space, n)
     if hasattr(space, "spaces") and isinstance(space.spaces, dict):
         return dict_space({k: batch_space(v, n) for k, v in space.spaces.items()})
     return batch_box(space, n)
