@@ -301,7 +301,7 @@ Runner AddDemoCommand(CLI::App& app) {
   auto o = std::make_shared<Options>();
   auto* demo = app.add_subcommand(
       "demo",
-      "The main job: the active-vision loop of the seed paper, headless. The POPEYE head finds "
+      "The main job, the active-vision loop of the seed paper, headless: the POPEYE head finds "
       "the faces on the scene's portraits (rejecting the cat), tracks each with CamShift, "
       "triangulates it and fixates it, closest first, moving on once inhibition of return "
       "suppresses it. Prints each fixation's object, 3D error against the true face centre, "

@@ -167,8 +167,9 @@ Runner AddRenderCommand(CLI::App& app) {
   auto o = std::make_shared<RenderOptions>();
   auto* render = app.add_subcommand(
       "render",
-      "Render a scene headless through its calibrated cameras (lens distortion, sensor noise "
-      "and motion blur as the scene describes them): DIR/<camera>/<frame>.png, each camera's "
+      "Render a scene headless to a data set with ground truth: its calibrated cameras, with "
+      "lens distortion, sensor noise and motion blur as the scene describes them, to "
+      "DIR/<camera>/<frame>.png, each camera's "
       "calibration as OpenCV YAML with the distortion that was rendered (DIR/<camera>.yaml, "
       "DIR/stereo.yaml for a head), and DIR/frames.jsonl with every frame's metadata. Ctrl-C "
       "stops after the frame in hand: only whole frames are left.");
@@ -208,7 +209,8 @@ Runner AddBenchCommand(CLI::App& app) {
   auto o = std::make_shared<BenchOptions>();
   auto* bench = app.add_subcommand(
       "bench",
-      "Stereo frames per second: every camera rendered and its pixels in CPU memory, with the "
+      "Time the renderer in stereo frames per second: every camera rendered and its pixels in CPU "
+      "memory, with the "
       "time per stage; then the cost of each effect (lens distortion, sensor noise, motion blur "
       "with the head panning at 2 rad/s, ground truth, all of them), each run alone with the "
       "others off, against a run with all of them off. The effect switches below apply to the "

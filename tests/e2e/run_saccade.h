@@ -28,9 +28,9 @@ struct CommandRun {
   std::string output;  ///< stdout and stderr together
 };
 
-/// `saccade ARGS 2>&1`, waiting for it to end.
-inline CommandRun Saccade(const std::string& args) {
-  const std::string command = std::string(SACCADE_BINARY) + " " + args + " 2>&1";
+/// A shell command line `COMMAND 2>&1`, waiting for it to end.
+inline CommandRun Run(const std::string& command_line) {
+  const std::string command = command_line + " 2>&1";
   CommandRun run;
   FILE* pipe = popen(command.c_str(), "r");
   if (pipe == nullptr) return run;
@@ -41,6 +41,11 @@ inline CommandRun Saccade(const std::string& args) {
   const int raw = pclose(pipe);
   run.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
   return run;
+}
+
+/// `saccade ARGS 2>&1`, waiting for it to end.
+inline CommandRun Saccade(const std::string& args) {
+  return Run(std::string(SACCADE_BINARY) + " " + args);
 }
 
 /// `argv` (argv[0] the program's path) in the background, its standard output piped to the

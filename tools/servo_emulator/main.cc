@@ -176,7 +176,7 @@ int Run(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     std::fprintf(stderr, "%s: error: %s\nRun with --help for more information.\n", kProgram,
                  e.what());
-    return 2;
+    return 1;  // bad input: status 1, as saccade (docs/cli.md)
   }
 
   ServoEmulatorOptions options;
@@ -219,7 +219,7 @@ int Run(int argc, char** argv) {
   } catch (const OptionError& e) {
     std::fprintf(stderr, "%s: error: %s\nRun with --help for more information.\n", kProgram,
                  e.message.c_str());
-    return 2;
+    return 1;  // bad input: status 1, as saccade (docs/cli.md)
   }
   options.drop_rate = drop_rate;
   options.corrupt_rate = corrupt_rate;
