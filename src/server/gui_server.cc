@@ -67,11 +67,14 @@ GuiServer::GuiServer(ServerOptions options) : impl_(std::make_unique<Impl>(std::
                             "scheme, port or path, in lower case)");
     }
   }
-  if (o.max_message_bytes == 0 || o.max_clients < 1 || o.max_queued_messages == 0) {
+  if (o.max_message_bytes == 0 || o.max_clients < 1 || o.max_queued_messages == 0 ||
+      o.max_http_sessions < 1 || o.http_timeout.count() <= 0) {
     throw InvalidArgument(
-        "GuiServer: max_message_bytes, max_clients and max_queued_messages must be positive, got " +
+        "GuiServer: max_message_bytes, max_clients, max_queued_messages, max_http_sessions and "
+        "http_timeout must be positive, got " +
         std::to_string(o.max_message_bytes) + ", " + std::to_string(o.max_clients) + ", " +
-        std::to_string(o.max_queued_messages));
+        std::to_string(o.max_queued_messages) + ", " + std::to_string(o.max_http_sessions) + ", " +
+        std::to_string(o.http_timeout.count()) + " ms");
   }
   for (const auto& [prefix, folder] : o.mounts) {
     if (prefix.empty() || prefix.front() != '/' || prefix.back() != '/') {
@@ -123,6 +126,7 @@ void GuiServer::Start() {
     impl.acceptor->bind(endpoint);
     impl.acceptor->listen(asio::socket_base::max_listen_connections);
     impl.bound_port = impl.acceptor->local_endpoint().port();
+    impl.host_policy.port = impl.bound_port;  // before the I/O thread reads it
   } catch (const boost::system::system_error& e) {
     impl.acceptor.reset();
     throw Error("GuiServer::Start: cannot listen on " + where + ": " + e.code().message());

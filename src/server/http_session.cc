@@ -18,7 +18,7 @@ void HttpSession::Close() {
 void HttpSession::DoRead() {
   parser_.emplace();
   parser_->body_limit(kHttpBodyLimit);
-  stream_.expires_after(kHttpTimeout);
+  stream_.expires_after(server_->options.http_timeout);
   http::async_read(
       stream_, buffer_, *parser_,
       [self = shared_from_this()](beast::error_code ec, std::size_t) { self->OnRead(ec); });
@@ -262,11 +262,22 @@ bool ServerCore::TokenOk(const http::request<http::string_body>& req,
 void ServerCore::DoAccept() {
   acceptor->async_accept([this](beast::error_code ec, tcp::socket socket) {
     if (stopping || !acceptor->is_open()) return;
-    if (!ec) {
+    if (ec) {
+      OnAcceptError(ec);
+      return;
+    }
+    accept_backoff = std::chrono::milliseconds(0);
+    if (accept_warned) {
+      log::Info("GUI server: accepting connections again");
+      accept_warned = false;
+    }
+    std::erase_if(http_sessions, [](const auto& weak) { return weak.expired(); });
+    if (static_cast<int>(http_sessions.size()) >= options.max_http_sessions) {
+      Refuse(std::move(socket));
+    } else {
       // Small messages (states, replies) go out at once rather than after a delayed ACK.
       beast::error_code option_ec;
       socket.set_option(tcp::no_delay(true), option_ec);
-      std::erase_if(http_sessions, [](const auto& weak) { return weak.expired(); });
       auto session = std::make_shared<HttpSession>(this, std::move(socket));
       http_sessions.push_back(session);
       session->Run();
@@ -275,9 +286,59 @@ void ServerCore::DoAccept() {
   });
 }
 
+void ServerCore::OnAcceptError(beast::error_code ec) {
+  if (ec == asio::error::connection_aborted) {
+    DoAccept();  // the peer gave up before we took it: it left the backlog, nothing to wait for
+    return;
+  }
+  accept_backoff = accept_backoff.count() == 0 ? kAcceptBackoffMin
+                                               : std::min(accept_backoff * 2, kAcceptBackoffMax);
+  ++accept_failures;
+  const auto now = std::chrono::steady_clock::now();
+  if (now - accept_logged >= kFloodLogInterval) {
+    log::Warn(
+        "GUI server: cannot accept a connection: {} ({} failed accepts since the last such line; "
+        "{} HTTP connections, {} WebSocket clients open); retrying after pauses of up to {} ms",
+        ec.message(), accept_failures, http_sessions.size(), Snapshot().size(),
+        kAcceptBackoffMax.count());
+    accept_logged = now;
+    accept_failures = 0;
+    accept_warned = true;
+  }
+  accept_timer.expires_after(accept_backoff);
+  accept_timer.async_wait([this](beast::error_code wait_ec) {
+    if (wait_ec || stopping || !acceptor->is_open()) return;
+    DoAccept();
+  });
+}
+
+void ServerCore::Refuse(tcp::socket socket) {
+  // Best effort and never blocking: a fresh socket's send buffer takes this at once.
+  static constexpr std::string_view kBusy =
+      "HTTP/1.1 503 Service Unavailable\r\nContent-Type: text/plain; charset=utf-8\r\n"
+      "Content-Length: 44\r\nConnection: close\r\n\r\n503: too many connections to the GUI "
+      "server\n";
+  beast::error_code ec;
+  socket.non_blocking(true, ec);
+  if (!ec) socket.write_some(asio::buffer(kBusy.data(), kBusy.size()), ec);
+  socket.shutdown(tcp::socket::shutdown_both, ec);
+  socket.close(ec);
+  ++refused_sessions;
+  const auto now = std::chrono::steady_clock::now();
+  if (now - refusal_logged >= kFloodLogInterval) {
+    log::Warn(
+        "GUI server: {} HTTP connections open (max_http_sessions); closed {} more since the last "
+        "such line",
+        options.max_http_sessions, refused_sessions);
+    refusal_logged = now;
+    refused_sessions = 0;
+  }
+}
+
 void ServerCore::CloseAll() {
   stopping = true;
   beast::error_code ec;
+  accept_timer.cancel();
   if (acceptor) acceptor->close(ec);
   for (const auto& weak : http_sessions) {
     if (auto session = weak.lock()) session->Close();

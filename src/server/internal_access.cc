@@ -36,28 +36,46 @@ bool IsUnspecified(const std::string& address) {
 
 }  // namespace
 
-std::string HostName(std::string_view host_header) {
-  if (host_header.empty()) return "";
+std::optional<HostHeader> ParseHostHeader(std::string_view host_header) {
+  HostHeader out;
   std::string_view host;
-  if (host_header.front() == '[') {
+  std::string_view rest;
+  if (!host_header.empty() && host_header.front() == '[') {
     const std::size_t close = host_header.find(']');
-    if (close == std::string_view::npos) return "";
+    if (close == std::string_view::npos) return std::nullopt;
     host = host_header.substr(1, close - 1);
-    const std::string_view rest = host_header.substr(close + 1);
-    if (!rest.empty() && rest.front() != ':') return "";
+    rest = host_header.substr(close + 1);
+    // Only an IPv6 address goes in brackets (no zone id: '%' is not allowed in a Host).
+    boost::system::error_code ec;
+    boost::asio::ip::make_address_v6(std::string(host), ec);
+    if (ec || host.find('%') != std::string_view::npos) return std::nullopt;
   } else {
     const std::size_t colon = host_header.find(':');
     host = host_header.substr(0, colon);
-    if (colon != std::string_view::npos &&
-        host_header.find(':', colon + 1) != std::string_view::npos) {
-      return "";  // an unbracketed IPv6 address or junk
+    rest = colon == std::string_view::npos ? std::string_view() : host_header.substr(colon);
+    if (host.empty()) return std::nullopt;
+    for (const char c : host) {
+      const auto u = static_cast<unsigned char>(c);
+      if (!(std::isalnum(u) || c == '.' || c == '-' || c == '_')) return std::nullopt;
     }
   }
-  for (const char c : host) {
-    const auto u = static_cast<unsigned char>(c);
-    if (!(std::isalnum(u) || c == '.' || c == '-' || c == ':' || c == '_')) return "";
+  if (!rest.empty()) {
+    // ':' then the port's digits and nothing else: no userinfo, path or second colon.
+    const std::string_view port = rest.substr(1);
+    if (rest.front() != ':' || port.empty() || port.size() > 5) return std::nullopt;
+    for (const char c : port) {
+      if (c < '0' || c > '9') return std::nullopt;
+    }
+    out.port = std::string(port);
+    out.has_port = true;
   }
-  return Lower(host);
+  out.host = Lower(host);
+  return out;
+}
+
+std::string HostName(std::string_view host_header) {
+  const std::optional<HostHeader> parsed = ParseHostHeader(host_header);
+  return parsed ? parsed->host : "";
 }
 
 bool HostAllowed(std::string_view host_header, const HostPolicy& policy, std::string* why) {
@@ -65,11 +83,19 @@ bool HostAllowed(std::string_view host_header, const HostPolicy& policy, std::st
     *why = "the request names no Host";
     return false;
   }
-  const std::string host = HostName(host_header);
-  if (host.empty()) {
-    *why = "the Host '" + std::string(host_header) + "' is malformed";
+  const std::optional<HostHeader> parsed = ParseHostHeader(host_header);
+  if (!parsed) {
+    *why = "the Host '" + std::string(host_header) +
+           "' is malformed (expected host[:port], e.g. 127.0.0.1:" + std::to_string(policy.port) +
+           ", [::1]:" + std::to_string(policy.port) + " or localhost)";
     return false;
   }
+  if (parsed->has_port && parsed->port != std::to_string(policy.port)) {
+    *why = "the Host '" + std::string(host_header) + "' names port " + parsed->port +
+           ", not this server's port " + std::to_string(policy.port);
+    return false;
+  }
+  const std::string& host = parsed->host;
   if (IsLoopbackAddress(host)) return true;
   if (host == Lower(policy.listen_address)) return true;
   if (IsUnspecified(policy.listen_address) && IsIpAddress(host)) return true;

@@ -1,6 +1,8 @@
 #pragma once
 // Who may talk to the GUI server (gui_server.h, "Security"): the Host a request names and the
 // Origin of the page that sent it. Pure functions of the headers, tested on their own.
+#include <cstdint>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -11,16 +13,32 @@ namespace saccade::server::internal {
 struct HostPolicy {
   std::string listen_address;              ///< ServerOptions::address
   std::vector<std::string> allowed_hosts;  ///< ServerOptions::allowed_hosts (names, no port)
+  uint16_t port = 0;                       ///< the bound port: the only one a Host may name
 };
 
+/// A Host header value taken apart (RFC 9110 7.2: `host [":" port]`).
+struct HostHeader {
+  std::string host;  ///< lower case, without brackets: "example.com", "127.0.0.1", "::1"
+  std::string port;  ///< the digits after the ':', exactly as sent; "" when none was
+  bool has_port = false;
+};
+
+/// Parses a Host header value: a name (letters, digits, '.', '-', '_'), an IPv4 address, or an
+/// IPv6 address in brackets ("[::1]"), then optionally ':' and 1 to 5 digits. Anything else
+/// (userinfo "a@b", a path, an empty or non-numeric port "x:" "x:80x", an unbracketed or
+/// invalid IPv6 address, a second ':') is malformed: nullopt.
+std::optional<HostHeader> ParseHostHeader(std::string_view host_header);
+
 /// The host part of a Host header value ("Example.com:8080" -> "example.com", "[::1]:80" ->
-/// "::1"): lower case, without port or brackets; "" when malformed.
+/// "::1"): lower case, without port or brackets; "" when malformed (ParseHostHeader).
 std::string HostName(std::string_view host_header);
 
-/// Whether a request naming `host_header` is for this server: a loopback name or address
-/// (localhost, 127.0.0.0/8, ::1), the listen address, any IP address when listening on all
-/// interfaces (0.0.0.0 or ::), or a name of `allowed_hosts`. A name that is none of these is
-/// what a DNS-rebinding page sends. On false, `why` says what was wrong.
+/// Whether a request naming `host_header` is for this server: exactly `host[:port]`
+/// (ParseHostHeader), the port, when given, the server's own (`policy.port`, in its canonical
+/// decimal form), and the host a loopback name or address (localhost, 127.0.0.0/8, ::1), the
+/// listen address, any IP address when listening on all interfaces (0.0.0.0 or ::), or a name
+/// of `allowed_hosts`. A name that is none of these is what a DNS-rebinding page sends. On
+/// false, `why` says what was wrong.
 bool HostAllowed(std::string_view host_header, const HostPolicy& policy, std::string* why);
 
 /// Whether a request's Origin header (`origin`, "" when absent) is the server's own page:

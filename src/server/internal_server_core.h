@@ -41,8 +41,7 @@ namespace fs = std::filesystem;
 using tcp = asio::ip::tcp;
 using nlohmann::json;
 
-inline constexpr auto kHttpTimeout = std::chrono::seconds(60);  // idle keep-alive and slow requests
-inline constexpr std::size_t kHttpBodyLimit = 64 * 1024;        // GET/HEAD carry no body worth more
+inline constexpr std::size_t kHttpBodyLimit = 64 * 1024;  // GET/HEAD carry no body worth more
 // The hard bound on one incoming WebSocket message, as a multiple of max_message_bytes:
 // messages up to it are read whole and answered with an error; beyond it Beast closes the
 // connection with 1009 (message too big).
@@ -50,6 +49,13 @@ inline constexpr std::size_t kHardMessageFactor = 16;
 inline constexpr const char* kServerName = "saccade";
 // The largest `frame_window` a client may ask for (frames sent and not acknowledged).
 inline constexpr int kMaxFrameWindow = 64;
+// After a failed accept (out of file descriptors, most often) the next waits this long,
+// doubling up to the cap; a success resets it. Retrying at once would spin: the connection
+// stays in the backlog and the next accept fails the same way.
+inline constexpr auto kAcceptBackoffMin = std::chrono::milliseconds(5);
+inline constexpr auto kAcceptBackoffMax = std::chrono::milliseconds(200);
+// Refused connections and failed accepts are logged at most this often, with a count.
+inline constexpr auto kFloodLogInterval = std::chrono::seconds(10);
 
 // Beast 1.74 speaks boost::string_view.
 inline std::string_view View(beast::string_view v) { return {v.data(), v.size()}; }
@@ -217,12 +223,23 @@ struct ServerCore {
   // I/O thread only (and Start/Stop while the thread is not running).
   std::optional<tcp::acceptor> acceptor;
   std::vector<std::weak_ptr<HttpSession>> http_sessions;
+  asio::steady_timer accept_timer{ioc};
+  std::chrono::milliseconds accept_backoff{0};  // 0: the last accept succeeded
+  int64_t accept_failures = 0;                  // since the last log line
+  bool accept_warned = false;                   // a failure was logged, the recovery not yet
+  int64_t refused_sessions = 0;                 // over max_http_sessions, since the last log line
+  std::chrono::steady_clock::time_point accept_logged{};
+  std::chrono::steady_clock::time_point refusal_logged{};
   std::atomic<bool> stopping{false};
 
   std::thread thread;
   std::atomic<uint16_t> bound_port{0};
 
   void DoAccept();
+  // A failed accept: waits accept_backoff (growing) before the next, logs now and then.
+  void OnAcceptError(beast::error_code ec);
+  // A connection over max_http_sessions: a best-effort 503, then closed.
+  void Refuse(tcp::socket socket);
   void CloseAll();
   void RemoveClient(int64_t id) {
     std::lock_guard lock(clients_mutex);

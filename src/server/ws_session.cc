@@ -12,7 +12,7 @@ WsSession::WsSession(ServerCore* server, tcp::socket socket, int64_t id)
 }
 
 void WsSession::Run(http::request<http::string_body> req) {
-  beast::get_lowest_layer(ws_).expires_after(kHttpTimeout);
+  beast::get_lowest_layer(ws_).expires_after(server_->options.http_timeout);
   ws_.set_option(websocket::stream_base::decorator(
       [](websocket::response_type& res) { res.set(http::field::server, kServerName); }));
   ws_.read_message_max(server_->options.max_message_bytes * kHardMessageFactor);

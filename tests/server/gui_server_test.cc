@@ -557,14 +557,15 @@ TEST(GuiServerAccessTest, HostNamesAreLowerCaseWithoutPortOrBrackets) {
   EXPECT_EQ(internal::HostName("::1"), "");  // IPv6 needs brackets in a Host header
   EXPECT_EQ(internal::HostName("[::1"), "");
   EXPECT_EQ(internal::HostName("evil.com/x"), "");
+  EXPECT_EQ(internal::HostName("127.0.0.1:8080@evil.com"), "");
   EXPECT_EQ(internal::HostName(""), "");
 }
 
 TEST(GuiServerAccessTest, HostPolicyAcceptsLoopbackTheListenAddressAndAllowedNamesOnly) {
   std::string why;
-  const internal::HostPolicy loopback{"127.0.0.1", {}};
+  const internal::HostPolicy loopback{"127.0.0.1", {}, 8080};
   for (const char* host :
-       {"127.0.0.1:8080", "localhost:8080", "LOCALHOST", "127.1.2.3", "[::1]:8"}) {
+       {"127.0.0.1:8080", "localhost:8080", "LOCALHOST", "127.1.2.3", "[::1]:8080", "[::1]"}) {
     EXPECT_TRUE(internal::HostAllowed(host, loopback, &why)) << host << ": " << why;
   }
   for (const char* host : {"evil.example.com:8080", "192.168.1.20:8080", "localhost.evil.com",
@@ -574,17 +575,63 @@ TEST(GuiServerAccessTest, HostPolicyAcceptsLoopbackTheListenAddressAndAllowedNam
   EXPECT_FALSE(internal::HostAllowed("evil.example.com:8080", loopback, &why));
   EXPECT_THAT(why, ::testing::HasSubstr("'evil.example.com:8080' is not this server"));
 
-  const internal::HostPolicy lab{"192.168.1.20", {"robot-head.local"}};
+  const internal::HostPolicy lab{"192.168.1.20", {"robot-head.local"}, 8080};
   EXPECT_TRUE(internal::HostAllowed("192.168.1.20:8080", lab, &why));
   EXPECT_TRUE(internal::HostAllowed("Robot-Head.local:8080", lab, &why));
   EXPECT_FALSE(internal::HostAllowed("192.168.1.21:8080", lab, &why));
   EXPECT_FALSE(internal::HostAllowed("robot-head.local.evil.com", lab, &why));
 
   // On every interface: any address literal (a page from one is this server's own), no name.
-  const internal::HostPolicy any{"0.0.0.0", {}};
+  const internal::HostPolicy any{"0.0.0.0", {}, 8080};
   EXPECT_TRUE(internal::HostAllowed("10.1.2.3:8080", any, &why));
   EXPECT_TRUE(internal::HostAllowed("[fe80::1]:8080", any, &why));
   EXPECT_FALSE(internal::HostAllowed("rebind.evil.com:8080", any, &why));
+}
+
+// Issue 46: the check read only the text before the first ':', so a Host with userinfo or a
+// port followed by junk named this server.
+TEST(GuiServerAccessTest, AHostThatIsNotExactlyHostAndThisPortIsRefused) {
+  std::string why;
+  const internal::HostPolicy policy{"127.0.0.1", {"robot-head.local"}, 8080};
+  for (const char* host : {"127.0.0.1:8080@evil.example.com",
+                           "user@127.0.0.1:8080",
+                           "user:pass@localhost:8080",
+                           "[::ffff:7f00:1]:8080x",
+                           "127.0.0.1:8080x",
+                           "127.0.0.1:",
+                           "[::1]:",
+                           "localhost:+8080",
+                           "localhost: 8080",
+                           "127.0.0.1:8080:8080",
+                           "127.0.0.1:123456",
+                           "[::1]x",
+                           "[::1]]:8080",
+                           "[127.0.0.1]:8080",
+                           "[fe80::1%25eth0]:8080",
+                           "[localhost]:8080",
+                           "127.0.0.1/x",
+                           "127.0.0.1:8080/x",
+                           ":8080",
+                           "127.0.0.1 :8080",
+                           "robot-head.local:8080@evil.example.com"}) {
+    EXPECT_FALSE(internal::HostAllowed(host, policy, &why)) << host;
+    EXPECT_THAT(why, ::testing::HasSubstr("is malformed (expected host[:port]")) << host;
+  }
+  for (const char* host : {"127.0.0.1:9090", "localhost:80", "[::1]:8081", "127.0.0.1:08080",
+                           "127.0.0.1:80800", "robot-head.local:443", "127.0.0.1:0"}) {
+    EXPECT_FALSE(internal::HostAllowed(host, policy, &why)) << host;
+    EXPECT_THAT(why, ::testing::HasSubstr("not this server's port 8080")) << host;
+  }
+  // Still this server: with or without the port, by any loopback form or an allowed name.
+  for (const char* host :
+       {"127.0.0.1:8080", "127.0.0.1", "localhost:8080", "[::1]:8080", "[::ffff:7f00:1]:8080",
+        "[::FFFF:127.0.0.1]", "robot-head.local:8080", "robot-head.local"}) {
+    EXPECT_TRUE(internal::HostAllowed(host, policy, &why)) << host << ": " << why;
+  }
+  ASSERT_TRUE(internal::ParseHostHeader("[::1]:8080").has_value());
+  EXPECT_EQ(internal::ParseHostHeader("[::1]:8080")->host, "::1");
+  EXPECT_EQ(internal::ParseHostHeader("[::1]:8080")->port, "8080");
+  EXPECT_FALSE(internal::ParseHostHeader("localhost")->has_port);
 }
 
 TEST(GuiServerAccessTest, OriginMustBeThePageOfTheHostAsked) {
@@ -661,6 +708,32 @@ TEST_F(AccessTest, AllowedHostNamesAreServed) {
   WsClient ws;
   EXPECT_EQ(ws.Connect(server_->port(), "/ws", "", host, "http://" + host), 101);
   EXPECT_EQ(Get(server_->port(), "/api/status", {{http::field::host, "other.local"}}).status, 403);
+}
+
+TEST_F(AccessTest, AHostWithUserinfoOrAnotherPortIs403OnTheApiAndTheWebSocket) {
+  const std::string port = std::to_string(server_->port());
+  const std::string other = std::to_string(server_->port() == 65535 ? 65534 : server_->port() + 1);
+  ::testing::internal::CaptureStderr();
+  for (const std::string& host :
+       {"127.0.0.1:" + port + "@evil.example.com", "[::ffff:7f00:1]:" + port + "x",
+        "evil@127.0.0.1:" + port, "127.0.0.1:" + other, "localhost:" + other,
+        std::string("127.0.0.1:"), "127.0.0.1:" + port + "x"}) {
+    EXPECT_EQ(Get(server_->port(), "/api/status", {{http::field::host, host}}).status, 403) << host;
+    WsClient ws;
+    EXPECT_EQ(ws.Connect(server_->port(), "/ws", "", host), 403) << host;
+  }
+  const std::string log = ::testing::internal::GetCapturedStderr();
+  EXPECT_THAT(log,
+              ::testing::HasSubstr("names port " + other + ", not this server's port " + port));
+  EXPECT_EQ(server_->client_count(), 0);
+  EXPECT_EQ(handled_, 0);
+  for (const std::string& host :
+       {"127.0.0.1:" + port, "localhost:" + port, "[::1]:" + port, std::string("127.0.0.1")}) {
+    EXPECT_EQ(Get(server_->port(), "/api/status", {{http::field::host, host}}).status, 200) << host;
+  }
+  WsClient ws;
+  const std::string host = "127.0.0.1:" + port;
+  EXPECT_EQ(ws.Connect(server_->port(), "/ws", "", host, "http://" + host), 101);
 }
 
 TEST(GuiServerWsTest, HelloCarriesProtocolClientAndExtraFieldsThenWelcome) {

@@ -15,9 +15,12 @@
 // that the operator happens to visit, which could otherwise open a WebSocket to the GUI on
 // 127.0.0.1 and move the head (the real robot's servos with a hardware file), or read the
 // scene through a DNS-rebinding name. So:
-// - Every request must name this server in its Host header: localhost, a loopback address,
-//   the listen address (any IP address when listening on 0.0.0.0 or ::), or a name of
-//   `allowed_hosts`. Anything else gets 403 and a log line (core/log.h) naming the peer.
+// - Every request must name this server in its Host header, exactly `host[:port]`: the host
+//   localhost, a loopback address, the listen address (any IP address when listening on
+//   0.0.0.0 or ::), or a name of `allowed_hosts`, IPv6 addresses in brackets; the port, when
+//   given, this server's own. Anything else (another name or port, userinfo "h@evil", a
+//   malformed port "8080x" or "h:", a path) gets 403 and a log line (core/log.h) naming the
+//   peer. (A tunnel must keep the port number: ssh -L 8080:127.0.0.1:8080.)
 // - A request that carries an Origin header (browsers send one on every WebSocket and on
 //   cross-origin requests) must come from this server's own page: Origin equal to
 //   "http://" + its Host. Anything else gets 403 and a log line. Programs that send no Origin
@@ -28,9 +31,19 @@
 //   `Authorization: Bearer ...`), or gets 401. The page itself and static files need no token
 //   (they hold no state). The applications set a random token (GenerateToken) on loopback too,
 //   unless told not to, and print it in the page's address, as Jupyter does.
+//
+// Resources (ServerOptions): at most max_http_sessions HTTP connections (64) and max_clients
+// WebSocket clients (32) at once; an HTTP connection idle for http_timeout (30 s) is closed.
+// A local program that opens connections by the hundred cannot make the server use more file
+// descriptors than these allow, and when the process runs out of them anyway (a low
+// RLIMIT_NOFILE), a failed accept is retried after a back-off growing from 5 ms to 200 ms
+// (reset by the next success, logged once per 10 s), not at once: the server does not spin,
+// and accepts again as soon as descriptors are free.
+//
 // Messages larger than max_message_bytes, malformed JSON, a missing or unknown `type`, and ids
 // that do not increase get an error reply naming what was wrong; the connection and every
 // other client go on.
+#include <chrono>
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -60,7 +73,17 @@ struct ServerOptions {
   /// Larger client messages get an error reply and are ignored; the connection stays open.
   /// Beyond 16 times this (a hard bound on what is read), the connection is closed with 1009.
   std::size_t max_message_bytes = 64 * 1024;
-  int max_clients = 32;                  ///< WebSocket clients at once; more get 503
+  /// WebSocket clients at once; a handshake beyond it gets 503. A client that sends nothing is
+  /// never timed out (a page may only watch), so this bounds what they can hold.
+  int max_clients = 32;
+  /// HTTP connections at once (the page, files, /api/, WebSocket handshakes not yet upgraded;
+  /// upgraded ones count against max_clients instead). A connection beyond it gets a 503 if
+  /// its socket takes one at once and is closed; one log line per 10 s says how many were.
+  int max_http_sessions = 64;
+  /// An HTTP connection that does not deliver a whole request within this time after it opens
+  /// or after its last response (an idle keep-alive, a request sent byte by byte, a WebSocket
+  /// handshake that never completes) is closed.
+  std::chrono::milliseconds http_timeout = std::chrono::seconds(30);
   std::size_t max_queued_messages = 64;  ///< replies and events per client; oldest dropped
   /// Fields merged into the hello message each client gets first ({"type": "hello",
   /// "protocol", "version", "client"} plus these, e.g. {"mode": "demo"}).
@@ -99,7 +122,8 @@ using CommandHandler = std::function<nlohmann::json(const nlohmann::json& comman
 class GuiServer {
  public:
   /// Checks the options (InvalidArgument naming the option): a non-loopback address without a
-  /// token, an unknown mount folder, a mount prefix that does not start and end with '/'.
+  /// token, an unknown mount folder, a mount prefix that does not start and end with '/', a
+  /// limit or timeout that is not positive.
   explicit GuiServer(ServerOptions options);
   ~GuiServer();  // Stop()
   GuiServer(const GuiServer&) = delete;
