@@ -22,6 +22,8 @@ using internal::FrameOf;
 
 namespace {
 
+using Options = vision::FaceDetector::Options;
+
 // Two boxes of one face: they overlap by more than half the smaller one.
 bool SameFace(const cv::Rect& a, const cv::Rect& b) {
   return (a & b).area() > 0.5 * std::min(a.area(), b.area());
@@ -72,7 +74,7 @@ FaceDetectorComponent::FaceDetectorComponent()
                "search faces on the image halved this many times (a quarter of the pixels a "
                "level); "
                "the cat and eye checks stay on the full image")
-      .Range(0, 4);
+      .Range(Options::kPyramidLevels);
   DeclareParam("latency_steps", &latency_steps_,
                "0: detect within the step; N: detect on a thread of its own, the faces emitted N "
                "steps after their image (simulated clock; real time: once ready)")
@@ -89,7 +91,7 @@ FaceDetectorComponent::FaceDetectorComponent()
                "searches (the faces they find are searched again around where they were, at "
                "pyramid_level), and of the whole-image searches for the other faces of a "
                "detector on its own thread in real time (realtime_thread)")
-      .Range(0, 4);
+      .Range(Options::kPyramidLevels);
   DeclareParam("realtime_thread", &realtime_thread_,
                "on the real-time clock (saccade demo --realtime, the GUI), detect on a thread of "
                "its own whatever latency_steps says, the faces emitted once ready, so that the "
@@ -142,21 +144,22 @@ FaceDetectorComponent::FaceDetectorComponent()
   DeclareParam("region_pyramid_level", &region_pyramid_level_,
                "the pyramid level of the search around the track (the whole image's is "
                "pyramid_level)")
-      .Range(0, 4);
+      .Range(Options::kPyramidLevels);
   DeclareParam("min_neighbors", &options_.min_neighbors, "overlapping hits needed to keep a box")
-      .Range(0, 1000);
+      .Range(Options::kNeighbors);
   DeclareParam("scale_factor", &options_.scale_factor, "size step between pyramid levels")
-      .Range(1.0001, 4.0);
+      .Range(Options::kScaleFactors);
   DeclareParam("discovery_scale_factor", &discovery_scale_factor_,
                "with a track region: the size step of the whole-image searches, which look for "
                "the other faces (the tracked face's box comes from the search around it, at "
                "scale_factor); scale_factor's value: one step everywhere")
-      .Range(1.0001, 4.0);
+      .Range(Options::kScaleFactors);
   DeclareParam("min_size_px", &options_.min_size_px, "smallest face side")
-      .Range(1, 100000)
+      .Range(Options::kMinSizes)
       .Unit("px");
-  DeclareParam("max_size_px", &options_.max_size_px, "largest face side; 0: no limit")
-      .Range(0, 100000)
+  DeclareParam("max_size_px", &options_.max_size_px,
+               "largest face side; 0: no limit, else at least min_size_px")
+      .Range(Options::kMaxSizes)
       .Unit("px");
   DeclareParam("reject_cats", &reject_cats_, "reject boxes that the cat-face cascade also finds");
   DeclareParam("require_eyes", &require_eyes_, "reject boxes without an eye inside");

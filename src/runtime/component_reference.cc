@@ -148,6 +148,8 @@ nlohmann::json ComponentsJson(const std::vector<ComponentReference>& components)
           {"required", p.required}, {"unit", p.unit},       {"doc", p.doc}};
       if (!p.min.is_null()) param["min"] = p.min;
       if (!p.max.is_null()) param["max"] = p.max;
+      if (p.min_open) param["min_exclusive"] = true;
+      if (p.max_open) param["max_exclusive"] = true;
       if (!p.choices.empty()) param["choices"] = p.choices;
       if (p.path) param["path"] = true;
       j["params"].push_back(param);

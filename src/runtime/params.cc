@@ -30,11 +30,12 @@ std::string Num(const nlohmann::json& v) {
   return v.is_number_integer() ? v.dump() : fmt::format("{}", v.get<double>());
 }
 
-// " in [0, 1000]", " in [0.1, inf]", "" (unbounded).
+// " in [0, 1000]", " in [0.1, inf]", " in (1, 4]", "" (unbounded).
 std::string RangeText(const ParamInfo& p) {
   if (p.min.is_null() && p.max.is_null()) return "";
-  return fmt::format(" in [{}, {}]", p.min.is_null() ? "-inf" : Num(p.min),
-                     p.max.is_null() ? "inf" : Num(p.max));
+  return fmt::format(" in {}{}, {}{}", p.min_open ? "(" : "[",
+                     p.min.is_null() ? "-inf" : Num(p.min), p.max.is_null() ? "inf" : Num(p.max),
+                     p.max_open ? ")" : "]");
 }
 
 // Empty when `v` is a valid value of `p`; else what was expected.
@@ -60,8 +61,8 @@ std::string Check(const ParamInfo& p, const nlohmann::json& v) {
     return std::string();
   }();
   const auto in_range = [&](double x) {
-    return (p.min.is_null() || x >= p.min.get<double>()) &&
-           (p.max.is_null() || x <= p.max.get<double>());
+    return (p.min.is_null() || (p.min_open ? x > p.min.get<double>() : x >= p.min.get<double>())) &&
+           (p.max.is_null() || (p.max_open ? x < p.max.get<double>() : x <= p.max.get<double>()));
   };
   bool ok = false;
   switch (p.kind) {
@@ -138,6 +139,23 @@ ParamDecl& ParamDecl::Range(double min, double max) {
   } else {
     info_->min = min;
     info_->max = max;
+  }
+  return *this;
+}
+
+ParamDecl& ParamDecl::Range(const Interval& interval) {
+  if (info_->kind == ParamKind::kInteger) {
+    // The integers inside: (1, 4] -> [2, 4], [0.5, 3.5) -> [1, 3].
+    const double low = interval.min_open ? std::floor(interval.min) + 1 : std::ceil(interval.min);
+    const double high = interval.max_open ? std::ceil(interval.max) - 1 : std::floor(interval.max);
+    info_->min = std::isinf(low) ? nlohmann::json() : nlohmann::json(static_cast<int64_t>(low));
+    info_->max = std::isinf(high) ? nlohmann::json() : nlohmann::json(static_cast<int64_t>(high));
+    info_->min_open = info_->max_open = false;
+  } else {
+    info_->min = std::isinf(interval.min) ? nlohmann::json() : nlohmann::json(interval.min);
+    info_->max = std::isinf(interval.max) ? nlohmann::json() : nlohmann::json(interval.max);
+    info_->min_open = interval.min_open && !std::isinf(interval.min);
+    info_->max_open = interval.max_open && !std::isinf(interval.max);
   }
   return *this;
 }

@@ -42,21 +42,23 @@ bool FaceDetector::Options::IsValid(std::string* error) const {
   std::string what;
   if (cascade_path.empty()) {
     what = "cascade_path is empty, expected the path of a face cascade";
-  } else if (!std::isfinite(scale_factor) || scale_factor <= 1.0 || scale_factor > 4.0) {
-    what = "scale_factor " + std::to_string(scale_factor) + ", expected 1 < scale_factor <= 4";
-  } else if (min_neighbors < 0) {
-    what = "min_neighbors " + std::to_string(min_neighbors) + ", expected >= 0";
-  } else if (pyramid_level < 0 || pyramid_level > 4) {
-    what = "pyramid_level " + std::to_string(pyramid_level) + ", expected 0 .. 4";
-  } else if (min_size_px < 1) {
-    what = "min_size_px " + std::to_string(min_size_px) + ", expected >= 1";
+  } else if (!kScaleFactors.Contains(scale_factor)) {
+    what = kScaleFactors.Refusal("scale_factor", scale_factor);
+  } else if (!kNeighbors.Contains(min_neighbors)) {
+    what = kNeighbors.Refusal("min_neighbors", min_neighbors);
+  } else if (!kPyramidLevels.Contains(pyramid_level)) {
+    what = kPyramidLevels.Refusal("pyramid_level", pyramid_level);
+  } else if (!kMinSizes.Contains(min_size_px)) {
+    what = kMinSizes.Refusal("min_size_px", min_size_px);
+  } else if (!kMaxSizes.Contains(max_size_px)) {
+    what = kMaxSizes.Refusal("max_size_px", max_size_px);
   } else if (max_size_px != 0 && max_size_px < min_size_px) {
     what = "max_size_px " + std::to_string(max_size_px) +
            ", expected 0 (no limit) or >= " + "min_size_px (" + std::to_string(min_size_px) + ")";
-  } else if (cat_min_neighbors < 0) {
-    what = "cat_min_neighbors " + std::to_string(cat_min_neighbors) + ", expected >= 0";
-  } else if (min_eyes < 1 || min_eyes > 2) {
-    what = "min_eyes " + std::to_string(min_eyes) + ", expected 1 or 2";
+  } else if (!kNeighbors.Contains(cat_min_neighbors)) {
+    what = kNeighbors.Refusal("cat_min_neighbors", cat_min_neighbors);
+  } else if (!kEyes.Contains(min_eyes)) {
+    what = kEyes.Refusal("min_eyes", min_eyes);
   }
   if (what.empty()) return true;
   if (error) *error = "FaceDetector::Options: " + what;

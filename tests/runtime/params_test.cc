@@ -7,6 +7,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <string>
 #include <vector>
 
@@ -85,6 +86,41 @@ TEST(Params, BadValuesNameTheParameterAndChangeNothing) {
             "parameter 'passes': expected an integer in [1, 5], got 0");
   EXPECT_EQ(blur.sigma, 1.5);
   EXPECT_EQ(blur.configured, 0);
+}
+
+// Ranges taken from a library's Interval: open ends stay open on numbers, and become the
+// nearest integers inside on integers; unbounded ends are unbounded.
+class Ranged final : public Component {
+ public:
+  Ranged() {
+    DeclareParam("ratio", &ratio, "a step above 1").Range(Interval::LeftOpen(1, 4));
+    DeclareParam("gap", &gap, "below 1").Range(Interval::RightOpen(-1, 1));
+    DeclareParam("count", &count, "above 1, at most 4").Range(Interval::LeftOpen(1, 4));
+    DeclareParam("level", &level, "fractional ends").Range(Interval::RightOpen(0.5, 3.5));
+    DeclareParam("many", &many, "at least 2").Range(Interval::AtLeast(2));
+  }
+  void Step(const StepContext&) override {}
+  double ratio = 2, gap = 0;
+  int count = 2, level = 1, many = 2;
+};
+
+TEST(Params, IntervalRangesKeepOpenEndsOnNumbersAndRoundIntegerEndsInside) {
+  Ranged r;
+  EXPECT_EQ(ErrorOf(r, {{"ratio", 1}}), "parameter 'ratio': expected a number in (1, 4], got 1");
+  EXPECT_EQ(ErrorOf(r, {{"ratio", 1.000001}}), "accepted");
+  EXPECT_EQ(ErrorOf(r, {{"ratio", 4}}), "accepted");
+  EXPECT_EQ(ErrorOf(r, {{"gap", 1}}), "parameter 'gap': expected a number in [-1, 1), got 1");
+  EXPECT_EQ(ErrorOf(r, {{"gap", -1}}), "accepted");
+  EXPECT_EQ(ErrorOf(r, {{"count", 1}}), "parameter 'count': expected an integer in [2, 4], got 1");
+  EXPECT_EQ(ErrorOf(r, {{"count", 4}}), "accepted");
+  EXPECT_EQ(ErrorOf(r, {{"level", 0}}), "parameter 'level': expected an integer in [1, 3], got 0");
+  EXPECT_EQ(ErrorOf(r, {{"level", 3}}), "accepted");
+  EXPECT_EQ(ErrorOf(r, {{"many", 1}}), "parameter 'many': expected an integer in [2, inf], got 1");
+  EXPECT_EQ(ErrorOf(r, {{"many", 2000000000}}), "accepted");
+  // The interval's own text and verdict, as a library's IsValid uses them.
+  EXPECT_EQ(Interval::LeftOpen(1, 4).Text(), "(1, 4]");
+  EXPECT_EQ(Interval::AtLeast(0.5).Text(), "[0.5, inf)");
+  EXPECT_FALSE(Interval::Closed(0, 1).Contains(std::nan("")));
 }
 
 TEST(Params, IntegersBeyondTheMembersTypeAreRefused) {

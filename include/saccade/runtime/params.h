@@ -22,6 +22,8 @@
 #include <utility>
 #include <vector>
 
+#include "saccade/core/interval.h"
+
 namespace saccade::runtime {
 
 enum class ParamKind {
@@ -41,6 +43,8 @@ struct ParamInfo {
   nlohmann::json default_value;  ///< the member's value at declaration; null when required
   bool required = false;
   nlohmann::json min, max;  ///< null when unbounded
+  bool min_open = false;    ///< kNumber: min itself is outside (an Interval's open end)
+  bool max_open = false;    ///< kNumber: max itself is outside
   std::vector<std::string> choices;
   std::size_t count = 0;                                            ///< kNumbers: how many
   std::pair<int64_t, int64_t> representable{INT64_MIN, INT64_MAX};  ///< kInteger: the member's
@@ -60,6 +64,10 @@ class ParamDecl {
  public:
   explicit ParamDecl(ParamInfo& info) : info_(&info) {}
   ParamDecl& Range(double min, double max);
+  /// The range a library declares for the value (its Options' Interval, which its IsValid
+  /// checks too): the component and the library then give the same verdict on every value.
+  /// On an integer, an open or fractional end becomes the nearest integer inside.
+  ParamDecl& Range(const Interval& interval);
   ParamDecl& Min(double min);
   ParamDecl& Max(double max);
   ParamDecl& Choices(std::vector<std::string> choices);

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "saccade/core/image.h"
+#include "saccade/core/interval.h"
 
 namespace saccade::vision {
 
@@ -50,9 +51,9 @@ class FaceDetector {
     /// boxes come back in the image's pixels, and the cat and eye checks run on the image
     /// itself. 0 .. 4; sizes (min_size_px, max_size_px) stay in the image's pixels.
     int pyramid_level = 0;
-    double scale_factor = 1.1;  ///< between pyramid levels: > 1 and <= 4
-    int min_neighbors = 3;      ///< hits needed to keep a box: >= 0
-    int min_size_px = 30;       ///< smallest face side, pixels: >= 1
+    double scale_factor = 1.1;  ///< between pyramid levels: kScaleFactors
+    int min_neighbors = 3;      ///< hits needed to keep a box: kNeighbors
+    int min_size_px = 30;       ///< smallest face side, pixels: kMinSizes
     int max_size_px = 0;        ///< largest face side, pixels; 0: no limit (else >= min)
     /// cv::equalizeHist before detection. Off by default: on the rendered portraits it
     /// halves alt2's hits on the true face (3 instead of ~30) and loses it at min_neighbors 3.
@@ -63,12 +64,23 @@ class FaceDetector {
     /// the cat are left to the eye check.
     std::string cat_cascade_path =
         "/usr/share/opencv4/haarcascades/haarcascade_frontalcatface_extended.xml";
-    int cat_min_neighbors = 3;  ///< >= 0
+    int cat_min_neighbors = 3;  ///< kNeighbors
     /// Reject candidates in whose upper 60 % this cascade finds fewer than `min_eyes` eyes;
     /// "" disables. Measured on the rendered portraits: the astronaut's face has them; the
     /// boxes the face cascades put on the cat and every other false box have none.
     std::string eye_cascade_path = "/usr/share/opencv4/haarcascades/haarcascade_eye.xml";
-    int min_eyes = 1;  ///< 1 or 2
+    int min_eyes = 1;  ///< kEyes: 1 or 2
+
+    // The valid values, stated once: IsValid checks them, and vision.face_detector declares
+    // its parameters with them (runtime::ParamDecl::Range(const Interval&)).
+    static constexpr Interval kPyramidLevels = Interval::Closed(0, 4);
+    static constexpr Interval kScaleFactors = Interval::LeftOpen(1, 4);
+    static constexpr Interval kNeighbors = Interval::Closed(0, 1000);
+    static constexpr Interval kMinSizes = Interval::Closed(1, 100000);
+    /// max_size_px: 0 (no limit) or in [min_size_px, 100000].
+    static constexpr Interval kMaxSizes = Interval::Closed(0, 100000);
+    static constexpr Interval kEyes = Interval::Closed(1, 2);
+
     bool IsValid(std::string* error) const;
   };
 
