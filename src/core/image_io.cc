@@ -15,6 +15,7 @@
 #include <string>
 
 #include "saccade/core/error.h"
+#include "saccade/core/temporary_file.h"
 
 #define STB_IMAGE_STATIC
 #define STB_IMAGE_IMPLEMENTATION
@@ -144,10 +145,8 @@ void WritePng(const ImageView& image, const std::filesystem::path& path) {
   }
   if (image.empty()) throw InvalidArgument(fmt::format("WritePng: {}: empty image", name));
 
-  static std::atomic<int> counter{0};
-  const std::filesystem::path temporary =
-      path.parent_path() /
-      fmt::format(".{}.tmp{}_{}", path.filename().string(), ::getpid(), counter++);
+  static std::atomic<unsigned> counter{0};
+  const std::filesystem::path temporary = TemporaryPathFor(path, counter++);
   File file(std::fopen(temporary.c_str(), "wb"));
   if (!file) throw FileError(name, 0, "", fmt::format("cannot write: {}", std::strerror(errno)));
 

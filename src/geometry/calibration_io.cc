@@ -19,6 +19,7 @@
 #include "core/internal_yaml.h"
 #include "internal_opencv_storage.h"
 #include "saccade/core/error.h"
+#include "saccade/core/temporary_file.h"
 
 namespace saccade::geometry {
 namespace {
@@ -495,8 +496,7 @@ void WriteFileAtomically(const std::filesystem::path& path, const std::string& c
   std::filesystem::path temporary;
   int fd = -1;
   for (int attempt = 0; attempt < 100 && fd < 0; ++attempt) {
-    temporary = directory / ("." + path.filename().string() + ".tmp" + std::to_string(::getpid()) +
-                             "_" + std::to_string(counter++));
+    temporary = TemporaryPathFor(directory / path.filename(), counter++);
     fd = ::open(temporary.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
     if (fd < 0 && errno != EEXIST) {
       throw FileError(

@@ -14,6 +14,7 @@
 #include "saccade/core/error.h"
 #include "saccade/core/image_io.h"
 #include "saccade/core/log.h"
+#include "saccade/core/temporary_file.h"
 #include "saccade/geometry/calibration_io.h"
 #include "saccade/geometry/image_camera.h"
 #include "saccade/geometry/json.h"
@@ -163,7 +164,9 @@ json FrameJson(int64_t index, double time, const std::vector<Frame>& frames,
 }
 
 /// The output folder: created if missing; one that already holds saccade output is refused
-/// unless `force`, in which case the old output of these cameras is removed first.
+/// unless `force`, in which case the old output of these cameras is removed first. Either way
+/// the hidden temporaries a killed run left there (".000012.png.tmp4242_7", core/
+/// temporary_file.h) go too; no other file is touched.
 void PrepareOutput(const fs::path& out, const std::vector<std::string>& cameras,
                    const TruthRequest& truth, bool force) {
   std::error_code error;
@@ -182,6 +185,18 @@ void PrepareOutput(const fs::path& out, const std::vector<std::string>& cameras,
     throw InvalidArgument(
         fmt::format("render: --out {} already holds output ({}); pass --force to replace it",
                     out.string(), existing.front().filename().string()));
+  }
+  // A run killed mid-write (SIGKILL) leaves its temporaries beside the frames and calibrations.
+  int stale = RemoveStaleTemporaries(out);
+  for (const auto& camera : cameras) {
+    stale += RemoveStaleTemporaries(out / camera);
+    for (const char* truth_folder : {"depth", "ids"}) {
+      stale += RemoveStaleTemporaries(out / camera / truth_folder);
+    }
+  }
+  if (stale > 0) {
+    log::Info("render: removed {} temporary files an interrupted run left in {}", stale,
+              out.string());
   }
   // Only our own frames: a camera folder holding anything else keeps it.
   const auto remove_frames = [](const fs::path& folder) {

@@ -109,6 +109,30 @@ TEST_F(RenderCli, RefusesToOverwriteWithoutForce) {
   EXPECT_EQ(Index(out).size(), 1u);
 }
 
+// Issue 46: a render killed with SIGKILL between writing a file and renaming it into place
+// leaves hidden temporaries (".000003.png.tmp<pid>_<n>"); a later run with --force into the
+// same folder removes them, and only them.
+TEST_F(RenderCli, ForceRemovesTheTemporariesAKilledRunLeftAndNothingElse) {
+  const fs::path out = dir_ / "out";
+  ASSERT_EQ(Saccade("render --scene " + kScene + " --frames 1 --out " + out.string()).status, 0);
+  const std::vector<fs::path> stale = {
+      out / "left" / ".000001.png.tmp4194301_2", out / "right" / ".000001.png.tmp4194301_3",
+      out / ".left.yaml.tmp4194301_0", out / "left" / "depth" / ".000001.png.tmp4194301_4"};
+  const std::vector<fs::path> kept = {out / "left" / "notes.txt", out / "left" / ".000001.png.tmp",
+                                      out / "left" / "000001.png.tmp4194301_2",
+                                      out / ".left.yaml.tmpX_0", out / "README"};
+  fs::create_directories(out / "left" / "depth");
+  for (const auto& path : stale) std::ofstream(path) << "half a file";
+  for (const auto& path : kept) std::ofstream(path) << "mine";
+  const CommandRun forced =
+      Saccade("render --scene " + kScene + " --frames 1 --force --out " + out.string());
+  ASSERT_EQ(forced.status, 0) << forced.output;
+  for (const auto& path : stale) EXPECT_FALSE(fs::exists(path)) << path;
+  for (const auto& path : kept) EXPECT_TRUE(fs::exists(path)) << path;
+  EXPECT_TRUE(fs::exists(out / "left" / "000000.png"));
+  EXPECT_EQ(Index(out).size(), 1u);
+}
+
 TEST_F(RenderCli, InterruptedRunLeavesOnlyWholeFrames) {
   const fs::path out = dir_ / "out";
   const pid_t child = fork();

@@ -40,7 +40,8 @@ void CheckIdsFitPng16(const scene::Scene& scene, const RendererOptions& options)
 class DatasetWriter {
  public:
   /// Creates `out` if missing. Output already there (frames.jsonl, a camera's folder or file)
-  /// is refused with InvalidArgument unless `force`, which removes the old frames first.
+  /// is refused with InvalidArgument unless `force`, which removes the old frames first; the
+  /// hidden temporaries an interrupted run left (RemoveStaleTemporaries) are removed too.
   /// `distortion_on`: whether the renderer was asked for lens distortion (a warning is
   /// logged when a camera's frames come without it).
   DatasetWriter(const scene::Scene& scene, std::vector<std::string> cameras,
