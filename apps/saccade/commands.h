@@ -44,6 +44,7 @@ struct DdsOverrides {
   std::string config;
   std::string interface;
   std::vector<std::string> peers;
+  bool wall_stamps = false;  // --wall-stamps: transport.stamps wall
 };
 void AddDdsOptions(CLI::App* command, DdsOverrides& o);
 void ApplyDdsOverrides(const DdsOverrides& o, runtime::PipelineSpec& spec);

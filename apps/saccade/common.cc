@@ -33,6 +33,10 @@ void AddDdsOptions(CLI::App* command, DdsOverrides& o) {
   command->add_option("--dds-peer", o.peers,
                       "Unicast discovery peer (host or address) for networks without multicast; "
                       "repeatable");
+  command->add_flag("--wall-stamps", o.wall_stamps,
+                    "Stamp messages (and /clock) with the wall clock at the start plus the "
+                    "simulated time, for ROS 2 tools without use_sim_time (default: simulated "
+                    "seconds from 0; transport.stamps: wall)");
 }
 
 void ApplyDdsOverrides(const DdsOverrides& o, runtime::PipelineSpec& spec) {
@@ -44,6 +48,7 @@ void ApplyDdsOverrides(const DdsOverrides& o, runtime::PipelineSpec& spec) {
     if (o.config.empty()) spec.transport["config"] = "network";
   }
   if (!o.peers.empty()) spec.transport["peers"] = o.peers;
+  if (o.wall_stamps) spec.transport["stamps"] = "wall";
 }
 
 }  // namespace saccade::app

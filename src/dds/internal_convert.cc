@@ -6,6 +6,8 @@
 #include <bit>
 #include <cstring>
 #include <limits>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include "saccade/geometry/image_camera.h"
 
@@ -24,6 +26,19 @@ builtin_interfaces_msg_dds__Time_ ToStamp(double seconds) {
 
 int64_t StampNs(const builtin_interfaces_msg_dds__Time_& stamp) {
   return static_cast<int64_t>(stamp.sec) * 1000000000 + stamp.nanosec;
+}
+
+builtin_interfaces_msg_dds__Time_ ShiftStamp(const builtin_interfaces_msg_dds__Time_& stamp,
+                                             int64_t offset_ns) {
+  if (offset_ns == 0) return stamp;
+  const int64_t ns = StampNs(stamp) + offset_ns;
+  int64_t sec = ns / 1000000000;
+  int64_t nanosec = ns % 1000000000;
+  if (nanosec < 0) {
+    nanosec += 1000000000;
+    sec -= 1;
+  }
+  return {static_cast<int32_t>(sec), static_cast<uint32_t>(nanosec)};
 }
 
 double FromStamp(const builtin_interfaces_msg_dds__Time_& stamp) {
@@ -92,6 +107,59 @@ bool FillImage(const Image& image, Holder& holder, sensor_msgs_msg_dds__Image_* 
   out->step = static_cast<uint32_t>(image.stride());
   out->data._maximum = out->data._length = static_cast<uint32_t>(image.size_bytes());
   out->data._buffer = const_cast<uint8_t*>(image.data());  // written, never modified
+  out->data._release = false;
+  return true;
+}
+
+bool FillCompressedImage(const Image& image, const std::string& format, int jpeg_quality,
+                         Holder& holder, std::vector<uint8_t>* bytes,
+                         sensor_msgs_msg_dds__CompressedImage_* out) {
+  const std::optional<std::string> encoding = RosEncoding(image.format());
+  if (!encoding) return false;
+  const bool jpeg = format == "jpeg";
+  int type = 0;
+  std::string compressed;  // what image_transport's plugin says the compressed pixels are
+  switch (image.format()) {
+    case PixelFormat::kRgb8:
+      type = CV_8UC3;
+      compressed = "bgr8";
+      break;
+    case PixelFormat::kRgba8:
+      type = CV_8UC4;
+      compressed = jpeg ? "bgr8" : "bgra8";
+      break;
+    case PixelFormat::kGray8:
+      type = CV_8UC1;
+      compressed = "mono8";
+      break;
+    case PixelFormat::kGray16:
+      if (jpeg) return false;
+      type = CV_16UC1;
+      compressed = "mono16";
+      break;
+    default:
+      return false;
+  }
+  const cv::Mat pixels(image.height(), image.width(), type, const_cast<uint8_t*>(image.data()),
+                       image.stride());
+  // Into a matrix of its own: the image is the pipeline's, never written.
+  cv::Mat converted;
+  if (image.format() == PixelFormat::kRgb8) {
+    cv::cvtColor(pixels, converted, cv::COLOR_RGB2BGR);
+  } else if (image.format() == PixelFormat::kRgba8) {
+    cv::cvtColor(pixels, converted, jpeg ? cv::COLOR_RGBA2BGR : cv::COLOR_RGBA2BGRA);
+  } else {
+    converted = pixels;  // encoded as it is
+  }
+  std::vector<int> params;
+  if (jpeg) params = {cv::IMWRITE_JPEG_QUALITY, jpeg_quality};
+  if (!cv::imencode(jpeg ? ".jpg" : ".png", converted, *bytes, params)) return false;
+  holder.strings.reserve(8);
+  const ImageMetadata& meta = image.metadata();
+  out->header = Header(meta.time, Keep(holder, OpticalFrame(meta.camera)));
+  out->format = Keep(holder, *encoding + "; " + format + " compressed " + compressed);
+  out->data._maximum = out->data._length = static_cast<uint32_t>(bytes->size());
+  out->data._buffer = bytes->data();
   out->data._release = false;
   return true;
 }

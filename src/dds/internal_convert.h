@@ -24,6 +24,15 @@ double FromStamp(const builtin_interfaces_msg_dds__Time_& stamp);
 /// The stamp in nanoseconds, exact (for matching an image with its pose).
 int64_t StampNs(const builtin_interfaces_msg_dds__Time_& stamp);
 
+/// `stamp` moved by `offset_ns` (TopicOptions::stamp_offset_ns), exactly.
+builtin_interfaces_msg_dds__Time_ ShiftStamp(const builtin_interfaces_msg_dds__Time_& stamp,
+                                             int64_t offset_ns);
+/// The simulated time of a stamp written with `offset_ns` (stamp - offset, whole ns, then
+/// seconds: the same double as FromStamp of the unshifted stamp).
+inline double FromStamp(const builtin_interfaces_msg_dds__Time_& stamp, int64_t offset_ns) {
+  return static_cast<double>(StampNs(stamp) - offset_ns) * 1e-9;
+}
+
 /// The world frame's name, and a camera's optical frame ("left" -> "left_optical").
 inline constexpr const char* kWorldFrame = "world";
 std::string OpticalFrame(const std::string& camera);
@@ -50,6 +59,14 @@ bool FillCameraInfo(const Image& image, Holder& holder, sensor_msgs_msg_dds__Cam
 /// The image's pose X_WC as a transform world -> the camera's optical frame; false when none.
 bool FillCameraTransform(const Image& image, Holder& holder,
                          geometry_msgs_msg_dds__TransformStamped_* out);
+
+/// `image` encoded as sensor_msgs/CompressedImage: `format` "jpeg" (quality 1..100) or
+/// "png", `*bytes` holds the encoded data and `out` borrows it. The format string is
+/// image_transport's compressed plugin's ("rgb8; jpeg compressed bgr8"). False for pixels it
+/// has no form for (JPEG: rgb8, rgba8, mono8; PNG: those and mono16).
+bool FillCompressedImage(const Image& image, const std::string& format, int jpeg_quality,
+                         Holder& holder, std::vector<uint8_t>* bytes,
+                         sensor_msgs_msg_dds__CompressedImage_* out);
 
 /// The camera model of a CameraInfo; nullopt (and `*error` says why) when it is not one
 /// (zero K, unknown distortion model, wrong coefficient count).

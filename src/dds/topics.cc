@@ -5,6 +5,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <cstdlib>
 #include <deque>
 #include <limits>
 #include <map>
@@ -75,16 +76,19 @@ Entity MakeTopic(const Participant& participant, const dds_topic_descriptor_t* d
       fmt::format("dds: cannot create topic {} ({})", name, descriptor->m_typename)));
 }
 
-// What a lockstep writer puts in its DDS user data (TopicOptions::lockstep), in ROS 2's
-// "key=value;" form.
+// What a lockstep writer puts in its DDS user data (TopicOptions::lockstep), and a writer whose
+// stamps carry an offset (TopicOptions::stamp_offset_ns), in ROS 2's "key=value;" form.
 constexpr char kLockstepUserData[] = "saccade.lockstep=1;";
+constexpr char kStampOffsetKey[] = "saccade.stamp_offset_ns=";
 // A step mark within this of the step's time is the step's (stamps are whole nanoseconds).
 constexpr double kStepMargin = 1e-6;
 
 Entity MakeWriter(const Participant& participant, const Entity& topic, const Qos& qos,
-                  const std::string& what, bool lockstep = false) {
+                  const std::string& what, bool lockstep = false, int64_t stamp_offset_ns = 0) {
   dds_qos_t* q = MakeQos(qos);
-  if (lockstep) dds_qset_userdata(q, kLockstepUserData, sizeof(kLockstepUserData) - 1);
+  std::string user_data = lockstep ? kLockstepUserData : "";
+  if (stamp_offset_ns != 0) user_data += fmt::format("{}{};", kStampOffsetKey, stamp_offset_ns);
+  if (!user_data.empty()) dds_qset_userdata(q, user_data.data(), user_data.size());
   const dds_entity_t writer = dds_create_writer(participant.handle(), topic.get(), q, nullptr);
   dds_delete_qos(q);
   return Entity(internal::Check(writer, "dds: cannot create the writer of " + what));
@@ -177,22 +181,80 @@ class DataWait {
   Entity condition_;
 };
 
+// What each writer matched by a reader announces in its user data (MakeWriter), asked once per
+// writer: whether it is in lockstep, and the offset of its stamps.
+class Announcements {
+ public:
+  struct Of {
+    bool lockstep = false;
+    int64_t stamp_offset_ns = 0;
+  };
+  const Of& Get(const Entity& reader, dds_instance_handle_t writer) {
+    const auto it = known_.find(writer);
+    if (it != known_.end()) return it->second;
+    Of of;
+    bool found = false;
+    if (dds_builtintopic_endpoint_t* e = dds_get_matched_publication_data(reader.get(), writer)) {
+      found = true;
+      void* data = nullptr;
+      size_t size = 0;
+      if (e->qos && dds_qget_userdata(e->qos, &data, &size) && data != nullptr) {
+        const std::string text(static_cast<const char*>(data), size);
+        of.lockstep = text.find(kLockstepUserData) != std::string::npos;
+        if (const auto at = text.find(kStampOffsetKey); at != std::string::npos) {
+          of.stamp_offset_ns =
+              std::strtoll(text.c_str() + at + sizeof(kStampOffsetKey) - 1, nullptr, 10);
+        }
+      }
+      dds_free(data);
+      dds_builtintopic_free_endpoint(e);
+    }
+    if (!found) {  // not matched (any more): asked again next time
+      scratch_ = of;
+      return scratch_;
+    }
+    return known_.emplace(writer, of).first->second;
+  }
+
+ private:
+  std::map<dds_instance_handle_t, Of> known_;
+  Of scratch_;
+};
+
 // ---- writers -------------------------------------------------------------------------------
 
 class ImageWriter final : public Writer {
  public:
   ImageWriter(std::shared_ptr<Participant> participant, const TopicOptions& options)
-      : Writer(MessageName<ImageMessage>(), options.topic), participant_(std::move(participant)) {
+      : Writer(MessageName<ImageMessage>(), options.topic),
+        participant_(std::move(participant)),
+        offset_(options.stamp_offset_ns),
+        compressed_format_(options.compressed_format),
+        jpeg_quality_(options.jpeg_quality) {
     const std::string info_topic = SiblingTopic(options.topic, "camera_info");
+    // Transient local whatever the QoS: the writer keeps its last images for readers that come
+    // later and ask for them (a perception started after the robot's first step gets that
+    // step's images); every reader, volatile or not, matches it.
+    Qos qos = options.qos;
+    qos.durability = Durability::kTransientLocal;
     image_topic_ = MakeTopic(*participant_, &sensor_msgs_msg_dds__Image__desc, options.topic);
-    image_ = MakeWriter(*participant_, image_topic_, options.qos, options.topic);
+    image_ = MakeWriter(*participant_, image_topic_, qos, options.topic, false, offset_);
     info_topic_ = MakeTopic(*participant_, &sensor_msgs_msg_dds__CameraInfo__desc, info_topic);
-    info_ = MakeWriter(*participant_, info_topic_, Qos::Latched(), info_topic);
+    info_ = MakeWriter(*participant_, info_topic_, Qos::Latched(), info_topic, false, offset_);
     if (!options.tf_topic.empty()) {
       tf_topic_ = MakeTopic(*participant_, &tf2_msgs_msg_dds__TFMessage__desc, options.tf_topic);
-      // ROS 2's tf QoS: reliable, volatile, keep last 100.
+      // ROS 2's tf QoS (reliable, keep last 100), transient local as the images: a reader of
+      // the images' history gets their poses too (ROS's volatile readers match).
       tf_ = MakeWriter(*participant_, tf_topic_,
-                       {Reliability::kReliable, Durability::kVolatile, 100}, options.tf_topic);
+                       {Reliability::kReliable, Durability::kTransientLocal, 100}, options.tf_topic,
+                       false, offset_);
+    }
+    if (!compressed_format_.empty()) {
+      compressed_topic_name_ = options.topic + "/compressed";
+      compressed_topic_ = MakeTopic(*participant_, &sensor_msgs_msg_dds__CompressedImage__desc,
+                                    compressed_topic_name_);
+      compressed_ =
+          MakeWriter(*participant_, compressed_topic_, qos, compressed_topic_name_, false, offset_);
     }
   }
 
@@ -206,27 +268,52 @@ class ImageWriter final : public Writer {
       geometry_msgs_msg_dds__TransformStamped_ transform{};
       if (internal::FillCameraTransform(image, holder, &transform)) {
         tf2_msgs_msg_dds__TFMessage_ tf{};
+        transform.header.stamp = internal::ShiftStamp(transform.header.stamp, offset_);
         tf.transforms = {1, 1, &transform, false};
         WriteSample(tf_, &tf, "/tf", stats_);
       }
     }
     sensor_msgs_msg_dds__CameraInfo_ info{};
-    if (internal::FillCameraInfo(image, holder, &info)) WriteSample(info_, &info, topic(), stats_);
+    if (internal::FillCameraInfo(image, holder, &info)) {
+      info.header.stamp = internal::ShiftStamp(info.header.stamp, offset_);
+      WriteSample(info_, &info, topic(), stats_);
+    }
     sensor_msgs_msg_dds__Image_ msg{};
     if (!internal::FillImage(image, holder, &msg)) {
       throw InvalidArgument(fmt::format("dds: {} images have no sensor_msgs/Image encoding ({})",
                                         ToString(image.format()), topic()));
     }
+    msg.header.stamp = internal::ShiftStamp(msg.header.stamp, offset_);
     WriteSample(image_, &msg, topic(), stats_);
     ++stats_.messages;
+    // Compressed only for a reader of it: encoding costs milliseconds an image.
+    if (compressed_.get() > 0 && PublicationMatches(compressed_) > 0) {
+      internal::Holder compressed_holder;
+      sensor_msgs_msg_dds__CompressedImage_ compressed{};
+      if (internal::FillCompressedImage(image, compressed_format_, jpeg_quality_, compressed_holder,
+                                        &compressed_bytes_, &compressed)) {
+        compressed.header.stamp = internal::ShiftStamp(compressed.header.stamp, offset_);
+        WriteSample(compressed_, &compressed, compressed_topic_name_, stats_);
+      } else if (!said_uncompressible_) {
+        said_uncompressible_ = true;
+        log::Log(log::Level::kWarn, "dds: {}: {} images have no {} form; none sent",
+                 compressed_topic_name_, ToString(image.format()), compressed_format_);
+      }
+    }
   }
   int matched() const override { return PublicationMatches(image_); }
   const LinkStats& stats() const override { return stats_; }
 
  private:
   std::shared_ptr<Participant> participant_;
-  Entity image_topic_, info_topic_, tf_topic_;
-  Entity image_, info_, tf_;
+  int64_t offset_;
+  std::string compressed_format_;
+  int jpeg_quality_;
+  std::string compressed_topic_name_;
+  Entity image_topic_, info_topic_, tf_topic_, compressed_topic_;
+  Entity image_, info_, tf_, compressed_;
+  std::vector<uint8_t> compressed_bytes_;  // reused: the encoded image
+  bool said_uncompressible_ = false;
   LinkStats stats_;
 };
 
@@ -238,12 +325,14 @@ class SimpleWriter final : public Writer {
                const dds_topic_descriptor_t* descriptor)
       : Writer(MessageName<M>(), options.topic),
         participant_(std::move(participant)),
-        lockstep_(options.lockstep) {
+        lockstep_(options.lockstep),
+        offset_(options.stamp_offset_ns) {
     topic_ = MakeTopic(*participant_, descriptor, options.topic);
-    writer_ = MakeWriter(*participant_, topic_, options.qos, options.topic, lockstep_);
+    writer_ = MakeWriter(*participant_, topic_, options.qos, options.topic, lockstep_, offset_);
     if (std::is_same_v<M, JointStateMessage> && !options.targets_topic.empty()) {
       targets_topic_ = MakeTopic(*participant_, descriptor, options.targets_topic);
-      targets_ = MakeWriter(*participant_, targets_topic_, options.qos, options.targets_topic);
+      targets_ = MakeWriter(*participant_, targets_topic_, options.qos, options.targets_topic,
+                            false, offset_);
       targets_topic_name_ = options.targets_topic;
     }
   }
@@ -258,12 +347,14 @@ class SimpleWriter final : public Writer {
         internal::Holder holder;
         Sample sample{};
         internal::FillJointState(m.time, targets, &velocities, holder, &sample);
+        sample.header.stamp = internal::ShiftStamp(sample.header.stamp, offset_);
         WriteSample(targets_, &sample, targets_topic_name_, stats_);
       }
     }
     internal::Holder holder;
     Sample sample{};
     Fill(m, holder, &sample);
+    sample.header.stamp = internal::ShiftStamp(sample.header.stamp, offset_);
     WriteSample(writer_, &sample, topic(), stats_);
     ++stats_.messages;
     written_up_to_ = std::max(written_up_to_, m.time);
@@ -278,6 +369,7 @@ class SimpleWriter final : public Writer {
         internal::FillJointState(time, {}, nullptr, holder, &mark);
         mark.name = {0, 0, nullptr, false};
         mark.position = mark.velocity = {0, 0, nullptr, false};
+        mark.header.stamp = internal::ShiftStamp(mark.header.stamp, offset_);
         WriteSample(writer_, &mark, topic(), stats_);
       }
     }
@@ -313,6 +405,7 @@ class SimpleWriter final : public Writer {
   Entity targets_topic_, targets_;  // joint states: their targets (TopicOptions::targets_topic)
   std::string targets_topic_name_;
   bool lockstep_;
+  int64_t offset_;
   // The latest stamp written since the last step mark (MarkStep).
   double written_up_to_ = -std::numeric_limits<double>::infinity();
   LinkStats stats_;
@@ -333,8 +426,9 @@ class ImageReader final : public Reader {
     info_ = MakeReader(*participant_, info_topic_, Qos::Latched(), info_topic);
     if (!options.tf_topic.empty()) {
       tf_topic_ = MakeTopic(*participant_, &tf2_msgs_msg_dds__TFMessage__desc, options.tf_topic);
+      // The images' durability: a reader of their history gets the poses of it.
       tf_ = MakeReader(*participant_, tf_topic_,
-                       {Reliability::kReliable, Durability::kVolatile, 100}, options.tf_topic);
+                       {Reliability::kReliable, options.qos.durability, 100}, options.tf_topic);
     }
     wait_ = std::make_unique<DataWait>(image_);
   }
@@ -380,17 +474,21 @@ class ImageReader final : public Reader {
       log::Log(log::Level::kWarn, "dds: {}: image dropped: {}", topic(), error);
       return nullptr;
     }
-    Complete(*image, chosen->stamp);
+    // The sender's simulated time: its stamp less the offset it announced (whole ns).
+    image->metadata().time = static_cast<double>(chosen->stamp) * 1e-9;
+    Complete(*image, chosen->stamp, chosen->raw_stamp);
     return std::make_shared<const ImageMessage>(ImageMessage{std::move(image)});
   }
   int matched() const override { return SubscriptionMatches(image_); }
   const LinkStats& stats() const override { return stats_; }
 
  private:
-  // A valid sample taken, with its reference, and its stamp in ns.
+  // A valid sample taken, with its reference, and its stamp in ns: the sender's simulated
+  // time (the writer's offset taken off) and as it was written (that of its pose on /tf).
   struct Received {
     ddsi_serdata* sample;
     int64_t stamp;
+    int64_t raw_stamp;
   };
   // Images kept for a later step (TakeErased's up_to): a few frames of a sender running ahead.
   static constexpr std::size_t kMaxPendingImages = 16;
@@ -423,18 +521,20 @@ class ImageReader final : public Reader {
           continue;
         }
         std::string error;
-        int64_t stamp = 0;
+        int64_t raw_stamp = 0;
         if (!WithView(samples[i], &error, [&](const sensor_msgs_msg_dds__Image_& msg) {
-              stamp = internal::StampNs(msg.header.stamp);
+              raw_stamp = internal::StampNs(msg.header.stamp);
             })) {
           ++stats_.lost;
           log::Log(log::Level::kWarn, "dds: {}: image dropped: {}", topic(), error);
           ddsi_serdata_unref(samples[i]);
           continue;
         }
+        const int64_t stamp =
+            raw_stamp - announcements_.Get(image_, infos[i].publication_handle).stamp_offset_ns;
         // The sender restarted (its stamps went back): what it sent before is of no step now.
         if (!pending_.empty() && stamp < pending_.back().stamp) Drop(pending_.size());
-        pending_.push_back({samples[i], stamp});
+        pending_.push_back({samples[i], stamp, raw_stamp});
         if (pending_.size() > kMaxPendingImages) Drop(1);
       }
       if (n < kMaxTake) break;
@@ -449,15 +549,16 @@ class ImageReader final : public Reader {
     }
   }
 
-  // Camera model, pose and frame index of a received image.
-  void Complete(Image& image, int64_t stamp) {
+  // Camera model, pose and frame index of a received image (`stamp` in the sender's simulated
+  // time, `raw_stamp` as written, as its pose's).
+  void Complete(Image& image, int64_t sim_stamp, int64_t stamp) {
     ImageMetadata& meta = image.metadata();
-    if (last_stamp_ && stamp < *last_stamp_) {
+    if (last_stamp_ && sim_stamp < *last_stamp_) {
       ++stats_.restarts;
       received_ = 0;
       poses_.clear();
     }
-    last_stamp_ = stamp;
+    last_stamp_ = sim_stamp;
     meta.frame_index = frame_period_s_ > 0
                            ? static_cast<int64_t>(std::llround(meta.time / frame_period_s_))
                            : received_;
@@ -527,6 +628,7 @@ class ImageReader final : public Reader {
 
   std::shared_ptr<Participant> participant_;
   double frame_period_s_;
+  Announcements announcements_;  // the image writers' stamp offsets
   Entity image_topic_, info_topic_, tf_topic_;
   Entity image_, info_, tf_;
   std::unique_ptr<DataWait> wait_;
@@ -611,14 +713,16 @@ class SimpleReader final : public Reader {
     if constexpr (std::is_same_v<M, JointStateMessage>) {
       // Before the states: each state's targets were written before it.
       if (targets_.get() > 0) {
-        TakeAll<Sample>(targets_, [&](const Sample& sample, const dds_sample_info_t&) {
+        TakeAll<Sample>(targets_, [&](const Sample& sample, const dds_sample_info_t& info) {
           Target target;
           std::string error;
           if (!internal::JointsOf(sample, &target.positions, &target.velocities, &error)) {
             log::Log(log::Level::kWarn, "dds: {}: targets dropped: {}", topic(), error);
             return;
           }
-          const double time = internal::FromStamp(sample.header.stamp);
+          const double time = internal::FromStamp(
+              sample.header.stamp,
+              targets_announcements_.Get(targets_, info.publication_handle).stamp_offset_ns);
           // The sender restarted (its stamps went back): its earlier targets are of no state.
           if (!targets_by_time_.empty() && time < targets_by_time_.rbegin()->first) {
             targets_by_time_.clear();
@@ -631,9 +735,13 @@ class SimpleReader final : public Reader {
       }
     }
     TakeAll<Sample>(reader_, [&](const Sample& sample, const dds_sample_info_t& info) {
+      // The sender's simulated time: the stamp less the offset its writer announced.
+      const double time =
+          internal::FromStamp(sample.header.stamp,
+                              announcements_.Get(reader_, info.publication_handle).stamp_offset_ns);
       if (lockstep_) {
         double& reached = reached_.try_emplace(info.publication_handle, -kInfinity).first->second;
-        reached = std::max(reached, internal::FromStamp(sample.header.stamp));
+        reached = std::max(reached, time);
       }
       if (IsStepMark(sample)) return;
       std::string error;
@@ -643,6 +751,7 @@ class SimpleReader final : public Reader {
         log::Log(log::Level::kWarn, "dds: {}: message dropped: {}", topic(), error);
         return;
       }
+      message->time = time;
       // The sender restarted (its stamps went back): what it sent before is of no step now.
       if (!pending_.empty() && message->time < pending_.back()->time) {
         stats_.lost += static_cast<int64_t>(pending_.size());
@@ -662,22 +771,7 @@ class SimpleReader final : public Reader {
     const dds_return_t n = dds_get_matched_publications(reader_.get(), handles, kMaxLockstepQuery);
     std::vector<dds_instance_handle_t> out;
     for (dds_return_t i = 0; i < std::min<dds_return_t>(n, kMaxLockstepQuery); ++i) {
-      auto [it, added] = announces_.try_emplace(handles[i], false);
-      if (added) {
-        if (dds_builtintopic_endpoint_t* e =
-                dds_get_matched_publication_data(reader_.get(), handles[i])) {
-          void* data = nullptr;
-          size_t size = 0;
-          if (e->qos && dds_qget_userdata(e->qos, &data, &size) && data != nullptr) {
-            it->second =
-                std::string_view(static_cast<const char*>(data), size).find(kLockstepUserData) !=
-                std::string_view::npos;
-          }
-          dds_free(data);
-          dds_builtintopic_free_endpoint(e);
-        }
-      }
-      if (it->second) out.push_back(handles[i]);
+      if (announcements_.Get(reader_, handles[i]).lockstep) out.push_back(handles[i]);
     }
     return out;
   }
@@ -744,7 +838,8 @@ class SimpleReader final : public Reader {
   // announced lockstep (by DDS instance handle).
   static constexpr dds_return_t kMaxLockstepQuery = 64;
   std::map<dds_instance_handle_t, double> reached_;
-  std::map<dds_instance_handle_t, bool> announces_;
+  // What the matched writers announce: lockstep, their stamps' offset.
+  Announcements announcements_, targets_announcements_;
   // Joint states: the targets received, by stamp (TopicOptions::targets_topic).
   struct Target {
     head::JointState positions, velocities;
@@ -757,6 +852,33 @@ class SimpleReader final : public Reader {
   LinkStats stats_;
 };
 
+// rosgraph_msgs/Clock on /clock (ClockWriter).
+class CycloneClockWriter final : public ClockWriter {
+ public:
+  CycloneClockWriter(std::shared_ptr<Participant> participant, const std::string& topic,
+                     int64_t stamp_offset_ns)
+      : participant_(std::move(participant)), topic_name_(topic), offset_(stamp_offset_ns) {
+    topic_ = MakeTopic(*participant_, &rosgraph_msgs_msg_dds__Clock__desc, topic);
+    // Reliable, volatile, keep last 1: rclcpp's ClockQoS (best effort, keep last 1) and
+    // reliable subscribers both match; keep last 1 never blocks on a slow reader.
+    writer_ = MakeWriter(*participant_, topic_, {Reliability::kReliable, Durability::kVolatile, 1},
+                         topic, false, offset_);
+  }
+  void Publish(double time) override {
+    rosgraph_msgs_msg_dds__Clock_ clock{};
+    clock.clock = internal::ShiftStamp(internal::ToStamp(time), offset_);
+    WriteSample(writer_, &clock, topic_name_, stats_);
+  }
+  int matched() const override { return PublicationMatches(writer_); }
+
+ private:
+  std::shared_ptr<Participant> participant_;
+  std::string topic_name_;
+  int64_t offset_;
+  Entity topic_, writer_;
+  LinkStats stats_;
+};
+
 void CheckCreate(const std::shared_ptr<Participant>& participant, const TopicOptions& options) {
   if (!participant) throw InvalidArgument("dds: no participant");
   DdsTopicName(options.topic);  // throws for a name that is not fully qualified and valid
@@ -765,6 +887,15 @@ void CheckCreate(const std::shared_ptr<Participant>& participant, const TopicOpt
     throw InvalidArgument("dds: QoS of " + options.topic + ": " + error);
   }
   if (!options.tf_topic.empty()) DdsTopicName(options.tf_topic);
+  if (options.compressed_format != "" && options.compressed_format != "jpeg" &&
+      options.compressed_format != "png") {
+    throw InvalidArgument("dds: compressed images of " + options.topic +
+                          ": expected jpeg, png or none, got '" + options.compressed_format + "'");
+  }
+  if (options.jpeg_quality < 1 || options.jpeg_quality > 100) {
+    throw InvalidArgument(fmt::format("dds: JPEG quality of {}: expected 1..100, got {}",
+                                      options.topic, options.jpeg_quality));
+  }
 }
 
 std::string SupportedList() {
@@ -841,6 +972,14 @@ std::unique_ptr<Writer> Writer::Create(std::shared_ptr<Participant> participant,
   }
   return std::make_unique<SimpleWriter<TargetMessage, geometry_msgs_msg_dds__PointStamped_>>(
       std::move(participant), options, &geometry_msgs_msg_dds__PointStamped__desc);
+}
+
+std::unique_ptr<ClockWriter> ClockWriter::Create(std::shared_ptr<Participant> participant,
+                                                 const std::string& topic,
+                                                 int64_t stamp_offset_ns) {
+  if (!participant) throw InvalidArgument("dds: no participant");
+  DdsTopicName(topic);  // throws for a name that is not fully qualified and valid
+  return std::make_unique<CycloneClockWriter>(std::move(participant), topic, stamp_offset_ns);
 }
 
 std::unique_ptr<Reader> Reader::Create(std::shared_ptr<Participant> participant,

@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <chrono>
 #include <limits>
 #include <map>
 #include <mutex>
@@ -101,10 +102,12 @@ Endpoint Resolve(const runtime::TopicEndpoint& endpoint, const std::set<std::str
   const std::string where = endpoint.where;
   CheckKeys(endpoint.options, keys, where);
   std::string ns;
+  TransportNames names;
   const nlohmann::json transport =
       endpoint.pipeline ? endpoint.pipeline->transport : nlohmann::json::object();
-  const DomainOptions domain = ParseTransport(transport, &ns);
+  const DomainOptions domain = ParseTransport(transport, &ns, &names);
   Endpoint out;
+  out.options.stamp_offset_ns = names.wall_stamps ? WallStampOffsetNs() : 0;
   out.options.topic = ResolveTopic(endpoint.topic, ns);
   RosTypeOf(endpoint.message_type);  // names the supported types when this one is not
   out.options.qos = DefaultQos(endpoint.message_type);
@@ -129,12 +132,34 @@ Endpoint Resolve(const runtime::TopicEndpoint& endpoint, const std::set<std::str
     const std::string targets = it->get<std::string>();
     out.options.targets_topic = targets.empty() ? "" : ResolveTopic(targets, ns);
   }
+  const bool image = endpoint.message_type == MessageName<ImageMessage>();
+  if (const auto it = endpoint.options.find("compressed"); it != endpoint.options.end()) {
+    if (!image) {
+      throw InvalidArgument(
+          fmt::format("{}.compressed: only images are compressed; this port "
+                      "carries {}",
+                      where, endpoint.message_type));
+    }
+    if (!it->is_string() || (*it != "jpeg" && *it != "png" && *it != "")) {
+      throw InvalidArgument(fmt::format("{}.compressed: expected jpeg, png or \"\" (none), got {}",
+                                        where, it->dump()));
+    }
+    out.options.compressed_format = it->get<std::string>();
+  }
+  if (const auto it = endpoint.options.find("jpeg_quality"); it != endpoint.options.end()) {
+    if (!image || !it->is_number_integer() || it->get<int64_t>() < 1 || it->get<int64_t>() > 100) {
+      throw InvalidArgument(
+          fmt::format("{}.jpeg_quality: expected an integer 1..100 (images), "
+                      "got {}",
+                      where, it->dump()));
+    }
+    out.options.jpeg_quality = it->get<int>();
+  }
   if (endpoint.pipeline && endpoint.pipeline->clock.mode == runtime::ClockMode::kSimulated) {
     out.options.frame_period_s = endpoint.pipeline->clock.step;
   }
   if (OnStamps(endpoint)) {
     // Deep enough to hold the message of the step's time while the sender runs ahead.
-    const bool image = endpoint.message_type == MessageName<ImageMessage>();
     out.options.qos.depth =
         std::max(out.options.qos.depth, image ? kOnStampsImageDepth : kOnStampsDepth);
   }
@@ -167,22 +192,8 @@ class TopicReaderComponent final : public runtime::Component, public runtime::Ti
         lockstep_(lockstep),
         output_(AddOutput<M>("message")) {}
 
-  void Start() override {
-    if (start_wait_s_ <= 0) return;
-    if (lockstep_) {
-      // Before the first step, so that it is in lockstep already.
-      if (!reader_->WaitForLockstepWriter(start_wait_s_)) {
-        log::Log(log::Level::kWarn,
-                 "dds: {}: no writer in lockstep after {} s; stepping on without waiting for one "
-                 "(until one comes)",
-                 reader_->topic(), start_wait_s_);
-      }
-    } else if (!reader_->WaitForWriters(1, start_wait_s_)) {
-      log::Log(log::Level::kWarn, "dds: {}: no writer after {} s; stepping on without one",
-               reader_->topic(), start_wait_s_);
-    }
-  }
   std::optional<double> NextTime() override {
+    StartWait();
     taken_ = true;
     // With no sender the steps have nothing to time them: each waits its wait_s for one to
     // come (picked up at once when it does) rather than spinning through empty steps.
@@ -202,6 +213,7 @@ class TopicReaderComponent final : public runtime::Component, public runtime::Ti
     // (SimulatedStepTime): a microsecond's margin, far below a sender's step, covers both.
     const double up_to = on_stamps_ ? context.time + 1e-6 : std::numeric_limits<double>::infinity();
     std::shared_ptr<const M> message;
+    StartWait();
     if (taken_) {
       message = std::move(pending_);
     } else if (lockstep_) {
@@ -232,6 +244,26 @@ class TopicReaderComponent final : public runtime::Component, public runtime::Ti
   }
 
  private:
+  // The first step's wait for the peer (start_wait_s), where its message is needed rather than
+  // in Start: the components before this reader have stepped, and published, already. In
+  // lockstep the step waits for a writer in lockstep, so that it is in lockstep already.
+  void StartWait() {
+    if (start_waited_) return;
+    start_waited_ = true;
+    if (start_wait_s_ <= 0) return;
+    if (lockstep_) {
+      if (!reader_->WaitForLockstepWriter(start_wait_s_)) {
+        log::Log(log::Level::kWarn,
+                 "dds: {}: no writer in lockstep after {} s; stepping on without waiting for one "
+                 "(until one comes)",
+                 reader_->topic(), start_wait_s_);
+      }
+    } else if (!reader_->WaitForWriters(1, start_wait_s_)) {
+      log::Log(log::Level::kWarn, "dds: {}: no writer after {} s; stepping on without one",
+               reader_->topic(), start_wait_s_);
+    }
+  }
+
   // Waits only while a writer is there: a sender that went away never blocks the loop.
   std::shared_ptr<const M> Take(double up_to) {
     const double wait = wait_s_ > 0 && reader_->matched() > 0 ? wait_s_ : 0.0;
@@ -245,6 +277,7 @@ class TopicReaderComponent final : public runtime::Component, public runtime::Ti
   bool lockstep_;
   int64_t late_steps_ = 0;
   runtime::Output<M>& output_;
+  bool start_waited_ = false;        // StartWait ran (the first step)
   bool taken_ = false;               // NextTime took this step's message
   bool waiting_for_writer_ = false;  // NextTime found no writer (said once)
   std::shared_ptr<const M> pending_;
@@ -258,19 +291,36 @@ std::function<void(const runtime::StepContext&)> AttachWriter(std::shared_ptr<Wr
                                                               runtime::OutputBase& port) {
   auto* typed = dynamic_cast<runtime::Output<M>*>(&port);
   SACCADE_ASSERT(typed != nullptr, "output of the wrong type");
-  auto first = std::make_shared<bool>(true);
-  typed->signal().Connect([writer, start_wait_s, first](const M& message) {
-    if (*first) {
-      *first = false;
-      if (start_wait_s > 0 && !writer->WaitForReaders(1, start_wait_s)) {
+  // The first message goes out at once, as every other topic's; the wait for a reader
+  // (start_wait_s) comes at the end of its step, against a deadline from that message, so that
+  // the pipeline's writers wait together, never one topic's first message for another's reader.
+  struct StartWait {
+    std::optional<std::chrono::steady_clock::time_point> deadline;
+    bool done = false;
+  };
+  auto start = std::make_shared<StartWait>();
+  typed->signal().Connect([writer, start_wait_s, start](const M& message) {
+    if (!start->deadline) {
+      start->deadline = std::chrono::steady_clock::now() +
+                        std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                            std::chrono::duration<double>(start_wait_s));
+    }
+    writer->Write(message);
+  });
+  if (!lockstep && start_wait_s <= 0) return {};
+  return [writer, start_wait_s, lockstep, start](const runtime::StepContext& context) {
+    if (lockstep) writer->MarkStep(context.time);
+    if (start_wait_s > 0 && start->deadline && !start->done) {
+      start->done = true;
+      const double left =
+          std::chrono::duration<double>(*start->deadline - std::chrono::steady_clock::now())
+              .count();
+      if (writer->matched() == 0 && !writer->WaitForReaders(1, std::max(0.0, left))) {
         log::Log(log::Level::kWarn, "dds: {}: no reader after {} s; writing without one",
                  writer->topic(), start_wait_s);
       }
     }
-    writer->Write(message);
-  });
-  if (!lockstep) return {};
-  return [writer](const runtime::StepContext& context) { writer->MarkStep(context.time); };
+  };
 }
 
 template <typename F>
@@ -285,10 +335,20 @@ auto Dispatch(const std::string& type, F&& f) {
 
 }  // namespace
 
-DomainOptions ParseTransport(const nlohmann::json& transport, std::string* ns) {
+int64_t WallStampOffsetNs() {
+  static const int64_t offset = std::chrono::duration_cast<std::chrono::nanoseconds>(
+                                    std::chrono::system_clock::now().time_since_epoch())
+                                    .count();
+  return offset;
+}
+
+DomainOptions ParseTransport(const nlohmann::json& transport, std::string* ns,
+                             TransportNames* names) {
   const std::string where = "transport";
   if (!transport.is_object()) throw InvalidArgument("transport: expected a map");
-  CheckKeys(transport, {"domain", "namespace", "config", "interface", "peers", "multicast"}, where);
+  CheckKeys(transport,
+            {"domain", "namespace", "config", "interface", "peers", "multicast", "stamps", "clock"},
+            where);
   DomainOptions options;
   if (const auto it = transport.find("domain"); it != transport.end()) {
     if (!it->is_number_integer() || it->get<int64_t>() < 0 || it->get<int64_t>() > kMaxDomainId) {
@@ -325,6 +385,32 @@ DomainOptions ParseTransport(const nlohmann::json& transport, std::string* ns) {
   if (!options.IsValid(&error)) throw InvalidArgument("transport: " + error);
   if (!name_space.empty()) ResolveTopic("x", name_space);  // checks the namespace
   if (ns) *ns = name_space;
+  TransportNames out;
+  out.ns = name_space;
+  if (const auto it = transport.find("stamps"); it != transport.end()) {
+    if (!it->is_string() || (*it != "sim" && *it != "wall")) {
+      throw InvalidArgument(fmt::format(
+          "transport.stamps: expected sim (simulated seconds from 0) or wall (the wall clock at "
+          "the start plus those), got {}",
+          it->dump()));
+    }
+    out.wall_stamps = *it == "wall";
+  }
+  if (const auto it = transport.find("clock"); it != transport.end()) {
+    if (!it->is_string()) {
+      throw InvalidArgument(
+          fmt::format("transport.clock: expected a topic or \"\" (none), got {}", it->dump()));
+    }
+    out.clock_topic = it->get<std::string>();
+  }
+  if (!out.clock_topic.empty()) {
+    try {
+      out.clock_topic = ResolveTopic(out.clock_topic, name_space);
+    } catch (const Error& error) {
+      throw InvalidArgument(std::string("transport.clock: ") + error.what());
+    }
+  }
+  if (names) *names = out;
   return options;
 }
 
@@ -356,13 +442,26 @@ void RegisterDdsTransport(runtime::ComponentRegistry& registry) {
   transport.attach_writer =
       [](const runtime::TopicEndpoint& endpoint,
          runtime::OutputBase& output) -> std::function<void(const runtime::StepContext&)> {
-    Endpoint e = Resolve(endpoint, {"qos", "start_wait_s", "tf", "targets", "lockstep"});
+    Endpoint e = Resolve(endpoint, {"qos", "start_wait_s", "tf", "targets", "lockstep",
+                                    "compressed", "jpeg_quality"});
     const double start_wait_s = Seconds(endpoint.options, "start_wait_s", endpoint.where);
     std::shared_ptr<Writer> writer =
         Writer::Create(e.participant, endpoint.message_type, e.options);
     return Dispatch(endpoint.message_type, [&](auto tag) {
       return AttachWriter<decltype(tag)>(writer, start_wait_s, e.options.lockstep, output);
     });
+  };
+  // A pipeline that times its own steps (no clock.source) publishes its clock on /clock at the
+  // start of each step, before its components: a ROS 2 node with use_sim_time sees the time of
+  // the messages that follow (Gazebo's /clock).
+  transport.attach_pipeline =
+      [](const runtime::PipelineSpec& spec) -> std::function<void(const runtime::StepContext&)> {
+    TransportNames names;
+    const DomainOptions domain = ParseTransport(spec.transport, nullptr, &names);
+    if (!spec.clock.source.empty() || names.clock_topic.empty()) return {};
+    std::shared_ptr<ClockWriter> clock = ClockWriter::Create(
+        SharedParticipant(domain), names.clock_topic, names.wall_stamps ? WallStampOffsetNs() : 0);
+    return [clock](const runtime::StepContext& context) { clock->Publish(context.time); };
   };
   registry.SetTopicTransport(std::move(transport));
 }

@@ -309,6 +309,7 @@ class PyPipeline {
       time_ = context.time;
       context.dt = dt;
       pipeline_.DeliverDelayed();
+      pipeline_.BeginStep(context);
       for (const auto& component : components) {
         if (component->enabled()) {
           runtime::StepContext own = context;

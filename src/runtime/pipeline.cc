@@ -745,6 +745,14 @@ Pipeline Pipeline::Build(const PipelineSpec& spec, const ComponentRegistry& regi
       throw FileError(file, out.line, key, error.what());
     }
   }
+  if (has_topics && transport->attach_pipeline) {
+    try {
+      auto step_begin = transport->attach_pipeline(spec);
+      if (step_begin) pipeline.step_begins_.push_back(std::move(step_begin));
+    } catch (const std::exception& error) {
+      throw FileError(file, spec.transport_line, "transport", error.what());
+    }
+  }
   return pipeline;
 }
 
@@ -753,6 +761,10 @@ Component* Pipeline::Find(const std::string& name) const {
     if (component->name() == name) return component.get();
   }
   return nullptr;
+}
+
+void Pipeline::BeginStep(const StepContext& context) {
+  for (const auto& step_begin : step_begins_) step_begin(context);
 }
 
 void Pipeline::EndStep(const StepContext& context) {

@@ -200,6 +200,7 @@ RunSummary RunPipeline(Pipeline& pipeline, const RunOptions& options) {
       if (options.seconds > 0.0 && context.time >= options.seconds) break;
 
       pipeline.DeliverDelayed();
+      pipeline.BeginStep(context);
       double component_seconds = 0.0;  // per level, the longest own time (the sum if serial)
       std::fill(timing.own.begin(), timing.own.end(), 0.0);
       std::fill(timing.finished.begin(), timing.finished.end(), 0.0);

@@ -8,7 +8,10 @@
 //   default      reliable, volatile, keep last 10
 //   images       reliable, volatile, keep last 2: a lost fragment loses a whole best-effort
 //                image (a 1024x768 RGB image is ~40 loopback packets), so images default to
-//                reliable with a short history (the receiver wants the newest)
+//                reliable with a short history (the receiver wants the newest). Image
+//                writers offer transient local whatever their QoS says (keeping their last
+//                `depth` images for readers that come later and ask for them: a perception
+//                started after the robot's first step); volatile readers match them as well
 //   latched      reliable, transient local, keep last 1: a late-joining reader gets the
 //                newest sample (the head's state, camera info)
 #include <nlohmann/json.hpp>

@@ -13,8 +13,16 @@
 //                                                          the sibling joint_targets topic
 //   head.command           sensor_msgs/JointState          positions, velocities
 //   vision.target          geometry_msgs/PointStamped      frame "world"; only valid targets
+//   (the simulated clock)  rosgraph_msgs/Clock on /clock   ClockWriter, as Gazebo publishes it
 //
-// Messages carry their capture time as header.stamp (builtin_interfaces/Time: sec, nanosec).
+// Images also go out JPEG- or PNG-compressed as sensor_msgs/CompressedImage on
+// `<topic>/compressed` (image_transport's compressed plugin's name and format string), encoded
+// only while a reader of it is matched: a best-effort reader with Cyclone's default
+// configuration loses most raw images (a lost fragment loses the image), few compressed ones.
+//
+// Messages carry their capture time as header.stamp (builtin_interfaces/Time: sec, nanosec):
+// simulated seconds from 0, or those plus an offset (TopicOptions::stamp_offset_ns, the wall
+// clock at the start) that each writer announces and saccade's readers take off again.
 // Frames are named "world" and "<camera>_optical" (OpenCV's camera frame: x right, y down,
 // z forward, as ROS's optical frames).
 //
@@ -58,6 +66,17 @@ struct TopicOptions {
   /// lockstep (a GUI, a ROS 2 tool) are never waited for. Empty JointStates are step marks,
   /// not commands, for every reader.
   bool lockstep = false;
+  /// Added to every stamp written, in ns (`transport.stamps: wall`: the wall clock's time at
+  /// the start, so that stamps are in the present); 0: simulated seconds from 0. A writer with
+  /// an offset announces it in its DDS user data ("saccade.stamp_offset_ns=N;"); saccade's
+  /// readers take each writer's offset off its stamps (exactly: whole ns), so that they see
+  /// the sender's simulated time either way.
+  int64_t stamp_offset_ns = 0;
+  /// Images written: "jpeg" or "png" publishes a sensor_msgs/CompressedImage beside the raw
+  /// image on `<topic>/compressed` (encoded only while a reader of it is matched); "" none.
+  std::string compressed_format = "jpeg";
+  /// JPEG quality of the compressed images, 1..100 (image_transport's default is 95).
+  int jpeg_quality = 90;
 };
 
 /// What crossed a link, for reports.
@@ -116,6 +135,24 @@ class Writer {
  private:
   std::string message_type_;
   std::string topic_;
+};
+
+/// Publishes the simulated clock on /clock as rosgraph_msgs/Clock, as Gazebo does, for ROS 2
+/// nodes run with `use_sim_time:=true` (their now() is the last clock received). QoS: reliable,
+/// volatile, keep last 1, which rclcpp's ClockQoS subscription (best effort, keep last 1)
+/// and reliable subscribers both match.
+class ClockWriter {
+ public:
+  /// `topic` a fully qualified ROS topic; `stamp_offset_ns` as TopicOptions'. Throws as
+  /// Writer::Create.
+  static std::unique_ptr<ClockWriter> Create(std::shared_ptr<Participant> participant,
+                                             const std::string& topic = "/clock",
+                                             int64_t stamp_offset_ns = 0);
+  virtual ~ClockWriter() = default;
+  /// Publishes `time` (simulated seconds) plus the offset. Does not throw (logs a refusal).
+  virtual void Publish(double time) = 0;
+  /// Readers matched now.
+  virtual int matched() const = 0;
 };
 
 /// Subscribes to one ROS topic and gives saccade messages of one type.

@@ -40,6 +40,12 @@ struct TopicTransport {
   std::function<std::function<void(const StepContext&)>(const TopicEndpoint& endpoint,
                                                         OutputBase& output)>
       attach_writer;
+  /// Optional. Called once for each pipeline with topic connections, after its readers and
+  /// writers: returns what the transport does at the start of each step, before any
+  /// component (DDS publishes the simulated clock on /clock), or an empty function. Throws
+  /// saccade::Error naming what is wrong with the pipeline's `transport:` map.
+  std::function<std::function<void(const StepContext&)>(const PipelineSpec& pipeline)>
+      attach_pipeline;
 };
 
 /// Makes components by type name ("vision.face_detector"). Modules register theirs.

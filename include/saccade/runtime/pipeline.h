@@ -249,6 +249,9 @@ class Pipeline {
 
   /// Hands over messages held back by delayed connections (the scheduler, each step).
   void DeliverDelayed();
+  /// Begins a step before its components: the topic transport's start-of-step work (DDS
+  /// publishes /clock, docs/dds.md). The scheduler and Python's step call it.
+  void BeginStep(const StepContext& context);
   /// Ends a step after its components: the topic writers' end-of-step work (a lockstep
   /// writer marks the step done, docs/dds.md). The scheduler and Python's step call it.
   void EndStep(const StepContext& context);
@@ -261,8 +264,9 @@ class Pipeline {
   PipelineSpec spec_;
   std::shared_ptr<Resources> resources_;
   std::vector<std::unique_ptr<Component>> components_;
-  TimeSource* time_source_ = nullptr;                               // one of components_
-  std::vector<std::function<void(const StepContext&)>> step_ends_;  // EndStep's, in file order
+  TimeSource* time_source_ = nullptr;                                 // one of components_
+  std::vector<std::function<void(const StepContext&)>> step_begins_;  // BeginStep's
+  std::vector<std::function<void(const StepContext&)>> step_ends_;    // EndStep's, in file order
   // Boxed so that the delivery callbacks' pointer stays valid when the pipeline moves.
   std::unique_ptr<double> delivery_seconds_ = std::make_unique<double>(0.0);
 };
