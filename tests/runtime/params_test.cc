@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -121,6 +122,8 @@ TEST(Params, IntervalRangesKeepOpenEndsOnNumbersAndRoundIntegerEndsInside) {
   EXPECT_EQ(Interval::LeftOpen(1, 4).Text(), "(1, 4]");
   EXPECT_EQ(Interval::AtLeast(0.5).Text(), "[0.5, inf)");
   EXPECT_FALSE(Interval::Closed(0, 1).Contains(std::nan("")));
+  EXPECT_FALSE(Interval::AtLeast(0).Contains(std::numeric_limits<double>::infinity()));
+  EXPECT_TRUE(Interval::AtLeast(0).Contains(1e308));
 }
 
 TEST(Params, IntegersBeyondTheMembersTypeAreRefused) {

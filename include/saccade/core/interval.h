@@ -31,9 +31,12 @@ struct Interval {
     return {min, std::numeric_limits<double>::infinity(), true, false};
   }
 
-  /// Whether `x` lies in the interval; NaN never does.
+  /// Whether `x` lies in the interval; NaN and the infinities never do (an unbounded end
+  /// means every finite number on that side, as a parameter's range does).
   constexpr bool Contains(double x) const {
-    return (min_open ? x > min : x >= min) && (max_open ? x < max : x <= max);
+    return x > -std::numeric_limits<double>::infinity() &&
+           x < std::numeric_limits<double>::infinity() && (min_open ? x > min : x >= min) &&
+           (max_open ? x < max : x <= max);
   }
   /// "[0, 4]", "(1, 4]", "[1, inf)": the interval as mathematics writes it.
   std::string Text() const;
