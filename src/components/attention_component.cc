@@ -34,16 +34,16 @@ AttentionComponent::AttentionComponent()
   DeclareParam("scene", &scene_param_, internal::kSceneParamDoc).Path();
   DeclareParam("fixation_time_s", &ior_options_.fixation_time_s,
                "dwell on a face before it is suppressed")
-      .Range(1e-6, 1e6)
+      .Range(vision::InhibitionOfReturn::Options::kDwells)
       .Unit("s");
   DeclareParam("radius_m", &ior_options_.radius_m, "size of a fixated or suppressed place")
-      .Range(1e-6, 1e6)
+      .Range(vision::InhibitionOfReturn::Options::kRadii)
       .Unit("m");
   DeclareParam("follow_objects", &ior_options_.follow,
                "suppressed places and the dwell follow the faces as they move");
   DeclareParam("suppression_time_s", &ior_options_.suppression_time_s,
                "how long a fixated place stays suppressed")
-      .Range(1e-6, 1e9)
+      .Range(vision::InhibitionOfReturn::Options::kSuppressions)
       .Unit("s");
   DeclareParam("lost_after_s", &lost_after_s_, "a target unseen this long is dropped")
       .Range(0.0, 1e6)

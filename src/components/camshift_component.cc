@@ -26,7 +26,7 @@ CamShiftComponent::CamShiftComponent()
       .Required();
   DeclareParam("min_mass_ratio", &options_.min_mass_ratio,
                "the track is lost when the window's hue mass falls below this share of the seed's")
-      .Range(0.0, 0.999);
+      .Range(vision::CamShiftTracker::Options::kMassRatios);
   DeclareParam("history_frames", &history_frames_,
                "images kept for detections that arrive late: one older than this is not used")
       .Range(1, 64);

@@ -19,7 +19,7 @@ using internal::FrameOf;
 
 MedianComponent::MedianComponent() {
   DeclareParam("kernel_size", &options_.kernel_size, "side of the square window, odd")
-      .Range(3, 255)
+      .Range(vision::MedianFilter::Options::kKernelSizes)
       .Unit("px");
 }
 

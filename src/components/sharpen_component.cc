@@ -19,9 +19,9 @@ using internal::FrameOf;
 
 SharpenComponent::SharpenComponent() {
   DeclareParam("amount", &options_.amount, "weight of the detail added back (unsharp mask)")
-      .Range(0.0, 100.0);
+      .Range(vision::Sharpener::Options::kAmounts);
   DeclareParam("sigma", &options_.sigma, "Gaussian blur whose difference is the detail")
-      .Range(1e-6, 50.0)
+      .Range(vision::Sharpener::Options::kSigmas)
       .Unit("px");
 }
 

@@ -16,6 +16,7 @@ namespace saccade::components {
 
 using internal::Centre;
 using internal::FrameOf;
+using Options = vision::StereoAssociator::Options;
 
 StereoFacesComponent::StereoFacesComponent()
     : left_(AddInput<FacesMessage>("left", /*required=*/true)),
@@ -29,19 +30,22 @@ StereoFacesComponent::StereoFacesComponent()
                "match each pair's left face patch in the right image (sub-pixel) for its depth");
   DeclareParam("max_reprojection_px", &options_.max_reprojection_px,
                "largest reprojection error of a left/right pair")
-      .Range(1e-6, 1e6)
+      .Range(Options::kReprojections)
       .Unit("px");
   DeclareParam("min_depth_m", &options_.min_depth_m, "nearest depth of a pair")
-      .Range(1e-6, 1e6)
+      .Range(Options::kDepths)
       .Unit("m");
-  DeclareParam("max_depth_m", &options_.max_depth_m, "farthest depth of a pair")
-      .Range(1e-6, 1e6)
+  DeclareParam("max_depth_m", &options_.max_depth_m,
+               "farthest depth of a pair; more than min_depth_m")
+      .Range(Options::kDepths)
       .Unit("m");
-  DeclareParam("min_width_m", &options_.min_width_m, "narrowest face; 0: no limit")
-      .Range(0.0, 1e6)
+  DeclareParam("min_width_m", &options_.min_width_m,
+               "narrowest face; 0 with max_width_m 0: no width check")
+      .Range(Options::kWidths)
       .Unit("m");
-  DeclareParam("max_width_m", &options_.max_width_m, "widest face; 0: no limit")
-      .Range(0.0, 1e6)
+  DeclareParam("max_width_m", &options_.max_width_m,
+               "widest face; more than min_width_m, or 0 with min_width_m 0: no width check")
+      .Range(Options::kWidths)
       .Unit("m");
 }
 

@@ -21,7 +21,7 @@ UndistortComponent::UndistortComponent() {
   DeclareParam("bilinear", &options_.bilinear, "bilinear interpolation (else nearest pixel)");
   DeclareParam("border_value", &options_.border_value,
                "grey level of the pixels that no source pixel maps to")
-      .Range(0, 255);
+      .Range(vision::Undistorter::Options::kBorderValues);
 }
 
 Image UndistortComponent::Apply(const Image& image) {

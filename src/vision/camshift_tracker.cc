@@ -9,34 +9,29 @@
 #include "saccade/core/error.h"
 
 namespace saccade::vision {
-namespace {
-
-bool InRange(int value, int lo, int hi) { return value >= lo && value <= hi; }
-
-}  // namespace
 
 bool CamShiftTracker::Options::IsValid(std::string* error) const {
   std::string what;
-  if (!InRange(hue_bins, 2, 180)) {
-    what = "hue_bins " + std::to_string(hue_bins) + ", expected 2 .. 180";
-  } else if (!InRange(saturation_bins, 1, 256)) {
-    what = "saturation_bins " + std::to_string(saturation_bins) + ", expected 1 .. 256";
-  } else if (!InRange(min_saturation, 0, 255)) {
-    what = "min_saturation " + std::to_string(min_saturation) + ", expected 0 .. 255";
-  } else if (!InRange(min_value, 0, 255)) {
-    what = "min_value " + std::to_string(min_value) + ", expected 0 .. 255";
-  } else if (!(seed_fraction > 0.0 && seed_fraction <= 1.0)) {
-    what = "seed_fraction " + std::to_string(seed_fraction) + ", expected 0 < x <= 1";
-  } else if (!(min_mass_ratio >= 0.0 && min_mass_ratio < 1.0)) {
-    what = "min_mass_ratio " + std::to_string(min_mass_ratio) + ", expected 0 <= x < 1";
-  } else if (min_window_px < 1) {
-    what = "min_window_px " + std::to_string(min_window_px) + ", expected >= 1";
-  } else if (!(max_growth > 1.0) || !std::isfinite(max_growth)) {
-    what = "max_growth " + std::to_string(max_growth) + ", expected a finite number > 1";
-  } else if (max_iterations < 1) {
-    what = "max_iterations " + std::to_string(max_iterations) + ", expected >= 1";
-  } else if (!(epsilon_px > 0.0) || !std::isfinite(epsilon_px)) {
-    what = "epsilon_px " + std::to_string(epsilon_px) + ", expected a finite number > 0";
+  if (!kHueBins.Contains(hue_bins)) {
+    what = kHueBins.Refusal("hue_bins", hue_bins);
+  } else if (!kSaturationBins.Contains(saturation_bins)) {
+    what = kSaturationBins.Refusal("saturation_bins", saturation_bins);
+  } else if (!kLevels.Contains(min_saturation)) {
+    what = kLevels.Refusal("min_saturation", min_saturation);
+  } else if (!kLevels.Contains(min_value)) {
+    what = kLevels.Refusal("min_value", min_value);
+  } else if (!kSeedFractions.Contains(seed_fraction)) {
+    what = kSeedFractions.Refusal("seed_fraction", seed_fraction);
+  } else if (!kMassRatios.Contains(min_mass_ratio)) {
+    what = kMassRatios.Refusal("min_mass_ratio", min_mass_ratio);
+  } else if (!kMinWindows.Contains(min_window_px)) {
+    what = kMinWindows.Refusal("min_window_px", min_window_px);
+  } else if (!kGrowths.Contains(max_growth)) {
+    what = kGrowths.Refusal("max_growth", max_growth);
+  } else if (!kIterations.Contains(max_iterations)) {
+    what = kIterations.Refusal("max_iterations", max_iterations);
+  } else if (!kEpsilons.Contains(epsilon_px)) {
+    what = kEpsilons.Refusal("epsilon_px", epsilon_px);
   }
   if (what.empty()) return true;
   if (error) *error = "CamShiftTracker::Options: " + what;

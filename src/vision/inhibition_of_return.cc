@@ -10,13 +10,12 @@ namespace saccade::vision {
 
 bool InhibitionOfReturn::Options::IsValid(std::string* error) const {
   std::string what;
-  if (!(fixation_time_s > 0.0) || !std::isfinite(fixation_time_s)) {
-    what = "fixation_time_s " + std::to_string(fixation_time_s) + ", expected a finite number > 0";
-  } else if (!(radius_m > 0.0) || !std::isfinite(radius_m)) {
-    what = "radius_m " + std::to_string(radius_m) + ", expected a finite number > 0";
-  } else if (!(suppression_time_s > 0.0) || !std::isfinite(suppression_time_s)) {
-    what = "suppression_time_s " + std::to_string(suppression_time_s) +
-           ", expected a finite number > 0";
+  if (!kDwells.Contains(fixation_time_s)) {
+    what = kDwells.Refusal("fixation_time_s", fixation_time_s);
+  } else if (!kRadii.Contains(radius_m)) {
+    what = kRadii.Refusal("radius_m", radius_m);
+  } else if (!kSuppressions.Contains(suppression_time_s)) {
+    what = kSuppressions.Refusal("suppression_time_s", suppression_time_s);
   }
   if (what.empty()) return true;
   if (error) *error = "InhibitionOfReturn::Options: " + what;

@@ -8,14 +8,15 @@
 namespace saccade::vision {
 
 bool MedianFilter::Options::IsValid(std::string* error) const {
-  if (kernel_size < 3 || kernel_size > 255 || kernel_size % 2 == 0) {
-    if (error) {
-      *error = "MedianFilter::Options: kernel_size " + std::to_string(kernel_size) +
-               ", expected an odd number in 3 .. 255";
-    }
-    return false;
+  std::string what;
+  if (!kKernelSizes.Contains(kernel_size)) {
+    what = kKernelSizes.Refusal("kernel_size", kernel_size);
+  } else if (kernel_size % 2 == 0) {
+    what = "kernel_size " + std::to_string(kernel_size) + ", expected an odd number";
   }
-  return true;
+  if (what.empty()) return true;
+  if (error) *error = "MedianFilter::Options: " + what;
+  return false;
 }
 
 MedianFilter::MedianFilter() : MedianFilter(Options()) {}

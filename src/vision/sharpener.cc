@@ -10,10 +10,10 @@ namespace saccade::vision {
 
 bool Sharpener::Options::IsValid(std::string* error) const {
   std::string what;
-  if (!std::isfinite(amount) || amount < 0.0) {
-    what = "amount " + std::to_string(amount) + ", expected a finite number >= 0";
-  } else if (!std::isfinite(sigma) || sigma <= 0.0 || sigma > 50.0) {
-    what = "sigma " + std::to_string(sigma) + " px, expected 0 < sigma <= 50";
+  if (!kAmounts.Contains(amount)) {
+    what = kAmounts.Refusal("amount", amount);
+  } else if (!kSigmas.Contains(sigma)) {
+    what = kSigmas.Refusal("sigma", sigma);
   }
   if (what.empty()) return true;
   if (error) *error = "Sharpener::Options: " + what;

@@ -20,17 +20,22 @@ StereoObservation StereoObservation::FromBox(const cv::Rect& box) {
 
 bool StereoAssociator::Options::IsValid(std::string* error) const {
   std::string what;
-  if (!(max_reprojection_px > 0.0) || !std::isfinite(max_reprojection_px)) {
-    what = "max_reprojection_px " + std::to_string(max_reprojection_px) + ", expected > 0";
-  } else if (!(min_depth_m > 0.0) || !std::isfinite(min_depth_m)) {
-    what = "min_depth_m " + std::to_string(min_depth_m) + ", expected > 0";
-  } else if (!(max_depth_m > min_depth_m) || !std::isfinite(max_depth_m)) {
+  if (!kReprojections.Contains(max_reprojection_px)) {
+    what = kReprojections.Refusal("max_reprojection_px", max_reprojection_px);
+  } else if (!kDepths.Contains(min_depth_m)) {
+    what = kDepths.Refusal("min_depth_m", min_depth_m);
+  } else if (!kDepths.Contains(max_depth_m)) {
+    what = kDepths.Refusal("max_depth_m", max_depth_m);
+  } else if (!(max_depth_m > min_depth_m)) {
     what = "max_depth_m " + std::to_string(max_depth_m) + ", expected > min_depth_m (" +
            std::to_string(min_depth_m) + ")";
-  } else if (!(min_width_m == 0.0 && max_width_m == 0.0) &&
-             !(min_width_m >= 0.0 && max_width_m > min_width_m && std::isfinite(max_width_m))) {
+  } else if (!kWidths.Contains(min_width_m)) {
+    what = kWidths.Refusal("min_width_m", min_width_m);
+  } else if (!kWidths.Contains(max_width_m)) {
+    what = kWidths.Refusal("max_width_m", max_width_m);
+  } else if (!(min_width_m == 0.0 && max_width_m == 0.0) && !(max_width_m > min_width_m)) {
     what = "min_width_m " + std::to_string(min_width_m) + ", max_width_m " +
-           std::to_string(max_width_m) + ", expected both 0 (off) or 0 <= min < max";
+           std::to_string(max_width_m) + ", expected both 0 (off) or min < max";
   }
   if (what.empty()) return true;
   if (error) *error = "StereoAssociator::Options: " + what;

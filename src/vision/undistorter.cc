@@ -13,11 +13,9 @@
 namespace saccade::vision {
 
 bool Undistorter::Options::IsValid(std::string* error) const {
-  if (border_value < 0 || border_value > 255) {
-    if (error) {
-      *error = "Undistorter::Options: border_value " + std::to_string(border_value) +
-               ", expected 0 .. 255";
-    }
+  if (!kBorderValues.Contains(border_value)) {
+    if (error)
+      *error = "Undistorter::Options: " + kBorderValues.Refusal("border_value", border_value);
     return false;
   }
   return true;

@@ -1104,7 +1104,7 @@ TEST(ComponentParams, UnknownMissingAndOutOfRangeParametersAreNamed) {
             "no scene: name it once at the top of the pipeline or hardware file (scene: FILE), or "
             "give this component the parameter 'scene'");
   EXPECT_EQ(message("vision.attention", {{"scene", kScene}, {"fixation_time_s", -1}}),
-            "parameter 'fixation_time_s': expected a number in [1e-06, 1000000], got -1");
+            "parameter 'fixation_time_s': expected a number in (0, 1000000], got -1");
   EXPECT_EQ(message("sim.cameras", {{"scene", kScene}, {"cameras", {"left", "middle"}}}),
             "parameter 'cameras': scene '" + kScene + "' has no camera 'middle'");
 }

@@ -229,17 +229,17 @@ TEST(CamShiftTracker, BadOptionsSayWhatIsWrong) {
     CamShiftTracker t(o);
     FAIL();
   } catch (const InvalidArgument& e) {
-    EXPECT_STREQ(e.what(), "CamShiftTracker::Options: hue_bins 1, expected 2 .. 180");
+    EXPECT_STREQ(e.what(), "CamShiftTracker::Options: hue_bins 1, expected [2, 180]");
   }
   std::string error;
   o = {};
   o.min_mass_ratio = 1.0;
   EXPECT_FALSE(o.IsValid(&error));
-  EXPECT_EQ(error, "CamShiftTracker::Options: min_mass_ratio 1.000000, expected 0 <= x < 1");
+  EXPECT_EQ(error, "CamShiftTracker::Options: min_mass_ratio 1, expected [0, 1)");
   o = {};
   o.seed_fraction = 0.0;
   EXPECT_FALSE(o.IsValid(&error));
-  EXPECT_EQ(error, "CamShiftTracker::Options: seed_fraction 0.000000, expected 0 < x <= 1");
+  EXPECT_EQ(error, "CamShiftTracker::Options: seed_fraction 0, expected (0, 1]");
   o = {};
   o.max_growth = 1.0;
   EXPECT_FALSE(o.IsValid(&error));

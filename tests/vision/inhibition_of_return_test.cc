@@ -134,15 +134,13 @@ TEST(InhibitionOfReturn, BadOptionsSayWhatIsWrong) {
     InhibitionOfReturn ior(o);
     FAIL();
   } catch (const InvalidArgument& e) {
-    EXPECT_STREQ(
-        e.what(),
-        "InhibitionOfReturn::Options: fixation_time_s 0.000000, expected a finite number > 0");
+    EXPECT_STREQ(e.what(), "InhibitionOfReturn::Options: fixation_time_s 0, expected (0, 1000000]");
   }
   std::string error;
   o = {};
   o.radius_m = -1;
   EXPECT_FALSE(o.IsValid(&error));
-  EXPECT_EQ(error, "InhibitionOfReturn::Options: radius_m -1.000000, expected a finite number > 0");
+  EXPECT_EQ(error, "InhibitionOfReturn::Options: radius_m -1, expected (0, 1000000]");
   o = {};
   o.suppression_time_s = std::numeric_limits<double>::infinity();
   EXPECT_FALSE(o.IsValid(&error));

@@ -250,6 +250,7 @@ TEST(MedianFilter, RemovesSaltAndPepperNoise) {
 
 TEST(MedianFilter, BadKernelSizesSayWhatIsExpected) {
   for (int size : {0, 1, 4, 257}) {
+    const std::string expected = size == 4 ? "an odd number" : "[3, 255]";
     MedianFilter::Options o;
     o.kernel_size = size;
     try {
@@ -257,8 +258,7 @@ TEST(MedianFilter, BadKernelSizesSayWhatIsExpected) {
       FAIL() << size;
     } catch (const InvalidArgument& e) {
       EXPECT_EQ(std::string(e.what()), "MedianFilter::Options: kernel_size " +
-                                           std::to_string(size) +
-                                           ", expected an odd number in 3 .. 255");
+                                           std::to_string(size) + ", expected " + expected);
     }
   }
 }
@@ -294,14 +294,14 @@ TEST(Sharpener, BadOptionsSayWhatIsWrong) {
   o.amount = -1.0;
   std::string error;
   EXPECT_FALSE(o.IsValid(&error));
-  EXPECT_EQ(error, "Sharpener::Options: amount -1.000000, expected a finite number >= 0");
+  EXPECT_EQ(error, "Sharpener::Options: amount -1, expected [0, 100]");
   o = {};
   o.sigma = 0.0;
   try {
     Sharpener s(o);
     FAIL();
   } catch (const InvalidArgument& e) {
-    EXPECT_STREQ(e.what(), "Sharpener::Options: sigma 0.000000 px, expected 0 < sigma <= 50");
+    EXPECT_STREQ(e.what(), "Sharpener::Options: sigma 0, expected (0, 50]");
   }
   EXPECT_THROW(Sharpener().Apply(Image(8, 8, PixelFormat::kUint32)), InvalidArgument);
 }

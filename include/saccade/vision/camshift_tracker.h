@@ -10,6 +10,7 @@
 #include <string>
 
 #include "saccade/core/image.h"
+#include "saccade/core/interval.h"
 
 namespace saccade::vision {
 
@@ -29,23 +30,36 @@ struct TrackState {
 class CamShiftTracker {
  public:
   struct Options {
-    int hue_bins = 30;         ///< histogram bins over OpenCV's hue 0 .. 180: 2 .. 180
-    int saturation_bins = 32;  ///< bins over saturation 0 .. 256: 1 .. 256
-    int min_saturation = 30;   ///< pixels less saturated are ignored (grey has no hue): 0 .. 255
-    int min_value = 30;        ///< darker pixels are ignored (noisy hue): 0 .. 255
+    int hue_bins = 30;         ///< histogram bins over OpenCV's hue 0 .. 180: kHueBins
+    int saturation_bins = 32;  ///< bins over saturation 0 .. 256: kSaturationBins
+    int min_saturation = 30;   ///< pixels less saturated are ignored (grey has no hue): kLevels
+    int min_value = 30;        ///< darker pixels are ignored (noisy hue): kLevels
     /// Fraction (per side) of the seed box, about its centre, whose colours make the model:
-    /// the detector's box holds some background at its corners. 0 < x <= 1.
+    /// the detector's box holds some background at its corners. kSeedFractions.
     double seed_fraction = 0.7;
     /// Lost when the back-projection mass in the window falls below this fraction of the
-    /// seed's: 0 <= x < 1.
+    /// seed's: kMassRatios.
     double min_mass_ratio = 0.3;
-    /// Lost when the window's side falls below this (pixels, >= 1) ...
+    /// Lost when the window's side falls below this (pixels, kMinWindows) ...
     int min_window_px = 8;
-    /// ... or its area grows beyond this multiple of the seed box's (> 1): it spread into
-    /// a background of similar colour.
+    /// ... or its area grows beyond this multiple of the seed box's (kGrowths): it spread
+    /// into a background of similar colour.
     double max_growth = 6.0;
-    int max_iterations = 10;  ///< mean-shift iterations per frame: >= 1
-    double epsilon_px = 0.5;  ///< mean-shift convergence, pixels: > 0
+    int max_iterations = 10;  ///< mean-shift iterations per frame: kIterations
+    double epsilon_px = 0.5;  ///< mean-shift convergence, pixels: kEpsilons
+
+    // The valid values, stated once: IsValid checks them, and vision.camshift declares its
+    // parameters with them (runtime::ParamDecl::Range(const Interval&)).
+    static constexpr Interval kHueBins = Interval::Closed(2, 180);
+    static constexpr Interval kSaturationBins = Interval::Closed(1, 256);
+    static constexpr Interval kLevels = Interval::Closed(0, 255);
+    static constexpr Interval kSeedFractions = Interval::LeftOpen(0, 1);
+    static constexpr Interval kMassRatios = Interval::RightOpen(0, 1);
+    static constexpr Interval kMinWindows = Interval::AtLeast(1);
+    static constexpr Interval kGrowths = Interval::Above(1);
+    static constexpr Interval kIterations = Interval::AtLeast(1);
+    static constexpr Interval kEpsilons = Interval::Above(0);
+
     bool IsValid(std::string* error) const;
   };
 

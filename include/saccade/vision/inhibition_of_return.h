@@ -13,16 +13,25 @@
 #include <string>
 #include <vector>
 
+#include "saccade/core/interval.h"
+
 namespace saccade::vision {
 
 /// Target selection with inhibition of return. State (not thread-safe); one per head.
 class InhibitionOfReturn {
  public:
   struct Options {
-    double fixation_time_s = 2.0;      ///< dwell before a place is suppressed, s: > 0
-    double radius_m = 0.15;            ///< size of a fixated / suppressed place, m: > 0
-    double suppression_time_s = 10.0;  ///< how long it stays suppressed, s: > 0
+    double fixation_time_s = 2.0;      ///< dwell before a place is suppressed, s: kDwells
+    double radius_m = 0.15;            ///< size of a fixated / suppressed place, m: kRadii
+    double suppression_time_s = 10.0;  ///< how long it stays suppressed, s: kSuppressions
     bool follow = true;                ///< suppressions and the dwell follow moving objects
+
+    // The valid values, stated once: IsValid checks them, and vision.attention declares its
+    // parameters with them (runtime::ParamDecl::Range(const Interval&)).
+    static constexpr Interval kDwells = Interval::LeftOpen(0, 1e6);
+    static constexpr Interval kRadii = Interval::LeftOpen(0, 1e6);
+    static constexpr Interval kSuppressions = Interval::LeftOpen(0, 1e9);
+
     bool IsValid(std::string* error) const;
   };
 

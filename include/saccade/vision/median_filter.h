@@ -4,6 +4,7 @@
 #include <string>
 
 #include "saccade/core/image.h"
+#include "saccade/core/interval.h"
 
 namespace saccade::vision {
 
@@ -11,8 +12,14 @@ namespace saccade::vision {
 class MedianFilter {
  public:
   struct Options {
-    /// Side of the square window, pixels: odd, 3 .. 255 (cv::medianBlur on 8-bit images).
+    /// Side of the square window, pixels: odd, in kKernelSizes (cv::medianBlur on 8-bit
+    /// images).
     int kernel_size = 3;
+
+    // The valid sizes, stated once: IsValid checks them (and that the size is odd), and
+    // vision.median declares its parameter with them (runtime::ParamDecl::Range).
+    static constexpr Interval kKernelSizes = Interval::Closed(3, 255);
+
     bool IsValid(std::string* error) const;
   };
 

@@ -5,6 +5,7 @@
 #include <string>
 
 #include "saccade/core/image.h"
+#include "saccade/core/interval.h"
 
 namespace saccade::vision {
 
@@ -12,10 +13,17 @@ namespace saccade::vision {
 class Sharpener {
  public:
   struct Options {
-    /// Gain of the detail (in - blur): >= 0 and finite; 0 leaves the image unchanged.
+    /// Gain of the detail (in - blur): kAmounts; 0 leaves the image unchanged.
     double amount = 1.0;
-    /// Standard deviation of the Gaussian blur, pixels: > 0 and <= 50.
+    /// Standard deviation of the Gaussian blur, pixels: kSigmas.
     double sigma = 1.0;
+
+    // The valid values, stated once: IsValid checks them, and vision.sharpen declares its
+    // parameters with them (runtime::ParamDecl::Range(const Interval&)). A gain above 100
+    // saturates every pixel off a flat area.
+    static constexpr Interval kAmounts = Interval::Closed(0, 100);
+    static constexpr Interval kSigmas = Interval::LeftOpen(0, 50);
+
     bool IsValid(std::string* error) const;
   };
 

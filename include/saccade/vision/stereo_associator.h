@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "saccade/core/image.h"
+#include "saccade/core/interval.h"
 
 namespace saccade::vision {
 
@@ -45,17 +46,25 @@ struct StereoMatch {
 class StereoAssociator {
  public:
   struct Options {
-    /// Largest reprojection error of an accepted pair in either image, pixels: > 0. Centres of
-    /// detections of one face differ between the eyes by a few pixels (box quantisation).
+    /// Largest reprojection error of an accepted pair in either image, pixels: kReprojections.
+    /// Centres of detections of one face differ between the eyes by a few pixels (box
+    /// quantisation).
     double max_reprojection_px = 4.0;
-    double min_depth_m = 0.1;   ///< > 0
-    double max_depth_m = 20.0;  ///< > min_depth_m
-    /// Physical width of an accepted face, metres; both 0 disables the check (else
-    /// 0 <= min < max). Human faces (as the cascades box them) are ~0.12 to 0.25 m wide.
+    double min_depth_m = 0.1;   ///< kDepths
+    double max_depth_m = 20.0;  ///< kDepths, and > min_depth_m
+    /// Physical width of an accepted face, metres, each in kWidths; both 0 disables the check
+    /// (else min < max). Human faces (as the cascades box them) are ~0.12 to 0.25 m wide.
     double min_width_m = 0.0;
     double max_width_m = 0.0;
     /// Refine each chosen pair's disparity by matching the left patch in the right image.
     bool refine_disparity = false;
+
+    // The valid values, stated once: IsValid checks them (and the orders across them), and
+    // vision.stereo_faces declares its parameters with them (runtime::ParamDecl::Range).
+    static constexpr Interval kReprojections = Interval::LeftOpen(0, 1e6);
+    static constexpr Interval kDepths = Interval::LeftOpen(0, 1e6);
+    static constexpr Interval kWidths = Interval::Closed(0, 1e6);
+
     bool IsValid(std::string* error) const;
   };
 

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "saccade/core/image.h"
+#include "saccade/core/interval.h"
 #include "saccade/geometry/camera_model.h"
 
 namespace saccade::vision {
@@ -17,8 +18,13 @@ class Undistorter {
   struct Options {
     /// Bilinear (true) or nearest-neighbour (false) sampling of the distorted image.
     bool bilinear = true;
-    /// Value of output pixels whose ray falls outside the distorted image (0 .. 255).
+    /// Value of output pixels whose ray falls outside the distorted image: kBorderValues.
     int border_value = 0;
+
+    // The valid values, stated once: IsValid checks them, and vision.undistort declares its
+    // parameter with them (runtime::ParamDecl::Range(const Interval&)).
+    static constexpr Interval kBorderValues = Interval::Closed(0, 255);
+
     bool IsValid(std::string* error) const;
   };
 
