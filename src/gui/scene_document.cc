@@ -71,13 +71,20 @@ std::string ModelBinary(const scene::Model& model) {
 
 }  // namespace
 
-/// A pose as 16 numbers, row-major (docs/gui-protocol.md).
-json MatrixJson(const geometry::Pose& X) {
-  json m = json::array();
-  for (int r = 0; r < 4; ++r) {
-    for (int c = 0; c < 4; ++c) m.push_back(X.matrix()(r, c));
+json FramesJson(const head::HeadFrames& frames) {
+  return {{"X_WB", ToJson(frames.X_WB)},        {"X_WN", ToJson(frames.X_WN)},
+          {"X_WC", ToJson(frames.X_WC)},        {"left_eye", ToJson(frames.X_WL)},
+          {"right_eye", ToJson(frames.X_WR)},   {"left", ToJson(frames.X_WCamLeft)},
+          {"right", ToJson(frames.X_WCamRight)}};
+}
+
+json MovingObjectsJson(const scene::Scene& scene, double t) {
+  json objects = json::array();
+  for (const scene::Object& o : scene.objects()) {
+    if (!o.motion.IsStatic())
+      objects.push_back({{"name", o.name}, {"X_WO", ToJson(o.motion.PoseAt(t))}});
   }
-  return m;
+  return objects;
 }
 
 json PublishScene(const scene::Scene& scene, const std::string& scene_name, const std::string& mode,
@@ -132,7 +139,7 @@ json PublishScene(const scene::Scene& scene, const std::string& scene_name, cons
                        {"id", o.id},
                        {"model", add_model(o.model)},
                        {"scale", ToJson(o.scale)},
-                       {"X_WO", MatrixJson(o.motion.PoseAt(0.0))},
+                       {"X_WO", ToJson(o.motion.PoseAt(0.0))},
                        {"moving", !o.motion.IsStatic()}});
   }
   json robot = nullptr;
@@ -142,7 +149,7 @@ json PublishScene(const scene::Scene& scene, const std::string& scene_name, cons
     for (const scene::RobotPart& p : scene.robot()->parts) {
       parts.push_back({{"link", LinkName(p.link)},
                        {"model", add_model(p.model)},
-                       {"X_LinkPart", MatrixJson(p.X_LinkPart)},
+                       {"X_LinkPart", ToJson(p.X_LinkPart)},
                        {"scale", ToJson(p.scale)}});
     }
     robot = {{"visible", scene.robot()->visible}, {"parts", parts}};
@@ -179,7 +186,7 @@ json PublishScene(const scene::Scene& scene, const std::string& scene_name, cons
     json camera = ToJson(c.model);
     camera["name"] = c.name;
     camera["eye"] = eye;
-    camera["X_WC"] = MatrixJson(c.X_WC);
+    camera["X_WC"] = ToJson(c.X_WC);
     camera["near"] = c.clip.near;
     camera["far"] = c.clip.far;
     cameras.push_back(camera);

@@ -390,13 +390,7 @@ json GuiSession::StateJson(const runtime::StepContext& context, const Latest& la
                        {"velocities", ToJson(j.velocities)},
                        {"arrived", j.arrived}};
     frames = head::ForwardKinematics(scene_.robot()->head, j.positions);
-    state["frames"] = {{"X_WB", internal::MatrixJson(frames->X_WB)},
-                       {"X_WN", internal::MatrixJson(frames->X_WN)},
-                       {"X_WC", internal::MatrixJson(frames->X_WC)},
-                       {"left_eye", internal::MatrixJson(frames->X_WL)},
-                       {"right_eye", internal::MatrixJson(frames->X_WR)},
-                       {"left", internal::MatrixJson(frames->X_WCamLeft)},
-                       {"right", internal::MatrixJson(frames->X_WCamRight)}};
+    state["frames"] = internal::FramesJson(*frames);
     state["fixation_W"] = frames->p_WFixation ? ToJson(*frames->p_WFixation) : json(nullptr);
     std::lock_guard lock(joints_mutex_);
     if (perception_) targets_ = j.targets;  // partial hand commands start from here
@@ -419,13 +413,7 @@ json GuiSession::StateJson(const runtime::StepContext& context, const Latest& la
     state["target"] = nullptr;
     state["fixation_error_deg"] = nullptr;
   }
-  json objects = json::array();
-  for (const scene::Object& o : scene_.objects()) {
-    if (!o.motion.IsStatic()) {
-      objects.push_back({{"name", o.name}, {"X_WO", internal::MatrixJson(o.motion.PoseAt(t))}});
-    }
-  }
-  state["objects"] = objects;
+  state["objects"] = internal::MovingObjectsJson(scene_, t);
   const double now = WallNow();
   double steps_per_s = 0.0, frames_per_s = 0.0;
   if (step_walls_.size() >= 2) {

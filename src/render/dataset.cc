@@ -26,12 +26,6 @@ namespace {
 using nlohmann::json;
 namespace fs = std::filesystem;
 
-json MatrixJson(const Eigen::Matrix4d& m) {
-  json out = json::array();
-  for (int r = 0; r < 4; ++r) out.push_back({m(r, 0), m(r, 1), m(r, 2), m(r, 3)});
-  return out;
-}
-
 constexpr const char* kTruthItems = "depth, ids, boxes";
 // 16-bit PNGs: depth in millimetres up to 65.535 m, ids up to 65535.
 constexpr uint16_t kMaxPng16 = 65535;
@@ -118,8 +112,8 @@ json ObjectsJson(const Frame& frame, bool scene_has_objects) {
                        {"name", o.name},
                        {"box", {o.x_min, o.y_min, o.x_max, o.y_max}},
                        {"pixels", o.pixels},
-                       {"X_CO", MatrixJson(o.X_CO)},
-                       {"X_WO", MatrixJson(o.X_WO)}});
+                       {"X_CO", ToJson(geometry::Pose(o.X_CO))},
+                       {"X_WO", ToJson(geometry::Pose(o.X_WO))}});
   }
   return objects;
 }
@@ -149,7 +143,8 @@ json FrameJson(int64_t index, double time, const std::vector<Frame>& frames,
     // The camera model's codec (geometry/json.h): width, height, K, distortion.
     json entry = ToJson(RenderedModel(m));
     entry["file"] = fmt::format("{}/{:06d}.png", m.camera, index);
-    entry["X_WC"] = MatrixJson(geometry::FindCameraPose(m)->matrix());
+    // Poses in geometry/json.h's one form, as everywhere else (4x4 nested, row by row).
+    entry["X_WC"] = ToJson(*geometry::FindCameraPose(m));
     entry["exposure_samples"] = m.exposure_samples;
     if (m.has_joints) {
       entry["joints"] =

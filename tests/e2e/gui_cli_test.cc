@@ -22,6 +22,7 @@
 #include <vector>
 
 #include "e2e/run_saccade.h"
+#include "saccade/geometry/json.h"
 
 namespace {
 
@@ -152,10 +153,10 @@ class Client {
   std::vector<std::string> binary_;
 };
 
+// A pose of the protocol, read through its one form (geometry/json.h: 4x4, row by row); throws
+// naming the form when it is anything else.
 Eigen::Matrix4d Matrix(const json& m) {
-  Eigen::Matrix4d X;
-  for (int i = 0; i < 16; ++i) X(i / 4, i % 4) = m[i].get<double>();
-  return X;
+  return saccade::FromJson<saccade::geometry::Pose>(m, "pose").matrix();
 }
 
 // Angle (deg) between a camera's optical axis (state.frames[camera]) and the way to p_W.
@@ -185,7 +186,7 @@ TEST_F(GuiCliTest, ServesTheSceneAndItsMeshesAsTheRendererLoadedThem) {
   ASSERT_EQ(scene_response.result_int(), 200);
   const json scene = json::parse(scene_response.body());
   EXPECT_EQ(scene["protocol"], "saccade-gui");
-  EXPECT_EQ(scene["version"], 1);
+  EXPECT_EQ(scene["version"], 2);
   EXPECT_EQ(scene["mode"], "gui");
   std::vector<std::string> names;
   for (const json& o : scene["objects"]) names.push_back(o["name"]);

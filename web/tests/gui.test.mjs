@@ -311,6 +311,61 @@ describe('saccade gui (portraits.yaml)', () => {
     assert.ok(result.inlierFraction > kWorldInlierFraction, report);
   });
 
+  test('the page places the world at the poses of the scene and the state, in their one form', async () => {
+    await waitReady(page);
+    const seen = await page.evaluate(() => {
+      const g = window.saccadeGui;
+      const s = g.state;  // the state the head was last placed from (same task)
+      return {
+        scene: {
+          objects: g.scene.objects.map((o) => ({ name: o.name, X_WO: o.X_WO, scale: o.scale })),
+          parts: (g.scene.robot?.parts ?? []).map((p) => p.X_LinkPart),
+          cameras: g.scene.cameras.map((c) => c.X_WC),
+        },
+        frames: s.frames,
+        stateObjects: s.objects,
+        placed: {
+          neck: g.placementOf('neck'),
+          left_eye: g.placementOf('left_eye'),
+          objects: Object.fromEntries(g.scene.objects.map((o) => [o.name, g.placementOf(o.name)])),
+        },
+      };
+    });
+    // geometry/json.h's one form (docs/gui-protocol.md): 4x4, row by row, last row [0, 0, 0, 1].
+    const isPose = (X) => Array.isArray(X) && X.length === 4 &&
+      X.every((row) => Array.isArray(row) && row.length === 4 && row.every(Number.isFinite)) &&
+      X[3].join() === '0,0,0,1';
+    const poses = [
+      ...seen.scene.objects.map((o) => [`scene objects ${o.name} X_WO`, o.X_WO]),
+      ...seen.scene.parts.map((X, i) => [`scene robot part ${i} X_LinkPart`, X]),
+      ...seen.scene.cameras.map((X, i) => [`scene camera ${i} X_WC`, X]),
+      ...Object.entries(seen.frames).map(([k, X]) => [`state frames ${k}`, X]),
+      ...seen.stateObjects.map((o) => [`state objects ${o.name} X_WO`, o.X_WO]),
+    ];
+    assert.ok(seen.scene.objects.length > 0 && seen.scene.parts.length > 0 &&
+      Object.keys(seen.frames).length === 7, JSON.stringify(seen.scene));
+    for (const [where, X] of poses) assert.ok(isPose(X), `${where}: ${JSON.stringify(X)}`);
+    // The page puts each link at its frame and each object at X_WO * diag(scale): the page
+    // reads the rows as rows (a transposed read would move every part).
+    const kPlacementTolerance = 1e-12;  // three.js multiplies by the scale in doubles
+    const near = (A, B, where) => {
+      for (let r = 0; r < 4; r++) {
+        for (let c = 0; c < 4; c++) {
+          assert.ok(Math.abs(A[r][c] - B[r][c]) <= kPlacementTolerance,
+            `${where} (${r}, ${c}): placed ${JSON.stringify(A)}, pose ${JSON.stringify(B)}`);
+        }
+      }
+    };
+    near(seen.placed.neck, seen.frames.X_WN, 'neck');
+    near(seen.placed.left_eye, seen.frames.left_eye, 'left_eye');
+    const moving = new Map(seen.stateObjects.map((o) => [o.name, o.X_WO]));
+    for (const o of seen.scene.objects) {
+      const X = moving.get(o.name) ?? o.X_WO;
+      const expected = X.map((row, r) => row.map((v, c) => (c < 3 && r < 4 ? v * o.scale[c] : v)));
+      near(seen.placed.objects[o.name], expected, `object ${o.name}`);
+    }
+  });
+
   test('a camera view finishes with every frame: shown, undecodable or replaced', async () => {
     // The frame window (docs/gui-protocol.md) counts on it: a frame the view never finishes
     // with would hold the server's window shut. A view of its own, in the page.
@@ -411,9 +466,9 @@ describe('saccade gui (portraits.yaml)', () => {
     // Each optical axis (z column of X_WC) against the direction to the clicked point.
     const axisErrors = (s, q) => ['left', 'right'].map((name) => {
       const m = s.frames[name];
-      const d = [q[0] - m[3], q[1] - m[7], q[2] - m[11]];
+      const d = [q[0] - m[0][3], q[1] - m[1][3], q[2] - m[2][3]];
       const n = Math.hypot(...d);
-      const cos = (m[2] * d[0] + m[6] * d[1] + m[10] * d[2]) / n;
+      const cos = (m[0][2] * d[0] + m[1][2] * d[1] + m[2][2] * d[2]) / n;
       return Math.acos(Math.min(1, cos)) * 180 / Math.PI;
     });
     // The head turns to it (new targets) and gets there (positions at the targets).

@@ -55,7 +55,8 @@
 
 namespace saccade::server {
 
-inline constexpr int kProtocolVersion = 1;
+/// 2: poses as 4x4 nested rows (geometry/json.h), was 16 numbers in one list (issue 46).
+inline constexpr int kProtocolVersion = 2;
 inline constexpr const char* kProtocolName = "saccade-gui";
 
 struct ServerOptions {

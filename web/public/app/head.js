@@ -4,7 +4,7 @@
 // fixation point and to the triangulated target, the clicked point, and the dome a click
 // on the empty sky hits.
 import * as THREE from 'three';
-import { instantiate, matrixFrom, scaledMatrix } from './scene.js';
+import { instantiate, matrixFrom, positionOf, scaledMatrix } from './scene.js';
 
 /** The state.frames entry each robot link hangs from. */
 export const kLinkFrames = {
@@ -102,7 +102,7 @@ class CameraRig {
     this.lines.geometry = lines;
   }
 
-  /** The camera pose X_WC (row-major 16). */
+  /** The camera pose X_WC (a 4x4 matrix, row by row). */
   setPose(X_WC) {
     this.group.matrix.copy(matrixFrom(X_WC));
     this.group.matrixWorldNeedsUpdate = true;
@@ -180,13 +180,13 @@ export class Head {
       group.matrixWorldNeedsUpdate = true;
       group.visible = true;
     }
-    if (f.X_WC) this.dome.position.set(f.X_WC[3], f.X_WC[7], f.X_WC[11]);
+    if (f.X_WC) this.dome.position.copy(positionOf(f.X_WC));
     const centres = [];
     for (const [name, rig] of this.rigs) {
       if (!f[name]) continue;
       rig.setPose(f[name]);
       rig.group.visible = true;
-      centres.push(new THREE.Vector3(f[name][3], f[name][7], f[name][11]));
+      centres.push(positionOf(f[name]));
     }
     const show = (rays, markerMesh, p) => {
       const visible = Array.isArray(p) && centres.length > 0;

@@ -58,7 +58,7 @@ export function installInteraction(canvas, app) {
     if (!n) return 1;
     const forward = new THREE.Vector3();
     app.camera.getWorldDirection(forward);
-    return forward.x * n[0] + forward.y * n[4] >= 0 ? 1 : -1;
+    return forward.x * n[0][0] + forward.y * n[1][0] >= 0 ? 1 : -1;  // the neck's x axis
   };
 
   canvas.addEventListener('pointerdown', (event) => {

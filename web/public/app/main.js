@@ -292,6 +292,14 @@ async function start() {
     controls.update();
     render();
   };
+  // The matrix the page placed an object or a head link with, row by row (the protocol's
+  // form of a pose; an object's includes its scale): for the browser test.
+  gui.placementOf = (name) => {
+    const root = world.objects.get(name) ?? (name in kLinkFrames ? head.links.get(name) : null);
+    if (!root) throw new Error(`placementOf: no object or link named '${name}'`);
+    const e = root.matrix.elements;  // column-major
+    return [0, 1, 2, 3].map((r) => [0, 1, 2, 3].map((c) => e[4 * c + r]));
+  };
   gui.send = (type, fields) => send(type, fields);
   gui.imagePlane = (name) => head.imagePlane(name);
   gui.render = render;

@@ -6,14 +6,30 @@
 import * as THREE from 'three';
 import { fetchApi } from './connection.js';
 
-/** A THREE.Matrix4 from 16 numbers in row-major order (the protocol's poses). */
-export function matrixFrom(rowMajor) {
-  return new THREE.Matrix4().set(...rowMajor);
+/** Whether `X` is a pose in the protocol's one form: a 4x4 matrix, row by row (rows of numbers). */
+export function isPose(X) {
+  return Array.isArray(X) && X.length === 4 &&
+    X.every((row) => Array.isArray(row) && row.length === 4 && row.every(Number.isFinite));
+}
+
+/**
+ * A THREE.Matrix4 from a pose in the protocol's one form (docs/gui-protocol.md, the C++
+ * geometry/json.h): its 4x4 matrix, row by row, [[r00, r01, r02, x], ..., [0, 0, 0, 1]].
+ * Throws on anything else, so that a change of form fails loudly rather than misplacing parts.
+ */
+export function matrixFrom(X) {
+  if (!isPose(X)) throw new Error(`a pose must be a 4x4 matrix, row by row; got ${JSON.stringify(X)}`);
+  return new THREE.Matrix4().set(...X[0], ...X[1], ...X[2], ...X[3]);
+}
+
+/** The translation of a pose (its last column): the frame's origin in the world. */
+export function positionOf(X) {
+  return new THREE.Vector3(X[0][3], X[1][3], X[2][3]);
 }
 
 /** X_WO * diag(sx, sy, sz). */
-export function scaledMatrix(rowMajor, scale) {
-  return matrixFrom(rowMajor).multiply(new THREE.Matrix4().makeScale(...scale));
+export function scaledMatrix(X, scale) {
+  return matrixFrom(X).multiply(new THREE.Matrix4().makeScale(...scale));
 }
 
 // Three's lights divide by pi (physically based Lambert); the simulator's do not.
