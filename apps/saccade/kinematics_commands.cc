@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "commands.h"
+#include "saccade/core/error.h"
 #include "saccade/geometry/calibration_report.h"
 #include "saccade/head/head_description.h"
 #include "saccade/head/kinematics.h"
@@ -44,11 +45,17 @@ int RunIk(const std::string& head_path, const std::vector<double>& target, const
   return 0;
 }
 
-int RunCamera(const std::string& path, double near, double far, bool as_json) {
+int RunCamera(const geometry::CalibrationReportInput& input, bool as_json) {
+  // A file without an image size (stereo_calib's intrinsics.yml): the user gives it.
+  if (!input.size && !geometry::ReadCalibrationImageSize(input.path)) {
+    throw InvalidArgument(input.path.string() +
+                          ": the file stores no image size (image_width, image_height); give "
+                          "it with --size W H (OpenCV's stereo_calib sample images are 640 x 480)");
+  }
   if (as_json) {
-    std::cout << geometry::CalibrationReportJson(path, near, far).dump(2) << "\n";
+    std::cout << geometry::CalibrationReportJson(input).dump(2) << "\n";
   } else {
-    fmt::print("{}", geometry::CalibrationReportText(path, near, far));
+    fmt::print("{}", geometry::CalibrationReportText(input));
   }
   return 0;
 }
@@ -102,25 +109,55 @@ Runner AddIkCommand(CLI::App& app) {
 
 Runner AddCameraCommand(CLI::App& app) {
   struct Options {
-    std::string calibration;
+    std::string calibration, right, extrinsics;
+    std::vector<int> size;
     double near = 0.01, far = 100.0;
     bool json = false;
   };
   auto o = std::make_shared<Options>();
-  auto* camera = app.add_subcommand("camera",
-                                    "Describe a calibration file: intrinsics, "
-                                    "distortion, field of view, OpenGL projection.");
+  auto* camera = app.add_subcommand(
+      "camera",
+      "Describe a calibration file: intrinsics, distortion, field of view, OpenGL projection; "
+      "for a stereo pair (OpenCV's M1 D1 M2 D2 [R T], or a ROS left/right pair) both cameras, "
+      "R and T, the baseline and the rectification.");
   camera
       ->add_option("--calibration", o->calibration,
-                   "OpenCV YAML/XML or ROS camera_info YAML calibration file")
+                   "OpenCV YAML/XML or ROS camera_info YAML calibration file: one camera, or a "
+                   "stereo pair in OpenCV's form (M1 D1 M2 D2, R T), or a ROS pair's left camera "
+                   "with --right")
       ->check(CLI::ExistingFile)
       ->required();
+  camera
+      ->add_option("--right", o->right,
+                   "The right camera_info of a ROS stereo pair (--calibration is the left): R "
+                   "and T from their rectification and projection matrices")
+      ->check(CLI::ExistingFile);
+  camera
+      ->add_option("--extrinsics", o->extrinsics,
+                   "R and T of an OpenCV stereo file that stores none (stereo_calib's "
+                   "extrinsics.yml beside intrinsics.yml)")
+      ->check(CLI::ExistingFile);
+  camera
+      ->add_option("--size", o->size,
+                   "W H: the image size in pixels, for files that store none (image_width, "
+                   "image_height)")
+      ->expected(2)
+      ->check(CLI::Range(1, 100000));
   camera->add_option("--near", o->near, "Near clip plane of the OpenGL projection (m)")
       ->capture_default_str();
   camera->add_option("--far", o->far, "Far clip plane of the OpenGL projection (m)")
       ->capture_default_str();
   camera->add_flag("--json", o->json, "Print JSON (stable interface, docs/cli.md)");
-  return [o] { return RunCamera(o->calibration, o->near, o->far, o->json); };
+  return [o] {
+    geometry::CalibrationReportInput input;
+    input.path = o->calibration;
+    if (!o->right.empty()) input.right = o->right;
+    if (!o->extrinsics.empty()) input.extrinsics = o->extrinsics;
+    if (o->size.size() == 2) input.size = geometry::ImageSize{o->size[0], o->size[1]};
+    input.near = o->near;
+    input.far = o->far;
+    return RunCamera(input, o->json);
+  };
 }
 
 }  // namespace saccade::app

@@ -539,6 +539,80 @@ bool IsRotation(const Eigen::Matrix3d& R) {
 
 }  // namespace
 
+bool IsStereoCalibrationFile(const std::filesystem::path& path) {
+  const Document doc = Load(path);
+  return doc.format != CalibrationFormat::kRosYaml && doc.Find("M1") != nullptr &&
+         doc.Find("camera_matrix") == nullptr;
+}
+
+bool HasStereoExtrinsics(const std::filesystem::path& path) {
+  const Document doc = Load(path);
+  return doc.Find("R") != nullptr && doc.Find("T") != nullptr;
+}
+
+namespace {
+
+// A ROS camera_info's rows x cols matrix `key`, required.
+Eigen::MatrixXd RosMatrixOf(const Document& doc, const std::string& key, int rows, int cols,
+                            const std::string& expected) {
+  const Matrix m = ReadMatrix(doc, doc.Require(key, expected), key, false);
+  if (m.rows != rows || m.cols != cols) {
+    doc.Fail(m.line, key,
+             "expected a " + std::to_string(rows) + "x" + std::to_string(cols) + " matrix, got " +
+                 m.Shape());
+  }
+  Eigen::MatrixXd out(rows, cols);
+  for (int r = 0; r < rows; ++r) {
+    for (int c = 0; c < cols; ++c) out(r, c) = m.values[static_cast<size_t>(cols * r + c)];
+  }
+  return out;
+}
+
+}  // namespace
+
+StereoCalibration ReadRosStereoPair(const std::filesystem::path& left,
+                                    const std::filesystem::path& right,
+                                    std::optional<ImageSize> size) {
+  const Document docs[2] = {Load(left), Load(right)};
+  Eigen::Matrix3d rect[2];
+  Eigen::Matrix<double, 3, 4> P[2];
+  std::vector<CameraModel> models;
+  for (int i = 0; i < 2; ++i) {
+    const Document& doc = docs[i];
+    if (doc.format != CalibrationFormat::kRosYaml) {
+      doc.Fail(0, "distortion_model",
+               "missing key; expected a ROS camera_info file (the " +
+                   std::string(i == 0 ? "left" : "right") + " camera of a ROS stereo pair)");
+    }
+    models.push_back(ReadRosCameraFile(doc, size).model);
+    rect[i] = RosMatrixOf(doc, "rectification_matrix", 3, 3,
+                          "the 3x3 rectification matrix of a stereo camera (rows, cols, data)");
+    if (!IsRotation(rect[i])) {
+      doc.Fail(doc.Require("rectification_matrix", "").key_line, "rectification_matrix",
+               "not a rotation matrix (expected R^T R = I and det R = 1)");
+    }
+    P[i] = RosMatrixOf(doc, "projection_matrix", 3, 4,
+                       "the 3x4 projection matrix of a stereo camera (rows, cols, data)");
+    if (!(P[i](0, 0) > 0.0) || !(P[i](1, 1) > 0.0)) {
+      doc.Fail(doc.Require("projection_matrix", "").key_line, "projection_matrix",
+               "expected fx' = P[0][0] > 0 and fy' = P[1][1] > 0");
+    }
+  }
+  // The rectified right camera sits at t' in the rectified left camera's frame (negated):
+  // P2 = K' [I | t'] with K' shared, as cv::stereoRectify writes it.
+  const Eigen::Vector3d t((P[1](0, 3) - P[0](0, 3)) / P[1](0, 0),
+                          (P[1](1, 3) - P[0](1, 3)) / P[1](1, 1), 0.0);
+  if (t.norm() == 0.0) {
+    docs[1].Fail(docs[1].Require("projection_matrix", "").key_line, "projection_matrix",
+                 "no baseline (P[0][3] and P[1][3] equal the left camera's): not the right "
+                 "camera of a calibrated stereo pair; expected P[0][3] = -fx' * baseline");
+  }
+  StereoCalibration stereo{models[0], models[1]};
+  stereo.R = rect[1].transpose() * rect[0];
+  stereo.T = rect[1].transpose() * t;
+  return stereo;
+}
+
 CalibrationFormat DetectCalibrationFormat(const std::filesystem::path& path) {
   return Load(path).format;
 }

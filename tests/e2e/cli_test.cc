@@ -15,6 +15,7 @@
 #include <nlohmann/json.hpp>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core.hpp>
+#include <opencv2/core/persistence.hpp>
 #include <string>
 
 #include "e2e/run_saccade.h"
@@ -121,6 +122,61 @@ TEST(Cli, CameraDescribesAnOpenCvCalibrationFile) {
   // JSON carries doubles with full precision (nlohmann prints 17 digits).
   EXPECT_NEAR(u, reference[0].x, 1e-9);
   EXPECT_NEAR(v, reference[0].y, 1e-9);
+  std::filesystem::remove_all(dir);
+}
+
+// OpenCV's own stereo sample (stereo_calib's intrinsics.yml: M1 D1 M2 D2, no size, no R T)
+// explained as the pair it is, then with an extrinsics file of R and T: the baseline, the
+// angle between the optical axes and the rectification (against cv::stereoRectify's R1).
+TEST(Cli, CameraExplainsAStereoCalibration) {
+  const std::string intrinsics = "/usr/share/doc/opencv-doc/examples/data/intrinsics.yml";
+  const CommandRun no_size = Saccade("camera --calibration " + intrinsics);
+  EXPECT_EQ(no_size.status, 1) << no_size.output;
+  EXPECT_THAT(no_size.output, HasSubstr("give it with --size W H"));
+
+  const CommandRun both = Saccade("camera --calibration " + intrinsics + " --size 640 480 --json");
+  ASSERT_EQ(both.status, 0) << both.output;
+  const json pair = json::parse(both.output);
+  EXPECT_TRUE(pair["stereo"].get<bool>());
+  EXPECT_DOUBLE_EQ(pair["left"]["cx"].get<double>(), 3.3568643204394891e+02);
+  EXPECT_DOUBLE_EQ(pair["right"]["cx"].get<double>(), 3.3455744527912015e+02);
+  EXPECT_FALSE(pair.contains("baseline"));  // the file has no R, T
+  EXPECT_THAT(Saccade("camera --calibration " + intrinsics + " --size 640 480").output,
+              HasSubstr("give the pose with --extrinsics FILE"));
+
+  const auto dir = TempDir();
+  const std::string extrinsics = (dir / "extrinsics.yml").string();
+  const cv::Vec3d rvec(0.01, -0.06, 0.002), T(-0.12, 0.001, 0.004);
+  cv::Matx33d R;
+  cv::Rodrigues(rvec, R);
+  {
+    cv::FileStorage fs(extrinsics, cv::FileStorage::WRITE);
+    fs << "R" << cv::Mat(R) << "T" << cv::Mat(T);
+  }
+  const CommandRun posed = Saccade("camera --calibration " + intrinsics + " --extrinsics " +
+                                   extrinsics + " --size 640 480 --json");
+  ASSERT_EQ(posed.status, 0) << posed.output;
+  const json stereo = json::parse(posed.output);
+  EXPECT_NEAR(stereo["baseline"].get<double>(), cv::norm(T), 1e-15);
+  EXPECT_NEAR(stereo["rotation_deg"].get<double>(), cv::norm(rvec) * 180 / M_PI, 1e-9);
+  cv::Mat R1, R2, P1, P2, Q;
+  cv::stereoRectify(cv::Matx33d::eye(), cv::noArray(), cv::Matx33d::eye(), cv::noArray(),
+                    cv::Size(640, 480), R, T, R1, R2, P1, P2, Q);
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) {
+      // JSON carries 17 digits; the two compute the same rotations (geometry tests: 1e-12).
+      EXPECT_NEAR(stereo["rectification"]["R1"][r][c].get<double>(), R1.at<double>(r, c), 1e-12);
+    }
+  }
+  const CommandRun text = Saccade("camera --calibration " + intrinsics + " --extrinsics " +
+                                  extrinsics + " --size 640 480");
+  EXPECT_THAT(text.output, HasSubstr("baseline |T| 0.120070812 "));
+  EXPECT_THAT(text.output, HasSubstr("rows are epipolar lines"));
+  // --right is for a ROS pair, not an OpenCV file.
+  const CommandRun wrong =
+      Saccade("camera --calibration " + intrinsics + " --right " + intrinsics + " --size 640 480");
+  EXPECT_EQ(wrong.status, 1);
+  EXPECT_THAT(wrong.output, HasSubstr("--right is for a ROS pair"));
   std::filesystem::remove_all(dir);
 }
 

@@ -73,6 +73,26 @@ StereoCalibration ReadStereoCalibration(
 CameraCalibration ReadStereoCameraCalibration(const std::filesystem::path& path, int index,
                                               std::optional<ImageSize> size = std::nullopt);
 
+/// Whether `path` holds a stereo calibration in OpenCV's form (M1 D1 M2 D2, as stereo_calib's
+/// intrinsics.yml), rather than one camera. Throws FileError as the readers.
+bool IsStereoCalibrationFile(const std::filesystem::path& path);
+
+/// Whether `path` (an OpenCV YAML or XML file) stores the pose of a stereo pair: R and T.
+bool HasStereoExtrinsics(const std::filesystem::path& path);
+
+/// Reads a ROS stereo pair: the left and right camera_info files of a calibrated pair, as
+/// ROS's camera_calibration writes them (left.yaml, right.yaml). Their rectification_matrix
+/// (R1, R2: each camera's optical frame into the shared rectified frame) and projection_matrix
+/// (P1, P2 = K' [I | t'], t' the right camera's offset in the rectified frame: P2[0][3] =
+/// -fx' * baseline for a horizontal pair) give the right camera's pose in the left, in
+/// cv::stereoCalibrate's convention (p2 = R p1 + T): R = R2^T R1, T = R2^T t', where t' =
+/// ((P2[0][3] - P1[0][3]) / P2[0][0], (P2[1][3] - P1[1][3]) / P2[1][1], 0). Throws FileError
+/// naming the file and key: a missing or malformed matrix, a rectification that is not a
+/// rotation, a right projection without a baseline (not a stereo pair).
+StereoCalibration ReadRosStereoPair(const std::filesystem::path& left,
+                                    const std::filesystem::path& right,
+                                    std::optional<ImageSize> size = std::nullopt);
+
 /// Writes M1 D1 M2 D2 R T, image_width and image_height in one OpenCV YAML or XML file.
 void WriteStereoCalibration(const StereoCalibration& calibration, const std::filesystem::path& path,
                             CalibrationFormat format);
