@@ -227,7 +227,8 @@ TEST(ServoEmulatorCliTest, TimedFaultsHappenOnSchedule) {
   EXPECT_EQ(child.Wait(), 0);
 }
 
-TEST(ServoEmulatorCliTest, BadOptionsExitWithStatus2NamingTheOption) {
+// Status 1 for bad input, as saccade itself (docs/cli.md, "Exit statuses").
+TEST(ServoEmulatorCliTest, BadOptionsExitWithStatus1NamingTheOption) {
   const std::vector<std::pair<std::vector<std::string>, std::string>> cases = {
       {{"--drop-rate", "2"}, "--drop-rate"},
       {{"--corrupt-rate", "-0.1"}, "--corrupt-rate"},
@@ -244,7 +245,7 @@ TEST(ServoEmulatorCliTest, BadOptionsExitWithStatus2NamingTheOption) {
   };
   for (const auto& [args, expected] : cases) {
     Child child(args);
-    EXPECT_EQ(child.Wait(), 2) << args[0];
+    EXPECT_EQ(child.Wait(), 1) << args[0];
     const std::string err = child.Stderr();
     EXPECT_NE(err.find(expected), std::string::npos) << "stderr: " << err;
     EXPECT_NE(err.find("saccade-servo-emulator: error:"), std::string::npos) << err;
