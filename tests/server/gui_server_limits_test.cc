@@ -276,6 +276,13 @@ constexpr auto kMeasured = milliseconds(1500);
 constexpr double kMaxCpuShare = 0.2;
 
 TEST(GuiServerFloodTest, OutOfFileDescriptorsTheServerBacksOffAndServesOnceTheFloodEnds) {
+#if defined(__SANITIZE_ADDRESS__)
+  // UBSan's vptr check tests that an object's memory is readable through a pipe of its own;
+  // at the file limit it gets none and reports every virtual call as on an invalid object
+  // (measured: "member call ... object has invalid vptr, memory cannot be printed" in fmt's
+  // buffer, then the child ends). The plain build runs this test.
+  GTEST_SKIP() << "out of file descriptors, the sanitizers' own checks fail (ASan+UBSan build)";
+#endif
   // The server runs in a child whose file limit is low (the test's own connections need
   // descriptors of their own). The child answers its port and limit, then serves until the
   // pipe from the test closes.
