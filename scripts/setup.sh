@@ -2,14 +2,24 @@
 # Sets up a Debian 12 machine for saccade and builds it. Idempotent: installs only the Debian
 # packages that are missing (apt-get update runs only then), reconfigures only what changed.
 #
-#   bash scripts/setup.sh [BUILD_DIR] [extra cmake args...]
+#   bash scripts/setup.sh [--program] [BUILD_DIR] [extra cmake args...]
 #
+# --program (the README's first command, scripts/demo.sh): only what the program needs, to build
+#   and run it: its Debian packages, the GUI's npm packages, and the target `saccade`. The tests'
+#   packages (Chromium, clang, GoogleTest, Python's, reference data ...) and targets come with
+#   the full setup (the second command, scripts/test.sh), which reuses what this one built.
 # SACCADE_BUILD_TARGET=T builds only target T (e.g. tests_unit) instead of everything.
 #
 # Runs as root (or through sudo when it is there). Nothing is downloaded at run time: every
 # asset comes from these packages.
 set -euo pipefail
 cd "$(dirname "$0")/.."
+
+program_only=false
+if [ "${1:-}" = "--program" ]; then
+  program_only=true
+  shift
+fi
 
 packages=(
   # toolchain
@@ -29,18 +39,23 @@ packages=(
   libdc1394-dev gstreamer1.0-plugins-base
   # OpenGL without a display or GPU: Mesa's EGL and llvmpipe
   libegl-mesa0 libgl1-mesa-dri
+  # demo assets: MuJoCo's mug; OpenCV's trained Haar cascades (faces, eyes, cat faces) for the
+  # perception loop
+  libmujoco-samples opencv-data
+  # DDS beyond one process (ROS 2's wire): Cyclone DDS's C library and idlc
+  cyclonedds-dev
+)
+# What the tests, benchmarks and the Python package add (the full setup only).
+test_packages=(
   # tests, benchmarks, the scene fuzzer (clang's libFuzzer)
   libgtest-dev libgmock-dev libbenchmark-dev clang libclang-rt-14-dev
   # the browser tests of the GUI: Debian's Chromium, driven by playwright-core (npm)
   chromium
-  # reference data and demo assets: OpenCV's sample calibration files, Assimp's test models
-  # (broken ones included), MuJoCo's mug
-  opencv-doc assimp-testmodels libmujoco-samples
-  # OpenCV's trained Haar cascades (faces, eyes, cat faces) for the perception loop
-  opencv-data
-  # DDS beyond one process (ROS 2's wire): Cyclone DDS's C library and idlc (cyclonedds-dev),
-  # ddsperf for the transport benchmark (cyclonedds-tools)
-  cyclonedds-dev cyclonedds-tools
+  # reference data: OpenCV's sample calibration files, Assimp's test models (broken ones
+  # included)
+  opencv-doc assimp-testmodels
+  # ddsperf for the DDS transport benchmark
+  cyclonedds-tools
   # the Python package (docs/python.md): pybind11 bindings for Debian's /usr/bin/python3, numpy
   # arrays, its tests under pytest
   pybind11-dev python3-numpy python3-pytest python3-dev
@@ -50,6 +65,9 @@ packages=(
   # the reference of the Python tests for the camera model (cv2.projectPoints)
   python3-opencv
 )
+if ! $program_only; then
+  packages+=("${test_packages[@]}")
+fi
 
 # Node.js and npm install the GUI's three.js and the browser tests' playwright-core (web/):
 # Debian's packages, unless a Node.js with npm is already there.
@@ -108,7 +126,7 @@ fi
 # The DDS tests' independent ROS 2 serializer (Foxglove's, tests/dds/ros2_reference/), exactly
 # as its package-lock.json pins it; again only when the lock file changed.
 ref=tests/dds/ros2_reference
-if ! cmp -s $ref/package-lock.json $ref/node_modules/.saccade-installed-lock 2>/dev/null; then
+if ! $program_only && ! cmp -s $ref/package-lock.json $ref/node_modules/.saccade-installed-lock 2>/dev/null; then
   echo "setup: installing the DDS tests' npm packages ($ref/package-lock.json)"
   (cd $ref && npm ci --no-audit --no-fund --loglevel=error)
   cp $ref/package-lock.json $ref/node_modules/.saccade-installed-lock
@@ -119,8 +137,14 @@ shift || true
 # Warnings are errors here as in CI (g++ 12 on Debian 12 builds the tree without one): the same
 # flags as CI's, so that ccache serves CI's fresh clone from a developer's build and back.
 # SACCADE_WERROR=OFF in the environment turns it off.
-cmake -S . -B "$build_dir" -G Ninja -DSACCADE_WERROR="${SACCADE_WERROR:-ON}" "$@" >/dev/null
-if [ -n "${SACCADE_BUILD_TARGET:-}" ]; then
+# --program configures the program alone (SACCADE_PROGRAM_ONLY); the full setup turns that off
+# again, in the same build folder.
+cmake -S . -B "$build_dir" -G Ninja -DSACCADE_WERROR="${SACCADE_WERROR:-ON}" \
+  -DSACCADE_PROGRAM_ONLY="$($program_only && echo ON || echo OFF)" "$@" >/dev/null
+if $program_only; then
+  echo "setup: building the program (the tests' targets come with scripts/test.sh)"
+  cmake --build "$build_dir" --target saccade
+elif [ -n "${SACCADE_BUILD_TARGET:-}" ]; then
   cmake --build "$build_dir" --target "$SACCADE_BUILD_TARGET"
 else
   cmake --build "$build_dir"
