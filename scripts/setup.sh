@@ -42,8 +42,9 @@ packages=(
   # demo assets: MuJoCo's mug; OpenCV's trained Haar cascades (faces, eyes, cat faces) for the
   # perception loop
   libmujoco-samples opencv-data
-  # DDS beyond one process (ROS 2's wire): Cyclone DDS's C library and idlc
-  cyclonedds-dev
+  # DDS beyond one process (ROS 2's wire): Cyclone DDS's C library (cyclonedds-dev), its IDL
+  # compiler idlc and ddsperf, for the transport benchmark (cyclonedds-tools)
+  cyclonedds-dev cyclonedds-tools
 )
 # What the tests, benchmarks and the Python package add (the full setup only).
 test_packages=(
@@ -54,8 +55,6 @@ test_packages=(
   # reference data: OpenCV's sample calibration files, Assimp's test models (broken ones
   # included)
   opencv-doc assimp-testmodels
-  # ddsperf for the DDS transport benchmark
-  cyclonedds-tools
   # the Python package (docs/python.md): pybind11 bindings for Debian's /usr/bin/python3, numpy
   # arrays, its tests under pytest
   pybind11-dev python3-numpy python3-pytest python3-dev
