@@ -39,9 +39,10 @@ packages=(
   libdc1394-dev gstreamer1.0-plugins-base
   # OpenGL without a display or GPU: Mesa's EGL and llvmpipe
   libegl-mesa0 libgl1-mesa-dri
-  # demo assets: MuJoCo's mug; OpenCV's trained Haar cascades (faces, eyes, cat faces) for the
+  # demo assets: MuJoCo's mug, Assimp's test models (the scenes' duck, cube and truck; broken
+  # ones besides, for the tests); OpenCV's trained Haar cascades (faces, eyes, cat faces) for the
   # perception loop
-  libmujoco-samples opencv-data
+  libmujoco-samples assimp-testmodels opencv-data
   # DDS beyond one process (ROS 2's wire): Cyclone DDS's C library (cyclonedds-dev), its IDL
   # compiler idlc and ddsperf, for the transport benchmark (cyclonedds-tools)
   cyclonedds-dev cyclonedds-tools
@@ -52,9 +53,8 @@ test_packages=(
   libgtest-dev libgmock-dev libbenchmark-dev clang libclang-rt-14-dev
   # the browser tests of the GUI: Debian's Chromium, driven by playwright-core (npm)
   chromium
-  # reference data: OpenCV's sample calibration files, Assimp's test models (broken ones
-  # included)
-  opencv-doc assimp-testmodels
+  # reference data: OpenCV's sample calibration files
+  opencv-doc
   # the Python package (docs/python.md): pybind11 bindings for Debian's /usr/bin/python3, numpy
   # arrays, its tests under pytest
   pybind11-dev python3-numpy python3-pytest python3-dev
