@@ -7,7 +7,7 @@
 # --program (the README's first command, scripts/demo.sh): only what the program needs, to build
 #   and run it: its Debian packages, the GUI's npm packages, and the target `saccade`. The tests'
 #   packages (Chromium, clang, GoogleTest, Python's, reference data ...) and targets come with
-#   the full setup (the second command, scripts/test.sh), which reuses what this one built.
+#   the full setup (the second command, scripts/test.sh).
 # SACCADE_BUILD_TARGET=T builds only target T (e.g. tests_unit) instead of everything.
 #
 # Runs as root (or through sudo when it is there). Nothing is downloaded at run time: every
