@@ -23,7 +23,7 @@ fi
 
 packages=(
   # toolchain
-  g++ cmake ninja-build pkg-config clang-format
+  g++ cmake ninja-build pkg-config
   # the compiler cache (its directory, ~/.cache/ccache, lies outside the clone, so a fresh clone
   # builds warm after any earlier build on the machine)
   ccache
@@ -49,6 +49,8 @@ packages=(
 )
 # What the tests, benchmarks and the Python package add (the full setup only).
 test_packages=(
+  # the code's format (.clang-format), for whoever changes the code
+  clang-format
   # tests, benchmarks, the scene fuzzer (clang's libFuzzer)
   libgtest-dev libgmock-dev libbenchmark-dev clang libclang-rt-14-dev
   # the browser tests of the GUI: Debian's Chromium, driven by playwright-core (npm)
