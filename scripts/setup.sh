@@ -4,10 +4,11 @@
 #
 #   bash scripts/setup.sh [--program] [BUILD_DIR] [extra cmake args...]
 #
-# --program (the README's first command, scripts/demo.sh): only what the program needs, to build
-#   and run it: its Debian packages, the GUI's npm packages, and the target `saccade`. The tests'
-#   packages (Chromium, clang, GoogleTest, Python's, reference data ...) and targets come with
-#   the full setup (the second command, scripts/test.sh).
+# --program (the README's first command, scripts/demo.sh): only what the programs need, to build
+#   and run them: their Debian packages, the GUI's npm packages, and the targets saccade and
+#   saccade-servo-emulator, without debug information. The tests' packages (Chromium, clang,
+#   GoogleTest, Python's, reference data ...) and targets come with the full setup (the second
+#   command, scripts/test.sh).
 # SACCADE_BUILD_TARGET=T builds only target T (e.g. tests_unit) instead of everything.
 #
 # Runs as root (or through sudo when it is there). Nothing is downloaded at run time: every
@@ -143,8 +144,8 @@ shift || true
 cmake -S . -B "$build_dir" -G Ninja -DSACCADE_WERROR="${SACCADE_WERROR:-ON}" \
   -DSACCADE_PROGRAM_ONLY="$($program_only && echo ON || echo OFF)" "$@" >/dev/null
 if $program_only; then
-  echo "setup: building the program (the tests' targets come with scripts/test.sh)"
-  cmake --build "$build_dir" --target saccade
+  echo "setup: building the programs (the tests' targets come with scripts/test.sh)"
+  cmake --build "$build_dir" --target saccade saccade-servo-emulator
 elif [ -n "${SACCADE_BUILD_TARGET:-}" ]; then
   cmake --build "$build_dir" --target "$SACCADE_BUILD_TARGET"
 else
