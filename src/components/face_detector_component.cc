@@ -66,6 +66,13 @@ FaceDetectorComponent::FaceDetectorComponent()
       selection_(AddInput<SelectionMessage>("selection")),
       partner_(AddInput<FacesMessage>("partner")),
       faces_(AddOutput<FacesMessage>("faces")) {
+  // In the order the component reference lists them.
+  DeclareImageParams();
+  DeclareTrackParams();
+  DeclareCascadeParams();
+}
+
+void FaceDetectorComponent::DeclareImageParams() {
   DeclareParam("cascade", &cascade_,
                "the face cascade: haar (alt2) or lbp (frontalface_improved; on "
                "scenes/portraits.yaml it misses the near portrait)")
@@ -96,6 +103,9 @@ FaceDetectorComponent::FaceDetectorComponent()
                "on the real-time clock (saccade demo --realtime, the GUI), detect on a thread of "
                "its own whatever latency_steps says, the faces emitted once ready, so that the "
                "loop runs at camera rate; false: within the step");
+}
+
+void FaceDetectorComponent::DeclareTrackParams() {
   DeclareParam("track_region_scale", &track_region_scale_,
                "with a track input: search a box this many times the track's window around "
                "it; 0: always the whole image (so does a detector whose track input is not "
@@ -141,6 +151,9 @@ FaceDetectorComponent::FaceDetectorComponent()
                "eye (the band's far end)")
       .Range(1e-3, 1e6)
       .Unit("m");
+}
+
+void FaceDetectorComponent::DeclareCascadeParams() {
   DeclareParam("region_pyramid_level", &region_pyramid_level_,
                "the pyramid level of the search around the track (the whole image's is "
                "pyramid_level)")

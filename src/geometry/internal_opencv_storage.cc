@@ -217,22 +217,31 @@ class XmlParser {
     Advance();  // '<'
     node.key = ParseName();
     if (node.key.empty()) Fail("expected an element name after '<'");
-    // Attributes.
+    if (!ParseAttributes(&node)) {
+      node.line = line_;
+      return node;  // an empty scalar
+    }
+    ParseContent(depth, &node);
+    return node;
+  }
+
+  // After the element's name: its attributes (type_id into node->type_id) up to the end of
+  // the start tag. False when the tag closes the element (`/>`), true when content follows.
+  bool ParseAttributes(StorageNode* node) {
     while (true) {
       SkipWhitespace();
-      if (AtEnd()) Fail("unexpected end of file in the tag <" + node.key + ">");
+      if (AtEnd()) Fail("unexpected end of file in the tag <" + node->key + ">");
       if (StartsWith("/>")) {
         Advance(2);
-        node.line = line_;
-        return node;  // an empty scalar
+        return false;
       }
       if (Peek() == '>') {
         Advance();
-        break;
+        return true;
       }
       const std::string attribute = ParseName();
       if (attribute.empty()) {
-        Fail("unexpected '" + std::string(1, Peek()) + "' in the tag <" + node.key + ">");
+        Fail("unexpected '" + std::string(1, Peek()) + "' in the tag <" + node->key + ">");
       }
       SkipWhitespace();
       if (AtEnd() || Peek() != '=') Fail("expected '=' after the attribute " + attribute);
@@ -241,25 +250,35 @@ class XmlParser {
       if (AtEnd() || (Peek() != '"' && Peek() != '\'')) {
         Fail("expected a quoted value for the attribute " + attribute);
       }
-      const char quote = Peek();
-      Advance();
-      std::string value;
-      while (true) {
-        if (AtEnd()) Fail("unterminated value of the attribute " + attribute);
-        const char c = Peek();
-        if (c == quote) break;
-        if (c == '<') Fail("'<' in the value of the attribute " + attribute);
-        if (c == '&') {
-          ParseEntity(&value);
-        } else {
-          value += c;
-          Advance();
-        }
-      }
-      Advance();  // closing quote
-      if (attribute == "type_id") node.type_id = value;
+      const std::string value = ParseAttributeValue(attribute);
+      if (attribute == "type_id") node->type_id = value;
     }
-    // Content.
+  }
+
+  // At the opening quote of the attribute's value: the value, entities decoded.
+  std::string ParseAttributeValue(const std::string& attribute) {
+    const char quote = Peek();
+    Advance();
+    std::string value;
+    while (true) {
+      if (AtEnd()) Fail("unterminated value of the attribute " + attribute);
+      const char c = Peek();
+      if (c == quote) break;
+      if (c == '<') Fail("'<' in the value of the attribute " + attribute);
+      if (c == '&') {
+        ParseEntity(&value);
+      } else {
+        value += c;
+        Advance();
+      }
+    }
+    Advance();  // closing quote
+    return value;
+  }
+
+  // After the start tag: the element's content up to and with its end tag, as child elements
+  // (a map, or a sequence when every child is <_>) or text (a scalar).
+  void ParseContent(int depth, StorageNode* node) {
     const int content_line = line_;
     std::string text;
     int text_line = 0;  // line of the first non-whitespace character of the text
@@ -267,9 +286,9 @@ class XmlParser {
     bool all_items = true;  // every child is <_>: an OpenCV sequence
     while (true) {
       if (AtEnd()) {
-        throw FileError(file_, line_, node.key,
-                        "unexpected end of file: <" + node.key + "> opened at line " +
-                            std::to_string(node.key_line) + " is not closed");
+        throw FileError(file_, line_, node->key,
+                        "unexpected end of file: <" + node->key + "> opened at line " +
+                            std::to_string(node->key_line) + " is not closed");
       }
       if (StartsWith("<!--")) {
         SkipPast("-->", "comment <!--");
@@ -283,23 +302,12 @@ class XmlParser {
       } else if (StartsWith("<?")) {
         SkipPast("?>", "processing instruction <?");
       } else if (StartsWith("</")) {
-        const int close_line = line_;
-        Advance(2);
-        const std::string name = ParseName();
-        SkipWhitespace();
-        if (AtEnd() || Peek() != '>') Fail("expected '>' to end </" + name);
-        Advance();
-        if (name != node.key) {
-          throw FileError(file_, close_line, node.key,
-                          "expected </" + node.key + "> to close <" + node.key +
-                              "> opened at line " + std::to_string(node.key_line) + ", got </" +
-                              name + ">");
-        }
+        ParseEndTag(*node);
         break;
       } else if (Peek() == '<') {
         StorageNode child = ParseElement(depth + 1);
         if (child.key != "_") all_items = false;
-        node.children.push_back(std::move(child));
+        node->children.push_back(std::move(child));
         has_children = true;
       } else {
         const char c = Peek();
@@ -315,21 +323,35 @@ class XmlParser {
     const auto first = std::find_if_not(text.begin(), text.end(), IsSpace);
     if (has_children) {
       if (first != text.end()) {
-        throw FileError(file_, text_line, node.key,
-                        "unexpected text mixed with elements inside <" + node.key + ">");
+        throw FileError(file_, text_line, node->key,
+                        "unexpected text mixed with elements inside <" + node->key + ">");
       }
-      node.kind = all_items ? StorageNode::Kind::kSequence : StorageNode::Kind::kMap;
-      node.line = node.children.front().key_line;
-      return node;
+      node->kind = all_items ? StorageNode::Kind::kSequence : StorageNode::Kind::kMap;
+      node->line = node->children.front().key_line;
+      return;
     }
     // A scalar: drop surrounding whitespace and the quotes FileStorage writes around strings.
     const auto last = std::find_if_not(text.rbegin(), text.rend(), IsSpace).base();
-    node.text = first < last ? std::string(first, last) : std::string();
-    if (node.text.size() >= 2 && node.text.front() == '"' && node.text.back() == '"') {
-      node.text = node.text.substr(1, node.text.size() - 2);
+    node->text = first < last ? std::string(first, last) : std::string();
+    if (node->text.size() >= 2 && node->text.front() == '"' && node->text.back() == '"') {
+      node->text = node->text.substr(1, node->text.size() - 2);
     }
-    node.line = text_line != 0 ? text_line : content_line;
-    return node;
+    node->line = text_line != 0 ? text_line : content_line;
+  }
+
+  // At "</": the end tag, which must close `node`.
+  void ParseEndTag(const StorageNode& node) {
+    const int close_line = line_;
+    Advance(2);
+    const std::string name = ParseName();
+    SkipWhitespace();
+    if (AtEnd() || Peek() != '>') Fail("expected '>' to end </" + name);
+    Advance();
+    if (name != node.key) {
+      throw FileError(file_, close_line, node.key,
+                      "expected </" + node.key + "> to close <" + node.key + "> opened at line " +
+                          std::to_string(node.key_line) + ", got </" + name + ">");
+    }
   }
 
   std::string_view text_;

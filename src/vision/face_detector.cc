@@ -36,6 +36,97 @@ void LoadCascade(const std::string& path, const char* key, cv::CascadeClassifier
 // (bench/baselines/loop-issue14-2core.md).
 constexpr double kCatScaleFactor = 1.1;
 
+// Rectangles of the image searched, in gray: of the gray image (equalised where asked), or
+// converted from the colour one where there is one (FaceDetector::DetectIn).
+struct GrayImage {
+  const cv::Mat& gray;
+  const cv::Mat* colour;
+  cv::Mat operator()(const cv::Rect& r) const {
+    if (colour == nullptr) return gray(r);
+    cv::Mat part;
+    cv::cvtColor((*colour)(r), part,
+                 colour->channels() == 4 ? cv::COLOR_RGBA2GRAY : cv::COLOR_RGB2GRAY);
+    return part;
+  }
+};
+
+// The faces found so far: boxes (image pixels) and the hits of each.
+struct Candidates {
+  std::vector<cv::Rect> boxes;
+  std::vector<int> neighbors;
+};
+
+// Adds a box with `n` hits to `candidates`, unless it overlaps one of the first `earlier`
+// (found in the regions before this one) by more than half the smaller: a face found in two
+// overlapping regions counts once (the box with more hits).
+void AddCandidate(const cv::Rect& box, int n, std::size_t earlier, Candidates* candidates) {
+  std::vector<cv::Rect>& boxes = candidates->boxes;
+  std::vector<int>& neighbors = candidates->neighbors;
+  for (std::size_t j = 0; j < earlier; ++j) {
+    const double overlap =
+        static_cast<double>((boxes[j] & box).area()) / std::min(boxes[j].area(), box.area());
+    if (overlap > 0.5) {
+      if (n > neighbors[j]) boxes[j] = box, neighbors[j] = n;
+      return;
+    }
+  }
+  boxes.push_back(box), neighbors.push_back(n);
+}
+
+// The index in `search.checked` of the candidate whose verdict `box` takes (it overlaps that
+// one most, by at least search.verdict_overlap of their union), or -1 for none.
+int CheckedVerdict(const FaceDetector::Search& search, const cv::Rect& box) {
+  int same = -1;
+  double most = 0.0;
+  for (std::size_t c = 0; c < search.checked.size(); ++c) {
+    const cv::Rect& checked = search.checked[c].box;
+    const double common = (checked & box).area();
+    const double all = checked.area() + box.area() - common;
+    if (all > 0 && common >= search.verdict_overlap * all && common / all > most) {
+      most = common / all;
+      same = static_cast<int>(c);
+    }
+  }
+  return same;
+}
+
+// Rejects `d` (rejected, reason) when the cat cascade finds a cat face around it or the eye
+// cascade too few eyes in its upper part; an empty cascade checks nothing.
+void CheckCandidate(cv::CascadeClassifier& cat, cv::CascadeClassifier& eye,
+                    const FaceDetector::Options& options, const GrayImage& gray_at,
+                    const cv::Rect& image_rect, FaceDetection* d) {
+  if (!cat.empty()) {
+    // The cat cascade is trained on tighter, lower boxes than the face cascade's: search a
+    // box enlarged by half on each side, for cat faces at least half the candidate's size,
+    // sizes a factor kCatScaleFactor apart.
+    const int mx = d->box.width / 2, my = d->box.height / 2;
+    const cv::Rect roi =
+        cv::Rect(d->box.x - mx, d->box.y - my, d->box.width + 2 * mx, d->box.height + 2 * my) &
+        image_rect;
+    std::vector<cv::Rect> cats;
+    cat.detectMultiScale(gray_at(roi), cats, kCatScaleFactor, options.cat_min_neighbors, 0,
+                         cv::Size(d->box.width / 2, d->box.height / 2));
+    if (!cats.empty()) {
+      d->rejected = true;
+      d->reason = "cat face: " + std::to_string(cats.size()) + " hit(s) of the cat cascade";
+      return;
+    }
+  }
+  if (!eye.empty()) {
+    // Eyes lie in the upper part of a frontal face.
+    const cv::Rect upper =
+        cv::Rect(d->box.x, d->box.y, d->box.width, d->box.height * 6 / 10) & image_rect;
+    std::vector<cv::Rect> eyes;
+    eye.detectMultiScale(gray_at(upper), eyes, 1.05, 3, 0,
+                         cv::Size(std::max(8, d->box.width / 8), std::max(8, d->box.width / 8)));
+    if (static_cast<int>(eyes.size()) < options.min_eyes) {
+      d->rejected = true;
+      d->reason = "no eyes: " + std::to_string(eyes.size()) + " eye(s) found, expected " +
+                  std::to_string(options.min_eyes);
+    }
+  }
+}
+
 }  // namespace
 
 bool FaceDetector::Options::IsValid(std::string* error) const {
@@ -113,14 +204,7 @@ std::vector<FaceDetection> FaceDetector::DetectIn(const cv::Mat& gray_image, con
     cv::equalizeHist(gray, equalized);
     gray = equalized;
   }
-  // Rectangle `r` of the gray image (equalised where asked).
-  const auto gray_at = [&](const cv::Rect& r) {
-    if (colour == nullptr) return gray(r);
-    cv::Mat part;
-    cv::cvtColor((*colour)(r), part,
-                 colour->channels() == 4 ? cv::COLOR_RGBA2GRAY : cv::COLOR_RGB2GRAY);
-    return part;
-  };
+  const GrayImage gray_at{gray, colour};
   // The level searched, and the factor from its pixels to the image's.
   cv::Mat level = gray;
   for (int k = 0; k < options_.pyramid_level; ++k) {
@@ -143,8 +227,7 @@ std::vector<FaceDetection> FaceDetector::DetectIn(const cv::Mat& gray_image, con
   const cv::Size max_size = max_px > 0 ? cv::Size(reduced(max_px), reduced(max_px)) : cv::Size();
   const cv::Rect level_rect =
       colour != nullptr ? cv::Rect(cv::Point(), size) : cv::Rect(0, 0, level.cols, level.rows);
-  std::vector<cv::Rect> boxes;
-  std::vector<int> neighbors;
+  Candidates candidates;
   for (const cv::Rect& region : search.regions) {
     const cv::Rect r(static_cast<int>(std::floor(region.x / scale)),
                      static_cast<int>(std::floor(region.y / scale)),
@@ -152,7 +235,7 @@ std::vector<FaceDetection> FaceDetector::DetectIn(const cv::Mat& gray_image, con
                      static_cast<int>(std::ceil(region.height / scale)));
     const cv::Rect roi = r & level_rect;
     if (roi.width < min_size.width || roi.height < min_size.height) continue;
-    const std::size_t earlier = boxes.size();  // found in the regions before this one
+    const std::size_t earlier = candidates.boxes.size();  // found in the regions before this one
     std::vector<cv::Rect> found;
     std::vector<int> hits;
     face_.detectMultiScale(colour != nullptr ? gray_at(roi) : level(roi), found, hits,
@@ -165,73 +248,23 @@ std::vector<FaceDetection> FaceDetector::DetectIn(const cv::Mat& gray_image, con
       const int x1 = static_cast<int>(std::ceil((f.x + f.width) * scale));
       const int y1 = static_cast<int>(std::ceil((f.y + f.height) * scale));
       const cv::Rect box = cv::Rect(x0, y0, x1 - x0, y1 - y0) & cv::Rect(cv::Point(), size);
-      const int n = i < hits.size() ? hits[i] : 0;
-      // A face found in two overlapping regions counts once (the box with more hits).
-      bool merged = false;
-      for (std::size_t j = 0; j < earlier; ++j) {
-        const double overlap =
-            static_cast<double>((boxes[j] & box).area()) / std::min(boxes[j].area(), box.area());
-        if (overlap > 0.5) {
-          if (n > neighbors[j]) boxes[j] = box, neighbors[j] = n;
-          merged = true;
-          break;
-        }
-      }
-      if (!merged) boxes.push_back(box), neighbors.push_back(n);
+      AddCandidate(box, i < hits.size() ? hits[i] : 0, earlier, &candidates);
     }
   }
-  std::vector<FaceDetection> out(boxes.size());
+  std::vector<FaceDetection> out(candidates.boxes.size());
   const cv::Rect image_rect(cv::Point(), size);
-  for (std::size_t i = 0; i < boxes.size(); ++i) {
+  for (std::size_t i = 0; i < candidates.boxes.size(); ++i) {
     FaceDetection& d = out[i];
-    d.box = boxes[i];
-    d.neighbors = i < neighbors.size() ? neighbors[i] : 0;
-    auto same = search.checked.end();
-    double most = 0.0;
-    for (auto c = search.checked.begin(); c != search.checked.end(); ++c) {
-      const double common = (c->box & d.box).area();
-      const double all = c->box.area() + d.box.area() - common;
-      if (all > 0 && common >= search.verdict_overlap * all && common / all > most) {
-        most = common / all;
-        same = c;
-      }
-    }
-    if (same != search.checked.end()) {
-      d.rejected = same->rejected;
-      d.reason = same->reason;
-      d.verdict_from = static_cast<int>(same - search.checked.begin());
+    d.box = candidates.boxes[i];
+    d.neighbors = i < candidates.neighbors.size() ? candidates.neighbors[i] : 0;
+    const int same = CheckedVerdict(search, d.box);
+    if (same >= 0) {
+      d.rejected = search.checked[same].rejected;
+      d.reason = search.checked[same].reason;
+      d.verdict_from = same;
       continue;
     }
-    if (!cat_.empty()) {
-      // The cat cascade is trained on tighter, lower boxes than the face cascade's: search a
-      // box enlarged by half on each side, for cat faces at least half the candidate's size,
-      // sizes a factor kCatScaleFactor apart.
-      const int mx = d.box.width / 2, my = d.box.height / 2;
-      const cv::Rect roi =
-          cv::Rect(d.box.x - mx, d.box.y - my, d.box.width + 2 * mx, d.box.height + 2 * my) &
-          image_rect;
-      std::vector<cv::Rect> cats;
-      cat_.detectMultiScale(gray_at(roi), cats, kCatScaleFactor, options_.cat_min_neighbors, 0,
-                            cv::Size(d.box.width / 2, d.box.height / 2));
-      if (!cats.empty()) {
-        d.rejected = true;
-        d.reason = "cat face: " + std::to_string(cats.size()) + " hit(s) of the cat cascade";
-        continue;
-      }
-    }
-    if (!eye_.empty()) {
-      // Eyes lie in the upper part of a frontal face.
-      const cv::Rect upper =
-          cv::Rect(d.box.x, d.box.y, d.box.width, d.box.height * 6 / 10) & image_rect;
-      std::vector<cv::Rect> eyes;
-      eye_.detectMultiScale(gray_at(upper), eyes, 1.05, 3, 0,
-                            cv::Size(std::max(8, d.box.width / 8), std::max(8, d.box.width / 8)));
-      if (static_cast<int>(eyes.size()) < options_.min_eyes) {
-        d.rejected = true;
-        d.reason = "no eyes: " + std::to_string(eyes.size()) + " eye(s) found, expected " +
-                   std::to_string(options_.min_eyes);
-      }
-    }
+    CheckCandidate(cat_, eye_, options_, gray_at, image_rect, &d);
   }
   std::sort(out.begin(), out.end(), [](const FaceDetection& a, const FaceDetection& b) {
     return a.box.area() > b.box.area();

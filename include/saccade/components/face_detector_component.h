@@ -112,6 +112,12 @@ class FaceDetectorComponent : public runtime::Component {
     // on a new target's scans, where the target's own verdict is among them.
     double verdict_overlap = vision::FaceDetector::kVerdictOverlap;
   };
+  // The parameters, declared by what they set: the whole image's search and when and on
+  // which thread it runs; the searches the track, selection and partner inputs steer; the
+  // cascades' levels, sizes, steps and checks.
+  void DeclareImageParams();
+  void DeclareTrackParams();
+  void DeclareCascadeParams();
   // options_ with the cascades the parameters choose.
   vision::FaceDetector::Options DetectorOptions() const;
   Search NextSearch(const Image& image);

@@ -227,60 +227,7 @@ void GlRenderer::DrawBatchTiles(const std::vector<BatchHead>& heads, std::size_t
   const std::size_t cameras = cameras_.size();
   const std::size_t count = last - first;
   const std::size_t tile_rgba = static_cast<std::size_t>(width) * height * 4;
-
-  // The layers and the pixel buffer, (re)made when the batch outgrows them. A batch of more
-  // tiles than the device's layers is drawn in parts, each read back before the next.
-  GLint max_layers = 0;
-  glGetIntegerv(GL_MAX_ARRAY_TEXTURE_LAYERS, &max_layers);
-  const int layers = static_cast<int>(std::min<std::size_t>(count, std::max(1, max_layers)));
-  if (batch_.framebuffer == 0 || layers > batch_.layers || count * tile_rgba > batch_.pixel_bytes) {
-    if (batch_.framebuffer != 0) {
-      glDeleteFramebuffers(1, &batch_.framebuffer);
-      glDeleteTextures(1, &batch_.color);
-      glDeleteRenderbuffers(1, &batch_.depth);
-      glDeleteBuffers(1, &batch_.pixels);
-    }
-    batch_.layers = std::max(layers, batch_.layers);
-    glGenTextures(1, &batch_.color);
-    glBindTexture(GL_TEXTURE_2D_ARRAY, batch_.color);
-    glTexImage3D(GL_TEXTURE_2D_ARRAY, 0, GL_RGBA8, width, height, batch_.layers, 0, GL_RGBA,
-                 GL_UNSIGNED_BYTE, nullptr);
-    glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
-    glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
-    glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MAX_LEVEL, 0);
-    glBindTexture(GL_TEXTURE_2D_ARRAY, 0);
-    glGenRenderbuffers(1, &batch_.depth);
-    glBindRenderbuffer(GL_RENDERBUFFER, batch_.depth);
-    glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT24, width, height);
-    glBindRenderbuffer(GL_RENDERBUFFER, 0);
-    glGenFramebuffers(1, &batch_.framebuffer);
-    glBindFramebuffer(GL_FRAMEBUFFER, batch_.framebuffer);
-    glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, batch_.color, 0, 0);
-    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, batch_.depth);
-    const GLenum status = glCheckFramebufferStatus(GL_FRAMEBUFFER);
-    if (status != GL_FRAMEBUFFER_COMPLETE) {
-      throw Error(fmt::format(
-          "Renderer::RenderBatch: the framebuffer of {} layers of {} x {} is incomplete: status "
-          "0x{:04X}",
-          batch_.layers, width, height, status));
-    }
-    batch_.pixel_bytes = std::max(batch_.pixel_bytes, count * tile_rgba);
-    glGenBuffers(1, &batch_.pixels);
-    glBindBuffer(GL_PIXEL_PACK_BUFFER, batch_.pixels);
-    glBufferData(GL_PIXEL_PACK_BUFFER, static_cast<GLsizeiptr>(batch_.pixel_bytes), nullptr,
-                 GL_STREAM_READ);
-    glBindBuffer(GL_PIXEL_PACK_BUFFER, 0);
-    CheckGlError("Renderer::RenderBatch: making the framebuffer of layers");
-  }
-  if (batch_views_.empty()) {
-    for (const scene::CameraSpec* camera : cameras_) {
-      const geometry::Intrinsics& K = camera->model.intrinsics();
-      ViewSetup view;
-      view.projection = geometry::GlProjectionFromIntrinsics(K, camera->clip, /*flip_rows=*/true);
-      view.focal = std::max(K.fx(), K.fy());
-      batch_views_.push_back(view);
-    }
-  }
+  const int layers = PrepareBatchTarget(count);
 
   glBindFramebuffer(GL_FRAMEBUFFER, batch_.framebuffer);
   glDisable(GL_SCISSOR_TEST);
@@ -296,16 +243,7 @@ void GlRenderer::DrawBatchTiles(const std::vector<BatchHead>& heads, std::size_t
       const BatchHead& head = heads[h];
       if (h != posed) {
         const Clock::time_point pose_start = Clock::now();
-        UpdatePoses(head.state);
-        for (std::size_t i = 0; i < items_.size(); ++i) {
-          const int object = items_[i].object;
-          if (object < 0) continue;
-          if (!head.hidden.empty() && head.hidden[object]) {
-            item_poses_[i] = Eigen::Isometry3d(Eigen::Translation3d(0.0, 0.0, -kHiddenDepth));
-          } else if (!head.object_poses.empty() && head.object_poses[object].has_value()) {
-            item_poses_[i] = *head.object_poses[object];
-          }
-        }
+        PoseBatchHead(head);
         posed = h;
         pose_ms += Milliseconds(pose_start, Clock::now());
       }
@@ -328,7 +266,99 @@ void GlRenderer::DrawBatchTiles(const std::vector<BatchHead>& heads, std::size_t
     read_ms += Milliseconds(read_start, Clock::now());
   }
   const Clock::time_point drawn = Clock::now();
+  ConvertBatchPixels(first, count, out);
+  glBindFramebuffer(GL_FRAMEBUFFER, 0);
+  CheckGlError("Renderer::RenderBatch");
+  const Clock::time_point end = Clock::now();
 
+  stats_.scene_update_ms += pose_ms;
+  stats_.draw_ms += Milliseconds(start, drawn) - pose_ms - read_ms;
+  stats_.readback_ms += Milliseconds(drawn, end) + read_ms;
+}
+
+int GlRenderer::PrepareBatchTarget(std::size_t count) {
+  const int width = cameras_[0]->model.intrinsics().width();
+  const int height = cameras_[0]->model.intrinsics().height();
+  const std::size_t tile_rgba = static_cast<std::size_t>(width) * height * 4;
+  // A batch of more tiles than the device's layers is drawn in parts, each read back before
+  // the next.
+  GLint max_layers = 0;
+  glGetIntegerv(GL_MAX_ARRAY_TEXTURE_LAYERS, &max_layers);
+  const int layers = static_cast<int>(std::min<std::size_t>(count, std::max(1, max_layers)));
+  if (batch_.framebuffer == 0 || layers > batch_.layers || count * tile_rgba > batch_.pixel_bytes) {
+    MakeBatchTarget(layers, count * tile_rgba);
+  }
+  if (batch_views_.empty()) {
+    for (const scene::CameraSpec* camera : cameras_) {
+      const geometry::Intrinsics& K = camera->model.intrinsics();
+      ViewSetup view;
+      view.projection = geometry::GlProjectionFromIntrinsics(K, camera->clip, /*flip_rows=*/true);
+      view.focal = std::max(K.fx(), K.fy());
+      batch_views_.push_back(view);
+    }
+  }
+  return layers;
+}
+
+void GlRenderer::MakeBatchTarget(int layers, std::size_t pixel_bytes) {
+  const int width = cameras_[0]->model.intrinsics().width();
+  const int height = cameras_[0]->model.intrinsics().height();
+  if (batch_.framebuffer != 0) {
+    glDeleteFramebuffers(1, &batch_.framebuffer);
+    glDeleteTextures(1, &batch_.color);
+    glDeleteRenderbuffers(1, &batch_.depth);
+    glDeleteBuffers(1, &batch_.pixels);
+  }
+  batch_.layers = std::max(layers, batch_.layers);
+  glGenTextures(1, &batch_.color);
+  glBindTexture(GL_TEXTURE_2D_ARRAY, batch_.color);
+  glTexImage3D(GL_TEXTURE_2D_ARRAY, 0, GL_RGBA8, width, height, batch_.layers, 0, GL_RGBA,
+               GL_UNSIGNED_BYTE, nullptr);
+  glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+  glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+  glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MAX_LEVEL, 0);
+  glBindTexture(GL_TEXTURE_2D_ARRAY, 0);
+  glGenRenderbuffers(1, &batch_.depth);
+  glBindRenderbuffer(GL_RENDERBUFFER, batch_.depth);
+  glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT24, width, height);
+  glBindRenderbuffer(GL_RENDERBUFFER, 0);
+  glGenFramebuffers(1, &batch_.framebuffer);
+  glBindFramebuffer(GL_FRAMEBUFFER, batch_.framebuffer);
+  glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, batch_.color, 0, 0);
+  glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, batch_.depth);
+  const GLenum status = glCheckFramebufferStatus(GL_FRAMEBUFFER);
+  if (status != GL_FRAMEBUFFER_COMPLETE) {
+    throw Error(fmt::format(
+        "Renderer::RenderBatch: the framebuffer of {} layers of {} x {} is incomplete: status "
+        "0x{:04X}",
+        batch_.layers, width, height, status));
+  }
+  batch_.pixel_bytes = std::max(batch_.pixel_bytes, pixel_bytes);
+  glGenBuffers(1, &batch_.pixels);
+  glBindBuffer(GL_PIXEL_PACK_BUFFER, batch_.pixels);
+  glBufferData(GL_PIXEL_PACK_BUFFER, static_cast<GLsizeiptr>(batch_.pixel_bytes), nullptr,
+               GL_STREAM_READ);
+  glBindBuffer(GL_PIXEL_PACK_BUFFER, 0);
+  CheckGlError("Renderer::RenderBatch: making the framebuffer of layers");
+}
+
+void GlRenderer::PoseBatchHead(const BatchHead& head) {
+  UpdatePoses(head.state);
+  for (std::size_t i = 0; i < items_.size(); ++i) {
+    const int object = items_[i].object;
+    if (object < 0) continue;
+    if (!head.hidden.empty() && head.hidden[object]) {
+      item_poses_[i] = Eigen::Isometry3d(Eigen::Translation3d(0.0, 0.0, -kHiddenDepth));
+    } else if (!head.object_poses.empty() && head.object_poses[object].has_value()) {
+      item_poses_[i] = *head.object_poses[object];
+    }
+  }
+}
+
+void GlRenderer::ConvertBatchPixels(std::size_t first, std::size_t count, uint8_t* out) {
+  const int width = cameras_[0]->model.intrinsics().width();
+  const int height = cameras_[0]->model.intrinsics().height();
+  const std::size_t tile_rgba = static_cast<std::size_t>(width) * height * 4;
   // One map for all of [first, last).
   glBindBuffer(GL_PIXEL_PACK_BUFFER, batch_.pixels);
   const auto* rgba = static_cast<const uint8_t*>(glMapBufferRange(
@@ -347,13 +377,6 @@ void GlRenderer::DrawBatchTiles(const std::vector<BatchHead>& heads, std::size_t
                    cores / static_cast<unsigned>(std::max(1, batch_contexts_)));
   glUnmapBuffer(GL_PIXEL_PACK_BUFFER);
   glBindBuffer(GL_PIXEL_PACK_BUFFER, 0);
-  glBindFramebuffer(GL_FRAMEBUFFER, 0);
-  CheckGlError("Renderer::RenderBatch");
-  const Clock::time_point end = Clock::now();
-
-  stats_.scene_update_ms += pose_ms;
-  stats_.draw_ms += Milliseconds(start, drawn) - pose_ms - read_ms;
-  stats_.readback_ms += Milliseconds(drawn, end) + read_ms;
 }
 
 void GlRenderer::BatchHelperDeleter::operator()(BatchHelper* helper) const { delete helper; }

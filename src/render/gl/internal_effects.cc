@@ -528,6 +528,21 @@ EffectTarget::EffectTarget(const geometry::LensMap& lens, int samples, bool blur
         "limit of {} a side",
         layers_, source_width_, source_height_, max_size));
   }
+  MakeSourceViews();
+  if (blur_) EnableBlur();
+  if (lens_.kind != geometry::LensMap::Kind::kIdentity) MakeLensRemap(lens_on_cpu);
+  output_color_ = MakeArray(GL_RGBA8, GL_RGBA, GL_UNSIGNED_BYTE, lens_.width, lens_.height, 1);
+  glGenFramebuffers(1, &output_framebuffer_);
+  glBindFramebuffer(GL_FRAMEBUFFER, output_framebuffer_);
+  glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, output_color_, 0, 0);
+  CheckComplete("camera image", lens_.width, lens_.height);
+  if (truth_) MakeTruthTargets();
+  glBindFramebuffer(GL_FRAMEBUFFER, 0);
+  CheckGlError(fmt::format("Renderer: making the effect targets ({} view(s) of {} x {})", layers_,
+                           source_width_, source_height_));
+}
+
+void EffectTarget::MakeSourceViews() {
   const int w = source_width_, h = source_height_;
   source_ = MakeArray(GL_RGBA8, GL_RGBA, GL_UNSIGNED_BYTE, w, h, layers_);
   FilterLinearly(source_);
@@ -547,77 +562,68 @@ EffectTarget::EffectTarget(const geometry::LensMap& lens, int samples, bool blur
     glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, source_, 0, 0);
     CheckComplete("source view", w, h);
   }
-  if (blur_) EnableBlur();
-  if (lens_.kind != geometry::LensMap::Kind::kIdentity) {
-    const RemapTable table = MakeRemapTable(lens_);
-    if (lens_on_cpu && layers_ == 1 && !truth_) {
-      cpu_lens_ = std::make_unique<CpuLens>(table, lens_.width, lens_.height, w, h);
-      source_buffers_ = std::make_unique<PixelBuffers>(w, h, 4);
-    }
-    map_ =
-        MakeTexture2d(GL_RGBA32F, GL_RGBA, GL_FLOAT, lens_.width, lens_.height, table.map.data());
-    footprint_ = MakeTexture2d(GL_RGBA32F, GL_RGBA, GL_FLOAT, lens_.width, lens_.height,
-                               table.footprint.data());
-    const LensMesh mesh = MakeLensMesh(table, lens_.width, lens_.height);
-    residual_ = MakeTexture2d(GL_RG8_SNORM, GL_RG, GL_BYTE, lens_.width, lens_.height,
-                              mesh.residual.data());
-    std::vector<uint32_t> indices = mesh.linear;
-    indices.insert(indices.end(), mesh.exact.begin(), mesh.exact.end());
-    mesh_linear_ = static_cast<GLsizei>(mesh.linear.size());
-    mesh_exact_ = static_cast<GLsizei>(mesh.exact.size());
-    glGenVertexArrays(1, &mesh_vao_);
-    glBindVertexArray(mesh_vao_);
-    glGenBuffers(1, &mesh_vertices_);
-    glBindBuffer(GL_ARRAY_BUFFER, mesh_vertices_);
-    glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(mesh.vertices.size() * sizeof(float)),
-                 mesh.vertices.data(), GL_STATIC_DRAW);
-    glGenBuffers(1, &mesh_indices_);
-    glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, mesh_indices_);
-    glBufferData(GL_ELEMENT_ARRAY_BUFFER,
-                 static_cast<GLsizeiptr>(indices.size() * sizeof(uint32_t)), indices.data(),
-                 GL_STATIC_DRAW);
-    constexpr GLsizei kStride = 5 * sizeof(float);
-    glEnableVertexAttribArray(0);
-    glVertexAttribPointer(0, 2, GL_FLOAT, GL_FALSE, kStride, nullptr);
-    glEnableVertexAttribArray(1);
-    glVertexAttribPointer(1, 3, GL_FLOAT, GL_FALSE, kStride,
-                          reinterpret_cast<const void*>(2 * sizeof(float)));
-    glBindVertexArray(0);
-    glBindBuffer(GL_ARRAY_BUFFER, 0);
-  }
-  output_color_ = MakeArray(GL_RGBA8, GL_RGBA, GL_UNSIGNED_BYTE, lens_.width, lens_.height, 1);
-  glGenFramebuffers(1, &output_framebuffer_);
-  glBindFramebuffer(GL_FRAMEBUFFER, output_framebuffer_);
-  glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, output_color_, 0, 0);
-  CheckComplete("camera image", lens_.width, lens_.height);
+}
 
-  if (truth_) {
-    truth_ids_ = MakeArray(GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, w, h, layers_);
-    truth_z_ = MakeArray(GL_RG32F, GL_RG, GL_FLOAT, w, h, layers_);  // camera z, view depth
-    truth_depth_ = MakeRenderbuffer(GL_DEPTH_COMPONENT32F, w, h, 0);
-    glGenFramebuffers(1, &truth_framebuffer_);
-    glBindFramebuffer(GL_FRAMEBUFFER, truth_framebuffer_);
-    glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, truth_ids_, 0, 0);
-    glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT1, truth_z_, 0, 0);
-    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, truth_depth_);
-    const GLenum buffers[] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
-    glDrawBuffers(2, buffers);
-    CheckComplete("ground truth", w, h);
-    output_ids_ =
-        MakeArray(GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, lens_.width, lens_.height, 1);
-    output_z_ = MakeArray(GL_R32F, GL_RED, GL_FLOAT, lens_.width, lens_.height, 1);
-    glGenFramebuffers(1, &output_truth_framebuffer_);
-    glBindFramebuffer(GL_FRAMEBUFFER, output_truth_framebuffer_);
-    glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, output_ids_, 0, 0);
-    glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT1, output_z_, 0, 0);
-    glDrawBuffers(2, buffers);
-    CheckComplete("ground truth image", lens_.width, lens_.height);
-    id_buffers_ = std::make_unique<PixelBuffers>(lens_.width, lens_.height, 4);
-    depth_buffers_ = std::make_unique<PixelBuffers>(lens_.width, lens_.height, 4);
+void EffectTarget::MakeLensRemap(bool lens_on_cpu) {
+  const int w = source_width_, h = source_height_;
+  const RemapTable table = MakeRemapTable(lens_);
+  if (lens_on_cpu && layers_ == 1 && !truth_) {
+    cpu_lens_ = std::make_unique<CpuLens>(table, lens_.width, lens_.height, w, h);
+    source_buffers_ = std::make_unique<PixelBuffers>(w, h, 4);
   }
-  glBindFramebuffer(GL_FRAMEBUFFER, 0);
-  CheckGlError(
-      fmt::format("Renderer: making the effect targets ({} view(s) of {} x {})", layers_, w, h));
+  map_ = MakeTexture2d(GL_RGBA32F, GL_RGBA, GL_FLOAT, lens_.width, lens_.height, table.map.data());
+  footprint_ = MakeTexture2d(GL_RGBA32F, GL_RGBA, GL_FLOAT, lens_.width, lens_.height,
+                             table.footprint.data());
+  const LensMesh mesh = MakeLensMesh(table, lens_.width, lens_.height);
+  residual_ =
+      MakeTexture2d(GL_RG8_SNORM, GL_RG, GL_BYTE, lens_.width, lens_.height, mesh.residual.data());
+  std::vector<uint32_t> indices = mesh.linear;
+  indices.insert(indices.end(), mesh.exact.begin(), mesh.exact.end());
+  mesh_linear_ = static_cast<GLsizei>(mesh.linear.size());
+  mesh_exact_ = static_cast<GLsizei>(mesh.exact.size());
+  glGenVertexArrays(1, &mesh_vao_);
+  glBindVertexArray(mesh_vao_);
+  glGenBuffers(1, &mesh_vertices_);
+  glBindBuffer(GL_ARRAY_BUFFER, mesh_vertices_);
+  glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(mesh.vertices.size() * sizeof(float)),
+               mesh.vertices.data(), GL_STATIC_DRAW);
+  glGenBuffers(1, &mesh_indices_);
+  glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, mesh_indices_);
+  glBufferData(GL_ELEMENT_ARRAY_BUFFER, static_cast<GLsizeiptr>(indices.size() * sizeof(uint32_t)),
+               indices.data(), GL_STATIC_DRAW);
+  constexpr GLsizei kStride = 5 * sizeof(float);
+  glEnableVertexAttribArray(0);
+  glVertexAttribPointer(0, 2, GL_FLOAT, GL_FALSE, kStride, nullptr);
+  glEnableVertexAttribArray(1);
+  glVertexAttribPointer(1, 3, GL_FLOAT, GL_FALSE, kStride,
+                        reinterpret_cast<const void*>(2 * sizeof(float)));
+  glBindVertexArray(0);
+  glBindBuffer(GL_ARRAY_BUFFER, 0);
+}
+
+void EffectTarget::MakeTruthTargets() {
+  const int w = source_width_, h = source_height_;
+  truth_ids_ = MakeArray(GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, w, h, layers_);
+  truth_z_ = MakeArray(GL_RG32F, GL_RG, GL_FLOAT, w, h, layers_);  // camera z, view depth
+  truth_depth_ = MakeRenderbuffer(GL_DEPTH_COMPONENT32F, w, h, 0);
+  glGenFramebuffers(1, &truth_framebuffer_);
+  glBindFramebuffer(GL_FRAMEBUFFER, truth_framebuffer_);
+  glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, truth_ids_, 0, 0);
+  glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT1, truth_z_, 0, 0);
+  glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, truth_depth_);
+  const GLenum buffers[] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
+  glDrawBuffers(2, buffers);
+  CheckComplete("ground truth", w, h);
+  output_ids_ = MakeArray(GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, lens_.width, lens_.height, 1);
+  output_z_ = MakeArray(GL_R32F, GL_RED, GL_FLOAT, lens_.width, lens_.height, 1);
+  glGenFramebuffers(1, &output_truth_framebuffer_);
+  glBindFramebuffer(GL_FRAMEBUFFER, output_truth_framebuffer_);
+  glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, output_ids_, 0, 0);
+  glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT1, output_z_, 0, 0);
+  glDrawBuffers(2, buffers);
+  CheckComplete("ground truth image", lens_.width, lens_.height);
+  id_buffers_ = std::make_unique<PixelBuffers>(lens_.width, lens_.height, 4);
+  depth_buffers_ = std::make_unique<PixelBuffers>(lens_.width, lens_.height, 4);
 }
 
 void EffectTarget::EnableBlur() {

@@ -282,6 +282,12 @@ class EffectTarget {
   // and the multisampled buffer resolved into that layer (nothing to do without MSAA).
   void BindLayerForDrawing(GLuint array, int layer) const;
   void ResolveInto(GLuint array, int layer) const;
+  // The constructor's parts: the source views' array and the framebuffer that draws them
+  // (with MSAA, its multisampled buffer and the one that resolves it); the lens remap's map,
+  // footprint and mesh (and the remap on the CPU where asked); the truth arrays and outputs.
+  void MakeSourceViews();
+  void MakeLensRemap(bool lens_on_cpu);
+  void MakeTruthTargets();
 
   geometry::LensMap lens_;
   int samples_;

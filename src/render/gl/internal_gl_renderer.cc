@@ -61,6 +61,38 @@ GlRenderer::GlRenderer(const scene::Scene& scene, const RendererOptions& options
     SACCADE_ASSERT(camera != nullptr, "MakeRenderer checked the camera names");
     cameras_.push_back(camera);
   }
+  SortLights();
+
+  // Multisampling: as many samples as asked, or the device's maximum when it has fewer
+  // (llvmpipe has 4); DeviceDescription says which.
+  GLint max_samples = 0;
+  glGetIntegerv(GL_MAX_SAMPLES, &max_samples);
+  samples_ = std::min(options_.msaa_samples, static_cast<int>(max_samples));
+
+  const std::string version = reinterpret_cast<const char*>(glGetString(GL_VERSION));
+  const std::string renderer = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
+  ChooseDevicePaths(renderer);
+  AddItems();
+
+  truth_ = options_.truth_depth || options_.truth_ids || options_.truth_objects;
+  BuildCameraSetups();
+  for (Pending& pending : pending_) {
+    pending.X_WC.resize(cameras_.size());
+    pending.exposure_samples.assign(cameras_.size(), 1);
+  }
+  image_pools_.resize(cameras_.size());
+  SetFixedState();
+
+  description_ = fmt::format("OpenGL {}, {} (EGL: {})", version, renderer, context_.display_name());
+  if (options_.msaa_samples > 0) {
+    description_ += samples_ == options_.msaa_samples
+                        ? fmt::format(", MSAA {}x", samples_)
+                        : fmt::format(", MSAA {}x ({}x asked; the device's maximum)", samples_,
+                                      options_.msaa_samples);
+  }
+}
+
+void GlRenderer::SortLights() {
   for (const scene::Light& light : scene_.lights()) {
     if (light.type == scene::Light::Type::kAmbient) {
       ambient_ += light.color * light.intensity;
@@ -76,15 +108,9 @@ GlRenderer::GlRenderer(const scene::Scene& scene, const RendererOptions& options
         "most {} (plus any number of ambient lights)",
         directional_lights_.size() + point_lights_.size(), kMaxLights));
   }
+}
 
-  // Multisampling: as many samples as asked, or the device's maximum when it has fewer
-  // (llvmpipe has 4); DeviceDescription says which.
-  GLint max_samples = 0;
-  glGetIntegerv(GL_MAX_SAMPLES, &max_samples);
-  samples_ = std::min(options_.msaa_samples, static_cast<int>(max_samples));
-
-  const std::string version = reinterpret_cast<const char*>(glGetString(GL_VERSION));
-  const std::string renderer = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
+void GlRenderer::ChooseDevicePaths(const std::string& renderer) {
   // Software rasterisers implement anisotropic filtering as an elliptical weighted average
   // that is slow and, where texels map about 1:1 (or 2^k:1) to pixels, moves fine texture
   // detail by up to 0.08 px with the sub-pixel phase (measured on llvmpipe and softpipe):
@@ -101,7 +127,9 @@ GlRenderer::GlRenderer(const scene::Scene& scene, const RendererOptions& options
   batch_contexts_ = options_.batch_contexts != 0
                         ? options_.batch_contexts
                         : (software && std::thread::hardware_concurrency() >= 2 ? 2 : 1);
+}
 
+void GlRenderer::AddItems() {
   for (std::size_t i = 0; i < scene_.objects().size(); ++i) {
     const scene::Object& object = scene_.objects()[i];
     if (object.model) AddItem(*object.model, object.scale, static_cast<int>(i), -1);
@@ -121,19 +149,13 @@ GlRenderer::GlRenderer(const scene::Scene& scene, const RendererOptions& options
     ground_vao_ = resources_->GroundQuad(0.5f * static_cast<float>(scene_.ground().size));
     BuildGroundProgram();
   }
+}
 
-  truth_ = options_.truth_depth || options_.truth_ids || options_.truth_objects;
-  BuildCameraSetups();
-  for (Pending& pending : pending_) {
-    pending.X_WC.resize(cameras_.size());
-    pending.exposure_samples.assign(cameras_.size(), 1);
-  }
-  image_pools_.resize(cameras_.size());
-
-  // Fixed state. The projection negates y (flip_rows), which mirrors the winding of every
-  // triangle: front faces (counter-clockwise in the model) are clockwise in window
-  // coordinates. Closed meshes have their back faces culled; open ones are two-sided, where
-  // gl_FrontFacing says which side is seen.
+void GlRenderer::SetFixedState() {
+  // The projection negates y (flip_rows), which mirrors the winding of every triangle: front
+  // faces (counter-clockwise in the model) are clockwise in window coordinates. Closed meshes
+  // have their back faces culled; open ones are two-sided, where gl_FrontFacing says which
+  // side is seen.
   glFrontFace(GL_CW);
   glCullFace(GL_BACK);
   glEnable(GL_DEPTH_TEST);
@@ -146,21 +168,8 @@ GlRenderer::GlRenderer(const scene::Scene& scene, const RendererOptions& options
   glClearDepth(1.0);
   glActiveTexture(GL_TEXTURE0);
   CheckGlError("MakeRenderer: setting up");
-
-  description_ = fmt::format("OpenGL {}, {} (EGL: {})", version, renderer, context_.display_name());
-  if (options_.msaa_samples > 0) {
-    description_ += samples_ == options_.msaa_samples
-                        ? fmt::format(", MSAA {}x", samples_)
-                        : fmt::format(", MSAA {}x ({}x asked; the device's maximum)", samples_,
-                                      options_.msaa_samples);
-  }
 }
 
-// How each camera renders, from options_'s effects: its source views, and its effect target
-// (or its plain target when it needs no effect). `reuse`: the previous setups (SetEffects), whose
-// effect targets are kept where the lens stays as it was (a switch of the noise or the blur
-// remakes nothing: blur adds the accumulation array once, and keeps it); `reuse_distortion`:
-// the distortion switch they were made with. Needs the context current.
 // Builds the final pass's programs of `setup` now, not in its first frame: the map variant,
 // and the mesh one where there is a lens.
 void GlRenderer::PrebuildFinal(const CameraSetup& setup) {
@@ -168,6 +177,11 @@ void GlRenderer::PrebuildFinal(const CameraSetup& setup) {
   if (setup.distorted) effect_programs_->GetFinal(false, setup.noise, /*mesh=*/true);
 }
 
+// How each camera renders, from options_'s effects: its source views, and its effect target
+// (or its plain target when it needs no effect). `reuse`: the previous setups (SetEffects), whose
+// effect targets are kept where the lens stays as it was (a switch of the noise or the blur
+// remakes nothing: blur adds the accumulation array once, and keeps it); `reuse_distortion`:
+// the distortion switch they were made with. Needs the context current.
 void GlRenderer::BuildCameraSetups(std::vector<CameraSetup> reuse, bool reuse_distortion) {
   targets_.clear();
   setups_.clear();
@@ -491,129 +505,256 @@ geometry::Pose GlRenderer::ItemPose(const DrawItem& item, const scene::SceneStat
   return LinkPose(*frames, part.link) * part.X_LinkPart;
 }
 
-double GlRenderer::ImageMotionPx(int camera, const scene::SceneState& s0,
-                                 const scene::SceneState& s1, double* camera_px,
-                                 std::vector<double>* item_px, double* turn_only_px) const {
-  const scene::CameraSpec& spec = *cameras_[camera];
-  const geometry::Intrinsics& k = spec.model.intrinsics();
-  const double near = spec.clip.near;
-  const double left = k.cx() / k.fx(), right = (k.width() - k.cx()) / k.fx();
-  const double top = k.cy() / k.fy(), bottom = (k.height() - k.cy()) / k.fy();
-  const double tx = std::max(left, right), ty = std::max(top, bottom);
-  const double f = std::max(k.fx(), k.fy());
-  // The camera turning by an angle moves a ray at angle a from its axis by f (1 + tan^2 a)
-  // pixels per radian, most at the image's corners; a point shifting by d at depth z moves by
-  // at most f (1 + tan a) d / z pixels.
-  const double turn_gain = f * (1.0 + tx * tx + ty * ty);
-  const double shift_gain = f * (1.0 + std::max(tx, ty));
-  const auto angle = [](const Eigen::Matrix3d& R) {
-    return Eigen::AngleAxisd(R).angle();  // in [0, pi]
-  };
-  const geometry::Pose X_WC0 = scene_.CameraPose(spec, s0);
-  const geometry::Pose X_WC1 = scene_.CameraPose(spec, s1);
-  // The camera's turn moves everything alike; its shift moves the ground most nearby (at
-  // its height) and each item by its own depth, as do the items' own motions.
-  const double turn = angle(X_WC0.linear().transpose() * X_WC1.linear());
-  const Eigen::Vector3d camera_shift = X_WC1.translation() - X_WC0.translation();
-  const double ground_shift_px =
-      shift_gain * camera_shift.norm() / std::max(std::abs(X_WC0.translation().z()), near);
-  double px = turn_gain * turn + ground_shift_px;
-  if (camera_px != nullptr) *camera_px = px;
+namespace {
+
+// The angle of a rotation, in [0, pi].
+double RotationAngle(const Eigen::Matrix3d& R) { return Eigen::AngleAxisd(R).angle(); }
+
+// The pose of a camera's source view: the camera's (X_WC) turned by the view's R_CV.
+geometry::Pose ViewPose(const ViewSetup& view, const geometry::Pose& X_WC) {
+  geometry::Pose X_WV = X_WC;
+  X_WV.linear() = X_WC.linear() * view.R_CV;
+  return X_WV;
+}
+
+// `state` dt seconds later (earlier for dt < 0), the joints moving at their velocities.
+scene::SceneState StateAfter(const scene::SceneState& state, double dt) {
+  scene::SceneState sub = state;
+  sub.time += dt;
+  sub.joints.pan += state.joint_velocities.pan * dt;
+  sub.joints.tilt += state.joint_velocities.tilt * dt;
+  sub.joints.left += state.joint_velocities.left * dt;
+  sub.joints.right += state.joint_velocities.right * dt;
+  return sub;
+}
+
+// A rectangle of a view's window: x0, y0, x1, y1 (pixels).
+using Rect = std::array<double, 4>;
+
+// The rectangle that holds the projections of `points` (eye frame) through P onto a view of
+// k's size, as the rasteriser projects them; none when one lies behind the eye.
+std::optional<Rect> ProjectedHull(const std::array<Eigen::Vector3d, 8>& points,
+                                  const Eigen::Matrix4d& P, const geometry::Intrinsics& k) {
+  Rect r{1e300, 1e300, -1e300, -1e300};
+  for (const Eigen::Vector3d& p_E : points) {
+    const Eigen::Vector4d clip = P * Eigen::Vector4d(p_E.x(), p_E.y(), p_E.z(), 1.0);
+    if (clip.w() <= 1e-9) return std::nullopt;
+    const double x = 0.5 * (clip.x() / clip.w() + 1.0) * k.width();
+    const double y = 0.5 * (clip.y() / clip.w() + 1.0) * k.height();
+    r = {std::min(r[0], x), std::min(r[1], y), std::max(r[2], x), std::max(r[3], y)};
+  }
+  return r;
+}
+
+// The rectangle of a view (eye frame X_EW, projection P, k's size) that holds the image of an
+// item at X_WO, or none. Its image lies within two hulls: of the corners of the cube around
+// its bounding sphere, and of the corners of its model's box (far tighter for a flat picture,
+// whose sphere reaches past it on every side). Their intersection holds it while every corner
+// of one of them lies in front of the eye; none when neither does.
+std::optional<Rect> ItemImageRect(const DrawItem& item, const geometry::Pose& X_WO,
+                                  const Eigen::Isometry3d& X_EW, const Eigen::Matrix4d& P,
+                                  const geometry::Intrinsics& k) {
+  const double r = item.radius_model;
+  const Eigen::Vector3d c_E = X_EW * (X_WO * item.center_model.cwiseProduct(item.scale));
+  std::array<Eigen::Vector3d, 8> corners;
+  for (int corner = 0; corner < 8; ++corner) {
+    corners[corner] =
+        c_E + Eigen::Vector3d((corner & 1) ? r : -r, (corner & 2) ? r : -r, (corner & 4) ? r : -r);
+  }
+  std::optional<Rect> rect = ProjectedHull(corners, P, k);
+  if (item.model != nullptr && !item.model->bounds.isEmpty()) {
+    for (int corner = 0; corner < 8; ++corner) {
+      const Eigen::Vector3d c =
+          item.model->bounds.corner(static_cast<Eigen::AlignedBox3f::CornerType>(corner))
+              .cast<double>();
+      corners[corner] = X_EW * (X_WO * c.cwiseProduct(item.scale));
+    }
+    if (const std::optional<Rect> box = ProjectedHull(corners, P, k)) {
+      rect = rect ? Rect{std::max((*rect)[0], (*box)[0]), std::max((*rect)[1], (*box)[1]),
+                         std::min((*rect)[2], (*box)[2]), std::min((*rect)[3], (*box)[3])}
+                  : *box;
+    }
+  }
+  return rect;
+}
+
+// The window rectangle (x, y, width, height) of a view (eye frame X_EW, projection P, k's
+// size) that holds the images of the `moving` items (each at its pose), with a margin; empty
+// when there are none; none when one reaches behind the eye.
+std::optional<std::array<int, 4>> MovingRegion(
+    const std::vector<std::pair<const DrawItem*, geometry::Pose>>& moving,
+    const Eigen::Isometry3d& X_EW, const Eigen::Matrix4d& P, const geometry::Intrinsics& k) {
+  double x0 = 1e300, y0 = 1e300, x1 = -1e300, y1 = -1e300;
+  for (const auto& [item, X_WO] : moving) {
+    const std::optional<Rect> rect = ItemImageRect(*item, X_WO, X_EW, P, k);
+    if (!rect) return std::nullopt;
+    x0 = std::min(x0, (*rect)[0]);
+    y0 = std::min(y0, (*rect)[1]);
+    x1 = std::max(x1, (*rect)[2]);
+    y1 = std::max(y1, (*rect)[3]);
+  }
+  // Margin: two pixels for rasterisation and multisampling, one for the camera's own motion
+  // (under a pixel over the exposure); empty when nothing moves in the view.
+  constexpr double kMarginPx = 3.0;
+  const int left = static_cast<int>(std::clamp(std::floor(x0 - kMarginPx), 0.0, double(k.width())));
+  const int right = static_cast<int>(std::clamp(std::ceil(x1 + kMarginPx), 0.0, double(k.width())));
+  const int bottom =
+      static_cast<int>(std::clamp(std::floor(y0 - kMarginPx), 0.0, double(k.height())));
+  const int top = static_cast<int>(std::clamp(std::ceil(y1 + kMarginPx), 0.0, double(k.height())));
+  return std::array<int, 4>{left, bottom, std::max(0, right - left), std::max(0, top - bottom)};
+}
+
+}  // namespace
+
+// The pinhole of a camera's K as ImageMotionPx bounds image motion through it.
+struct GlRenderer::MotionGains {
+  MotionGains(const geometry::Intrinsics& k, double near_clip)
+      : near(near_clip),
+        left(k.cx() / k.fx()),
+        right((k.width() - k.cx()) / k.fx()),
+        top(k.cy() / k.fy()),
+        bottom((k.height() - k.cy()) / k.fy()) {
+    const double tx = std::max(left, right), ty = std::max(top, bottom);
+    f = std::max(k.fx(), k.fy());
+    // The camera turning by an angle moves a ray at angle a from its axis by f (1 + tan^2 a)
+    // pixels per radian, most at the image's corners; a point shifting by d at depth z moves
+    // by at most f (1 + tan a) d / z pixels.
+    turn_gain = f * (1.0 + tx * tx + ty * ty);
+    shift_gain = f * (1.0 + std::max(tx, ty));
+    corner = std::hypot(tx, ty);
+  }
+
   // What a homography of the turn cannot follow: the parallax of a shift d (camera frame)
   // moves a point at depth z and normalised image position q by (q d_z - d_xy) / (z - d_z),
   // at most (|d_xy| + |q|max |d_z|) / (z - |d_z|): a sideways shift (the eyes swung by the
   // neck's pan) is not charged the corners' gain, which only the shift along the axis has.
-  const double corner = std::hypot(tx, ty);
-  const auto parallax_px = [&](const Eigen::Vector3d& d_C, double depth) {
+  double ParallaxPx(const Eigen::Vector3d& d_C, double depth) const {
     return f * (d_C.head<2>().norm() + corner * std::abs(d_C.z())) /
            std::max(depth - std::abs(d_C.z()), near);
-  };
-  double off_turn = parallax_px(X_WC0.linear().transpose() * camera_shift,
-                                std::max(std::abs(X_WC0.translation().z()), near));
-  std::optional<head::HeadFrames> frames0, frames1;
-  if (draw_robot_) {
-    frames0 = head::ForwardKinematics(scene_.robot()->head, s0.joints);
-    frames1 = head::ForwardKinematics(scene_.robot()->head, s1.joints);
   }
+
   // Whether a sphere (centre in the camera frame, radius) lies wholly outside the view.
-  const auto outside = [&](const Eigen::Vector3d& c, double r) {
+  bool Outside(const Eigen::Vector3d& c, double r) const {
     const auto beyond = [&](double lateral, double tan_half) {  // past one side plane
       return (lateral - tan_half * c.z()) / std::sqrt(1.0 + tan_half * tan_half) > r;
     };
     return c.z() + r < near || beyond(c.x(), right) || beyond(-c.x(), left) ||
            beyond(c.y(), bottom) || beyond(-c.y(), top);
-  };
-  const geometry::Pose X_CW0 = X_WC0.inverse(), X_CW1 = X_WC1.inverse();
+  }
+
+  double near;                      // the near clip plane
+  double left, right, top, bottom;  // tangents of the view's half-angles from its axis
+  double f = 0.0;                   // the larger focal length (pixels)
+  double turn_gain = 0.0, shift_gain = 0.0;
+  double corner = 0.0;  // the tangent of the angle to the farthest corner
+};
+
+// A camera's motion between two states (ImageMotionPx).
+struct GlRenderer::CameraMotion {
+  geometry::Pose X_WC0, X_WC1, X_CW0, X_CW1;
+  Eigen::Vector3d shift;  // X_WC1's origin less X_WC0's (world frame)
+  double turn = 0.0;      // the angle between their orientations (radians)
+};
+
+double GlRenderer::ImageMotionPx(int camera, const scene::SceneState& s0,
+                                 const scene::SceneState& s1, double* camera_px,
+                                 std::vector<double>* item_px, double* turn_only_px) const {
+  const scene::CameraSpec& spec = *cameras_[camera];
+  const double near = spec.clip.near;
+  const MotionGains gains(spec.model.intrinsics(), near);
+  CameraMotion motion;
+  motion.X_WC0 = scene_.CameraPose(spec, s0);
+  motion.X_WC1 = scene_.CameraPose(spec, s1);
+  // The camera's turn moves everything alike; its shift moves the ground most nearby (at
+  // its height) and each item by its own depth, as do the items' own motions.
+  motion.turn = RotationAngle(motion.X_WC0.linear().transpose() * motion.X_WC1.linear());
+  motion.shift = motion.X_WC1.translation() - motion.X_WC0.translation();
+  const double ground_depth = std::max(std::abs(motion.X_WC0.translation().z()), near);
+  const double ground_shift_px = gains.shift_gain * motion.shift.norm() / ground_depth;
+  double px = gains.turn_gain * motion.turn + ground_shift_px;
+  if (camera_px != nullptr) *camera_px = px;
+  double off_turn =
+      gains.ParallaxPx(motion.X_WC0.linear().transpose() * motion.shift, ground_depth);
+  std::optional<head::HeadFrames> frames0, frames1;
+  if (draw_robot_) {
+    frames0 = head::ForwardKinematics(scene_.robot()->head, s0.joints);
+    frames1 = head::ForwardKinematics(scene_.robot()->head, s1.joints);
+  }
+  motion.X_CW0 = motion.X_WC0.inverse();
+  motion.X_CW1 = motion.X_WC1.inverse();
   if (item_px != nullptr) item_px->assign(items_.size(), 0.0);
-  const std::vector<ViewSetup>& views = setups_[camera].views;
   for (std::size_t i = 0; i < items_.size(); ++i) {
     const DrawItem& item = items_[i];
-    const geometry::Pose X_WO0 = ItemPose(item, s0, frames0);
-    const geometry::Pose X_WO1 = ItemPose(item, s1, frames1);
-    const Eigen::Vector3d centre = item.center_model.cwiseProduct(item.scale);
-    const Eigen::Vector3d c0 = X_WO0 * centre, c1 = X_WO1 * centre;  // world
-    // Out of view at both ends of the exposure (a robot part behind the eye, say): its motion
-    // is not seen.
-    if (outside(X_CW0 * c0, item.radius_model) && outside(X_CW1 * c1, item.radius_model)) {
-      continue;
-    }
-    // A point of the item's bounding sphere moves by its centre's motion plus at most its
-    // turn times the radius, seen at the sphere's nearest depth. Two bounds, the smaller
-    // kept: in the camera's frame (an item that moves with the camera, a part of the head,
-    // hardly moves), and in the world's, the camera's turn apart (a still item does not).
-    const double r = item.radius_model;
-    const double depth = std::max((X_CW0 * c0).z() - r, near);
-    const double relative_turn =
-        angle((X_CW0.linear() * X_WO0.linear()).transpose() * (X_CW1.linear() * X_WO1.linear()));
-    const double in_camera =
-        shift_gain * ((X_CW1 * c1 - X_CW0 * c0).norm() + relative_turn * r) / depth;
-    const double item_turn = angle(X_WO0.linear().transpose() * X_WO1.linear());
-    const double in_world =
-        turn_gain * turn + shift_gain * (((c1 - c0) - camera_shift).norm() + item_turn * r) / depth;
-    const double item_motion = std::min(in_camera, in_world);
-    if (item_px != nullptr) (*item_px)[i] = item_motion;
-    px = std::max(px, item_motion);
-    if (turn_only_px == nullptr) continue;  // turn blur off: the bound below is not needed
-    // Where the item is at s1 in the camera, against where the camera's turn alone would put
-    // it: a still item is off by the camera's shift (parallax), a part that moves with the
-    // camera by the turn itself, a moving item by its motion. An item whose box is out of the
-    // (single) view at both ends is not seen: the head's body behind the eyes, whose bounding
-    // sphere reaches past them.
-    if (item.model != nullptr && !item.model->bounds.isEmpty() && views.size() == 1) {
-      const auto box_outside = [&](const geometry::Pose& X_WC, const geometry::Pose& X_WO) {
-        geometry::Pose X_WV = X_WC;
-        X_WV.linear() = X_WC.linear() * views[0].R_CV;
-        Eigen::Affine3d MV = EyeFromWorld(X_WV) * X_WO;
-        MV.linear() = MV.linear() * item.scale.asDiagonal();
-        return OutsideFrustum(views[0].projection * MV.matrix(), item.model->bounds);
-      };
-      if (box_outside(X_WC0, X_WO0) && box_outside(X_WC1, X_WO1)) continue;
-    }
-    const Eigen::Vector3d p0 = X_CW0 * c0, p1 = X_CW1 * c1;
-    const Eigen::Vector3d turned = X_CW1.linear() * X_WC0.linear() * p0;
-    off_turn = std::max(
-        off_turn, parallax_px(p1 - turned, depth) + f * (1.0 + corner) * item_turn * r / depth);
+    const std::optional<double> item_motion =
+        ItemMotionPx(item, ItemPose(item, s0, frames0), ItemPose(item, s1, frames1), gains, motion,
+                     setups_[camera].views, turn_only_px != nullptr ? &off_turn : nullptr);
+    if (!item_motion) continue;
+    if (item_px != nullptr) (*item_px)[i] = *item_motion;
+    px = std::max(px, *item_motion);
   }
   if (turn_only_px != nullptr) *turn_only_px = off_turn;
   return px;
 }
 
-std::vector<std::optional<GlRenderer::Region>> GlRenderer::MovingRegions(
-    int camera, const std::vector<scene::SceneState>& subs, std::size_t whole,
-    const std::vector<double>& item_px,
-    const std::function<geometry::Pose(const geometry::Pose&, int)>& view_pose) const {
-  const CameraSetup& setup = setups_[camera];
-  const scene::CameraSpec& spec = *cameras_[camera];
-  const int views = static_cast<int>(setup.views.size());
-  const geometry::Pose X_WC = scene_.CameraPose(spec, subs[whole]);
+std::optional<double> GlRenderer::ItemMotionPx(const DrawItem& item, const geometry::Pose& X_WO0,
+                                               const geometry::Pose& X_WO1,
+                                               const MotionGains& gains, const CameraMotion& camera,
+                                               const std::vector<ViewSetup>& views,
+                                               double* off_turn) const {
+  const Eigen::Vector3d centre = item.center_model.cwiseProduct(item.scale);
+  const Eigen::Vector3d c0 = X_WO0 * centre, c1 = X_WO1 * centre;  // world
+  // Out of view at both ends of the exposure (a robot part behind the eye, say): its motion
+  // is not seen.
+  if (gains.Outside(camera.X_CW0 * c0, item.radius_model) &&
+      gains.Outside(camera.X_CW1 * c1, item.radius_model)) {
+    return std::nullopt;
+  }
+  // A point of the item's bounding sphere moves by its centre's motion plus at most its
+  // turn times the radius, seen at the sphere's nearest depth. Two bounds, the smaller
+  // kept: in the camera's frame (an item that moves with the camera, a part of the head,
+  // hardly moves), and in the world's, the camera's turn apart (a still item does not).
+  const double r = item.radius_model;
+  const double depth = std::max((camera.X_CW0 * c0).z() - r, gains.near);
+  const double relative_turn = RotationAngle((camera.X_CW0.linear() * X_WO0.linear()).transpose() *
+                                             (camera.X_CW1.linear() * X_WO1.linear()));
+  const double in_camera = gains.shift_gain *
+                           ((camera.X_CW1 * c1 - camera.X_CW0 * c0).norm() + relative_turn * r) /
+                           depth;
+  const double item_turn = RotationAngle(X_WO0.linear().transpose() * X_WO1.linear());
+  const double in_world =
+      gains.turn_gain * camera.turn +
+      gains.shift_gain * (((c1 - c0) - camera.shift).norm() + item_turn * r) / depth;
+  const double item_motion = std::min(in_camera, in_world);
+  if (off_turn == nullptr) return item_motion;  // turn blur off: the bound below is not needed
+  // Where the item is at s1 in the camera, against where the camera's turn alone would put
+  // it: a still item is off by the camera's shift (parallax), a part that moves with the
+  // camera by the turn itself, a moving item by its motion. An item whose box is out of the
+  // (single) view at both ends is not seen: the head's body behind the eyes, whose bounding
+  // sphere reaches past them.
+  if (item.model != nullptr && !item.model->bounds.isEmpty() && views.size() == 1) {
+    const auto box_outside = [&](const geometry::Pose& X_WC, const geometry::Pose& X_WO) {
+      Eigen::Affine3d MV = EyeFromWorld(ViewPose(views[0], X_WC)) * X_WO;
+      MV.linear() = MV.linear() * item.scale.asDiagonal();
+      return OutsideFrustum(views[0].projection * MV.matrix(), item.model->bounds);
+    };
+    if (box_outside(camera.X_WC0, X_WO0) && box_outside(camera.X_WC1, X_WO1)) return item_motion;
+  }
+  const Eigen::Vector3d p0 = camera.X_CW0 * c0, p1 = camera.X_CW1 * c1;
+  const Eigen::Vector3d turned = camera.X_CW1.linear() * camera.X_WC0.linear() * p0;
+  *off_turn = std::max(*off_turn, gains.ParallaxPx(p1 - turned, depth) +
+                                      gains.f * (1.0 + gains.corner) * item_turn * r / depth);
+  return item_motion;
+}
+
+GlRenderer::MovingPoses GlRenderer::MovingItems(const std::vector<scene::SceneState>& subs,
+                                                const std::vector<double>& item_px) const {
   std::vector<std::optional<head::HeadFrames>> frames(subs.size());
   if (draw_robot_) {
     for (std::size_t k = 0; k < subs.size(); ++k) {
       frames[k] = head::ForwardKinematics(scene_.robot()->head, subs[k].joints);
     }
   }
-  // The items that move, with their pose at every sub-frame (world frame).
-  std::vector<std::pair<const DrawItem*, geometry::Pose>> moving;
+  MovingPoses moving;
   for (std::size_t i = 0; i < items_.size(); ++i) {
     // Under a pixel over the exposure, an item is as still as the camera (no ghost step).
     if (item_px[i] < 1.0) continue;
@@ -628,124 +769,48 @@ std::vector<std::optional<GlRenderer::Region>> GlRenderer::MovingRegions(
     if (!moves) continue;
     for (const geometry::Pose& X_WO : poses) moving.emplace_back(&item, X_WO);
   }
+  return moving;
+}
+
+std::vector<std::optional<GlRenderer::Region>> GlRenderer::MovingRegions(
+    int camera, const std::vector<scene::SceneState>& subs, std::size_t whole,
+    const std::vector<double>& item_px) const {
+  const CameraSetup& setup = setups_[camera];
+  const int views = static_cast<int>(setup.views.size());
+  const geometry::Pose X_WC = scene_.CameraPose(*cameras_[camera], subs[whole]);
+  const MovingPoses moving = MovingItems(subs, item_px);
   std::vector<std::optional<Region>> regions(views);
   for (int v = 0; v < views; ++v) {
-    const geometry::Intrinsics& k = setup.effects->lens().views[v].intrinsics;
-    const Eigen::Isometry3d X_EW = EyeFromWorld(view_pose(X_WC, v));
-    const Eigen::Matrix4d& P = setup.views[v].projection;
-    // The rectangle that holds the projections of `points` (eye frame), as the rasteriser
-    // projects them; none when one lies behind the eye.
-    using Rect = std::array<double, 4>;  // x0, y0, x1, y1
-    const auto hull = [&](const auto& points) -> std::optional<Rect> {
-      Rect r{1e300, 1e300, -1e300, -1e300};
-      for (const Eigen::Vector3d& p_E : points) {
-        const Eigen::Vector4d clip = P * Eigen::Vector4d(p_E.x(), p_E.y(), p_E.z(), 1.0);
-        if (clip.w() <= 1e-9) return std::nullopt;
-        const double x = 0.5 * (clip.x() / clip.w() + 1.0) * k.width();
-        const double y = 0.5 * (clip.y() / clip.w() + 1.0) * k.height();
-        r = {std::min(r[0], x), std::min(r[1], y), std::max(r[2], x), std::max(r[3], y)};
-      }
-      return r;
-    };
-    double x0 = 1e300, y0 = 1e300, x1 = -1e300, y1 = -1e300;
-    bool all = false;
-    // Each moving item's image lies within two hulls: of the corners of the cube around its
-    // bounding sphere, and of the corners of its model's box (far tighter for a flat picture,
-    // whose sphere reaches past it on every side). Their intersection holds it while every
-    // corner of one of them lies in front of the eye.
-    for (const auto& [item_ptr, X_WO] : moving) {
-      const DrawItem& item = *item_ptr;
-      const double r = item.radius_model;
-      const Eigen::Vector3d c_E = X_EW * (X_WO * item.center_model.cwiseProduct(item.scale));
-      std::array<Eigen::Vector3d, 8> corners;
-      for (int corner = 0; corner < 8; ++corner) {
-        corners[corner] = c_E + Eigen::Vector3d((corner & 1) ? r : -r, (corner & 2) ? r : -r,
-                                                (corner & 4) ? r : -r);
-      }
-      std::optional<Rect> rect = hull(corners);
-      if (item.model != nullptr && !item.model->bounds.isEmpty()) {
-        for (int corner = 0; corner < 8; ++corner) {
-          const Eigen::Vector3d c =
-              item.model->bounds.corner(static_cast<Eigen::AlignedBox3f::CornerType>(corner))
-                  .cast<double>();
-          corners[corner] = X_EW * (X_WO * c.cwiseProduct(item.scale));
-        }
-        if (const std::optional<Rect> box = hull(corners)) {
-          rect = rect ? Rect{std::max((*rect)[0], (*box)[0]), std::max((*rect)[1], (*box)[1]),
-                             std::min((*rect)[2], (*box)[2]), std::min((*rect)[3], (*box)[3])}
-                      : *box;
-        }
-      }
-      if (!rect) {
-        all = true;
-        break;
-      }
-      x0 = std::min(x0, (*rect)[0]);
-      y0 = std::min(y0, (*rect)[1]);
-      x1 = std::max(x1, (*rect)[2]);
-      y1 = std::max(y1, (*rect)[3]);
-    }
-    if (all) continue;
-    // Margin: two pixels for rasterisation and multisampling, one for the camera's own motion
-    // (under a pixel over the exposure); empty when nothing moves in the view.
-    constexpr double kMarginPx = 3.0;
-    const int left =
-        static_cast<int>(std::clamp(std::floor(x0 - kMarginPx), 0.0, double(k.width())));
-    const int right =
-        static_cast<int>(std::clamp(std::ceil(x1 + kMarginPx), 0.0, double(k.width())));
-    const int bottom =
-        static_cast<int>(std::clamp(std::floor(y0 - kMarginPx), 0.0, double(k.height())));
-    const int top =
-        static_cast<int>(std::clamp(std::ceil(y1 + kMarginPx), 0.0, double(k.height())));
-    regions[v] = Region{left, bottom, std::max(0, right - left), std::max(0, top - bottom)};
+    regions[v] = MovingRegion(moving, EyeFromWorld(ViewPose(setup.views[v], X_WC)),
+                              setup.views[v].projection, setup.effects->lens().views[v].intrinsics);
   }
   return regions;
 }
 
-void GlRenderer::DrawEffects(int camera, const scene::SceneState& state, int64_t frame_index,
-                             const geometry::Pose& X_WC, int slot) {
+GlRenderer::ExposurePlan GlRenderer::PlanExposure(int camera,
+                                                  const scene::SceneState& state) const {
   const CameraSetup& setup = setups_[camera];
-  const EffectTarget& effects = *setup.effects;
   const scene::CameraSpec& spec = *cameras_[camera];
-  const double near = spec.clip.near;
-  const auto view_pose = [&](const geometry::Pose& X_WCk, int view) {
-    geometry::Pose X_WV = X_WCk;
-    X_WV.linear() = X_WCk.linear() * setup.views[view].R_CV;
-    return X_WV;
-  };
-
+  ExposurePlan plan;
   // Motion blur: sub-frames at the midpoints of n equal slices of the exposure, centred on the
   // frame's time, the joints moving at their velocities. n is what the image motion over the
   // exposure needs for no step between sub-frames to exceed a pixel (1 when nothing moves:
   // one instant), up to the scene's blur_samples.
-  const auto at = [&state](double dt) {
-    scene::SceneState sub = state;
-    sub.time += dt;
-    sub.joints.pan += state.joint_velocities.pan * dt;
-    sub.joints.tilt += state.joint_velocities.tilt * dt;
-    sub.joints.left += state.joint_velocities.left * dt;
-    sub.joints.right += state.joint_velocities.right * dt;
-    return sub;
-  };
-  std::vector<scene::SceneState> sub_states;
-  int n = 1;
-  double camera_px = 0.0;       // the camera's own share of the image motion
-  std::vector<double> item_px;  // and each item's
-  double turn_only_px = 0.0;    // how far the image departs from the camera's turn alone
-  bool accumulated = false;     // the final pass reads the accumulation
   if (setup.blur) {
     const double exposure = spec.sensor.exposure;
     const double motion_px =
-        ImageMotionPx(camera, at(-0.5 * exposure), at(0.5 * exposure), &camera_px, &item_px,
-                      turn_blur_max_error_px_ >= 0.0 ? &turn_only_px : nullptr);
-    n = static_cast<int>(
+        ImageMotionPx(camera, StateAfter(state, -0.5 * exposure), StateAfter(state, 0.5 * exposure),
+                      &plan.camera_px, &plan.item_px,
+                      turn_blur_max_error_px_ >= 0.0 ? &plan.turn_only_px : nullptr);
+    const int n = static_cast<int>(
         std::clamp(std::ceil(motion_px), 1.0, static_cast<double>(spec.sensor.blur_samples)));
+    plan.samples = n;
     if (n > 1) {
-      for (int k = 0; k < n; ++k) sub_states.push_back(at(exposure * ((k + 0.5) / n - 0.5)));
+      for (int k = 0; k < n; ++k) {
+        plan.sub_states.push_back(StateAfter(state, exposure * ((k + 0.5) / n - 0.5)));
+      }
     }
   }
-  pending_[slot].exposure_samples[camera] = n;
-  const int views = static_cast<int>(setup.views.size());
   // A turning camera (a saccade): the n sub-frames fall into m stretches of the exposure, and
   // each stretch's are the instant drawn at its middle seen through the turn's homographies:
   // m scene passes and m passes of fetches instead of n scene passes. What the turn cannot
@@ -755,125 +820,167 @@ void GlRenderer::DrawEffects(int camera, const scene::SceneState& state, int64_t
   // (at most half a stretch): m is the fewest stretches that keep that within
   // turn_blur_max_error_px, and the turn is used when m < n (an eye's saccade: 1; the neck's
   // pan, whose turn swings the eyes, or a ball rolling by: 2 or 3).
-  const int count = static_cast<int>(sub_states.size());
-  int stretches = 0;  // 0: every sub-frame drawn
-  if (count > 1 && views == 1 && camera_px >= 1.0 && count <= kMaxTurnBlurSamples &&
-      turn_blur_max_error_px_ >= 0.0) {
-    for (int m = 1; m < count && stretches == 0; ++m) {
+  const int count = static_cast<int>(plan.sub_states.size());
+  if (count > 1 && setup.views.size() == 1 && plan.camera_px >= 1.0 &&
+      count <= kMaxTurnBlurSamples && turn_blur_max_error_px_ >= 0.0) {
+    for (int m = 1; m < count && plan.stretches == 0; ++m) {
       const int longest = (count + m - 1) / m;  // sub-frames in the longest stretch
-      if (0.5 * longest * turn_only_px / count <= turn_blur_max_error_px_) stretches = m;
+      if (0.5 * longest * plan.turn_only_px / count <= turn_blur_max_error_px_) plan.stretches = m;
     }
   }
+  return plan;
+}
+
+void GlRenderer::DrawEffects(int camera, const scene::SceneState& state, int64_t frame_index,
+                             const geometry::Pose& X_WC, int slot) {
+  const CameraSetup& setup = setups_[camera];
+  const EffectTarget& effects = *setup.effects;
+  const double near = cameras_[camera]->clip.near;
+  const ExposurePlan plan = PlanExposure(camera, state);
+  pending_[slot].exposure_samples[camera] = plan.samples;
   // Up to kMaxTurnStretches stretches are drawn into layers of their own and the final pass
   // fetches every sub-frame through its homography (TurnSamples): no accumulation pass. More
   // stretches accumulate each one's sub-frames (TurnBlur) and the final pass reads the sum.
   TurnSamples turn;
-  const bool fused = stretches > 0 && stretches <= effects.turn_stretches();
-  if (stretches > 0) {
-    const Eigen::Matrix3d K = effects.lens().views[0].intrinsics.Matrix();
-    const Eigen::Matrix3d K_inv = K.inverse();
-    const double exposure = spec.sensor.exposure;
-    std::vector<Eigen::Matrix3f> homographies;
-    for (int g = 0; g < stretches; ++g) {
-      const int first = g * count / stretches, end = (g + 1) * count / stretches;
-      const scene::SceneState middle = at(exposure * (0.5 * (first + end) / count - 0.5));
-      UpdatePoses(middle);
-      const geometry::Pose X_WV = view_pose(scene_.CameraPose(spec, middle), 0);
-      if (fused) {
-        effects.BindStretchForDrawing(g);
-      } else {
-        effects.BindViewForDrawing(0);
-      }
-      glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
-      DrawScene(setup.views[0], near, X_WV);
-      if (fused) {
-        effects.FinishStretch(g);
-      } else {
-        effects.FinishView(0);
-      }
-      homographies.clear();
-      for (int k = first; k < end; ++k) {
-        // A pixel of sub-frame k: its ray in view k, in the world, in the drawn view, its pixel.
-        const Eigen::Matrix3d R_VVk = X_WV.linear().transpose() *
-                                      view_pose(scene_.CameraPose(spec, sub_states[k]), 0).linear();
-        homographies.push_back((K * R_VVk * K_inv).cast<float>());
-      }
-      if (fused) {
-        turn.homographies.insert(turn.homographies.end(), homographies.begin(), homographies.end());
-        turn.layers.insert(turn.layers.end(), homographies.size(), static_cast<float>(g));
-        continue;
-      }
-      effects.TurnBlur(
-          *effect_programs_, 0, homographies, 1.0f / static_cast<float>(count),
-          g == 0 ? EffectTarget::Accumulation::kReplace : EffectTarget::Accumulation::kAdd);
-    }
-    UpdatePoses(state);
+  const bool fused = plan.stretches > 0 && plan.stretches <= effects.turn_stretches();
+  bool accumulated = false;  // the final pass reads the accumulation
+  if (plan.stretches > 0) {
+    DrawTurnStretches(camera, state, plan, fused ? &turn : nullptr);
     accumulated = !fused;
-  } else if (sub_states.empty()) {
-    for (int v = 0; v < views; ++v) {
+  } else if (plan.sub_states.empty()) {
+    for (int v = 0; v < static_cast<int>(setup.views.size()); ++v) {
       effects.BindViewForDrawing(v);
       glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
-      DrawScene(setup.views[v], near, view_pose(X_WC, v));
+      DrawScene(setup.views[v], near, ViewPose(setup.views[v], X_WC));
       effects.FinishView(v);
     }
   } else {
-    // The camera still (under a pixel over the exposure: as for blur itself, a sub-pixel step
-    // is no ghost), the sub-frame nearest the frame's time is drawn whole and the others only
-    // where they can differ from it (MovingRegions: the moving items' sweep), the whole one
-    // standing for all of them elsewhere: a still head watching a small moving ball redraws
-    // the ball's box, not the image, per sub-frame. A moving camera redraws everything.
-    const std::size_t count = sub_states.size(), whole = count / 2;
-    const bool still = camera_px < 1.0;
-    std::vector<std::optional<Region>> regions(views);
-    if (still) regions = MovingRegions(camera, sub_states, whole, item_px, view_pose);
-    const auto scissor = [](const Region& r) {
-      glEnable(GL_SCISSOR_TEST);
-      glScissor(r[0], r[1], r[2], r[3]);
-    };
-    const float weight = 1.0f / static_cast<float>(count);
-    using Mode = EffectTarget::Accumulation;
-    for (std::size_t i = 0; i < count; ++i) {
-      const std::size_t k = i == 0 ? whole : (i <= whole ? i - 1 : i);  // whole one first
-      UpdatePoses(sub_states[k]);
-      const geometry::Pose X_WCk = scene_.CameraPose(spec, sub_states[k]);
-      for (int v = 0; v < views; ++v) {
-        const std::optional<Region>& region = regions[v];
-        const bool part = i > 0 && region;
-        if (part) scissor(*region);
-        effects.BindViewForDrawing(v);
-        glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
-        if (part) {
-          // Only the items that reach the region: the frustum of its rectangle.
-          const geometry::Intrinsics& size = effects.lens().views[v].intrinsics;
-          const Eigen::Matrix4d cull = RegionFrustum(*region, size.width(), size.height());
-          DrawScene(setup.views[v], near, view_pose(X_WCk, v), &cull);
-        } else {
-          DrawScene(setup.views[v], near, view_pose(X_WCk, v));
-        }
-        effects.FinishView(v);
-        if (region) scissor(*region);
-        effects.Accumulate(*effect_programs_, v, weight, i == 0 ? Mode::kReplace : Mode::kAdd);
-        glDisable(GL_SCISSOR_TEST);
-      }
-    }
-    // Still camera: the blurred regions go back into the source views, which hold the whole
-    // sub-frame elsewhere, and the final pass reads those (8 bits, as without blur).
-    if (still) {
-      for (int v = 0; v < views; ++v) {
-        if (regions[v]) scissor(*regions[v]);
-        effects.WriteBack(*effect_programs_, v);
-        glDisable(GL_SCISSOR_TEST);
-      }
-    }
-    accumulated = !still;
-    UpdatePoses(state);
+    accumulated = DrawSubFrames(camera, state, plan);
   }
   if (effects.has_truth()) {
-    for (int v = 0; v < views; ++v) {
+    for (int v = 0; v < static_cast<int>(setup.views.size()); ++v) {
       effects.BindTruthForDrawing(v);
-      DrawTruth(setup.views[v], near, view_pose(X_WC, v));
+      DrawTruth(setup.views[v], near, ViewPose(setup.views[v], X_WC));
     }
   }
+  FinishEffects(camera, frame_index, slot, accumulated, fused ? &turn : nullptr, plan.stretches);
+}
+
+void GlRenderer::DrawTurnStretches(int camera, const scene::SceneState& state,
+                                   const ExposurePlan& plan, TurnSamples* turn) {
+  const CameraSetup& setup = setups_[camera];
+  const EffectTarget& effects = *setup.effects;
+  const scene::CameraSpec& spec = *cameras_[camera];
+  const bool fused = turn != nullptr;
+  const int count = static_cast<int>(plan.sub_states.size()), stretches = plan.stretches;
+  const Eigen::Matrix3d K = effects.lens().views[0].intrinsics.Matrix();
+  const Eigen::Matrix3d K_inv = K.inverse();
+  const double exposure = spec.sensor.exposure;
+  std::vector<Eigen::Matrix3f> homographies;
+  for (int g = 0; g < stretches; ++g) {
+    const int first = g * count / stretches, end = (g + 1) * count / stretches;
+    const scene::SceneState middle =
+        StateAfter(state, exposure * (0.5 * (first + end) / count - 0.5));
+    UpdatePoses(middle);
+    const geometry::Pose X_WV = ViewPose(setup.views[0], scene_.CameraPose(spec, middle));
+    if (fused) {
+      effects.BindStretchForDrawing(g);
+    } else {
+      effects.BindViewForDrawing(0);
+    }
+    glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+    DrawScene(setup.views[0], spec.clip.near, X_WV);
+    if (fused) {
+      effects.FinishStretch(g);
+    } else {
+      effects.FinishView(0);
+    }
+    homographies.clear();
+    for (int k = first; k < end; ++k) {
+      // A pixel of sub-frame k: its ray in view k, in the world, in the drawn view, its pixel.
+      const Eigen::Matrix3d R_VVk =
+          X_WV.linear().transpose() *
+          ViewPose(setup.views[0], scene_.CameraPose(spec, plan.sub_states[k])).linear();
+      homographies.push_back((K * R_VVk * K_inv).cast<float>());
+    }
+    if (fused) {
+      turn->homographies.insert(turn->homographies.end(), homographies.begin(), homographies.end());
+      turn->layers.insert(turn->layers.end(), homographies.size(), static_cast<float>(g));
+      continue;
+    }
+    effects.TurnBlur(
+        *effect_programs_, 0, homographies, 1.0f / static_cast<float>(count),
+        g == 0 ? EffectTarget::Accumulation::kReplace : EffectTarget::Accumulation::kAdd);
+  }
+  UpdatePoses(state);
+}
+
+bool GlRenderer::DrawSubFrames(int camera, const scene::SceneState& state,
+                               const ExposurePlan& plan) {
+  const CameraSetup& setup = setups_[camera];
+  const EffectTarget& effects = *setup.effects;
+  const scene::CameraSpec& spec = *cameras_[camera];
+  const double near = spec.clip.near;
+  const int views = static_cast<int>(setup.views.size());
+  const std::vector<scene::SceneState>& sub_states = plan.sub_states;
+  // The camera still (under a pixel over the exposure: as for blur itself, a sub-pixel step
+  // is no ghost), the sub-frame nearest the frame's time is drawn whole and the others only
+  // where they can differ from it (MovingRegions: the moving items' sweep), the whole one
+  // standing for all of them elsewhere: a still head watching a small moving ball redraws
+  // the ball's box, not the image, per sub-frame. A moving camera redraws everything.
+  const std::size_t count = sub_states.size(), whole = count / 2;
+  const bool still = plan.camera_px < 1.0;
+  std::vector<std::optional<Region>> regions(views);
+  if (still) regions = MovingRegions(camera, sub_states, whole, plan.item_px);
+  const auto scissor = [](const Region& r) {
+    glEnable(GL_SCISSOR_TEST);
+    glScissor(r[0], r[1], r[2], r[3]);
+  };
+  const float weight = 1.0f / static_cast<float>(count);
+  using Mode = EffectTarget::Accumulation;
+  for (std::size_t i = 0; i < count; ++i) {
+    const std::size_t k = i == 0 ? whole : (i <= whole ? i - 1 : i);  // whole one first
+    UpdatePoses(sub_states[k]);
+    const geometry::Pose X_WCk = scene_.CameraPose(spec, sub_states[k]);
+    for (int v = 0; v < views; ++v) {
+      const std::optional<Region>& region = regions[v];
+      const bool part = i > 0 && region;
+      if (part) scissor(*region);
+      effects.BindViewForDrawing(v);
+      glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+      if (part) {
+        // Only the items that reach the region: the frustum of its rectangle.
+        const geometry::Intrinsics& size = effects.lens().views[v].intrinsics;
+        const Eigen::Matrix4d cull = RegionFrustum(*region, size.width(), size.height());
+        DrawScene(setup.views[v], near, ViewPose(setup.views[v], X_WCk), &cull);
+      } else {
+        DrawScene(setup.views[v], near, ViewPose(setup.views[v], X_WCk));
+      }
+      effects.FinishView(v);
+      if (region) scissor(*region);
+      effects.Accumulate(*effect_programs_, v, weight, i == 0 ? Mode::kReplace : Mode::kAdd);
+      glDisable(GL_SCISSOR_TEST);
+    }
+  }
+  // Still camera: the blurred regions go back into the source views, which hold the whole
+  // sub-frame elsewhere, and the final pass reads those (8 bits, as without blur).
+  if (still) {
+    for (int v = 0; v < views; ++v) {
+      if (regions[v]) scissor(*regions[v]);
+      effects.WriteBack(*effect_programs_, v);
+      glDisable(GL_SCISSOR_TEST);
+    }
+  }
+  UpdatePoses(state);
+  return !still;
+}
+
+void GlRenderer::FinishEffects(int camera, int64_t frame_index, int slot, bool accumulated,
+                               TurnSamples* turn, int stretches) {
+  const CameraSetup& setup = setups_[camera];
+  const EffectTarget& effects = *setup.effects;
+  const scene::CameraSpec& spec = *cameras_[camera];
+  const bool fused = turn != nullptr;
   NoiseParams noise;
   noise.read_sigma_dn = static_cast<float>(spec.sensor.read_noise_dn);
   noise.gain_dn_per_e = static_cast<float>(spec.sensor.gain_dn_per_e);
@@ -888,8 +995,8 @@ void GlRenderer::DrawEffects(int camera, const scene::SceneState& state, int64_t
   if (fused && turn_on_cpu_ && !effects.has_truth() &&
       effects.lens().kind == geometry::LensMap::Kind::kIdentity) {
     CpuTurn cpu_turn;
-    cpu_turn.homographies = std::move(turn.homographies);
-    for (const float layer : turn.layers) cpu_turn.layers.push_back(static_cast<int>(layer));
+    cpu_turn.homographies = std::move(turn->homographies);
+    for (const float layer : turn->layers) cpu_turn.layers.push_back(static_cast<int>(layer));
     cpu_turn.stretches = stretches;
     if (setup.noise) pending_[slot].cpu_noise[camera] = noise;
     pending_[slot].cpu_turn[camera] = std::move(cpu_turn);
@@ -902,8 +1009,7 @@ void GlRenderer::DrawEffects(int camera, const scene::SceneState& state, int64_t
     effects.ReadSource(slot);
     return;
   }
-  effects.Finish(*effect_programs_, accumulated, setup.noise ? &noise : nullptr, slot,
-                 fused ? &turn : nullptr);
+  effects.Finish(*effect_programs_, accumulated, setup.noise ? &noise : nullptr, slot, turn);
 }
 
 std::vector<Frame> GlRenderer::Render(const scene::SceneState& state, int64_t frame_index) {

@@ -10,11 +10,11 @@
 #include <array>
 #include <chrono>
 #include <cstdint>
-#include <functional>
 #include <map>
 #include <memory>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "render/gl/internal_camera_target.h"
@@ -173,6 +173,13 @@ class GlRenderer final : public Renderer {
  private:
   struct CameraSetup;
   void BuildCameraSetups(std::vector<CameraSetup> reuse = {}, bool reuse_distortion = false);
+  // Set-up (the constructor's parts): the scene's lights by kind (throws beyond kMaxLights);
+  // the GPU resources and where each effect runs, for the device `renderer` names; the items
+  // and the ground with their programs; the GL state every pass keeps.
+  void SortLights();
+  void ChooseDevicePaths(const std::string& renderer);
+  void AddItems();
+  void SetFixedState();
   void PrebuildFinal(const CameraSetup& setup);
   // A submitted state whose pixels are on their way.
   struct Pending {
@@ -219,8 +226,34 @@ class GlRenderer final : public Renderer {
   void DrawGround(GLint mvp, GLint mv, const Eigen::Matrix4d& P, const Eigen::Isometry3d& X_EW);
   // Readback (internal_readback.cc): the frame's metadata, and truth (internal_truth.cc).
   void Describe(int camera, const Pending& pending, ImageMetadata* meta) const;
+  // The effect path of one camera: its exposure's sub-frames drawn (one instant, every
+  // sub-frame, or a turning camera's stretches), its truth, then the final pass or the
+  // readback that stands for it into `slot`.
   void DrawEffects(int camera, const scene::SceneState& state, int64_t frame_index,
                    const geometry::Pose& X_WC, int slot);
+  // How a camera's exposure is drawn in one frame (PlanExposure).
+  struct ExposurePlan {
+    std::vector<scene::SceneState> sub_states;  // motion blur's sub-frames; empty: one instant
+    int samples = 1;                            // sub-frames (1: one instant)
+    double camera_px = 0.0;       // the camera's own share of the image motion (ImageMotionPx)
+    std::vector<double> item_px;  // and each item's
+    double turn_only_px = 0.0;    // how far the image departs from the camera's turn alone
+    int stretches = 0;            // a turning camera's stretches; 0: every sub-frame drawn
+  };
+  ExposurePlan PlanExposure(int camera, const scene::SceneState& state) const;
+  // A turning camera's stretches, each drawn at its middle: into the stretch layers, their
+  // sub-frames' homographies added to `turn` (fused into the final pass); or, `turn` null,
+  // into the source view, accumulated through the homographies (TurnBlur).
+  void DrawTurnStretches(int camera, const scene::SceneState& state, const ExposurePlan& plan,
+                         TurnSamples* turn);
+  // Every sub-frame drawn and accumulated (with the camera still, only the moving items'
+  // regions redrawn after the first, then written back); whether the final pass reads the
+  // accumulation. The poses are `state`'s again after.
+  bool DrawSubFrames(int camera, const scene::SceneState& state, const ExposurePlan& plan);
+  // The final pass, or the readback that replaces it where the CPU finishes the image (noise,
+  // lens remap, a turn's fetches). `turn`: the stretches' homographies when fused, else null.
+  void FinishEffects(int camera, int64_t frame_index, int slot, bool accumulated, TurnSamples* turn,
+                     int stretches);
   // How far, at most, anything the camera sees moves on its image between s0 and s1
   // (pixels, a bound through the pinhole of K): motion blur draws that many sub-frames.
   // `camera_px`, when given, gets the camera's own share (its turn and shift), `item_px` each
@@ -231,15 +264,28 @@ class GlRenderer final : public Renderer {
   double ImageMotionPx(int camera, const scene::SceneState& s0, const scene::SceneState& s1,
                        double* camera_px = nullptr, std::vector<double>* item_px = nullptr,
                        double* turn_only_px = nullptr) const;
+  struct MotionGains;
+  struct CameraMotion;
+  // One item's share of ImageMotionPx, at X_WO0 and X_WO1: its bound, or nullopt when it is
+  // out of view at both ends; `off_turn`, when given, raised to its departure from the turn.
+  std::optional<double> ItemMotionPx(const DrawItem& item, const geometry::Pose& X_WO0,
+                                     const geometry::Pose& X_WO1, const MotionGains& gains,
+                                     const CameraMotion& camera,
+                                     const std::vector<ViewSetup>& views, double* off_turn) const;
   // Motion blur's sub-frames with the camera still: per view of the camera, the window
   // rectangle (x, y, width, height) outside which every sub-frame equals sub-frame `whole`
   // (the items that move by a pixel or more, by `item_px`, do not reach there), or nullopt for
   // all of the view (a moving item reaches behind the eye).
   using Region = std::array<int, 4>;
-  std::vector<std::optional<Region>> MovingRegions(
-      int camera, const std::vector<scene::SceneState>& subs, std::size_t whole,
-      const std::vector<double>& item_px,
-      const std::function<geometry::Pose(const geometry::Pose&, int)>& view_pose) const;
+  std::vector<std::optional<Region>> MovingRegions(int camera,
+                                                   const std::vector<scene::SceneState>& subs,
+                                                   std::size_t whole,
+                                                   const std::vector<double>& item_px) const;
+  // The items that move by a pixel or more (by `item_px`) over sub-frames `subs`, each with
+  // its pose at every sub-frame (world frame).
+  using MovingPoses = std::vector<std::pair<const DrawItem*, geometry::Pose>>;
+  MovingPoses MovingItems(const std::vector<scene::SceneState>& subs,
+                          const std::vector<double>& item_px) const;
   geometry::Pose ItemPose(const DrawItem& item, const scene::SceneState& state,
                           const std::optional<head::HeadFrames>& frames) const;
   // Eye frame from world, and the pixels per model unit at an item's nearest point.
@@ -313,6 +359,15 @@ class GlRenderer final : public Renderer {
   // into their place in `out` (internal_batch.cc).
   void DrawBatchTiles(const std::vector<BatchHead>& heads, std::size_t first, std::size_t last,
                       uint8_t* out);
+  // Its parts: the layers a part of a batch of `count` tiles draws at once, the framebuffer of
+  // layers and the pixel buffer (re)made when the batch outgrows them (MakeBatchTarget: at
+  // least `layers` layers and `pixel_bytes` bytes), and the cameras' views on the first batch;
+  // a head's poses (its objects placed or hidden); tiles [first, first + count) of the pixel
+  // buffer mapped and converted to RGB into their place in `out`.
+  int PrepareBatchTarget(std::size_t count);
+  void MakeBatchTarget(int layers, std::size_t pixel_bytes);
+  void PoseBatchHead(const BatchHead& head);
+  void ConvertBatchPixels(std::size_t first, std::size_t count, uint8_t* out);
   // The second context of RenderBatch (RendererOptions::batch_contexts): a renderer of the
   // same scene on a thread of its own, made on the first batch of two images or more.
   class BatchHelper;
