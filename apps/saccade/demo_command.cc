@@ -14,15 +14,15 @@
 #include <vector>
 
 #include "commands.h"
-#include "saccade/components/demo_report.h"
-#include "saccade/components/fixation_scoring.h"
+#include "saccade/components/demo/fixation_scoring.h"
+#include "saccade/components/demo/overlay.h"
+#include "saccade/components/demo/recording.h"
+#include "saccade/components/demo/summary.h"
 #include "saccade/components/messages.h"
 #include "saccade/components/register.h"
 #include "saccade/components/roles.h"
 #include "saccade/core/error.h"
 #include "saccade/dds/transport.h"
-#include "saccade/gui/overlay.h"
-#include "saccade/gui/recording.h"
 #include "saccade/gui/session.h"
 #include "saccade/runtime/component_reference.h"
 #include "saccade/runtime/pipeline.h"
@@ -34,8 +34,8 @@ namespace {
 
 namespace fs = std::filesystem;
 using components::HeadStatusMessage;
+using components::demo::Recorder;
 using gui::GuiSession;
-using gui::Recorder;
 using nlohmann::json;
 
 std::atomic<bool> g_stop{false};
@@ -96,12 +96,12 @@ int RunDemo(Options o) {
         " has no eye cameras (a sim.cameras, hw.cameras or remote.cameras component)");
   }
   pipeline.FindRole<components::HeadRole>(&head_name);
-  components::CaptureToCommand latency(spec, cameras_name, head_name);
-  components::LoopFigures figures(pipeline);
+  components::demo::CaptureToCommand latency(spec, cameras_name, head_name);
+  components::demo::LoopFigures figures(pipeline);
   const bool truth = cameras->rendered() != nullptr;
   // Real cameras: the scene only carries the robot; its pictures are not what they see.
   const scene::Scene& scene = cameras->scene();
-  components::FixationScorer scorer(scene, truth);
+  components::demo::FixationScorer scorer(scene, truth);
   const int faces_total = scorer.faces_total();
   if (!truth && !o.json) {
     for (const runtime::ComponentSpec& c : spec.components) {
@@ -112,10 +112,10 @@ int RunDemo(Options o) {
     }
   }
 
-  components::Latest latest;
-  components::TapLoopOutputs(pipeline, &latest);
+  components::demo::Latest latest;
+  components::demo::TapLoopOutputs(pipeline, &latest);
   std::optional<HeadStatusMessage> head_status;
-  components::Tap<HeadStatusMessage>(pipeline, [&](const HeadStatusMessage& m) {
+  components::demo::Tap<HeadStatusMessage>(pipeline, [&](const HeadStatusMessage& m) {
     if (!o.json && m.fault != (head_status ? head_status->fault : "") && !m.fault.empty()) {
       fmt::print("t = {:6.2f} s  head FAULT: {}\n", m.time, m.fault);
     }
@@ -155,17 +155,17 @@ int RunDemo(Options o) {
   run.after_step = [&](const runtime::StepContext& context) {
     const double t = context.time;
     figures.AfterStep(t, latest);
-    const components::FixationScorer::Step scored = scorer.Update(context.step, t, latest);
+    const components::demo::FixationScorer::Step scored = scorer.Update(context.step, t, latest);
     const bool fixated_now = scored.fixated_now;
     const std::string& status = scored.status;
-    const std::vector<components::Fixation>& fixations = scorer.fixations();
+    const std::vector<components::demo::Fixation>& fixations = scorer.fixations();
 
     if (fixated_now && !o.json) {
-      fmt::print("{}", components::FixationText(fixations.back(), t));
+      fmt::print("{}", components::demo::FixationText(fixations.back(), t));
       std::fflush(stdout);
     }
     if (recorder) {
-      const cv::Mat frame = gui::Compose(latest, t, status);
+      const cv::Mat frame = components::demo::Compose(latest, t, status);
       recorder->Write(context.step, frame);
       if (fixated_now) {
         recorder->WriteFixation(static_cast<int>(fixations.size()), fixations.back().object, frame);
@@ -190,7 +190,7 @@ int RunDemo(Options o) {
   const bool nothing_ran = summary.steps == 0 && !summary.errors.empty();
 
   // ---- the report ----
-  components::DemoReport report;
+  components::demo::DemoReport report;
   report.pipeline = o.pipeline;
   report.scene = o.scene;
   report.hardware_file = spec.hardware_file;

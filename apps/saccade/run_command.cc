@@ -14,9 +14,9 @@
 #include <vector>
 
 #include "commands.h"
-#include "saccade/components/demo_report.h"
-#include "saccade/components/fixation_scoring.h"
-#include "saccade/components/loop_outputs.h"
+#include "saccade/components/demo/fixation_scoring.h"
+#include "saccade/components/demo/loop_outputs.h"
+#include "saccade/components/demo/summary.h"
 #include "saccade/components/messages.h"
 #include "saccade/components/register.h"
 #include "saccade/core/error.h"
@@ -68,7 +68,7 @@ int Run(const RunCommandOptions& o) {
   }
   json fixations = json::array();
   bool was_arrived = true;
-  components::Tap<components::JointStateMessage>(
+  components::demo::Tap<components::JointStateMessage>(
       pipeline, [&](const components::JointStateMessage& m) {
         if (csv) {
           *csv << fmt::format("{:.6f},{:.17g},{:.17g},{:.17g},{:.17g},{}\n", m.time,
@@ -95,8 +95,8 @@ int Run(const RunCommandOptions& o) {
   // --score: the fixations attention selected, against the scene's ground truth, as `saccade
   // demo` scores them, from what this process sees (its images, selection, target, joints):
   // perception.yaml's half of a simulated robot scores the split loop.
-  std::unique_ptr<components::FixationScorer> scorer;
-  components::Latest latest;
+  std::unique_ptr<components::demo::FixationScorer> scorer;
+  components::demo::Latest latest;
   if (o.score) {
     std::shared_ptr<const scene::Scene> scene = pipeline.resources().Default<scene::Scene>("scene");
     if (!scene) {
@@ -115,11 +115,11 @@ int Run(const RunCommandOptions& o) {
                             " selects no targets (no vision.attention): there are no fixations "
                             "to score in this process");
     }
-    scorer = std::make_unique<components::FixationScorer>(*scene, /*truth=*/true);
+    scorer = std::make_unique<components::demo::FixationScorer>(*scene, /*truth=*/true);
     if (scorer->faces_total() == 0) {
       throw InvalidArgument("run: --score: the scene has no pictures of faces to score against");
     }
-    components::TapLoopOutputs(pipeline, &latest);
+    components::demo::TapLoopOutputs(pipeline, &latest);
   }
 
   runtime::RunOptions run;
@@ -130,7 +130,7 @@ int Run(const RunCommandOptions& o) {
     // The frame index of the step's images (the sender's, with clock.source).
     const auto frame = static_cast<int64_t>(std::llround(context.time / dt));
     if (scorer->Update(frame, context.time, latest).fixated_now && !o.json) {
-      fmt::print("{}", components::FixationText(scorer->fixations().back(), context.time));
+      fmt::print("{}", components::demo::FixationText(scorer->fixations().back(), context.time));
       std::fflush(stdout);
     }
   };
@@ -153,8 +153,8 @@ int Run(const RunCommandOptions& o) {
                 {"fixations", fixations}};
     if (scorer) {
       json scored = json::array();
-      for (const components::Fixation& f : scorer->fixations()) {
-        scored.push_back(components::FixationJson(f));
+      for (const components::demo::Fixation& f : scorer->fixations()) {
+        scored.push_back(components::demo::FixationJson(f));
       }
       out["faces"] = scorer->faces_total();
       out["faces_fixated"] = scorer->faces_fixated();

@@ -1,12 +1,12 @@
-#include "saccade/components/demo_report.h"
+#include "saccade/components/demo/summary.h"
 
 #include <fmt/format.h>
 
 #include <algorithm>
 
-#include "saccade/components/loop_outputs.h"
+#include "saccade/components/demo/loop_outputs.h"
 
-namespace saccade::components {
+namespace saccade::components::demo {
 
 using nlohmann::json;
 
@@ -218,4 +218,4 @@ std::string FixationText(const Fixation& f, double t) {
   return fmt::format("t = {:6.2f} s  fixated {} (not a face)  took {:.2f} s\n", t, f.object, took);
 }
 
-}  // namespace saccade::components
+}  // namespace saccade::components::demo

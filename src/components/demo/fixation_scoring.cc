@@ -1,4 +1,4 @@
-#include "saccade/components/fixation_scoring.h"
+#include "saccade/components/demo/fixation_scoring.h"
 
 #include <fmt/format.h>
 
@@ -8,7 +8,7 @@
 #include "saccade/geometry/json.h"
 #include "saccade/vision/image_camera.h"
 
-namespace saccade::components {
+namespace saccade::components::demo {
 namespace {
 
 using nlohmann::json;
@@ -214,4 +214,4 @@ json FixationScorer::DecoysJson() const {
   return decoys;
 }
 
-}  // namespace saccade::components
+}  // namespace saccade::components::demo

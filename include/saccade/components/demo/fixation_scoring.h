@@ -13,11 +13,11 @@
 #include <string>
 #include <vector>
 
-#include "saccade/components/face_truth.h"
-#include "saccade/components/loop_outputs.h"
+#include "saccade/components/demo/face_truth.h"
+#include "saccade/components/demo/loop_outputs.h"
 #include "saccade/scene/scene.h"
 
-namespace saccade::components {
+namespace saccade::components::demo {
 
 /// One target attention selected, and how the head fixated it.
 struct Fixation {
@@ -75,4 +75,4 @@ class FixationScorer {
   std::map<std::string, std::map<std::string, int>> decoy_rejections_;  // picture, reason
 };
 
-}  // namespace saccade::components
+}  // namespace saccade::components::demo

@@ -9,14 +9,14 @@
 #include <string>
 #include <vector>
 
-#include "saccade/components/fixation_scoring.h"
+#include "saccade/components/demo/fixation_scoring.h"
 #include "saccade/components/messages.h"
 #include "saccade/components/roles.h"
 #include "saccade/core/streaming_stats.h"
 #include "saccade/runtime/pipeline.h"
 #include "saccade/runtime/scheduler.h"
 
-namespace saccade::components {
+namespace saccade::components::demo {
 
 /// The loop's latency, per step: from the end of the eye cameras' capture (its images
 /// delivered) to the end of the component that commands the head (the source of the head's
@@ -89,4 +89,4 @@ struct DemoReport {
 /// The line printed when a fixation arrives at time `t`.
 std::string FixationText(const Fixation& f, double t);
 
-}  // namespace saccade::components
+}  // namespace saccade::components::demo
