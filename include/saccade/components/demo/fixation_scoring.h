@@ -67,6 +67,14 @@ class FixationScorer {
   nlohmann::json DecoysJson() const;
 
  private:
+  /// Rejected detections on a decoy picture (the cat) in this step's images, by reason.
+  void CountDecoyRejections(int64_t step, const Latest& latest);
+  /// The fixation arrives: its target, distance and object, and its errors against the truth.
+  void Arrive(Fixation& f, double time, const Latest& latest, const Image& left,
+              const Image& right) const;
+  /// One step of the dwell: each eye's angular error from the true face centre.
+  void AddDwellSample(Fixation& f, double time, const Image& left, const Image& right) const;
+
   const scene::Scene& scene_;
   bool truth_;
   std::vector<PictureFace> pictures_;
