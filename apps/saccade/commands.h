@@ -5,6 +5,7 @@
 
 #include <CLI/CLI.hpp>
 #include <functional>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
 #include <vector>
@@ -47,6 +48,8 @@ struct DdsOverrides {
   bool wall_stamps = false;  // --wall-stamps: transport.stamps wall
 };
 void AddDdsOptions(CLI::App* command, DdsOverrides& o);
+/// The entries of the pipeline's `transport:` map that the options replace.
+nlohmann::json DdsTransport(const DdsOverrides& o);
 void ApplyDdsOverrides(const DdsOverrides& o, runtime::PipelineSpec& spec);
 
 }  // namespace saccade::app

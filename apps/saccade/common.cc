@@ -39,16 +39,22 @@ void AddDdsOptions(CLI::App* command, DdsOverrides& o) {
                     "seconds from 0; transport.stamps: wall)");
 }
 
-void ApplyDdsOverrides(const DdsOverrides& o, runtime::PipelineSpec& spec) {
-  if (o.domain) spec.transport["domain"] = *o.domain;
-  if (!o.ns.empty()) spec.transport["namespace"] = o.ns;
-  if (!o.config.empty()) spec.transport["config"] = o.config;
+nlohmann::json DdsTransport(const DdsOverrides& o) {
+  nlohmann::json transport = nlohmann::json::object();
+  if (o.domain) transport["domain"] = *o.domain;
+  if (!o.ns.empty()) transport["namespace"] = o.ns;
+  if (!o.config.empty()) transport["config"] = o.config;
   if (!o.interface.empty()) {
-    spec.transport["interface"] = o.interface;
-    if (o.config.empty()) spec.transport["config"] = "network";
+    transport["interface"] = o.interface;
+    if (o.config.empty()) transport["config"] = "network";
   }
-  if (!o.peers.empty()) spec.transport["peers"] = o.peers;
-  if (o.wall_stamps) spec.transport["stamps"] = "wall";
+  if (!o.peers.empty()) transport["peers"] = o.peers;
+  if (o.wall_stamps) transport["stamps"] = "wall";
+  return transport;
+}
+
+void ApplyDdsOverrides(const DdsOverrides& o, runtime::PipelineSpec& spec) {
+  spec.transport.update(DdsTransport(o));
 }
 
 }  // namespace saccade::app

@@ -1,56 +1,45 @@
-// demo: the active-vision loop (seed section 6) run headless on a scene, with a report of
-// every fixation against the scene's ground truth, the loop's latency and, optionally, a
-// recording of the annotated frames.
+// demo and gui: the command lines of the demo module (components/demo/demo_session.h), the
+// active-vision loop (seed section 6) with a report of every fixation against the scene's
+// ground truth, the loop's latency and, optionally, a recording of the annotated frames. Here
+// only the options, the terminal, the signals and the browser GUI are wired to it.
 
 #include <fmt/format.h>
 
 #include <atomic>
-#include <cmath>
 #include <csignal>
+#include <cstdio>
 #include <filesystem>
 #include <memory>
-#include <optional>
 #include <string>
-#include <vector>
 
 #include "commands.h"
-#include "saccade/components/demo_report.h"
-#include "saccade/components/fixation_scoring.h"
-#include "saccade/components/messages.h"
+#include "saccade/components/demo/demo_session.h"
 #include "saccade/components/register.h"
-#include "saccade/components/roles.h"
-#include "saccade/core/error.h"
 #include "saccade/dds/transport.h"
-#include "saccade/gui/overlay.h"
-#include "saccade/gui/recording.h"
 #include "saccade/gui/session.h"
 #include "saccade/runtime/component_reference.h"
-#include "saccade/runtime/pipeline.h"
-#include "saccade/runtime/scheduler.h"
-#include "saccade/scene/scene.h"
 
 namespace saccade::app {
 namespace {
 
 namespace fs = std::filesystem;
-using components::HeadStatusMessage;
+using components::demo::DemoSession;
+using components::demo::DemoSummary;
 using gui::GuiSession;
-using gui::Recorder;
-using nlohmann::json;
 
 std::atomic<bool> g_stop{false};
 extern "C" void OnDemoInterrupt(int) { g_stop = true; }
 
+/// The demo's defaults: pipelines/demo.yaml.
+components::demo::DemoOptions DefaultDemo() {
+  components::demo::DemoOptions demo;
+  demo.pipeline = ShippedFile("pipelines/demo.yaml");
+  return demo;
+}
+
 struct Options {
-  std::string pipeline = ShippedFile("pipelines/demo.yaml");
-  std::string scene;
-  std::string hardware;
-  double duration = 40.0;
-  std::string record;
-  bool force = false;
+  components::demo::DemoOptions demo = DefaultDemo();
   bool json = false;
-  bool realtime = false;
-  bool keep_going = false;
   bool list = false;
   bool markdown = false;
   bool gui = false;
@@ -59,169 +48,79 @@ struct Options {
   gui::GuiOptions gui_options;
 };
 
-/// One attended target, from its selection to the end of its dwell.
-int RunDemo(Options o) {
-  components::RegisterComponents();
-  if (o.list) {
-    const auto reference = runtime::DescribeComponents(runtime::ComponentRegistry::Global());
-    fmt::print("{}", o.json       ? runtime::ComponentsJson(reference).dump(2) + "\n"
-                     : o.markdown ? runtime::ComponentsMarkdown(reference)
-                                  : runtime::ComponentsText(reference));
-    return 0;
-  }
-  if (!(o.duration > 0.0) || !std::isfinite(o.duration)) {
-    throw InvalidArgument(fmt::format("demo: --duration must be > 0 s, got {}", o.duration));
-  }
-  // Topic connections (pipelines/remote.yaml, or any file with topics) go over DDS.
-  dds::RegisterDdsTransport(runtime::ComponentRegistry::Global());
-  runtime::PipelineSpec spec = runtime::LoadPipelineFile(o.pipeline, o.hardware);
-  if (!o.scene.empty()) runtime::ReplaceScene(spec, o.scene, "--scene");
-  ApplyDdsOverrides(o.dds_overrides, spec);
-  if (o.keep_going) spec.on_error = runtime::OnError::kContinue;
-  const double dt = spec.clock.step;
-  if (o.realtime) {
-    spec.clock.mode = runtime::ClockMode::kRealtime;
-    spec.clock.rate_hz = 1.0 / dt;
-  }
-  runtime::Pipeline pipeline = runtime::Pipeline::Build(spec);
+/// --list-components: the component types, as text, JSON or docs/components.md.
+int ListComponents(const Options& o) {
+  const auto reference = runtime::DescribeComponents(runtime::ComponentRegistry::Global());
+  fmt::print("{}", o.json       ? runtime::ComponentsJson(reference).dump(2) + "\n"
+                   : o.markdown ? runtime::ComponentsMarkdown(reference)
+                                : runtime::ComponentsText(reference));
+  return 0;
+}
 
-  // The robot by its roles (components/roles.h). Simulated cameras give ground truth; real
-  // ones (hw.cameras) give none.
-  std::string cameras_name, head_name;
-  const components::EyeCamerasRole* cameras =
-      pipeline.FindRole<components::EyeCamerasRole>(&cameras_name);
-  if (!cameras) {
-    throw InvalidArgument(
-        "demo: pipeline " + o.pipeline +
-        " has no eye cameras (a sim.cameras, hw.cameras or remote.cameras component)");
-  }
-  pipeline.FindRole<components::HeadRole>(&head_name);
-  components::CaptureToCommand latency(spec, cameras_name, head_name);
-  components::LoopFigures figures(pipeline);
-  const bool truth = cameras->rendered() != nullptr;
-  // Real cameras: the scene only carries the robot; its pictures are not what they see.
-  const scene::Scene& scene = cameras->scene();
-  components::FixationScorer scorer(scene, truth);
-  const int faces_total = scorer.faces_total();
-  if (!truth && !o.json) {
-    for (const runtime::ComponentSpec& c : spec.components) {
-      if (c.name == cameras_name) {
-        fmt::print("real cameras ({}): no ground truth; fixations are reported as triangulated\n",
-                   c.type);
-      }
-    }
-  }
+/// The browser GUI on the session's pipeline (demo --gui, gui).
+std::unique_ptr<GuiSession> ServeGui(Options& o, DemoSession& session) {
+  o.gui_options.web_dir = ShippedFile("web");
+  const std::string scene_name =
+      o.demo.scene.empty() ? fs::path(o.demo.pipeline).filename().string() : o.demo.scene;
+  auto gui =
+      std::make_unique<GuiSession>(session.pipeline(), session.scene(), scene_name, o.gui_options);
+  fmt::print("gui: serving {}  (open it in a browser; Ctrl-C to stop)\n", gui->url());
+  std::fflush(stdout);
+  return gui;
+}
 
-  components::Latest latest;
-  components::TapLoopOutputs(pipeline, &latest);
-  std::optional<HeadStatusMessage> head_status;
-  components::Tap<HeadStatusMessage>(pipeline, [&](const HeadStatusMessage& m) {
-    if (!o.json && m.fault != (head_status ? head_status->fault : "") && !m.fault.empty()) {
-      fmt::print("t = {:6.2f} s  head FAULT: {}\n", m.time, m.fault);
-    }
-    head_status = m;
-  });
-
-  std::unique_ptr<GuiSession> gui;
-  if (o.gui) {
-    o.gui_options.web_dir = ShippedFile("web");
-    gui = std::make_unique<GuiSession>(
-        pipeline, scene, o.scene.empty() ? fs::path(o.pipeline).filename().string() : o.scene,
-        o.gui_options);
-    fmt::print("gui: serving {}  (open it in a browser; Ctrl-C to stop)\n", gui->url());
-    std::fflush(stdout);
-  }
-
-  std::unique_ptr<Recorder> recorder;
-  if (!o.record.empty()) recorder = std::make_unique<Recorder>(o.record, 1.0 / dt, o.force);
-
-  runtime::RunOptions run;
-  // With the GUI the loop runs until Ctrl-C (or SIGTERM).
-  // On the real-time clock --duration is wall seconds: a loop slower than its rate still ends on
-  // time (a step count would run longer).
-  run.steps = o.gui || o.realtime ? 0 : static_cast<int64_t>(std::ceil(o.duration / dt - 1e-9));
-  if (o.realtime && !o.gui) run.seconds = o.duration;
-  run.live = o.gui;  // paced by the page: detection on its own thread, frames pipelined
-  g_stop = false;
-  run.stop = &g_stop;
-  run.on_error = [&](const runtime::StepError& error) {
+/// The demo's loop until it ends or Ctrl-C (or SIGTERM).
+DemoSummary RunUntilDone(DemoSession& session, GuiSession* gui) {
+  components::demo::RunHooks hooks;
+  hooks.on_error = [](const runtime::StepError& error) {
     fmt::print(stderr, "saccade: error: {}\n", error.ToString());
   };
-  // While a step waits for its frames, the GUI takes the commands that came meanwhile.
-  if (gui) run.while_waiting = [&] { gui->WhileWaiting(); };
-  run.step_timing = [&](const runtime::StepContext&, const runtime::StepTiming& timing) {
-    latency.Add(timing);
-  };
-  run.after_step = [&](const runtime::StepContext& context) {
-    const double t = context.time;
-    figures.AfterStep(t, latest);
-    const components::FixationScorer::Step scored = scorer.Update(context.step, t, latest);
-    const bool fixated_now = scored.fixated_now;
-    const std::string& status = scored.status;
-    const std::vector<components::Fixation>& fixations = scorer.fixations();
-
-    if (fixated_now && !o.json) {
-      fmt::print("{}", components::FixationText(fixations.back(), t));
-      std::fflush(stdout);
-    }
-    if (recorder) {
-      const cv::Mat frame = gui::Compose(latest, t, status);
-      recorder->Write(context.step, frame);
-      if (fixated_now) {
-        recorder->WriteFixation(static_cast<int>(fixations.size()), fixations.back().object, frame);
-      }
-    }
-    // Done once every face has been fixated and let go.
-    if (gui) {
-      gui->AfterStep(context, latest, g_stop);
-    } else if (faces_total > 0 && scorer.faces_done() == faces_total) {
-      g_stop = true;
-    }
-  };
-
+  if (gui != nullptr) {
+    hooks.while_waiting = [gui] { gui->WhileWaiting(); };
+    hooks.after_step =
+        [gui](const runtime::StepContext& context, const components::demo::Latest& latest,
+              const std::atomic<bool>& stop) { gui->AfterStep(context, latest, stop); };
+  }
+  g_stop = false;
   auto previous_int = std::signal(SIGINT, OnDemoInterrupt);
   auto previous_term = std::signal(SIGTERM, OnDemoInterrupt);
-  const runtime::RunSummary summary = runtime::RunPipeline(pipeline, run);
+  DemoSummary summary = session.Run(g_stop, hooks);
   std::signal(SIGINT, previous_int);
   std::signal(SIGTERM, previous_term);
+  return summary;
+}
 
-  // Nothing ran (a device that would not open, a component that failed to start): the
-  // error, printed above, is the whole story for people (the JSON and summary.json keep it).
-  const bool nothing_ran = summary.steps == 0 && !summary.errors.empty();
-
-  // ---- the report ----
-  components::DemoReport report;
-  report.pipeline = o.pipeline;
-  report.scene = o.scene;
-  report.hardware_file = spec.hardware_file;
-  report.dt = dt;
-  report.summary = summary;
-  report.scorer = &scorer;
-  report.truth = truth;
-  report.capture_to_command_ms = latency.milliseconds();
-  report.detection_age_ms = figures.detection_age_ms();
-  report.exposure_samples = figures.exposure_samples();
-  report.pair_counts = cameras->pair_counts();
-  if (report.pair_counts) report.cameras_description = cameras->Describe();
-  report.head = head_status;
-  report.interrupted = g_stop.load() && scorer.faces_fixated() < faces_total;
-  report.realtime = o.realtime;
-  json report_json = report.Json();
-  if (recorder) {
-    report_json["record"] = {{"folder", o.record},
-                             {"frames", recorder->frames()},
-                             {"video", (fs::path(o.record) / "demo.avi").string()}};
-    recorder->WriteSummary(report_json);
-    recorder.reset();  // closes the video
+/// `demo` and `gui`: the demo module (components/demo/demo_session.h) wired to the terminal,
+/// the signals and, with --gui, the browser GUI.
+int RunDemo(Options o) {
+  components::RegisterComponents();
+  if (o.list) return ListComponents(o);
+  // Topic connections (pipelines/remote.yaml, or any file with topics) go over DDS.
+  dds::RegisterDdsTransport(runtime::ComponentRegistry::Global());
+  o.demo.transport = DdsTransport(o.dds_overrides);
+  o.demo.live = o.gui;
+  DemoSession::Progress progress;
+  if (!o.json) {
+    progress = [](const std::string& line) {
+      fmt::print("{}", line);
+      std::fflush(stdout);
+    };
   }
+  DemoSession session(o.demo, progress);
+  std::unique_ptr<GuiSession> gui;
+  if (o.gui) gui = ServeGui(o, session);
+  const DemoSummary summary = RunUntilDone(session, gui.get());
+
   if (o.json) {
-    fmt::print("{}\n", report_json.dump(2));
-  } else if (!nothing_ran) {
-    fmt::print("{}", report.Text(o.record));
+    fmt::print("{}\n", summary.Json().dump(2));
+  } else if (!summary.nothing_ran()) {
+    // Nothing ran: the error, printed above, is the whole story for people (the JSON and
+    // summary.json keep it).
+    fmt::print("{}", summary.FullReport());
   }
   if (gui) fmt::print("{}\n", gui->Describe());
-  if (!summary.errors.empty() && summary.stopped_on_error) return 1;
-  if (scorer.faces_fixated() == 0 && !o.gui) {
+  if (!summary.run.errors.empty() && summary.run.stopped_on_error) return 1;
+  if (summary.faces_fixated == 0 && !o.gui) {
     fmt::print(stderr, "saccade: demo: no face was fixated\n");
     return 3;
   }
@@ -272,13 +171,14 @@ Runner AddGuiCommand(CLI::App& app) {
       "perception loop, pause, step and change the speed. Prints the page's address and runs "
       "until Ctrl-C. The protocol (also for scripts): docs/gui-protocol.md. Perception starts "
       "off; `saccade demo --gui` starts with it on.");
-  gui->add_option("--scene", o->scene, "Scene YAML (default: the demo's, scenes/portraits.yaml)")
+  gui->add_option("--scene", o->demo.scene,
+                  "Scene YAML (default: the demo's, scenes/portraits.yaml)")
       ->check(CLI::ExistingFile);
-  gui->add_option("--pipeline", o->pipeline, "Pipeline YAML (default: the demo's)")
+  gui->add_option("--pipeline", o->demo.pipeline, "Pipeline YAML (default: the demo's)")
       ->check(CLI::ExistingFile)
       ->capture_default_str();
   auto* pipeline_option = gui->get_option("--pipeline");
-  gui->add_option("--hardware", o->hardware,
+  gui->add_option("--hardware", o->demo.hardware,
                   "Hardware file (pipelines/hardware/): the GUI drives the real head too")
       ->check(CLI::ExistingFile);
   gui->add_flag("--dds", o->dds,
@@ -291,7 +191,7 @@ Runner AddGuiCommand(CLI::App& app) {
   AddGuiOptions(gui, *o);
   return [o, pipeline_option] {
     if (o->dds && pipeline_option->count() == 0) {
-      o->pipeline = ShippedFile("pipelines/remote.yaml");
+      o->demo.pipeline = ShippedFile("pipelines/remote.yaml");
     }
     return RunDemo(*o);
   };
@@ -308,31 +208,31 @@ Runner AddDemoCommand(CLI::App& app) {
       "each eye's angular error as it began and the time it took; at the end each eye's "
       "largest error over each fixation, then the latency of every stage. "
       "Exit status: 0 when at least one face was fixated, 3 when none was, 1 on an error.");
-  demo->add_option("--pipeline", o->pipeline, "Pipeline YAML (components and connections)")
+  demo->add_option("--pipeline", o->demo.pipeline, "Pipeline YAML (components and connections)")
       ->check(CLI::ExistingFile)
       ->capture_default_str();
-  demo->add_option("--scene", o->scene,
+  demo->add_option("--scene", o->demo.scene,
                    "Scene YAML; replaces every component's `scene` parameter (default: the "
                    "pipeline's, scenes/portraits.yaml; scenes/portraits_moving.yaml shows "
                    "smooth pursuit)")
       ->check(CLI::ExistingFile);
-  demo->add_option("--hardware", o->hardware,
+  demo->add_option("--hardware", o->demo.hardware,
                    "Hardware file: which robot runs the loop, replacing the pipeline's "
                    "`hardware:` line (pipelines/hardware/: simulator.yaml, "
                    "recorded_cameras.yaml, emulated_servos.yaml, mirror.yaml, robot.yaml)")
       ->check(CLI::ExistingFile);
-  demo->add_option("--duration", o->duration,
+  demo->add_option("--duration", o->demo.duration,
                    "Longest run, in seconds of the loop's clock (simulated; wall seconds with "
                    "--realtime); it ends sooner once every face was fixated")
       ->capture_default_str();
-  demo->add_option("--record", o->record,
+  demo->add_option("--record", o->demo.record,
                    "Folder for the annotated frames (frames/*.jpg), a video (demo.avi, MJPEG), "
                    "a PNG per fixation and summary.json");
-  demo->add_flag("--force", o->force, "Replace an earlier recording in the --record folder");
+  demo->add_flag("--force", o->demo.force, "Replace an earlier recording in the --record folder");
   demo->add_flag("--json", o->json, "Print the report as JSON (the same as summary.json)");
-  demo->add_flag("--realtime", o->realtime,
+  demo->add_flag("--realtime", o->demo.realtime,
                  "Run on the wall clock at the pipeline's rate instead of simulated time");
-  demo->add_flag("--keep-going", o->keep_going,
+  demo->add_flag("--keep-going", o->demo.keep_going,
                  "Continue after a component fails (the pipeline's on_error: continue)");
   demo->add_flag("--list-components", o->list,
                  "List the component types a pipeline can use: ports, methods and parameters "

@@ -14,9 +14,9 @@
 #include <vector>
 
 #include "commands.h"
-#include "saccade/components/demo_report.h"
-#include "saccade/components/fixation_scoring.h"
-#include "saccade/components/loop_outputs.h"
+#include "saccade/components/demo/fixation_scoring.h"
+#include "saccade/components/demo/loop_outputs.h"
+#include "saccade/components/demo/summary.h"
 #include "saccade/components/messages.h"
 #include "saccade/components/register.h"
 #include "saccade/core/error.h"
@@ -45,6 +45,95 @@ struct RunCommandOptions {
   DdsOverrides dds;  // the pipeline's `transport:` map, overridden
 };
 
+/// The head's state as the pipeline's components emit it, to --joints-csv (when given) and as
+/// fixations: a fixation is the head coming to rest after a move (JointStateMessage::arrived
+/// turning true). `csv` and `fixations` must outlive the pipeline's run.
+void LogJoints(runtime::Pipeline& pipeline, const RunCommandOptions& o, std::ofstream* csv,
+               json* fixations) {
+  auto was_arrived = std::make_shared<bool>(true);
+  components::demo::Tap<components::JointStateMessage>(
+      pipeline, [=, &o](const components::JointStateMessage& m) {
+        if (csv) {
+          *csv << fmt::format("{:.6f},{:.17g},{:.17g},{:.17g},{:.17g},{}\n", m.time,
+                              m.positions.pan, m.positions.tilt, m.positions.left,
+                              m.positions.right, m.arrived ? 1 : 0);
+        }
+        if (m.arrived && !*was_arrived) {
+          fixations->push_back({{"time", m.time},
+                                {"pan", m.positions.pan},
+                                {"tilt", m.positions.tilt},
+                                {"left", m.positions.left},
+                                {"right", m.positions.right}});
+          if (!o.json) {
+            fmt::print(
+                "t = {:6.2f} s  fixation: pan {:+.4f} tilt {:+.4f} left {:+.4f} right "
+                "{:+.4f} rad\n",
+                m.time, m.positions.pan, m.positions.tilt, m.positions.left, m.positions.right);
+            std::fflush(stdout);
+          }
+        }
+        *was_arrived = m.arrived;
+      });
+}
+
+/// --score: the fixations attention selected, against the scene's ground truth, as `saccade
+/// demo` scores them, from what this process sees (its images, selection, target, joints):
+/// perception.yaml's half of a simulated robot scores the split loop. Taps the loop's outputs
+/// into `latest`.
+std::unique_ptr<components::demo::FixationScorer> MakeScorer(runtime::Pipeline& pipeline,
+                                                             const RunCommandOptions& o,
+                                                             components::demo::Latest* latest) {
+  std::shared_ptr<const scene::Scene> scene = pipeline.resources().Default<scene::Scene>("scene");
+  if (!scene) {
+    throw InvalidArgument("run: --score needs the pipeline's scene (`scene:` in " + o.pipeline +
+                          "): the ground truth comes from it");
+  }
+  bool selects = false;
+  for (const auto& component : pipeline.components()) {
+    for (const auto& output : component->outputs()) {
+      selects =
+          selects || output->message_type() == runtime::MessageName<components::SelectionMessage>();
+    }
+  }
+  if (!selects) {
+    throw InvalidArgument("run: --score: " + o.pipeline +
+                          " selects no targets (no vision.attention): there are no fixations "
+                          "to score in this process");
+  }
+  auto scorer = std::make_unique<components::demo::FixationScorer>(*scene, /*truth=*/true);
+  if (scorer->faces_total() == 0) {
+    throw InvalidArgument("run: --score: the scene has no pictures of faces to score against");
+  }
+  components::demo::TapLoopOutputs(pipeline, latest);
+  return scorer;
+}
+
+/// The result: JSON, or the scored faces and the run's brief report.
+void PrintResult(const RunCommandOptions& o, const runtime::RunSummary& summary,
+                 const json& fixations, const components::demo::FixationScorer* scorer) {
+  if (o.json) {
+    json out = {{"pipeline", o.pipeline},
+                {"steps", summary.steps},
+                {"errors", summary.errors_total},
+                {"fixations", fixations}};
+    if (scorer) {
+      json scored = json::array();
+      for (const components::demo::Fixation& f : scorer->fixations()) {
+        scored.push_back(components::demo::FixationJson(f));
+      }
+      out["faces"] = scorer->faces_total();
+      out["faces_fixated"] = scorer->faces_fixated();
+      out["scored"] = scored;
+    }
+    fmt::print("{}\n", out.dump(2));
+    return;
+  }
+  if (scorer) {
+    fmt::print("{} of {} faces fixated\n", scorer->faces_fixated(), scorer->faces_total());
+  }
+  fmt::print("{}: {}\n", o.pipeline, summary.BriefReport());
+}
+
 int Run(const RunCommandOptions& o) {
   components::RegisterComponents();
   dds::RegisterDdsTransport(runtime::ComponentRegistry::Global());
@@ -58,8 +147,6 @@ int Run(const RunCommandOptions& o) {
   ApplyDdsOverrides(o.dds, spec);
   runtime::Pipeline pipeline = runtime::Pipeline::Build(spec);
 
-  // The head's state as the pipeline's components emit it: a fixation is the head coming to
-  // rest after a move (JointStateMessage::arrived turning true).
   std::unique_ptr<std::ofstream> csv;
   if (!o.joints_csv.empty()) {
     csv = std::make_unique<std::ofstream>(o.joints_csv);
@@ -67,60 +154,10 @@ int Run(const RunCommandOptions& o) {
     *csv << "time,pan,tilt,left,right,arrived\n";
   }
   json fixations = json::array();
-  bool was_arrived = true;
-  components::Tap<components::JointStateMessage>(
-      pipeline, [&](const components::JointStateMessage& m) {
-        if (csv) {
-          *csv << fmt::format("{:.6f},{:.17g},{:.17g},{:.17g},{:.17g},{}\n", m.time,
-                              m.positions.pan, m.positions.tilt, m.positions.left,
-                              m.positions.right, m.arrived ? 1 : 0);
-        }
-        if (m.arrived && !was_arrived) {
-          fixations.push_back({{"time", m.time},
-                               {"pan", m.positions.pan},
-                               {"tilt", m.positions.tilt},
-                               {"left", m.positions.left},
-                               {"right", m.positions.right}});
-          if (!o.json) {
-            fmt::print(
-                "t = {:6.2f} s  fixation: pan {:+.4f} tilt {:+.4f} left {:+.4f} right "
-                "{:+.4f} rad\n",
-                m.time, m.positions.pan, m.positions.tilt, m.positions.left, m.positions.right);
-            std::fflush(stdout);
-          }
-        }
-        was_arrived = m.arrived;
-      });
-
-  // --score: the fixations attention selected, against the scene's ground truth, as `saccade
-  // demo` scores them, from what this process sees (its images, selection, target, joints):
-  // perception.yaml's half of a simulated robot scores the split loop.
-  std::unique_ptr<components::FixationScorer> scorer;
-  components::Latest latest;
-  if (o.score) {
-    std::shared_ptr<const scene::Scene> scene = pipeline.resources().Default<scene::Scene>("scene");
-    if (!scene) {
-      throw InvalidArgument("run: --score needs the pipeline's scene (`scene:` in " + o.pipeline +
-                            "): the ground truth comes from it");
-    }
-    bool selects = false;
-    for (const auto& component : pipeline.components()) {
-      for (const auto& output : component->outputs()) {
-        selects = selects ||
-                  output->message_type() == runtime::MessageName<components::SelectionMessage>();
-      }
-    }
-    if (!selects) {
-      throw InvalidArgument("run: --score: " + o.pipeline +
-                            " selects no targets (no vision.attention): there are no fixations "
-                            "to score in this process");
-    }
-    scorer = std::make_unique<components::FixationScorer>(*scene, /*truth=*/true);
-    if (scorer->faces_total() == 0) {
-      throw InvalidArgument("run: --score: the scene has no pictures of faces to score against");
-    }
-    components::TapLoopOutputs(pipeline, &latest);
-  }
+  LogJoints(pipeline, o, csv.get(), &fixations);
+  components::demo::Latest latest;
+  std::unique_ptr<components::demo::FixationScorer> scorer;
+  if (o.score) scorer = MakeScorer(pipeline, o, &latest);
 
   runtime::RunOptions run;
   run.steps = o.steps;
@@ -130,7 +167,7 @@ int Run(const RunCommandOptions& o) {
     // The frame index of the step's images (the sender's, with clock.source).
     const auto frame = static_cast<int64_t>(std::llround(context.time / dt));
     if (scorer->Update(frame, context.time, latest).fixated_now && !o.json) {
-      fmt::print("{}", components::FixationText(scorer->fixations().back(), context.time));
+      fmt::print("{}", components::demo::FixationText(scorer->fixations().back(), context.time));
       std::fflush(stdout);
     }
   };
@@ -146,27 +183,7 @@ int Run(const RunCommandOptions& o) {
   std::signal(SIGINT, previous_int);
   std::signal(SIGTERM, previous_term);
   if (csv) csv->flush();
-  if (o.json) {
-    json out = {{"pipeline", o.pipeline},
-                {"steps", summary.steps},
-                {"errors", summary.errors_total},
-                {"fixations", fixations}};
-    if (scorer) {
-      json scored = json::array();
-      for (const components::Fixation& f : scorer->fixations()) {
-        scored.push_back(components::FixationJson(f));
-      }
-      out["faces"] = scorer->faces_total();
-      out["faces_fixated"] = scorer->faces_fixated();
-      out["scored"] = scored;
-    }
-    fmt::print("{}\n", out.dump(2));
-  } else {
-    if (scorer) {
-      fmt::print("{} of {} faces fixated\n", scorer->faces_fixated(), scorer->faces_total());
-    }
-    fmt::print("{}: {}\n", o.pipeline, summary.BriefReport());
-  }
+  PrintResult(o, summary, fixations, scorer.get());
   // Stops the components (the DDS readers report what crossed) before exiting.
   return !summary.errors.empty() && summary.stopped_on_error ? 1 : 0;
 }

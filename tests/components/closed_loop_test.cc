@@ -1,6 +1,6 @@
 // The closed loop of pipelines/demo.yaml: rendered eyes -> faces -> stereo -> attention ->
 // CamShift -> triangulation -> inverse kinematics -> motors -> rendered eyes. Measured against
-// the scenes' ground truth (face_truth.h).
+// the scenes' ground truth (components/demo/face_truth.h).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-#include "saccade/components/face_truth.h"
+#include "saccade/components/demo/face_truth.h"
 #include "saccade/components/messages.h"
 #include "saccade/components/register.h"
 #include "saccade/runtime/pipeline.h"
@@ -21,6 +21,10 @@
 
 namespace saccade::components {
 namespace {
+
+using demo::FaceCentreAt;
+using demo::FindPictureFaces;
+using demo::PictureFace;
 
 const std::string kSource = SACCADE_SOURCE_DIR;
 

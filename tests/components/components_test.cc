@@ -15,7 +15,7 @@
 #include <thread>
 
 #include "image_camera_helpers.h"
-#include "saccade/components/face_truth.h"
+#include "saccade/components/demo/face_truth.h"
 #include "saccade/components/messages.h"
 #include "saccade/components/register.h"
 #include "saccade/core/error.h"
@@ -30,6 +30,9 @@
 namespace saccade::components {
 namespace {
 
+using demo::FaceCentreAt;
+using demo::FindPictureFaces;
+using demo::PictureFace;
 using nlohmann::json;
 using runtime::Component;
 
@@ -96,18 +99,6 @@ PictureFace Astronaut() {
   }
   ADD_FAILURE() << "no face in " << kScene;
   return {};
-}
-
-TEST(FacePictures, OnlyTheAstronautHasAFaceTheCatIsADecoy) {
-  const auto pictures = FindPictureFaces(Scene());
-  ASSERT_EQ(pictures.size(), 2u);
-  EXPECT_EQ(pictures[0].name, "astronaut");
-  EXPECT_TRUE(pictures[0].has_face);
-  EXPECT_EQ(pictures[1].name, "chelsea");
-  EXPECT_FALSE(pictures[1].has_face);
-  // A human face on a 0.8 m portrait, as the cascade boxes it.
-  EXPECT_GT(pictures[0].width_m, 0.08);
-  EXPECT_LT(pictures[0].width_m, 0.25);
 }
 
 // The head fixates a point beside the face: the face is detected in both eyes, the cat's

@@ -14,7 +14,7 @@
 #include <vector>
 
 #include "image_camera_helpers.h"
-#include "saccade/components/face_truth.h"
+#include "saccade/components/demo/face_truth.h"
 #include "saccade/components/messages.h"
 #include "saccade/components/register.h"
 #include "saccade/core/error.h"
@@ -31,6 +31,9 @@ namespace saccade::components {
 namespace {
 
 namespace fs = std::filesystem;
+using demo::FaceCentreAt;
+using demo::FindPictureFaces;
+using demo::PictureFace;
 using nlohmann::json;
 
 const std::string kSource = SACCADE_SOURCE_DIR;

@@ -9,7 +9,7 @@
 #include <thread>
 
 #include "dds_test_util.h"
-#include "saccade/components/loop_outputs.h"
+#include "saccade/components/demo/loop_outputs.h"
 #include "saccade/components/messages.h"
 #include "saccade/components/register.h"
 #include "saccade/dds/transport.h"
@@ -76,7 +76,7 @@ TEST_F(PipelineTopics, PlainPublisherOfJointStateCommandsMovesTheHead) {
   ASSERT_EQ(dds_write(writer.get(), &command), DDS_RETCODE_OK);
 
   std::optional<components::JointStateMessage> last;
-  components::Tap<components::JointStateMessage>(
+  components::demo::Tap<components::JointStateMessage>(
       pipeline, [&](const components::JointStateMessage& m) { last = m; });
   const runtime::RunSummary summary = runtime::RunPipeline(pipeline);
   ASSERT_EQ(summary.errors_total, 0);
@@ -126,7 +126,7 @@ TEST_F(PipelineTopics, ClockSourceStepsOnTheReceivedStamps) {
   Send(1, 0);
   std::vector<double> times;
   std::vector<double> targets;  // the head's pan target after each step
-  components::Tap<components::JointStateMessage>(
+  components::demo::Tap<components::JointStateMessage>(
       pipeline, [&](const components::JointStateMessage& m) { targets.push_back(m.targets.pan); });
   runtime::RunOptions options;
   options.after_step = [&](const runtime::StepContext& context) {

@@ -23,8 +23,8 @@
 #include <thread>
 #include <vector>
 
+#include "saccade/components/demo/overlay.h"
 #include "saccade/components/roles.h"
-#include "saccade/gui/overlay.h"
 #include "saccade/render/renderer.h"
 #include "saccade/runtime/pipeline.h"
 #include "saccade/runtime/run_control.h"
@@ -32,6 +32,12 @@
 #include "saccade/server/gui_server.h"
 
 namespace saccade::gui {
+
+// What the loop said in a step, and its annotated eye views: the demo module's (components/demo/).
+using components::JointStateMessage;
+using components::demo::Annotate;
+using components::demo::Latest;
+using components::demo::Tap;
 
 struct GuiOptions {
   std::string listen = "127.0.0.1";

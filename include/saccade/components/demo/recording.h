@@ -11,9 +11,9 @@
 #include <opencv2/videoio.hpp>
 #include <string>
 
-#include "saccade/gui/overlay.h"
+#include "saccade/components/demo/overlay.h"
 
-namespace saccade::gui {
+namespace saccade::components::demo {
 
 /// Both eyes' annotated views at half size, side by side, under "t = 1.23 s   <status>".
 cv::Mat Compose(const Latest& latest, double time, const std::string& status);
@@ -38,4 +38,4 @@ class Recorder {
   int64_t frames_ = 0;
 };
 
-}  // namespace saccade::gui
+}  // namespace saccade::components::demo

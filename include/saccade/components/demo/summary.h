@@ -1,5 +1,5 @@
 #pragma once
-// The report of `saccade demo`: what the loop fixated, against the scene's ground truth, and
+// The summary of `saccade demo`: what the loop fixated, against the scene's ground truth, and
 // how fast it ran (steps per second, the real-time factor, the latency of every stage and
 // from capture to motor command). JSON for scripts and summary.json (docs/demo.md), text
 // for people.
@@ -9,14 +9,14 @@
 #include <string>
 #include <vector>
 
-#include "saccade/components/fixation_scoring.h"
+#include "saccade/components/demo/fixation_scoring.h"
 #include "saccade/components/messages.h"
 #include "saccade/components/roles.h"
 #include "saccade/core/streaming_stats.h"
 #include "saccade/runtime/pipeline.h"
 #include "saccade/runtime/scheduler.h"
 
-namespace saccade::components {
+namespace saccade::components::demo {
 
 /// The loop's latency, per step: from the end of the eye cameras' capture (its images
 /// delivered) to the end of the component that commands the head (the source of the head's
@@ -59,13 +59,18 @@ class LoopFigures {
   std::map<std::string, int64_t> last_frame_;  // per camera, the frame counted last
 };
 
-struct DemoReport {
-  std::string pipeline;       ///< the pipeline file
-  std::string scene;          ///< --scene; empty: the pipeline's
-  std::string hardware_file;  ///< empty: the pipeline's robot (simulated)
-  double dt = 0.0;            ///< s, the clock's step
-  runtime::RunSummary summary;
-  const FixationScorer* scorer = nullptr;
+/// What a demo run did (DemoSession::Run): every fixation against the scene's ground truth, the
+/// decoys, the speed and latency of the loop, the head's last status and the recording.
+struct DemoSummary {
+  std::string pipeline;             ///< the pipeline file
+  std::string scene;                ///< --scene; empty: the pipeline's
+  std::string hardware_file;        ///< empty: the pipeline's robot (simulated)
+  double dt = 0.0;                  ///< s, the clock's step
+  runtime::RunSummary run;          ///< the scheduler's: steps, errors, every stage's timing
+  std::vector<Fixation> fixations;  ///< in the order attention selected them
+  int faces_total = 0;              ///< faces in the scene's pictures (0 without ground truth)
+  int faces_fixated = 0;            ///< different faces fixated
+  nlohmann::json decoys = nlohmann::json::array();  ///< FixationScorer::DecoysJson
   bool truth = false;                       ///< rendered cameras: fixations scored against truth
   StreamingStats capture_to_command_ms;     ///< per step, from the cameras to the head command
   StreamingStats detection_age_ms;          ///< LoopFigures
@@ -75,18 +80,27 @@ struct DemoReport {
   std::optional<HeadStatusMessage> head;        ///< the head's last status
   bool interrupted = false;                     ///< stopped before every face was fixated
   bool realtime = false;                        ///< on the real-time clock (overruns count)
+  std::string record;           ///< the recording's folder (recording.h); empty: none
+  int64_t recorded_frames = 0;  ///< frames written to it
 
-  double sim_time() const { return summary.sim_time + dt; }
+  double sim_time() const { return run.sim_time + dt; }
   double steps_per_second() const;
   /// Simulated seconds per wall second: 1 is as fast as the cameras deliver.
   double real_time_factor() const;
+  /// Nothing ran (a device that would not open, a component that failed to start): the
+  /// errors are the whole story.
+  bool nothing_ran() const { return run.steps == 0 && !run.errors.empty(); }
 
+  /// Its JSON form: `saccade demo --json` and the recording's summary.json (docs/demo.md).
   nlohmann::json Json() const;
-  /// The summary after the run; `record`: the recording's folder (empty: none).
-  std::string Text(const std::string& record) const;
+  /// One line: the faces fixated, in how much of the loop's time, steps and wall time.
+  std::string BriefReport() const;
+  /// The report after the run: the brief line, speed, each fixation's error over its dwell,
+  /// the cameras, the head, the decoys, the latency of every stage and the recording.
+  std::string FullReport() const;
 };
 
 /// The line printed when a fixation arrives at time `t`.
 std::string FixationText(const Fixation& f, double t);
 
-}  // namespace saccade::components
+}  // namespace saccade::components::demo

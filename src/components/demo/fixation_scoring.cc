@@ -1,4 +1,4 @@
-#include "saccade/components/fixation_scoring.h"
+#include "saccade/components/demo/fixation_scoring.h"
 
 #include <fmt/format.h>
 
@@ -8,7 +8,7 @@
 #include "saccade/geometry/json.h"
 #include "saccade/vision/image_camera.h"
 
-namespace saccade::components {
+namespace saccade::components::demo {
 namespace {
 
 using nlohmann::json;
@@ -60,8 +60,7 @@ FixationScorer::FixationScorer(const scene::Scene& scene, bool truth)
   for (const PictureFace& p : pictures_) faces_total_ += p.has_face ? 1 : 0;
 }
 
-FixationScorer::Step FixationScorer::Update(int64_t step, double time, const Latest& latest) {
-  // Rejected detections on a decoy picture (the cat), by reason.
+void FixationScorer::CountDecoyRejections(int64_t step, const Latest& latest) {
   for (const auto& [camera, faces] : latest.faces) {
     if (!faces.image || faces.image->metadata().frame_index != step) continue;
     for (const FacesMessage::Face& face : faces.faces) {
@@ -77,12 +76,70 @@ FixationScorer::Step FixationScorer::Update(int64_t step, double time, const Lat
       }
     }
   }
+}
+
+void FixationScorer::Arrive(Fixation& f, double time, const Latest& latest, const Image& left,
+                            const Image& right) const {
+  f.fixated_at = time;
+  f.p_W = latest.target && latest.target->valid ? latest.target->p_W : latest.selection->p_W;
+  f.source = latest.target ? latest.target->source : "selection";
+  f.distance_m = (f.p_W - 0.5 * (vision::CameraPoseOf(left).translation() +
+                                 vision::CameraPoseOf(right).translation()))
+                     .norm();
+  // Identify the object: the nearest face centre (or decoy picture) to the target.
+  double best = 0.35;
+  for (const PictureFace& p : pictures_) {
+    scene::SceneState state = scene_.InitialState();
+    state.time = time;
+    const Eigen::Vector3d ref =
+        p.has_face ? FaceCentreAt(scene_, p, time)
+                   : scene_.ObjectPose(scene_.objects()[p.object], state).translation();
+    const double d = (ref - f.p_W).norm();
+    if (d < best) {
+      best = d;
+      f.object = p.name;
+      f.is_face = p.has_face;
+      f.truth_W = ref;
+    }
+  }
+  if (!truth_) {
+    // Real cameras: every target attention picks is a face the detectors found.
+    f.object = fmt::format("face {}", f.target_id);
+    f.is_face = true;
+  }
+  f.has_truth = truth_ && f.is_face;
+  if (f.has_truth) {
+    f.error_3d_m = (f.p_W - f.truth_W).norm();
+    f.left_error_deg = AxisErrorDeg(left, f.truth_W);
+    f.right_error_deg = AxisErrorDeg(right, f.truth_W);
+  }
+}
+
+void FixationScorer::AddDwellSample(Fixation& f, double time, const Image& left,
+                                    const Image& right) const {
+  // Pursuit: how well the eyes stay on the (possibly moving) true face centre.
+  const PictureFace* p = nullptr;
+  for (const PictureFace& q : pictures_) {
+    if (q.name == f.object) p = &q;
+  }
+  const Eigen::Vector3d truth = FaceCentreAt(scene_, *p, time);
+  const double e[2] = {AxisErrorDeg(left, truth), AxisErrorDeg(right, truth)};
+  for (int k = 0; k < 2; ++k) {
+    f.dwell_sum_deg[k] += e[k];
+    f.dwell_max_deg[k] = std::max(f.dwell_max_deg[k], e[k]);
+  }
+  ++f.dwell_samples;
+}
+
+FixationScorer::Step FixationScorer::Update(int64_t step, double time, const Latest& latest) {
+  CountDecoyRejections(step, latest);
 
   Step out;
   out.status = "looking for faces";
   const SelectionMessage* sel = latest.selection ? &*latest.selection : nullptr;
+  if (sel == nullptr) return out;
 
-  if (sel != nullptr && sel->valid && !sel->exploring) {
+  if (sel->valid && !sel->exploring) {
     if (fixations_.empty() || fixations_.back().target_id != sel->target_id) {
       Fixation f;
       f.target_id = sel->target_id;
@@ -93,78 +150,24 @@ FixationScorer::Step FixationScorer::Update(int64_t step, double time, const Lat
     out.status = fmt::format("target {}: {}", f.target_id, sel->fixating ? "fixating" : "saccade");
     const auto left = latest.images.find("left");
     const auto right = latest.images.find("right");
-    const bool eyes = left != latest.images.end() && right != latest.images.end();
-    if (sel->fixating && eyes) {
+    if (sel->fixating && left != latest.images.end() && right != latest.images.end()) {
       if (!f.fixated_at) {
-        // Identify the object: the nearest face centre (or decoy picture) to the target.
-        f.fixated_at = time;
-        f.p_W = latest.target && latest.target->valid ? latest.target->p_W : sel->p_W;
-        f.source = latest.target ? latest.target->source : "selection";
-        f.distance_m = (f.p_W - 0.5 * (vision::CameraPoseOf(*left->second).translation() +
-                                       vision::CameraPoseOf(*right->second).translation()))
-                           .norm();
-        double best = 0.35;
-        for (const PictureFace& p : pictures_) {
-          scene::SceneState state = scene_.InitialState();
-          state.time = time;
-          const Eigen::Vector3d ref =
-              p.has_face ? FaceCentreAt(scene_, p, time)
-                         : scene_.ObjectPose(scene_.objects()[p.object], state).translation();
-          const double d = (ref - f.p_W).norm();
-          if (d < best) {
-            best = d;
-            f.object = p.name;
-            f.is_face = p.has_face;
-            f.truth_W = ref;
-          }
-        }
-        if (!truth_) {
-          // Real cameras: every target attention picks is a face the detectors found.
-          f.object = fmt::format("face {}", f.target_id);
-          f.is_face = true;
-        }
-        f.has_truth = truth_ && f.is_face;
-        if (f.has_truth) {
-          f.error_3d_m = (f.p_W - f.truth_W).norm();
-          f.left_error_deg = AxisErrorDeg(*left->second, f.truth_W);
-          f.right_error_deg = AxisErrorDeg(*right->second, f.truth_W);
-        }
+        Arrive(f, time, latest, *left->second, *right->second);
         out.fixated_now = true;
       }
-      if (f.has_truth) {
-        // Pursuit: how well the eyes stay on the (possibly moving) true face centre.
-        const PictureFace* p = nullptr;
-        for (const PictureFace& q : pictures_) {
-          if (q.name == f.object) p = &q;
-        }
-        const Eigen::Vector3d truth = FaceCentreAt(scene_, *p, time);
-        const double e[2] = {AxisErrorDeg(*left->second, truth),
-                             AxisErrorDeg(*right->second, truth)};
-        for (int k = 0; k < 2; ++k) {
-          f.dwell_sum_deg[k] += e[k];
-          f.dwell_max_deg[k] = std::max(f.dwell_max_deg[k], e[k]);
-        }
-        ++f.dwell_samples;
-      }
+      if (f.has_truth) AddDwellSample(f, time, *left->second, *right->second);
     }
-    if (f.fixated_at) {
-      for (const Eigen::Vector3d& s : sel->suppressed_W) {
-        if ((s - f.p_W).norm() < 0.2) f.completed = true;
-      }
-    }
-  } else if (sel != nullptr && sel->exploring) {
+  } else if (sel->exploring) {
     out.status = "exploring: looking straight ahead";
   }
-  // Earlier targets the selection moved away from are complete once suppressed too.
-  if (sel != nullptr) {
-    for (Fixation& f : fixations_) {
-      if (!f.fixated_at || f.completed) continue;
-      for (const Eigen::Vector3d& s : sel->suppressed_W) {
-        if ((s - f.p_W).norm() < 0.2) f.completed = true;
-      }
+  // A fixated target is complete once inhibition of return suppresses it, whether the
+  // selection is still on it or has moved away.
+  for (Fixation& f : fixations_) {
+    if (!f.fixated_at || f.completed) continue;
+    for (const Eigen::Vector3d& s : sel->suppressed_W) {
+      if ((s - f.p_W).norm() < 0.2) f.completed = true;
     }
   }
-
   return out;
 }
 
@@ -214,4 +217,4 @@ json FixationScorer::DecoysJson() const {
   return decoys;
 }
 
-}  // namespace saccade::components
+}  // namespace saccade::components::demo

@@ -13,7 +13,7 @@
 #include "saccade/core/image.h"
 #include "saccade/scene/scene.h"
 
-namespace saccade::components {
+namespace saccade::components::demo {
 
 struct PictureFace {
   std::string name;        ///< the object's name
@@ -35,4 +35,4 @@ Eigen::Vector3d FaceCentreAt(const scene::Scene& scene, const PictureFace& face,
 std::optional<std::array<double, 4>> ProjectedBox(const scene::Scene& scene,
                                                   const scene::Object& object, const Image& image);
 
-}  // namespace saccade::components
+}  // namespace saccade::components::demo

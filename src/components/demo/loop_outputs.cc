@@ -1,6 +1,6 @@
-#include "saccade/components/loop_outputs.h"
+#include "saccade/components/demo/loop_outputs.h"
 
-namespace saccade::components {
+namespace saccade::components::demo {
 
 void TapLoopOutputs(runtime::Pipeline& pipeline, Latest* latest) {
   Tap<runtime::ImageMessage>(pipeline, [latest](const runtime::ImageMessage& m) {
@@ -17,4 +17,4 @@ void TapLoopOutputs(runtime::Pipeline& pipeline, Latest* latest) {
   Tap<JointStateMessage>(pipeline, [latest](const JointStateMessage& m) { latest->joints = m; });
 }
 
-}  // namespace saccade::components
+}  // namespace saccade::components::demo

@@ -1,10 +1,10 @@
-#include "saccade/gui/overlay.h"
+#include "saccade/components/demo/overlay.h"
 
 #include <opencv2/imgproc.hpp>
 
 #include "saccade/vision/image_camera.h"
 
-namespace saccade::gui {
+namespace saccade::components::demo {
 
 cv::Mat Annotate(const Latest& latest, const std::string& camera, double scale) {
   const auto it = latest.images.find(camera);
@@ -52,4 +52,4 @@ cv::Mat Annotate(const Latest& latest, const std::string& camera, double scale) 
   return scaled;
 }
 
-}  // namespace saccade::gui
+}  // namespace saccade::components::demo

@@ -1,4 +1,4 @@
-#include "saccade/components/face_truth.h"
+#include "saccade/components/demo/face_truth.h"
 
 #include <algorithm>
 #include <array>
@@ -6,7 +6,7 @@
 #include "saccade/vision/face_detector.h"
 #include "saccade/vision/image_camera.h"
 
-namespace saccade::components {
+namespace saccade::components::demo {
 
 std::vector<PictureFace> FindPictureFaces(const scene::Scene& scene) {
   std::vector<PictureFace> out;
@@ -73,4 +73,4 @@ std::optional<std::array<double, 4>> ProjectedBox(const scene::Scene& scene,
   return box;
 }
 
-}  // namespace saccade::components
+}  // namespace saccade::components::demo

@@ -13,11 +13,11 @@
 #include <string>
 #include <vector>
 
-#include "saccade/components/face_truth.h"
-#include "saccade/components/loop_outputs.h"
+#include "saccade/components/demo/face_truth.h"
+#include "saccade/components/demo/loop_outputs.h"
 #include "saccade/scene/scene.h"
 
-namespace saccade::components {
+namespace saccade::components::demo {
 
 /// One target attention selected, and how the head fixated it.
 struct Fixation {
@@ -67,6 +67,14 @@ class FixationScorer {
   nlohmann::json DecoysJson() const;
 
  private:
+  /// Rejected detections on a decoy picture (the cat) in this step's images, by reason.
+  void CountDecoyRejections(int64_t step, const Latest& latest);
+  /// The fixation arrives: its target, distance and object, and its errors against the truth.
+  void Arrive(Fixation& f, double time, const Latest& latest, const Image& left,
+              const Image& right) const;
+  /// One step of the dwell: each eye's angular error from the true face centre.
+  void AddDwellSample(Fixation& f, double time, const Image& left, const Image& right) const;
+
   const scene::Scene& scene_;
   bool truth_;
   std::vector<PictureFace> pictures_;
@@ -75,4 +83,4 @@ class FixationScorer {
   std::map<std::string, std::map<std::string, int>> decoy_rejections_;  // picture, reason
 };
 
-}  // namespace saccade::components
+}  // namespace saccade::components::demo

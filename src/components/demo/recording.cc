@@ -1,4 +1,4 @@
-#include "saccade/gui/recording.h"
+#include "saccade/components/demo/recording.h"
 
 #include <fmt/format.h>
 
@@ -8,7 +8,7 @@
 
 #include "saccade/core/error.h"
 
-namespace saccade::gui {
+namespace saccade::components::demo {
 
 namespace fs = std::filesystem;
 
@@ -87,4 +87,4 @@ void Recorder::WriteSummary(const nlohmann::json& summary) {
   fs::rename(tmp, dir_ / "summary.json");
 }
 
-}  // namespace saccade::gui
+}  // namespace saccade::components::demo

@@ -1,12 +1,13 @@
-#include "saccade/components/demo_report.h"
+#include "saccade/components/demo/summary.h"
 
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <filesystem>
 
-#include "saccade/components/loop_outputs.h"
+#include "saccade/components/demo/loop_outputs.h"
 
-namespace saccade::components {
+namespace saccade::components::demo {
 
 using nlohmann::json;
 
@@ -63,41 +64,41 @@ json ExposureJson(const std::map<int, int64_t>& samples) {
 }
 }  // namespace
 
-double DemoReport::steps_per_second() const {
-  return summary.steps / std::max(summary.wall_seconds, 1e-9);
+double DemoSummary::steps_per_second() const {
+  return run.steps / std::max(run.wall_seconds, 1e-9);
 }
 
-double DemoReport::real_time_factor() const {
-  return sim_time() / std::max(summary.wall_seconds, 1e-9);
+double DemoSummary::real_time_factor() const {
+  return sim_time() / std::max(run.wall_seconds, 1e-9);
 }
 
-json DemoReport::Json() const {
+json DemoSummary::Json() const {
   json stages = json::array();
-  for (const runtime::ComponentTiming& c : summary.components) {
+  for (const runtime::ComponentTiming& c : run.components) {
     stages.push_back({{"name", c.name},
                       {"median_ms", c.median_ms},
                       {"p95_ms", c.p95_ms},
                       {"mean_ms", c.mean_ms},
                       {"max_ms", c.max_ms}});
   }
-  json fixations = json::array();
-  for (const Fixation& f : scorer->fixations()) fixations.push_back(FixationJson(f));
+  json scored = json::array();
+  for (const Fixation& f : fixations) scored.push_back(FixationJson(f));
   json errors = json::array();
-  for (const runtime::StepError& e : summary.errors) errors.push_back(e.ToString());
+  for (const runtime::StepError& e : run.errors) errors.push_back(e.ToString());
   const StreamingStats& latency = capture_to_command_ms;
-  return {
+  json out = {
       {"pipeline", pipeline},
       {"scene", scene.empty() ? json(nullptr) : json(scene)},
-      {"steps", summary.steps},
+      {"steps", run.steps},
       {"sim_time_s", sim_time()},
-      {"wall_s", summary.wall_seconds},
+      {"wall_s", run.wall_seconds},
       {"real_time_factor", real_time_factor()},
       {"steps_per_second", steps_per_second()},
-      {"overruns", realtime ? json(summary.overruns) : json(nullptr)},
-      {"faces", scorer->faces_total()},
-      {"faces_fixated", scorer->faces_fixated()},
-      {"fixations", fixations},
-      {"decoys", scorer->DecoysJson()},
+      {"overruns", realtime ? json(run.overruns) : json(nullptr)},
+      {"faces", faces_total},
+      {"faces_fixated", faces_fixated},
+      {"fixations", scored},
+      {"decoys", decoys},
       {"latency_ms",
        {{"capture_to_command",
          {{"median", latency.Quantile(0.5)},
@@ -110,8 +111,8 @@ json DemoReport::Json() const {
           {"max", detection_age_ms.max()}}},
         {"stages", stages}}},
       {"exposure_samples", ExposureJson(exposure_samples)},
-      {"overhead_share", summary.overhead_share},
-      {"overhead_ms", {{"median", summary.overhead_median_ms}, {"p95", summary.overhead_p95_ms}}},
+      {"overhead_share", run.overhead_share},
+      {"overhead_ms", {{"median", run.overhead_median_ms}, {"p95", run.overhead_p95_ms}}},
       {"errors", errors},
       {"hardware", hardware_file.empty() ? json(nullptr) : json(hardware_file)},
       {"ground_truth", truth},
@@ -121,25 +122,32 @@ json DemoReport::Json() const {
                               : json(nullptr)},
       {"head", head ? runtime::MessageTraits<HeadStatusMessage>::ToJson(*head) : json(nullptr)},
       {"interrupted", interrupted}};
+  if (!record.empty()) {
+    out["record"] = {{"folder", record},
+                     {"frames", recorded_frames},
+                     {"video", (std::filesystem::path(record) / "demo.avi").string()}};
+  }
+  return out;
 }
 
-std::string DemoReport::Text(const std::string& record) const {
-  const int faces_fixated = scorer->faces_fixated();
-  std::string out;
+std::string DemoSummary::BriefReport() const {
   if (truth) {
-    out += fmt::format(
-        "\n{} of {} faces fixated in {:.2f} s of simulated time ({} steps, {:.1f} s wall)\n",
-        faces_fixated, scorer->faces_total(), sim_time(), summary.steps, summary.wall_seconds);
-  } else {
-    out += fmt::format("\n{} faces fixated in {:.2f} s ({} steps, {:.1f} s wall)\n", faces_fixated,
-                       sim_time(), summary.steps, summary.wall_seconds);
+    return fmt::format(
+        "{} of {} faces fixated in {:.2f} s of simulated time ({} steps, {:.1f} s wall)",
+        faces_fixated, faces_total, sim_time(), run.steps, run.wall_seconds);
   }
+  return fmt::format("{} faces fixated in {:.2f} s ({} steps, {:.1f} s wall)", faces_fixated,
+                     sim_time(), run.steps, run.wall_seconds);
+}
+
+std::string DemoSummary::FullReport() const {
+  std::string out = "\n" + BriefReport() + "\n";
   out += fmt::format("{:.1f} steps per second, real-time factor {:.2f} (simulated s per wall s)\n",
                      steps_per_second(), real_time_factor());
   // The lines above give each fixation's errors as it began; over the whole fixation (pursuit
   // of a moving face included), the largest:
   std::string dwell;
-  for (const Fixation& f : scorer->fixations()) {
+  for (const Fixation& f : fixations) {
     if (!f.has_truth || f.dwell_samples == 0) continue;
     dwell += fmt::format("  {:<16} L {:.3f} R {:.3f} deg  (mean {:.3f} / {:.3f} over {} steps)\n",
                          f.object, f.dwell_max_deg[0], f.dwell_max_deg[1],
@@ -151,7 +159,7 @@ std::string DemoReport::Text(const std::string& record) const {
     // A step that ends after the next tick was due: the loop skips the missed ticks (no
     // backlog, no burst), so this counts the camera periods it could not keep.
     out += fmt::format("real time: {} of {} steps overran their period of {:.1f} ms\n",
-                       summary.overruns, summary.steps, 1e3 * dt);
+                       run.overruns, run.steps, 1e3 * dt);
   }
   if (pair_counts) out += fmt::format("cameras: {}\n", cameras_description);
   if (!exposure_samples.empty()) {
@@ -167,7 +175,7 @@ std::string DemoReport::Text(const std::string& record) const {
         h.limited_commands, h.watchdog_trips, h.emergency_stopped ? ", EMERGENCY STOP" : "",
         h.fault.empty() ? "" : ", FAULT: " + h.fault);
   }
-  for (const json& d : scorer->DecoysJson()) {
+  for (const json& d : decoys) {
     out +=
         fmt::format("decoy {}: {} ({} detections on it rejected{})\n", d["name"].get<std::string>(),
                     d["fixated"].get<bool>() ? "FIXATED (not rejected)" : "rejected, never fixated",
@@ -176,7 +184,7 @@ std::string DemoReport::Text(const std::string& record) const {
   }
   out += "\nlatency per stage (ms, wall clock on this machine):\n";
   out += fmt::format("  {:<14} {:>8} {:>8} {:>8}\n", "stage", "median", "p95", "max");
-  for (const runtime::ComponentTiming& c : summary.components) {
+  for (const runtime::ComponentTiming& c : run.components) {
     out += fmt::format("  {:<14} {:>8.2f} {:>8.2f} {:>8.2f}\n", c.name, c.median_ms, c.p95_ms,
                        c.max_ms);
   }
@@ -192,7 +200,7 @@ std::string DemoReport::Text(const std::string& record) const {
   out += fmt::format(
       "  outside the components (messaging, scheduling): {:.4f} ms/step median, "
       "{:.3f} % of the loop\n",
-      summary.overhead_median_ms, 100.0 * summary.overhead_share);
+      run.overhead_median_ms, 100.0 * run.overhead_share);
   if (!record.empty()) {
     out +=
         fmt::format("\nrecorded to {}: frames/, demo.avi, summary.json, fixation_*.png\n", record);
@@ -218,4 +226,4 @@ std::string FixationText(const Fixation& f, double t) {
   return fmt::format("t = {:6.2f} s  fixated {} (not a face)  took {:.2f} s\n", t, f.object, took);
 }
 
-}  // namespace saccade::components
+}  // namespace saccade::components::demo

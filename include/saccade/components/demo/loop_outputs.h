@@ -11,7 +11,7 @@
 #include "saccade/core/image.h"
 #include "saccade/runtime/pipeline.h"
 
-namespace saccade::components {
+namespace saccade::components::demo {
 
 /// Everything the loop's outputs said during the current step.
 struct Latest {
@@ -39,4 +39,4 @@ void Tap(runtime::Pipeline& pipeline, Slot slot) {
 /// message the pipeline emits. `latest` must outlive the pipeline's run.
 void TapLoopOutputs(runtime::Pipeline& pipeline, Latest* latest);
 
-}  // namespace saccade::components
+}  // namespace saccade::components::demo
