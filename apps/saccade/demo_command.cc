@@ -16,6 +16,7 @@
 #include "saccade/components/demo/demo_session.h"
 #include "saccade/components/register.h"
 #include "saccade/dds/transport.h"
+#include "saccade/gui/protocol.h"
 #include "saccade/gui/session.h"
 #include "saccade/runtime/component_reference.h"
 
@@ -189,7 +190,19 @@ Runner AddGuiCommand(CLI::App& app) {
       ->excludes("--hardware");
   AddDdsOptions(gui, o->dds_overrides);
   AddGuiOptions(gui, *o);
-  return [o, pipeline_option] {
+  // The protocol's table (gui/protocol.h) as its generated files; nothing is served.
+  auto protocol_markdown = std::make_shared<bool>(false);
+  auto protocol_js = std::make_shared<bool>(false);
+  gui->add_flag("--protocol-markdown", *protocol_markdown,
+                "Print the protocol, docs/gui-protocol.md, and exit");
+  gui->add_flag("--protocol-js", *protocol_js,
+                "Print the page's copy of the protocol, web/public/app/protocol.js, and exit")
+      ->excludes("--protocol-markdown");
+  return [o, pipeline_option, protocol_markdown, protocol_js] {
+    if (*protocol_markdown || *protocol_js) {
+      fmt::print("{}", *protocol_js ? gui::protocol::JavaScript() : gui::protocol::Markdown());
+      return 0;
+    }
     if (o->dds && pipeline_option->count() == 0) {
       o->demo.pipeline = ShippedFile("pipelines/remote.yaml");
     }

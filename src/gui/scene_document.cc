@@ -87,31 +87,24 @@ json MovingObjectsJson(const scene::Scene& scene, double t) {
   return objects;
 }
 
-json PublishScene(const scene::Scene& scene, const std::string& scene_name, const std::string& mode,
-                  const json& commands, server::GuiServer& server) {
-  // The scene: models and textures once, as the renderer has them.
-  std::map<const scene::Model*, int> model_index;
-  std::map<const scene::Texture*, int> texture_index;
-  json models = json::array();
-  const auto add_model = [&](const std::shared_ptr<const scene::Model>& model) {
+namespace {
+
+// The scene's models, each once, as the renderer has them: their meshes and textures put on
+// the server as documents, their descriptions gathered for the scene document's "models".
+class ModelCatalog {
+ public:
+  explicit ModelCatalog(server::GuiServer& server) : server_(server) {}
+
+  /// The model's index in "models" (-1 for none), adding it the first time.
+  int Add(const std::shared_ptr<const scene::Model>& model) {
     if (!model) return -1;
-    if (const auto it = model_index.find(model.get()); it != model_index.end()) return it->second;
-    const int index = static_cast<int>(models.size());
-    model_index[model.get()] = index;
+    if (const auto it = index_.find(model.get()); it != index_.end()) return it->second;
+    const int index = static_cast<int>(models_.size());
+    index_[model.get()] = index;
     json materials = json::array();
     for (const scene::Material& m : model->materials) {
-      json texture = nullptr;
-      if (m.texture) {
-        auto [it, added] =
-            texture_index.emplace(m.texture.get(), static_cast<int>(texture_index.size()));
-        if (added) {
-          server.SetDocument(fmt::format("/api/textures/{}.png", it->second), "image/png",
-                             EncodePng(m.texture->image));
-        }
-        texture = fmt::format("/api/textures/{}.png", it->second);
-      }
       materials.push_back({{"base_color", Vec(m.base_color)},
-                           {"texture", texture},
+                           {"texture", m.texture ? json(Texture(*m.texture)) : json(nullptr)},
                            {"specular", m.specular},
                            {"shininess", m.shininess}});
     }
@@ -123,8 +116,8 @@ json PublishScene(const scene::Scene& scene, const std::string& scene_name, cons
                         {"material", mesh.material}});
     }
     const std::string url = fmt::format("/api/models/{}.bin", index);
-    server.SetDocument(url, "application/octet-stream", ModelBinary(*model));
-    models.push_back(
+    server_.SetDocument(url, "application/octet-stream", ModelBinary(*model));
+    models_.push_back(
         {{"source", model->source},
          {"url", url},
          {"bounds",
@@ -132,27 +125,53 @@ json PublishScene(const scene::Scene& scene, const std::string& scene_name, cons
          {"materials", materials},
          {"meshes", meshes}});
     return index;
-  };
+  }
+
+  const json& models() const { return models_; }
+
+ private:
+  // The texture's URL, putting it on the server the first time.
+  std::string Texture(const scene::Texture& texture) {
+    auto [it, added] = texture_index_.emplace(&texture, static_cast<int>(texture_index_.size()));
+    const std::string url = fmt::format("/api/textures/{}.png", it->second);
+    if (added) server_.SetDocument(url, "image/png", EncodePng(texture.image));
+    return url;
+  }
+
+  server::GuiServer& server_;
+  std::map<const scene::Model*, int> index_;
+  std::map<const scene::Texture*, int> texture_index_;
+  json models_ = json::array();
+};
+
+json ObjectsJson(const scene::Scene& scene, ModelCatalog& models) {
   json objects = json::array();
   for (const scene::Object& o : scene.objects()) {
     objects.push_back({{"name", o.name},
                        {"id", o.id},
-                       {"model", add_model(o.model)},
+                       {"model", models.Add(o.model)},
                        {"scale", ToJson(o.scale)},
                        {"X_WO", ToJson(o.motion.PoseAt(0.0))},
                        {"moving", !o.motion.IsStatic()}});
   }
-  json robot = nullptr;
+  return objects;
+}
+
+json RobotJson(const scene::Scene& scene, ModelCatalog& models) {
+  if (!scene.robot()) return nullptr;
+  json parts = json::array();
+  for (const scene::RobotPart& p : scene.robot()->parts) {
+    parts.push_back({{"link", LinkName(p.link)},
+                     {"model", models.Add(p.model)},
+                     {"X_LinkPart", ToJson(p.X_LinkPart)},
+                     {"scale", ToJson(p.scale)}});
+  }
+  return {{"visible", scene.robot()->visible}, {"parts", parts}};
+}
+
+json HeadJson(const scene::Scene& scene) {
   json joints = json::array();
   if (scene.robot()) {
-    json parts = json::array();
-    for (const scene::RobotPart& p : scene.robot()->parts) {
-      parts.push_back({{"link", LinkName(p.link)},
-                       {"model", add_model(p.model)},
-                       {"X_LinkPart", ToJson(p.X_LinkPart)},
-                       {"scale", ToJson(p.scale)}});
-    }
-    robot = {{"visible", scene.robot()->visible}, {"parts", parts}};
     for (head::Joint j : head::kAllJoints) {
       const head::JointLimits& l = scene.robot()->head.limits(j);
       joints.push_back({{"name", head::JointName(j)},
@@ -161,6 +180,10 @@ json PublishScene(const scene::Scene& scene, const std::string& scene_name, cons
                         {"max_velocity", l.max_velocity}});
     }
   }
+  return {{"joints", joints}};
+}
+
+json LightsJson(const scene::Scene& scene) {
   json lights = json::array();
   for (const scene::Light& l : scene.lights()) {
     const char* type = l.type == scene::Light::Type::kAmbient       ? "ambient"
@@ -173,10 +196,20 @@ json PublishScene(const scene::Scene& scene, const std::string& scene_name, cons
                       {"position", ToJson(l.position_W)},
                       {"attenuation", l.attenuation}});
   }
-  const scene::Ground& g = scene.ground();
+  return lights;
+}
+
+json GroundJson(const scene::Ground& g) {
   const char* pattern = g.pattern == scene::Ground::Pattern::kPlain  ? "plain"
                         : g.pattern == scene::Ground::Pattern::kGrid ? "grid"
                                                                      : "checker";
+  return {{"enabled", g.enabled},       {"size", g.size},
+          {"pattern", pattern},         {"cell", g.cell},
+          {"line_width", g.line_width}, {"color", Vec(g.color)},
+          {"color2", Vec(g.color2)}};
+}
+
+json CamerasJson(const scene::Scene& scene) {
   json cameras = json::array();
   for (const scene::CameraSpec& c : scene.cameras()) {
     const char* eye = c.mount == scene::CameraMount::kLeftEye    ? "left"
@@ -191,26 +224,29 @@ json PublishScene(const scene::Scene& scene, const std::string& scene_name, cons
     camera["far"] = c.clip.far;
     cameras.push_back(camera);
   }
+  return cameras;
+}
+
+}  // namespace
+
+json PublishScene(const scene::Scene& scene, const std::string& scene_name, const std::string& mode,
+                  const json& commands, server::GuiServer& server) {
+  ModelCatalog models(server);
+  json objects = ObjectsJson(scene, models);
+  json robot = RobotJson(scene, models);
   return {{"protocol", server::kProtocolName},
           {"version", server::kProtocolVersion},
           {"mode", mode},
           {"name", scene_name},
           {"time", 0.0},
           {"background", Vec(scene.background())},
-          {"ground",
-           {{"enabled", g.enabled},
-            {"size", g.size},
-            {"pattern", pattern},
-            {"cell", g.cell},
-            {"line_width", g.line_width},
-            {"color", Vec(g.color)},
-            {"color2", Vec(g.color2)}}},
-          {"lights", lights},
-          {"models", models},
+          {"ground", GroundJson(scene.ground())},
+          {"lights", LightsJson(scene)},
+          {"models", models.models()},
           {"objects", objects},
           {"robot", robot},
-          {"head", {{"joints", joints}}},
-          {"cameras", cameras},
+          {"head", HeadJson(scene)},
+          {"cameras", CamerasJson(scene)},
           {"commands", commands}};
 }
 

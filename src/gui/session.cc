@@ -14,8 +14,11 @@
 #include <set>
 
 #include "gui/internal_scene_document.h"
+#include "gui/internal_state_message.h"
 #include "saccade/core/error.h"
+#include "saccade/core/log.h"
 #include "saccade/geometry/json.h"
+#include "saccade/gui/protocol.h"
 #include "saccade/head/json.h"
 #include "saccade/head/kinematics.h"
 #include "saccade/vision/image_camera.h"
@@ -35,26 +38,19 @@ double WallNow() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
 }
 
-/// The value of a number field, finite; CommandError naming the command and the field.
-double FiniteNumber(const json& value, const std::string& where) {
-  if (!value.is_number()) throw CommandError(where + ": expected a number, got " + value.dump());
-  const double x = value.get<double>();
-  if (!std::isfinite(x)) throw CommandError(where + ": expected a finite number");
-  return x;
+/// A message of the server's own that breaks the protocol's table is a bug here (or in the
+/// table): said in the log, the first few times, and sent anyway.
+void Conform(const std::string& problem) {
+  static std::atomic<int> said{0};
+  if (problem.empty() || said.fetch_add(1) >= 5) return;
+  log::Error("gui: a message of the server breaks docs/gui-protocol.md (a bug): {}", problem);
 }
 
-bool Flag(const json& command, const std::string& field, bool current) {
-  if (!command.contains(field)) return current;
-  if (!command[field].is_boolean()) {
-    throw CommandError(command["type"].get<std::string>() + ": " + field +
-                       " must be true or false, got " + command[field].dump());
-  }
-  return command[field].get<bool>();
-}
-
-double AxisErrorDeg(const geometry::Pose& X_WC, const Eigen::Vector3d& p_W) {
-  const Eigen::Vector3d to = (p_W - X_WC.translation()).normalized();
-  return std::acos(std::clamp(X_WC.linear().col(2).dot(to), -1.0, 1.0)) * kRadToDeg;
+/// An event for every client (docs/gui-protocol.md, `event`).
+json Event(const std::string& level, const std::string& message) {
+  json event = {{"type", "event"}, {"level", level}, {"message", message}};
+  Conform(protocol::CheckServerMessage(event));
+  return event;
 }
 
 }  // namespace
@@ -62,6 +58,7 @@ double AxisErrorDeg(const geometry::Pose& X_WC, const Eigen::Vector3d& p_W) {
 GuiSession::GuiSession(runtime::Pipeline& pipeline, const scene::Scene& scene,
                        const std::string& scene_name, const GuiOptions& options)
     : scene_(scene), options_(options), control_(options.paused) {
+  CheckCommandTable();
   perception_ = options.perception;
   if (!(options.speed >= 0.05 && options.speed <= 10.0)) {
     throw InvalidArgument(fmt::format("--speed must be in [0.05, 10], got {}", options.speed));
@@ -137,6 +134,7 @@ GuiSession::GuiSession(runtime::Pipeline& pipeline, const scene::Scene& scene,
       {"effects", rendered_}, {"perception", !perception_components_.empty()}, {"estop", hw_head_}};
   const json scene_json =
       internal::PublishScene(scene_, scene_name, options.mode, commands, *server_);
+  Conform(protocol::CheckSceneDocument(scene_json));
   server_->SetDocument("/api/scene", "application/json", scene_json.dump());
   server_->SetCommandHandler(
       [this](const json& command, int64_t client) { return Handle(command, client); });
@@ -187,7 +185,7 @@ int GuiSession::ApplyQueued() {
     try {
       action();
     } catch (const std::exception& error) {
-      server_->Broadcast({{"type", "event"}, {"level", "error"}, {"message", error.what()}});
+      server_->Broadcast(Event("error", error.what()));
     }
   }
   return static_cast<int>(actions.size());
@@ -198,240 +196,227 @@ void GuiSession::SetPerception(bool enabled) {
   perception_ = enabled;
 }
 
-json GuiSession::Handle(const json& command, int64_t client) {
-  (void)client;
-  const std::string type = command["type"].get<std::string>();
-  if (type == "ping") return {{"time", sim_time_.load()}};
-  if (type == "joints" || type == "fixate") {
-    if (!head_ || !scene_.robot()) throw CommandError(type + ": this pipeline has no head to move");
-    const head::HeadDescription& head = scene_.robot()->head;
-    head::JointState target = CurrentTargets();
-    json reply;
-    if (type == "joints") {
-      if (!command.contains("positions") || !command["positions"].is_object() ||
-          command["positions"].empty()) {
-        throw CommandError("joints: expected positions: {pan, tilt, left, right or vergence: rad}");
-      }
-      for (const auto& [name, value] : command["positions"].items()) {
-        const double x = FiniteNumber(value, "joints: " + name);
-        if (name == "vergence") {
-          // Symmetric vergence (seed appendix A): > 0 converges, the left eye turning right.
-          target.left = -x;
-          target.right = x;
-          continue;
-        }
-        bool known = false;
-        for (head::Joint j : head::kAllJoints) {
-          if (name == head::JointName(j)) {
-            target[j] = x;
-            known = true;
-          }
-        }
-        if (!known) {
-          throw CommandError("joints: unknown joint '" + name +
-                             "' (pan, tilt, left, right or vergence)");
-        }
-      }
-      // The server's check (docs/gui-protocol.md): a value outside the limits rejects the
-      // whole command; the page's clamping is a convenience, never the safety.
-      for (head::Joint j : head::kAllJoints) {
-        const head::JointLimits& l = head.limits(j);
-        if (!l.Contains(target[j])) {
-          throw CommandError(fmt::format(
-              "joints: {} {:.4f} rad ({:.2f} deg) is outside its limits [{:.4f}, {:.4f}] rad",
-              head::JointName(j), target[j], target[j] * kRadToDeg, l.min, l.max));
-        }
-      }
-      reply = {{"targets", ToJson(target)}};
-    } else {
-      const json& p = command.contains("p_W") ? command["p_W"] : json();
-      if (!p.is_array() || p.size() != 3) {
-        throw CommandError("fixate: expected p_W: [x, y, z] (metres, world frame), got " +
-                           p.dump());
-      }
-      const Eigen::Vector3d p_W(FiniteNumber(p[0], "fixate: p_W[0]"),
-                                FiniteNumber(p[1], "fixate: p_W[1]"),
-                                FiniteNumber(p[2], "fixate: p_W[2]"));
-      head::IkOptions ik;
-      ik.seed = target;
-      const head::IkResult solution = head::SolveFixation(head, p_W, ik);
-      if (!solution.reachable()) {
-        throw CommandError(fmt::format("fixate: [{:.3f}, {:.3f}, {:.3f}] cannot be fixated: {}",
-                                       p_W.x(), p_W.y(), p_W.z(), solution.message));
-      }
-      target = solution.joints;
-      reply = {{"targets", ToJson(target)}, {"axis_error_deg", solution.axis_error * kRadToDeg}};
-    }
-    {
-      std::lock_guard lock(joints_mutex_);
-      targets_ = target;
-    }
-    Enqueue([this, target] {
-      SetPerception(false);  // the hand overrides the loop
-      JointCommand c;
-      c.time = sim_time_;
-      c.positions = target;
-      c.velocities = {0.0, 0.0, 0.0, 0.0};
-      commanded_ = head_->Move(c);
-    });
-    reply["perception"] = false;
-    return reply;
-  }
-  if (type == "perception") {
-    if (perception_components_.empty()) {
-      throw CommandError("perception: this pipeline has no components besides the robot");
-    }
-    const bool enabled = Flag(command, "enabled", perception_);
-    Enqueue([this, enabled] { SetPerception(enabled); });
-    return {{"perception", enabled}};
-  }
-  if (type == "effects") {
-    if (!rendered_) {
-      throw CommandError("effects: the cameras are not simulated: they have no effects to switch");
-    }
-    for (const auto& [name, value] : command.items()) {
-      if (name != "type" && name != "id" && name != "distortion" && name != "noise" &&
-          name != "motion_blur") {
-        throw CommandError("effects: unknown field '" + name +
-                           "' (distortion, noise, motion_blur)");
-      }
-    }
-    std::lock_guard lock(effects_mutex_);
-    const bool d = Flag(command, "distortion", effects_.distortion);
-    const bool n = Flag(command, "noise", effects_.noise);
-    const bool b = Flag(command, "motion_blur", effects_.motion_blur);
-    effects_.distortion = d;
-    effects_.noise = n;
-    effects_.motion_blur = b;
-    Enqueue([this, d, n, b] { cameras_->SetEffects(d, n, b); });
-    return {{"effects", {{"distortion", d}, {"noise", n}, {"motion_blur", b}}}};
-  }
-  if (type == "pause") {
-    control_.Pause();
-    return {{"paused", true}};
-  }
-  if (type == "resume") {
-    control_.Resume();
-    return {{"paused", false}};
-  }
-  if (type == "step") {
-    int count = 1;
-    if (command.contains("count")) {
-      if (!command["count"].is_number_integer() || command["count"].get<int64_t>() < 1 ||
-          command["count"].get<int64_t>() > 1000) {
-        throw CommandError("step: count must be an integer in [1, 1000], got " +
-                           command["count"].dump());
-      }
-      count = command["count"].get<int>();
-    }
-    if (!control_.paused()) {
-      throw CommandError("step: pause first (steps are for a paused simulation)");
-    }
-    control_.Step(count);
-    return {{"steps", count}};
-  }
-  if (type == "speed") {
-    const double factor = command.contains("factor")
-                              ? FiniteNumber(command["factor"], "speed: factor")
-                              : std::nan("");
-    if (!(factor >= 0.05 && factor <= 10.0)) {
-      throw CommandError("speed: factor must be in [0.05, 10] (simulated s per wall s), got " +
-                         (command.contains("factor") ? command["factor"].dump() : "nothing"));
-    }
-    control_.SetSpeed(factor);
-    return {{"speed", factor}};
-  }
-  if (type == "stop" || type == "estop" || type == "clear") {
-    if (!head_) throw CommandError(type + ": this pipeline has no head");
-    if ((type == "estop" || type == "clear") && !hw_head_) {
-      throw CommandError(type +
-                         ": only a hardware head (hw.head) has an emergency stop; use stop to "
-                         "brake the simulated one");
-    }
-    Enqueue([this, type] {
-      SetPerception(false);
-      if (type == "stop") {
-        head_->StopHead();
-      } else if (type == "estop") {
-        head_->EmergencyStop();
-      } else {
-        head_->ClearFault();
-      }
-    });
-    return {{"perception", false}};
-  }
-  throw CommandError("unknown command type '" + type +
-                     "' (joints, fixate, perception, effects, pause, resume, step, speed, stop, "
-                     "estop, clear, ping, frame_window, frame_ack: docs/gui-protocol.md)");
+// The commands of the protocol's table that the session answers (the server module answers
+// frame_window and frame_ack itself): the constructor holds the two lists equal.
+const std::map<std::string, GuiSession::CommandFn>& GuiSession::CommandTable() {
+  static const std::map<std::string, CommandFn> table = {{"joints", &GuiSession::OnJoints},
+                                                         {"fixate", &GuiSession::OnFixate},
+                                                         {"perception", &GuiSession::OnPerception},
+                                                         {"effects", &GuiSession::OnEffects},
+                                                         {"pause", &GuiSession::OnPause},
+                                                         {"resume", &GuiSession::OnResume},
+                                                         {"step", &GuiSession::OnStep},
+                                                         {"speed", &GuiSession::OnSpeed},
+                                                         {"stop", &GuiSession::OnHeadStop},
+                                                         {"estop", &GuiSession::OnHeadStop},
+                                                         {"clear", &GuiSession::OnHeadStop},
+                                                         {"ping", &GuiSession::OnPing}};
+  return table;
 }
 
-json GuiSession::StateJson(const runtime::StepContext& context, const Latest& latest) {
-  const double t = context.time + context.dt;  // the state after this step
-  json state = {{"type", "state"},
-                {"step", context.step},
-                {"time", t},
-                {"paused", control_.paused()},
-                {"speed", control_.speed()},
-                {"perception", perception_.load()},
-                {"manual", !perception_.load()}};
-  if (rendered_) {
-    const render::RendererOptions& o = *cameras_->rendered();
-    state["effects"] = {
-        {"distortion", o.distortion}, {"noise", o.noise}, {"motion_blur", o.motion_blur}};
-  } else {
-    state["effects"] = nullptr;
+void GuiSession::CheckCommandTable() {
+  std::vector<std::string> declared, handled;
+  for (const protocol::Message& m : protocol::Messages()) {
+    if (m.channel == protocol::Channel::kCommand && !m.transport) declared.push_back(m.type);
   }
-  std::optional<head::HeadFrames> frames;
+  for (const auto& [type, unused] : CommandTable()) handled.push_back(type);
+  std::sort(declared.begin(), declared.end());
+  if (declared != handled) {
+    throw Error("gui: the protocol's commands and the session's handlers differ (a bug)");
+  }
+}
+
+json GuiSession::Handle(const json& command, int64_t client) {
+  (void)client;
+  // The protocol's table first: a command that breaks it is refused naming the field.
+  if (const std::string problem = protocol::CheckCommand(command); !problem.empty()) {
+    throw CommandError(problem);
+  }
+  const std::string type = command["type"].get<std::string>();
+  const auto handler = CommandTable().find(type);
+  if (handler == CommandTable().end()) {
+    throw CommandError(type + ": the server module answers it, not the session");
+  }
+  const json reply = (this->*handler->second)(command);
+  json message = reply;  // as the server module sends it
+  message["type"] = "reply";
+  message["id"] = command["id"];
+  message["ok"] = true;
+  Conform(protocol::CheckServerMessage(message, type));
+  return reply;
+}
+
+const head::HeadDescription& GuiSession::RequireHead(const std::string& type) const {
+  if (!head_ || !scene_.robot()) throw CommandError(type + ": this pipeline has no head to move");
+  return scene_.robot()->head;
+}
+
+json GuiSession::MoveTo(const head::JointState& target, json reply) {
+  {
+    std::lock_guard lock(joints_mutex_);
+    targets_ = target;
+  }
+  Enqueue([this, target] {
+    SetPerception(false);  // the hand overrides the loop
+    JointCommand c;
+    c.time = sim_time_;
+    c.positions = target;
+    c.velocities = {0.0, 0.0, 0.0, 0.0};
+    commanded_ = head_->Move(c);
+  });
+  reply["targets"] = ToJson(target);
+  reply["perception"] = false;
+  return reply;
+}
+
+json GuiSession::OnJoints(const json& command) {
+  const head::HeadDescription& head = RequireHead("joints");
+  head::JointState target = CurrentTargets();
+  // The table allows pan, tilt, left, right and vergence, numbers, at least one.
+  for (const auto& [name, value] : command["positions"].items()) {
+    const double x = value.get<double>();
+    if (name == "vergence") {
+      // Symmetric vergence (seed appendix A): > 0 converges, the left eye turning right.
+      target.left = -x;
+      target.right = x;
+      continue;
+    }
+    for (head::Joint j : head::kAllJoints) {
+      if (name == head::JointName(j)) target[j] = x;
+    }
+  }
+  // The server's check (docs/gui-protocol.md): a value outside the limits refuses the whole
+  // command; the page's clamping is a convenience, never the safety.
+  for (head::Joint j : head::kAllJoints) {
+    const head::JointLimits& l = head.limits(j);
+    if (!l.Contains(target[j])) {
+      throw CommandError(fmt::format(
+          "joints: {} {:.4f} rad ({:.2f} deg) is outside its limits [{:.4f}, {:.4f}] rad",
+          head::JointName(j), target[j], target[j] * kRadToDeg, l.min, l.max));
+    }
+  }
+  return MoveTo(target, json::object());
+}
+
+json GuiSession::OnFixate(const json& command) {
+  const head::HeadDescription& head = RequireHead("fixate");
+  const json& p = command["p_W"];  // three numbers (the table's point)
+  const Eigen::Vector3d p_W(p[0].get<double>(), p[1].get<double>(), p[2].get<double>());
+  head::IkOptions ik;
+  ik.seed = CurrentTargets();
+  const head::IkResult solution = head::SolveFixation(head, p_W, ik);
+  if (!solution.reachable()) {
+    throw CommandError(fmt::format("fixate: [{:.3f}, {:.3f}, {:.3f}] cannot be fixated: {}",
+                                   p_W.x(), p_W.y(), p_W.z(), solution.message));
+  }
+  return MoveTo(solution.joints, {{"axis_error_deg", solution.axis_error * kRadToDeg}});
+}
+
+json GuiSession::OnPerception(const json& command) {
+  if (perception_components_.empty()) {
+    throw CommandError("perception: this pipeline has no components besides the robot");
+  }
+  const bool enabled = command.value("enabled", perception_.load());
+  Enqueue([this, enabled] { SetPerception(enabled); });
+  return {{"perception", enabled}};
+}
+
+json GuiSession::OnEffects(const json& command) {
+  if (!rendered_) {
+    throw CommandError("effects: the cameras are not simulated: they have no effects to switch");
+  }
+  std::lock_guard lock(effects_mutex_);
+  const bool d = command.value("distortion", effects_.distortion);
+  const bool n = command.value("noise", effects_.noise);
+  const bool b = command.value("motion_blur", effects_.motion_blur);
+  effects_.distortion = d;
+  effects_.noise = n;
+  effects_.motion_blur = b;
+  Enqueue([this, d, n, b] { cameras_->SetEffects(d, n, b); });
+  return {{"effects", {{"distortion", d}, {"noise", n}, {"motion_blur", b}}}};
+}
+
+json GuiSession::OnPause(const json&) {
+  control_.Pause();
+  return {{"paused", true}};
+}
+
+json GuiSession::OnResume(const json&) {
+  control_.Resume();
+  return {{"paused", false}};
+}
+
+json GuiSession::OnStep(const json& command) {
+  const int count = command.value("count", 1);  // the table holds it to [1, 1000]
+  if (!control_.paused()) {
+    throw CommandError("step: pause first (steps are for a paused simulation)");
+  }
+  control_.Step(count);
+  return {{"steps", count}};
+}
+
+json GuiSession::OnSpeed(const json& command) {
+  const double factor = command["factor"].get<double>();  // the table holds it to [0.05, 10]
+  control_.SetSpeed(factor);
+  return {{"speed", factor}};
+}
+
+json GuiSession::OnHeadStop(const json& command) {
+  const std::string type = command["type"].get<std::string>();
+  if (!head_) throw CommandError(type + ": this pipeline has no head");
+  if (type != "stop" && !hw_head_) {
+    throw CommandError(type +
+                       ": only a hardware head (hw.head) has an emergency stop; use stop to "
+                       "brake the simulated one");
+  }
+  Enqueue([this, type] {
+    SetPerception(false);
+    if (type == "stop") {
+      head_->StopHead();
+    } else if (type == "estop") {
+      head_->EmergencyStop();
+    } else {
+      head_->ClearFault();
+    }
+  });
+  return {{"perception", false}};
+}
+
+json GuiSession::OnPing(const json&) { return {{"time", sim_time_.load()}}; }
+
+json GuiSession::StateJson(const runtime::StepContext& context, const Latest& latest) {
+  internal::StateParts parts;
+  parts.step = context.step;
+  parts.time = context.time + context.dt;  // the state after this step
+  parts.paused = control_.paused();
+  parts.speed = control_.speed();
+  parts.perception = perception_.load();
+  if (rendered_) parts.effects = *cameras_->rendered();
   const std::optional<JointStateMessage>& joints = commanded_ ? commanded_ : latest.joints;
   if (joints && scene_.robot()) {
-    const JointStateMessage& j = *joints;
-    state["joints"] = {{"positions", ToJson(j.positions)},
-                       {"targets", ToJson(j.targets)},
-                       {"velocities", ToJson(j.velocities)},
-                       {"arrived", j.arrived}};
-    frames = head::ForwardKinematics(scene_.robot()->head, j.positions);
-    state["frames"] = internal::FramesJson(*frames);
-    state["fixation_W"] = frames->p_WFixation ? ToJson(*frames->p_WFixation) : json(nullptr);
+    parts.joints = *joints;
+    parts.head = &scene_.robot()->head;
     std::lock_guard lock(joints_mutex_);
-    if (perception_) targets_ = j.targets;  // partial hand commands start from here
-  } else {
-    state["joints"] = nullptr;
-    state["frames"] = nullptr;
-    state["fixation_W"] = nullptr;
+    if (perception_) targets_ = joints->targets;  // partial hand commands start from here
   }
-  if (perception_ && latest.target && latest.target->valid) {
-    state["target"] = {
-        {"valid", true}, {"p_W", ToJson(latest.target->p_W)}, {"id", latest.target->target_id}};
-    if (frames) {
-      state["fixation_error_deg"] = {
-          {"left", AxisErrorDeg(frames->X_WCamLeft, latest.target->p_W)},
-          {"right", AxisErrorDeg(frames->X_WCamRight, latest.target->p_W)}};
-    } else {
-      state["fixation_error_deg"] = nullptr;
-    }
-  } else {
-    state["target"] = nullptr;
-    state["fixation_error_deg"] = nullptr;
-  }
-  state["objects"] = internal::MovingObjectsJson(scene_, t);
+  if (perception_ && latest.target && latest.target->valid) parts.target = *latest.target;
   const double now = WallNow();
-  double steps_per_s = 0.0, frames_per_s = 0.0;
   if (step_walls_.size() >= 2) {
-    steps_per_s =
+    parts.steps_per_s =
         (step_walls_.size() - 1) / std::max(1e-9, step_walls_.back() - step_walls_.front());
   }
   {
     std::lock_guard lock(encode_mutex_);
     if (encode_walls_.size() >= 2 && now - encode_walls_.back() < 2.0) {
-      frames_per_s =
+      parts.frames_per_s =
           (encode_walls_.size() - 1) / std::max(1e-9, encode_walls_.back() - encode_walls_.front());
     }
   }
-  state["timing"] = {{"step_ms", last_step_ms_},
-                     {"steps_per_s", steps_per_s},
-                     {"realtime_factor", steps_per_s * context.dt},
-                     {"frames_per_s", frames_per_s}};
-  state["head_status"] = head_status_;
+  parts.step_ms = last_step_ms_;
+  parts.realtime_factor = parts.steps_per_s * context.dt;
+  parts.head_status = head_status_;
+  json state = internal::StateJson(parts, scene_);
+  Conform(protocol::CheckServerMessage(state));
   return state;
 }
 
@@ -518,6 +503,7 @@ void GuiSession::EncodeLoop() {
                              {"width", bgr.cols},
                              {"height", bgr.rows},
                              {"overlay", true}};
+        Conform(protocol::CheckFrameHeader(header));
         server_->PublishFrame(camera, header,
                               std::make_shared<const std::string>(jpeg.begin(), jpeg.end()));
       }
@@ -526,7 +512,7 @@ void GuiSession::EncodeLoop() {
       encode_walls_.push_back(WallNow());
       if (encode_walls_.size() > 26) encode_walls_.erase(encode_walls_.begin());
     } catch (const std::exception& error) {
-      server_->Broadcast({{"type", "event"}, {"level", "error"}, {"message", error.what()}});
+      server_->Broadcast(Event("error", error.what()));
     }
   }
 }

@@ -102,6 +102,11 @@ async function waitReady(page) {
     null, { timeout: kReadyTimeoutMs, polling: 200 });
   const fatal = await page.evaluate(() => window.saccadeGui.fatal);
   assert.equal(fatal, undefined, `the page failed: ${fatal}`);
+  // Everything the page received so far conformed to the protocol (protocol.js checks each).
+  const checked = await page.evaluate(() => ({
+    refused: window.saccadeGui.protocolErrors, checked: window.saccadeGui.messagesChecked }));
+  assert.deepEqual(checked.refused, [], 'messages of the server that break docs/gui-protocol.md');
+  assert.ok(checked.checked > 0, 'the page checked no message');
 }
 
 /** Sends a command from the page's WebSocket; resolves with the reply or error. */
@@ -488,6 +493,37 @@ describe('saccade gui (portraits.yaml)', () => {
     const errors = axisErrors(s, click);
     console.log(`fixated [${click.map((v) => v.toFixed(3))}]: axis errors ${errors.map((x) => x.toFixed(3))} deg`);
     for (const e of errors) assert.ok(e < kFixationToleranceDeg, `axis errors ${errors} deg`);
+  });
+
+  test('a message that breaks the protocol is refused by the page, the field named', async () => {
+    // A page of its own (the refusals stay there), fed a state and a frame that break
+    // docs/gui-protocol.md as if the server had sent them.
+    const other = await openPage(browser, server.url.href);
+    await other.waitForFunction(() => window.saccadeGui?.state?.joints, null,
+      { timeout: kReadyTimeoutMs, polling: 200 });
+    const result = await other.evaluate(() => {
+      const g = window.saccadeGui;
+      if (g.protocolErrors.length) throw new Error(`refused already: ${g.protocolErrors}`);
+      const broken = structuredClone(g.state);
+      broken.joints.positions.pan = 'left';
+      g.connection.receive(JSON.stringify(broken));
+      const header = new TextEncoder().encode(JSON.stringify(
+        { type: 'frame', camera: 'left', frame: 1, time: 0, height: 48, overlay: true }));
+      const buffer = new ArrayBuffer(4 + header.length + 2);
+      new DataView(buffer).setUint32(0, header.length, true);
+      new Uint8Array(buffer, 4).set(header);
+      const received = g.framesReceived.left;
+      g.connection.receive(buffer);
+      return { refused: [...g.protocolErrors], pan: g.state.joints.positions.pan,
+        framesReceived: g.framesReceived.left - received };
+    });
+    assert.deepEqual(result.refused, ["state: field 'joints.positions.pan' must be a number, got string",
+      "frame: missing field 'width'"]);
+    assert.equal(typeof result.pan, 'number', 'the broken state was applied');
+    assert.equal(result.framesReceived, 0, 'the broken frame was shown');
+    assert.match(await other.locator('#log').innerText(),
+      /refused a message that breaks the protocol: state: field 'joints\.positions\.pan'/);
+    await other.close();
   });
 
   test('figures: frames per second, ping and joints latency', async () => {

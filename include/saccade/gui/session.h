@@ -15,6 +15,7 @@
 #include <atomic>
 #include <condition_variable>
 #include <functional>
+#include <map>
 #include <memory>
 #include <mutex>
 #include <nlohmann/json.hpp>
@@ -77,7 +78,26 @@ class GuiSession {
   std::string Describe() const;
 
  private:
+  // The commands (docs/gui-protocol.md): Handle checks each against the protocol's table
+  // (gui/protocol.h) and hands it to its handler, on the I/O thread; a handler checks what the
+  // table cannot (the joints' limits, reachability) and queues the work.
+  using CommandFn = nlohmann::json (GuiSession::*)(const nlohmann::json& command);
+  static const std::map<std::string, CommandFn>& CommandTable();
+  static void CheckCommandTable();  // throws Error unless it and the table name the same
   nlohmann::json Handle(const nlohmann::json& command, int64_t client);
+  nlohmann::json OnJoints(const nlohmann::json& command);
+  nlohmann::json OnFixate(const nlohmann::json& command);
+  nlohmann::json OnPerception(const nlohmann::json& command);
+  nlohmann::json OnEffects(const nlohmann::json& command);
+  nlohmann::json OnPause(const nlohmann::json& command);
+  nlohmann::json OnResume(const nlohmann::json& command);
+  nlohmann::json OnStep(const nlohmann::json& command);
+  nlohmann::json OnSpeed(const nlohmann::json& command);
+  nlohmann::json OnHeadStop(const nlohmann::json& command);  // stop, estop, clear
+  nlohmann::json OnPing(const nlohmann::json& command);
+  const head::HeadDescription& RequireHead(const std::string& type) const;
+  // Sets the targets, queues the motion (perception off) and completes `reply` with them.
+  nlohmann::json MoveTo(const head::JointState& target, nlohmann::json reply);
   void Enqueue(std::function<void()> action);
   int ApplyQueued();  // how many commands it applied
   nlohmann::json StateJson(const runtime::StepContext& context, const Latest& latest);

@@ -1,6 +1,9 @@
-// The connection to the saccade server (docs/gui-protocol.md, saccade-gui/1): the access
+// The connection to the saccade server (docs/gui-protocol.md, saccade-gui/2): the access
 // token, the /api/ documents, and the WebSocket that carries states, camera frames and
-// commands.
+// commands. Every message received is checked against the protocol's table (protocol.js): one
+// that breaks it is refused, reported with the field named (onProtocolError), and goes no
+// further.
+import { checkFrameHeader, checkServerMessage } from './protocol.js';
 
 /** The access token from the page's address (?token=...), or '' when there is none. */
 export const token = new URLSearchParams(location.search).get('token') || '';
@@ -24,13 +27,17 @@ export async function fetchApi(path) {
 
 /**
  * The WebSocket session. Callbacks: onHello(msg), onState(state), onFrame(header, jpegBlob),
- * onReply(msg), onError(msg), onEvent(msg), onClose(). Commands get increasing ids.
+ * onReply(msg), onError(msg), onEvent(msg), onClose(), and onProtocolError(problem, message,
+ * kind) for a message that breaks the protocol (kind 'text' or 'frame'): refused, it reaches
+ * no other callback (a refused reply or error resolves its command as an error). Commands get
+ * increasing ids.
  */
 export class Connection {
   constructor(handlers) {
     this.handlers = handlers;
     this.nextId = 1;
-    this.pending = new Map();  // id -> {resolve, sent}
+    this.pending = new Map();  // id -> {resolve, sent, type}
+    this.checked = 0;  // messages checked against the protocol (text and frame headers)
     const scheme = location.protocol === 'https:' ? 'wss:' : 'ws:';
     this.url = withToken(`${scheme}//${location.host}/ws`);
     this.socket = new WebSocket(this.url);
@@ -54,7 +61,7 @@ export class Connection {
     const message = { type, id, ...fields };
     return new Promise((resolve) => {
       if (!this.open) { resolve({ type: 'error', id, error: `${type}: not connected` }); return; }
-      this.pending.set(id, { resolve, sent: performance.now() });
+      this.pending.set(id, { resolve, sent: performance.now(), type });
       this.socket.send(JSON.stringify(message));
     });
   }
@@ -64,6 +71,18 @@ export class Connection {
     let message;
     try { message = JSON.parse(data); } catch { return; }
     const h = this.handlers;
+    this.checked++;
+    const problem = checkServerMessage(message, this.pending.get(message?.id)?.type ?? '');
+    if (problem) {
+      const answers = message?.type === 'reply' || message?.type === 'error';
+      const waiting = answers ? this.pending.get(message.id) : undefined;
+      if (waiting) {
+        this.pending.delete(message.id);
+        waiting.resolve({ type: 'error', id: message.id, error: `refused by the page: ${problem}` });
+      }
+      h.onProtocolError?.(problem, message, 'text');
+      return;
+    }
     switch (message.type) {
       case 'hello': h.onHello?.(message); break;
       case 'state': h.onState?.(message); break;
@@ -85,6 +104,9 @@ export class Connection {
     if (4 + n > buffer.byteLength) return;
     let header;
     try { header = JSON.parse(new TextDecoder().decode(new Uint8Array(buffer, 4, n))); } catch { return; }
+    this.checked++;
+    const problem = checkFrameHeader(header);
+    if (problem) { this.handlers.onProtocolError?.(problem, header, 'frame'); return; }
     const jpeg = new Blob([new Uint8Array(buffer, 4 + n)], { type: 'image/jpeg' });
     this.handlers.onFrame?.(header, jpeg);
   }

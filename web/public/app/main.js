@@ -4,6 +4,7 @@
 import * as THREE from 'three';
 import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
 import { AccessError, Connection, fetchApi, token } from './connection.js';
+import { checkSceneDocument } from './protocol.js';
 import { buildWorld, loadModels, updateObjects } from './scene.js';
 import { Head, kLinkFrames } from './head.js';
 import { installInteraction, kDragGainDegPerPx } from './interact.js';
@@ -25,6 +26,8 @@ const gui = window.saccadeGui = {
   pageFps: { left: 0, right: 0 },
   lastClick: null,
   errors: [],
+  protocolErrors: [],        // messages refused for breaking the protocol (protocol.js), each named
+  messagesChecked: 0,        // messages checked against it
   dragGainDegPerPx: kDragGainDegPerPx,
   tokenPresent: !!token,
 };
@@ -44,6 +47,11 @@ async function start() {
   } catch (e) {
     if (e instanceof AccessError) { showAccessDenied(); return; }
     throw e;
+  }
+  const sceneProblem = checkSceneDocument(doc);
+  if (sceneProblem) {
+    gui.protocolErrors.push(sceneProblem);
+    throw new Error(`the server's /api/scene breaks the protocol: ${sceneProblem}`);
   }
   gui.scene = doc;
   $('scene-name').textContent = `${doc.name} (${doc.mode})`;
@@ -173,6 +181,12 @@ async function start() {
       log(logElement, `error${m.id != null ? ` (#${m.id})` : ''}: ${m.error}`, 'error');
     },
     onEvent: (m) => log(logElement, m.message, m.level),
+    onProtocolError: (problem, message, kind) => {
+      // Refused: what the server sent does not match docs/gui-protocol.md.
+      gui.protocolErrors.push(problem);
+      log(logElement, `refused a message that breaks the protocol: ${problem}`, 'error');
+      if (kind === 'frame') frameDone();  // dropped: the frame window counts it done
+    },
     onClose: () => {
       $('connection').textContent = 'disconnected: retrying';
       $('connection').className = 'badge bad';
@@ -192,6 +206,7 @@ async function start() {
     },
   });
   gui.connection = connection;
+  Object.defineProperty(gui, 'messagesChecked', { get: () => connection.checked });
 
   // Page frame rates, once a second.
   let counted = { ...gui.framesShown }, countedAt = performance.now();

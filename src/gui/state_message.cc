@@ -1,0 +1,70 @@
+#include <algorithm>
+#include <cmath>
+
+#include "gui/internal_scene_document.h"
+#include "gui/internal_state_message.h"
+#include "saccade/geometry/json.h"
+#include "saccade/head/json.h"
+
+namespace saccade::gui::internal {
+namespace {
+
+using nlohmann::json;
+
+constexpr double kRadToDeg = 180.0 / M_PI;
+
+double AxisErrorDeg(const geometry::Pose& X_WC, const Eigen::Vector3d& p_W) {
+  const Eigen::Vector3d to = (p_W - X_WC.translation()).normalized();
+  return std::acos(std::clamp(X_WC.linear().col(2).dot(to), -1.0, 1.0)) * kRadToDeg;
+}
+
+}  // namespace
+
+json StateJson(const StateParts& parts, const scene::Scene& scene) {
+  json state = {{"type", "state"},
+                {"step", parts.step},
+                {"time", parts.time},
+                {"paused", parts.paused},
+                {"speed", parts.speed},
+                {"perception", parts.perception},
+                {"manual", !parts.perception}};
+  state["effects"] = nullptr;
+  if (parts.effects) {
+    const render::RendererOptions& o = *parts.effects;
+    state["effects"] = {
+        {"distortion", o.distortion}, {"noise", o.noise}, {"motion_blur", o.motion_blur}};
+  }
+  std::optional<head::HeadFrames> frames;
+  state["joints"] = nullptr;
+  state["frames"] = nullptr;
+  state["fixation_W"] = nullptr;
+  if (parts.joints && parts.head != nullptr) {
+    const components::JointStateMessage& j = *parts.joints;
+    state["joints"] = {{"positions", ToJson(j.positions)},
+                       {"targets", ToJson(j.targets)},
+                       {"velocities", ToJson(j.velocities)},
+                       {"arrived", j.arrived}};
+    frames = head::ForwardKinematics(*parts.head, j.positions);
+    state["frames"] = FramesJson(*frames);
+    if (frames->p_WFixation) state["fixation_W"] = ToJson(*frames->p_WFixation);
+  }
+  state["target"] = nullptr;
+  state["fixation_error_deg"] = nullptr;
+  if (parts.target) {
+    const components::TargetMessage& target = *parts.target;
+    state["target"] = {{"valid", true}, {"p_W", ToJson(target.p_W)}, {"id", target.target_id}};
+    if (frames) {
+      state["fixation_error_deg"] = {{"left", AxisErrorDeg(frames->X_WCamLeft, target.p_W)},
+                                     {"right", AxisErrorDeg(frames->X_WCamRight, target.p_W)}};
+    }
+  }
+  state["objects"] = MovingObjectsJson(scene, parts.time);
+  state["timing"] = {{"step_ms", parts.step_ms},
+                     {"steps_per_s", parts.steps_per_s},
+                     {"realtime_factor", parts.realtime_factor},
+                     {"frames_per_s", parts.frames_per_s}};
+  state["head_status"] = parts.head_status;
+  return state;
+}
+
+}  // namespace saccade::gui::internal
