@@ -15,7 +15,10 @@
 
 namespace saccade::python {
 
-void BindGeometry(py::module_& m) {
+namespace {
+
+// Intrinsics: the image size and K.
+void BindIntrinsics(py::module_& m) {
   using namespace geometry;
   py::class_<Intrinsics>(m, "Intrinsics",
                          "Image size and K = [fx skew cx; 0 fy cy; 0 0 1] in pixels "
@@ -42,7 +45,11 @@ void BindGeometry(py::module_& m) {
                ", fx=" + std::to_string(k.fx()) + ", fy=" + std::to_string(k.fy()) +
                ", cx=" + std::to_string(k.cx()) + ", cy=" + std::to_string(k.cy()) + ")";
       });
+}
 
+// Distortion: the lens models and their coefficients.
+void BindDistortion(py::module_& m) {
+  using namespace geometry;
   py::class_<Distortion>(m, "Distortion",
                          "A lens distortion model and its coefficients, OpenCV's order "
                          "(include/saccade/geometry/distortion.h).")
@@ -62,7 +69,11 @@ void BindGeometry(py::module_& m) {
       .def("distort", &Distortion::Distort, "xy"_a,
            "Distorted normalized coordinates of undistorted (x, y) = (X/Z, Y/Z).")
       .def(py::self == py::self);
+}
 
+// CameraModel: points to pixels and back.
+void BindCameraModel(py::module_& m) {
+  using namespace geometry;
   py::class_<CameraModel>(m, "CameraModel",
                           "Intrinsics and distortion: points to pixels as cv::projectPoints, "
                           "pixels to rays.")
@@ -100,7 +111,11 @@ void BindGeometry(py::module_& m) {
           "uv"_a, "Unit ray through pixel (u, v), distortion removed; None when it diverges.")
       .def("contains", &CameraModel::Contains, "uv"_a)
       .def(py::self == py::self);
+}
 
+// Calibrated cameras and stereo pairs, and their files.
+void BindCalibration(py::module_& m) {
+  using namespace geometry;
   py::class_<CameraCalibration>(m, "CameraCalibration", "A calibrated camera and its name.")
       .def(py::init<CameraModel, std::string>(), "model"_a, "name"_a = "")
       .def_readwrite("model", &CameraCalibration::model)
@@ -147,7 +162,11 @@ void BindGeometry(py::module_& m) {
       },
       "path"_a, "extrinsics_path"_a = py::none(), "size"_a = py::none(),
       "Reads M1 D1 M2 D2 R T (OpenCV YAML or XML).");
+}
 
+// Rotations and poses.
+void BindPoses(py::module_& m) {
+  using namespace geometry;
   m.def("rotation_from_rpy", &RotationFromRpy, "roll"_a, "pitch"_a, "yaw"_a,
         "R = Rz(yaw) Ry(pitch) Rx(roll) (REP 103), radians.");
   m.def("rpy_from_rotation", &RpyFromRotation, "R"_a);
@@ -155,7 +174,11 @@ void BindGeometry(py::module_& m) {
       "make_pose",
       [](const Eigen::Matrix3d& R, const Eigen::Vector3d& t) { return MakePose(R, t).matrix(); },
       "R"_a, "t"_a, "A 4x4 pose from a rotation and a translation.");
+}
 
+// Rays and triangulation (seed section 4.2).
+void BindTriangulation(py::module_& m) {
+  using namespace geometry;
   py::class_<Ray>(m, "Ray", "A ray: origin (metres) and unit direction.")
       .def(py::init([](const Eigen::Vector3d& origin, const Eigen::Vector3d& direction) {
              if (!(direction.norm() > 0.0) || !direction.allFinite() || !origin.allFinite()) {
@@ -176,6 +199,17 @@ void BindGeometry(py::module_& m) {
         "Midpoint of the shortest segment between two rays (seed section 4.2).");
   m.def("triangulate_dlt", &TriangulateDlt, "view_a"_a, "xy_a"_a, "view_b"_a, "xy_b"_a,
         "Linear triangulation from two 3x4 [R|t] world-to-camera views and normalized points.");
+}
+
+}  // namespace
+
+void BindGeometry(py::module_& m) {
+  BindIntrinsics(m);
+  BindDistortion(m);
+  BindCameraModel(m);
+  BindCalibration(m);
+  BindPoses(m);
+  BindTriangulation(m);
 }
 
 }  // namespace saccade::python

@@ -12,7 +12,10 @@
 
 namespace saccade::python {
 
-void BindHead(py::module_& m) {
+namespace {
+
+// JointState, and the sequences that convert to it.
+void BindJointState(py::module_& m) {
   using namespace head;
   py::class_<JointState>(m, "JointState", "Joint angles in radians: pan, tilt, left, right.")
       .def(py::init<>())
@@ -46,7 +49,11 @@ void BindHead(py::module_& m) {
   py::implicitly_convertible<py::list, JointState>();
   py::implicitly_convertible<py::tuple, JointState>();
   py::implicitly_convertible<py::array, JointState>();
+}
 
+// The head description: limits, geometry, the file.
+void BindHeadDescription(py::module_& m) {
+  using namespace head;
   py::class_<JointLimits>(m, "JointLimits", "Position (rad), velocity (rad/s), acceleration.")
       .def_readonly("min", &JointLimits::min)
       .def_readonly("max", &JointLimits::max)
@@ -84,7 +91,11 @@ void BindHead(py::module_& m) {
       .def("within_limits", &HeadDescription::WithinLimits, "joints"_a)
       .def("check_limits", &HeadDescription::CheckLimits, "joints"_a,
            "Raises InvalidArgument naming the first joint outside its limits.");
+}
 
+// Forward kinematics: the frames, and the optical axes' errors.
+void BindForwardKinematics(py::module_& m) {
+  using namespace head;
   py::class_<HeadFrames>(m, "HeadFrames", "Every frame of the head in the world (4x4 poses).")
       .def_property_readonly("X_WB", [](const HeadFrames& f) { return PoseToMatrix(f.X_WB); })
       .def_property_readonly("X_WN", [](const HeadFrames& f) { return PoseToMatrix(f.X_WN); })
@@ -134,7 +145,11 @@ void BindHead(py::module_& m) {
       "head"_a, "joints"_a, "p_W"_a,
       "Angle (rad) between each camera's optical axis and the ray to p_W: (left, right); for "
       "joints (n, 4) and points (n, 3), an (n, 2) array, one row a head.");
+}
 
+// Inverse kinematics: fixation (appendix A).
+void BindInverseKinematics(py::module_& m) {
+  using namespace head;
   py::class_<IkResult>(m, "IkResult")
       .def_readonly("joints", &IkResult::joints, "The solution, within the joint limits.")
       .def_property_readonly("reachability",
@@ -162,6 +177,15 @@ void BindHead(py::module_& m) {
       "Inverse kinematics: the joints that bring p_W (world, metres) onto both optical axes.");
   m.def("solve_fixation_closed_form", &SolveFixationClosedForm, "head"_a, "p_W"_a,
         "Closed form of eqs. 10-13 (symmetric vergence, D = H = 0).");
+}
+
+}  // namespace
+
+void BindHead(py::module_& m) {
+  BindJointState(m);
+  BindHeadDescription(m);
+  BindForwardKinematics(m);
+  BindInverseKinematics(m);
 }
 
 }  // namespace saccade::python

@@ -41,9 +41,40 @@ struct PyRenderer {
   int width = 0, height = 0;  // of the first camera
 };
 
-}  // namespace
+// Renderer.render: every camera's Frame, or (out=) their colour images into the caller's array.
+py::object Render(PyRenderer& r, const scene::SceneState& state, int64_t frame_index,
+                  std::optional<py::array> out) {
+  using render::Frame;
+  std::vector<Frame> frames;
+  uint8_t* target = nullptr;
+  std::size_t bytes = 0;
+  if (out) {
+    const auto cameras = static_cast<py::ssize_t>(r.renderer->camera_names().size());
+    target = CheckOut(*out, {cameras, r.height, r.width, 3}, "Renderer.render");
+    bytes = static_cast<std::size_t>(r.height) * r.width * 3;
+  }
+  {
+    py::gil_scoped_release release;
+    frames = r.renderer->Render(state, frame_index);
+    if (target != nullptr) {
+      for (std::size_t i = 0; i < frames.size(); ++i) {
+        const Image& color = *frames[i].color;
+        if (color.size_bytes() != bytes) {
+          throw InvalidArgument(
+              "Renderer.render: out= needs every camera at the "
+              "first camera's size; camera '" +
+              r.renderer->camera_names()[i] + "' differs");
+        }
+        std::memcpy(target + i * bytes, color.data(), bytes);
+      }
+    }
+  }
+  if (out) return *out;
+  return py::cast(std::move(frames));
+}
 
-void BindRender(py::module_& m) {
+// A camera's frame and its ground truth.
+void BindFrames(py::module_& m) {
   using namespace render;
   py::class_<ObjectTruth>(m, "ObjectTruth", "Ground truth of one object in one frame.")
       .def_readonly("id", &ObjectTruth::id)
@@ -76,7 +107,11 @@ void BindRender(py::module_& m) {
           },
           "The colour image's owner, with its metadata.")
       .def_readonly("objects", &Frame::objects);
+}
 
+// The renderer's time per stage.
+void BindRenderStats(py::module_& m) {
+  using namespace render;
   py::class_<RenderStats>(m, "RenderStats", "Cumulative time per stage, milliseconds.")
       .def_readonly("frames", &RenderStats::frames)
       .def_readonly("scene_update_ms", &RenderStats::scene_update_ms)
@@ -87,7 +122,11 @@ void BindRender(py::module_& m) {
                     "Of readback_ms: the lens remap and the noise done on the CPU (a software "
                     "rasteriser's way).")
       .def_readonly("total_ms", &RenderStats::total_ms);
+}
 
+// One head of a batch render.
+void BindBatchHead(py::module_& m) {
+  using namespace render;
   py::class_<BatchHead>(m, "BatchHead",
                         "One head of a batch: its state and, optionally, per scene object a "
                         "4x4 pose replacing its motion (None: keep it) and a hidden flag.")
@@ -111,7 +150,11 @@ void BindRender(py::module_& m) {
            }),
            "state"_a, "object_poses"_a = py::none(), "hidden"_a = py::none())
       .def_readwrite("state", &BatchHead::state);
+}
 
+// The renderer.
+void BindRenderer(py::module_& m) {
+  using namespace render;
   py::class_<PyRenderer>(m, "Renderer",
                          "Renders a scene's cameras headless (OpenGL 3.3 through EGL: llvmpipe "
                          "without a GPU). Not thread-safe: use it from one thread.")
@@ -167,40 +210,9 @@ void BindRender(py::module_& m) {
           "Switches the effects of every camera in place, as the constructor's arguments would: "
           "the next renders are bit for bit those of a Renderer made with them, without a new "
           "context or uploads (say, effects drawn at random per episode).")
-      .def(
-          "render",
-          [](PyRenderer& r, const scene::SceneState& state, int64_t frame_index,
-             std::optional<py::array> out) -> py::object {
-            std::vector<Frame> frames;
-            uint8_t* target = nullptr;
-            std::size_t bytes = 0;
-            if (out) {
-              const auto cameras = static_cast<py::ssize_t>(r.renderer->camera_names().size());
-              target = CheckOut(*out, {cameras, r.height, r.width, 3}, "Renderer.render");
-              bytes = static_cast<std::size_t>(r.height) * r.width * 3;
-            }
-            {
-              py::gil_scoped_release release;
-              frames = r.renderer->Render(state, frame_index);
-              if (target != nullptr) {
-                for (std::size_t i = 0; i < frames.size(); ++i) {
-                  const Image& color = *frames[i].color;
-                  if (color.size_bytes() != bytes) {
-                    throw InvalidArgument(
-                        "Renderer.render: out= needs every camera at the "
-                        "first camera's size; camera '" +
-                        r.renderer->camera_names()[i] + "' differs");
-                  }
-                  std::memcpy(target + i * bytes, color.data(), bytes);
-                }
-              }
-            }
-            if (out) return *out;
-            return py::cast(std::move(frames));
-          },
-          "state"_a, "frame_index"_a = 0, "out"_a = py::none(),
-          "Renders every camera in `state`. Returns one Frame per camera; with out= (a uint8 "
-          "array cameras x height x width x 3) fills it instead and returns it. Releases the GIL.")
+      .def("render", &Render, "state"_a, "frame_index"_a = 0, "out"_a = py::none(),
+           "Renders every camera in `state`. Returns one Frame per camera; with out= (a uint8 "
+           "array cameras x height x width x 3) fills it instead and returns it. Releases the GIL.")
       .def(
           "render_batch",
           [](PyRenderer& r, const std::vector<BatchHead>& heads, std::optional<py::array> out) {
@@ -221,6 +233,15 @@ void BindRender(py::module_& m) {
           "every camera in one call and one readback. Returns (or fills) a uint8 array heads x "
           "cameras x height x width x 3: the pinhole images of K (no distortion, noise or "
           "blur). Releases the GIL.");
+}
+
+}  // namespace
+
+void BindRender(py::module_& m) {
+  BindFrames(m);
+  BindRenderStats(m);
+  BindBatchHead(m);
+  BindRenderer(m);
 }
 
 }  // namespace saccade::python

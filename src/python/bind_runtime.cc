@@ -3,17 +3,20 @@
 // dicts in their JSON form); any method called; components written in Python registered as
 // types that pipeline files name.
 //
-// Stepping: Pipeline.step runs the serial schedule of runtime::RunPipeline (scheduler.cc) one
-// tick at a time: delayed messages delivered, then every enabled component in execution order,
-// its inputs marked seen; simulated time step * dt (or clock.source's stamps); a failing component
-// raises saccade.Error "component 'name' failed at step k: ..." (on_error: stop). The GIL is
-// released while C++ components step; a Python component takes it back for its own step.
+// Stepping: Pipeline.step runs runtime::Stepper's step (scheduler.h), the one runtime::RunPipeline
+// loops over: delayed messages delivered, the components level by level (a level's at the same
+// time on the pipeline's threads), their inputs marked seen; simulated time step * dt (or
+// clock.source's stamps) whatever the file's clock. A failing component raises saccade.Error
+// "component 'name' failed at step k: ..." after the step (which on_error: stop ends at the
+// failure). The GIL is released while C++ components step; a Python component (thread-affine:
+// on the calling thread) takes it back for its own step.
 #include <fmt/format.h>
 #include <pybind11/eigen.h>
 #include <pybind11/functional.h>
 #include <pybind11/stl.h>
 
 #include <map>
+#include <optional>
 
 #include "python/internal_bindings.h"
 #include "saccade/components/messages.h"
@@ -289,44 +292,18 @@ class PyPipeline {
   }
 
   runtime::Pipeline& pipeline() { return pipeline_; }
-  int64_t steps_done() const { return step_; }
+  int64_t steps_done() const { return stepper_.steps_done(); }
 
+  // runtime::Stepper's steps (scheduler.h), on simulated time; the first failure raised.
   void Step(int64_t count) {
     if (closed_) throw Error("Pipeline.step: the pipeline is closed");
     if (count < 0)
       throw InvalidArgument("Pipeline.step: count must be >= 0, got " + std::to_string(count));
     py::gil_scoped_release release;
-    if (!started_) StartAll();
-    const auto& components = pipeline_.components();
-    const double dt = pipeline_.spec().clock.mode == runtime::ClockMode::kRealtime
-                          ? 1.0 / pipeline_.spec().clock.rate_hz
-                          : pipeline_.spec().clock.step;
+    if (!started_) Start();
     for (int64_t n = 0; n < count; ++n) {
-      runtime::StepContext context;
-      context.step = step_;
-      // step * dt, or the stamps of `clock.source` (scheduler.h)
-      context.time = runtime::SimulatedStepTime(pipeline_, step_, time_);
-      time_ = context.time;
-      context.dt = dt;
-      pipeline_.DeliverDelayed();
-      pipeline_.BeginStep(context);
-      for (const auto& component : components) {
-        if (component->enabled()) {
-          runtime::StepContext own = context;
-          own.seed = component->seed();
-          try {
-            component->Step(own);
-          } catch (const std::exception& error) {
-            for (const auto& input : component->inputs()) input->MarkSeen();
-            ++step_;
-            throw Error(fmt::format("component '{}' failed at step {}: {}", component->name(),
-                                    context.step, error.what()));
-          }
-        }
-        for (const auto& input : component->inputs()) input->MarkSeen();
-      }
-      pipeline_.EndStep(context);
-      ++step_;
+      const runtime::StepResult& result = stepper_.Step();
+      if (!result.errors.empty()) throw Error(result.errors.front().ToString());
     }
   }
 
@@ -338,13 +315,9 @@ class PyPipeline {
     closed_ = true;
     py::gil_scoped_release release;
     std::string errors;
-    for (auto it = pipeline_.components().rbegin(); it != pipeline_.components().rend(); ++it) {
-      try {
-        (*it)->Stop();
-      } catch (const std::exception& error) {
-        errors += fmt::format("{}component '{}' failed to stop: {}", errors.empty() ? "" : "; ",
-                              (*it)->name(), error.what());
-      }
+    for (const runtime::StepError& error : stepper_.Stop()) {
+      errors += fmt::format("{}component '{}' failed to stop: {}", errors.empty() ? "" : "; ",
+                            error.component, error.message);
     }
     if (!errors.empty()) throw Error(errors);
   }
@@ -400,33 +373,28 @@ class PyPipeline {
   }
 
  private:
-  void StartAll() {
-    const auto& components = pipeline_.components();
-    for (std::size_t i = 0; i < components.size(); ++i) {
-      try {
-        components[i]->Start();
-      } catch (const std::exception& error) {
-        for (std::size_t j = i; j-- > 0;) {
-          try {
-            components[j]->Stop();
-          } catch (const std::exception&) {
-            // The start failure is the one reported.
-          }
-        }
-        closed_ = true;
-        throw Error(
-            fmt::format("component '{}' failed to start: {}", components[i]->name(), error.what()));
-      }
+  static runtime::StepperOptions SimulatedTime() {
+    runtime::StepperOptions options;
+    options.simulated_time = true;
+    return options;
+  }
+
+  void Start() {
+    if (const std::optional<runtime::StepError> failure = stepper_.Start()) {
+      stepper_.Stop();  // those that started; the start failure is the one reported
+      closed_ = true;
+      throw Error(
+          fmt::format("component '{}' failed to start: {}", failure->component, failure->message));
     }
     started_ = true;
   }
 
   runtime::Pipeline pipeline_;
+  // Python paces the steps: the simulated clock's times whatever the file's clock.
+  runtime::Stepper stepper_{pipeline_, SimulatedTime()};
   std::map<std::string, std::shared_ptr<Tap>> taps_;
   bool started_ = false;
   bool closed_ = false;
-  int64_t step_ = 0;
-  double time_ = 0.0;  // the last step's
 };
 
 py::object TapValue(const Tap& tap) {
@@ -435,13 +403,8 @@ py::object TapValue(const Tap& tap) {
   return JsonToPython(tap.json);
 }
 
-}  // namespace
-
-void BindRuntime(py::module_& m) {
-  components::RegisterComponents(runtime::ComponentRegistry::Global());
-  // Pipeline connections that name a topic go over DDS, as under `saccade run` (docs/dds.md).
-  dds::RegisterDdsTransport(runtime::ComponentRegistry::Global());
-
+// Components written in Python, and the types pipelines may name.
+void BindComponentTypes(py::module_& m) {
   m.def(
       "register_component",
       [](const std::string& type, py::function callable, const std::string& description) {
@@ -478,50 +441,12 @@ void BindRuntime(py::module_& m) {
         return names;
       },
       "The message types a Python component's ports may have.");
+}
 
-  py::class_<PyPipeline>(m, "Pipeline",
-                         "A pipeline built from a YAML file (include/saccade/runtime/pipeline.h "
-                         "documents the format), stepped from Python. Use as a context manager "
-                         "or call close() to stop its components.")
-      .def_static(
-          "load",
-          [](const std::string& path, const std::string& hardware) {
-            return std::make_unique<PyPipeline>(runtime::Pipeline::Build(
-                runtime::LoadPipelineFile(path, hardware), runtime::ComponentRegistry::Global()));
-          },
-          "path"_a, "hardware"_a = "",
-          "Builds a pipeline file; `hardware` (a hardware file) replaces the file's own "
-          "`hardware:` line. Raises FileError with file:line: key.")
-      .def_static(
-          "from_yaml_string",
-          [](const std::string& text, const std::string& source, const std::string& hardware) {
-            return std::make_unique<PyPipeline>(
-                runtime::Pipeline::Build(runtime::ParsePipeline(text, source, hardware),
-                                         runtime::ComponentRegistry::Global()));
-          },
-          "text"_a, "source"_a = "<string>", "hardware"_a = "",
-          "Builds a pipeline from YAML text (relative paths resolve against the current folder).")
-      .def("step", &PyPipeline::Step, "count"_a = 1,
-           "Runs `count` steps (starting the components before the first). Releases the GIL. "
-           "Raises saccade.Error naming the component and step when one fails.")
-      .def("close", &PyPipeline::Close, "Stops every component (once).")
-      .def(
-          "__enter__", [](PyPipeline& p) -> PyPipeline& { return p; },
-          py::return_value_policy::reference)
-      .def("__exit__", [](PyPipeline& p, py::args) { p.Close(); })
-      .def_property_readonly("steps_done", &PyPipeline::steps_done)
-      .def_property_readonly("dt", [](PyPipeline& p) { return p.pipeline().spec().clock.step; })
-      .def_property_readonly(
-          "hardware_file", [](PyPipeline& p) { return p.pipeline().spec().hardware_file; },
-          "The hardware file used ('' when none).")
-      .def_property_readonly(
-          "components",
-          [](PyPipeline& p) {
-            std::vector<std::string> names;
-            for (const auto& c : p.pipeline().components()) names.push_back(c->name());
-            return names;
-          },
-          "Component names in execution order.")
+// Pipeline's components and signals: what they declare, their latest messages, their methods,
+// switching them on and off.
+void BindPipelineComponents(py::class_<PyPipeline>& pipeline) {
+  pipeline
       .def(
           "describe",
           [](PyPipeline& p, const std::string& name) {
@@ -582,6 +507,67 @@ void BindRuntime(py::module_& m) {
             return component ? component->impl() : py::none();
           },
           "component"_a, "The Python object behind a Python component, or None.");
+}
+
+// Pipeline: building, stepping, closing, what it is made of.
+void BindPipeline(py::module_& m) {
+  py::class_<PyPipeline> pipeline(
+      m, "Pipeline",
+      "A pipeline built from a YAML file (include/saccade/runtime/pipeline.h "
+      "documents the format), stepped from Python. Use as a context manager "
+      "or call close() to stop its components.");
+  pipeline
+      .def_static(
+          "load",
+          [](const std::string& path, const std::string& hardware) {
+            return std::make_unique<PyPipeline>(runtime::Pipeline::Build(
+                runtime::LoadPipelineFile(path, hardware), runtime::ComponentRegistry::Global()));
+          },
+          "path"_a, "hardware"_a = "",
+          "Builds a pipeline file; `hardware` (a hardware file) replaces the file's own "
+          "`hardware:` line. Raises FileError with file:line: key.")
+      .def_static(
+          "from_yaml_string",
+          [](const std::string& text, const std::string& source, const std::string& hardware) {
+            return std::make_unique<PyPipeline>(
+                runtime::Pipeline::Build(runtime::ParsePipeline(text, source, hardware),
+                                         runtime::ComponentRegistry::Global()));
+          },
+          "text"_a, "source"_a = "<string>", "hardware"_a = "",
+          "Builds a pipeline from YAML text (relative paths resolve against the current folder).")
+      .def("step", &PyPipeline::Step, "count"_a = 1,
+           "Runs `count` steps (starting the components before the first): the scheduler's "
+           "step, on simulated time whatever the file's clock. Releases the GIL. Raises "
+           "saccade.Error naming the component and step when one fails.")
+      .def("close", &PyPipeline::Close, "Stops every component (once).")
+      .def(
+          "__enter__", [](PyPipeline& p) -> PyPipeline& { return p; },
+          py::return_value_policy::reference)
+      .def("__exit__", [](PyPipeline& p, py::args) { p.Close(); })
+      .def_property_readonly("steps_done", &PyPipeline::steps_done)
+      .def_property_readonly("dt", [](PyPipeline& p) { return p.pipeline().spec().clock.step; })
+      .def_property_readonly(
+          "hardware_file", [](PyPipeline& p) { return p.pipeline().spec().hardware_file; },
+          "The hardware file used ('' when none).")
+      .def_property_readonly(
+          "components",
+          [](PyPipeline& p) {
+            std::vector<std::string> names;
+            for (const auto& c : p.pipeline().components()) names.push_back(c->name());
+            return names;
+          },
+          "Component names in execution order.");
+  BindPipelineComponents(pipeline);
+}
+
+}  // namespace
+
+void BindRuntime(py::module_& m) {
+  components::RegisterComponents(runtime::ComponentRegistry::Global());
+  // Pipeline connections that name a topic go over DDS, as under `saccade run` (docs/dds.md).
+  dds::RegisterDdsTransport(runtime::ComponentRegistry::Global());
+  BindComponentTypes(m);
+  BindPipeline(m);
 }
 
 }  // namespace saccade::python

@@ -299,38 +299,33 @@ std::string PortNames(const Ports& ports) {
 
 std::string ComponentKey(std::size_t index) { return fmt::format("components[{}]", index); }
 
-}  // namespace
-
-PipelineSpec ParsePipeline(const std::string& text, const std::string& source,
-                           const std::string& hardware) {
-  const YAML::Node root_node = saccade::internal::ParseYaml(text, source);
-  const Entry root(root_node, "", &source, 1);
-  root.ExpectMap(
-      {"clock", "seed", "threads", "on_error", "scene", "hardware", "transport", "components"},
-      "a pipeline {clock, seed, threads, on_error, scene, hardware, transport, components}");
-  PipelineSpec spec;
-  spec.file = source;
+// The top-level settings: transport, scene, clock, seed, threads, on_error.
+void ParseSettings(const Entry& root, PipelineSpec* spec) {
   if (const auto transport = root.Find("transport")) {
     if (!transport->IsMap()) transport->Fail("expected a map, got " + transport->Describe());
-    spec.transport = ToJson(*transport);
-    spec.transport_line = transport->line();
+    spec->transport = ToJson(*transport);
+    spec->transport_line = transport->line();
   }
-  if (auto scene = ParseScene(root, source)) spec.resources["scene"] = std::move(*scene);
-  if (const auto clock = root.Find("clock")) spec.clock = ParseClock(*clock);
-  if (const auto seed = root.Find("seed")) spec.seed = seed->AsUint64();
+  if (auto scene = ParseScene(root, spec->file)) spec->resources["scene"] = std::move(*scene);
+  if (const auto clock = root.Find("clock")) spec->clock = ParseClock(*clock);
+  if (const auto seed = root.Find("seed")) spec->seed = seed->AsUint64();
   if (const auto threads = root.Find("threads")) {
-    spec.threads = static_cast<int>(threads->AsInteger(0, kMaxThreads));
+    spec->threads = static_cast<int>(threads->AsInteger(0, kMaxThreads));
   }
   if (const auto on_error = root.Find("on_error")) {
     const std::string value = on_error->AsString();
     if (value == "stop") {
-      spec.on_error = OnError::kStop;
+      spec->on_error = OnError::kStop;
     } else if (value == "continue") {
-      spec.on_error = OnError::kContinue;
+      spec->on_error = OnError::kContinue;
     } else {
       on_error->Fail("expected stop or continue, got " + on_error->Describe());
     }
   }
+}
+
+// The `components:` list, in order; names unique.
+std::vector<ComponentSpec> ParseComponents(const Entry& root) {
   const Entry components = root.Get("components");
   const std::vector<Entry> entries = components.AsSequence("components");
   if (entries.empty()) components.Fail("expected at least one component, got an empty list");
@@ -338,6 +333,7 @@ PipelineSpec ParsePipeline(const std::string& text, const std::string& source,
     components.Fail(fmt::format("{} components, more than the {} a pipeline may have",
                                 entries.size(), kMaxComponents));
   }
+  std::vector<ComponentSpec> specs;
   std::map<std::string, int> lines;  // name -> line of its first use
   for (const Entry& entry : entries) {
     ComponentSpec component = ParseComponent(entry);
@@ -346,25 +342,30 @@ PipelineSpec ParsePipeline(const std::string& text, const std::string& source,
       entry.Get("name").Fail(fmt::format("duplicate component name '{}' (first at line {})",
                                          component.name, it->second));
     }
-    spec.components.push_back(std::move(component));
+    specs.push_back(std::move(component));
   }
+  return specs;
+}
 
-  // The hardware file fills in the components without a type.
+// Reads the hardware file (`hardware`, else the file's `hardware:` line) and fills in the
+// components without a type from it; each of its components must be in the pipeline.
+void ApplyHardwareFile(const Entry& root, const std::string& hardware, PipelineSpec* spec) {
+  const std::string& source = spec->file;
   std::optional<Entry> hardware_entry = root.Find("hardware");
   if (!hardware.empty()) {
-    spec.hardware_file = hardware;
+    spec->hardware_file = hardware;
   } else if (hardware_entry) {
     const std::filesystem::path relative = hardware_entry->AsNonEmptyString();
-    spec.hardware_file = relative.is_absolute()
-                             ? relative.string()
-                             : (std::filesystem::path(source).parent_path() / relative).string();
+    spec->hardware_file = relative.is_absolute()
+                              ? relative.string()
+                              : (std::filesystem::path(source).parent_path() / relative).string();
   }
   std::map<std::string, ComponentSpec> parts;
-  if (!spec.hardware_file.empty()) {
+  if (!spec->hardware_file.empty()) {
     try {
       std::optional<ResourceSpec> scene;
-      parts = LoadHardware(spec.hardware_file, &scene);
-      if (scene) spec.resources["scene"] = std::move(*scene);  // the hardware file's wins
+      parts = LoadHardware(spec->hardware_file, &scene);
+      if (scene) spec->resources["scene"] = std::move(*scene);  // the hardware file's wins
     } catch (const FileError& error) {
       if (hardware.empty() && hardware_entry && error.line() == 0) {
         hardware_entry->Fail(error.what());  // a missing file: name the pipeline's line too
@@ -372,27 +373,27 @@ PipelineSpec ParsePipeline(const std::string& text, const std::string& source,
       throw;
     }
   }
-  for (std::size_t i = 0; i < spec.components.size(); ++i) {
-    ComponentSpec& component = spec.components[i];
+  for (std::size_t i = 0; i < spec->components.size(); ++i) {
+    ComponentSpec& component = spec->components[i];
     const auto part = parts.find(component.name);
     if (!component.type.empty()) {
       if (part != parts.end()) {
         throw FileError(source, component.type_line, ComponentKey(i) + ".type",
                         fmt::format("component '{}' is in the hardware file {} (line {}): leave "
                                     "its type and params to that file",
-                                    component.name, spec.hardware_file, part->second.line));
+                                    component.name, spec->hardware_file, part->second.line));
       }
       continue;
     }
     if (part == parts.end()) {
       throw FileError(source, component.line, ComponentKey(i),
-                      spec.hardware_file.empty()
+                      spec->hardware_file.empty()
                           ? fmt::format("component '{}' has no type (and the pipeline names no "
                                         "hardware file that would give it one)",
                                         component.name)
                           : fmt::format("component '{}' has no type, and the hardware file {} "
                                         "does not define it",
-                                        component.name, spec.hardware_file));
+                                        component.name, spec->hardware_file));
     }
     component.type = part->second.type;
     component.params = part->second.params;
@@ -408,6 +409,23 @@ PipelineSpec ParsePipeline(const std::string& text, const std::string& source,
                                 "component of that name",
                                 extra.name, source));
   }
+}
+
+}  // namespace
+
+PipelineSpec ParsePipeline(const std::string& text, const std::string& source,
+                           const std::string& hardware) {
+  const YAML::Node root_node = saccade::internal::ParseYaml(text, source);
+  const Entry root(root_node, "", &source, 1);
+  root.ExpectMap(
+      {"clock", "seed", "threads", "on_error", "scene", "hardware", "transport", "components"},
+      "a pipeline {clock, seed, threads, on_error, scene, hardware, transport, components}");
+  PipelineSpec spec;
+  spec.file = source;
+  ParseSettings(root, &spec);
+  spec.components = ParseComponents(root);
+  // The hardware file fills in the components without a type.
+  ApplyHardwareFile(root, hardware, &spec);
   return spec;
 }
 
@@ -452,36 +470,55 @@ Pipeline Pipeline::LoadString(const std::string& text, const std::string& source
   return Build(ParsePipeline(text, source), registry);
 }
 
-Pipeline Pipeline::Build(const PipelineSpec& spec, const ComponentRegistry& registry) {
-  Pipeline pipeline;
-  pipeline.spec_ = spec;
-  const std::string& file = spec.file;
-  const std::size_t n = spec.components.size();
-  std::map<std::string, std::size_t> index;
-  for (std::size_t i = 0; i < n; ++i) {
+namespace {
+
+// Build's phases, in order: names, resources, components, topics, clock source, connections.
+
+// Throws FileError naming the second of two components of the same name.
+void CheckUniqueNames(const PipelineSpec& spec) {
+  std::set<std::string> names;
+  for (std::size_t i = 0; i < spec.components.size(); ++i) {
     const ComponentSpec& c = spec.components[i];
-    if (!index.emplace(c.name, i).second) {
-      throw FileError(file, c.line, ComponentKey(i) + ".name",
+    if (!names.insert(c.name).second) {
+      throw FileError(spec.file, c.line, ComponentKey(i) + ".name",
                       "duplicate component name '" + c.name + "'");
     }
   }
+}
 
-  // The shared resources, loaded before any component so that a bad file is reported at the
-  // line that names it.
-  pipeline.resources_ = std::make_shared<Resources>(registry.resource_loaders());
+// Each component's index by name (the first, should two share one).
+std::map<std::string, std::size_t> NameIndex(const PipelineSpec& spec) {
+  std::map<std::string, std::size_t> index;
+  for (std::size_t i = 0; i < spec.components.size(); ++i)
+    index.emplace(spec.components[i].name, i);
+  return index;
+}
+
+// The shared resources, loaded before any component so that a bad file is reported at the
+// line that names it.
+std::shared_ptr<Resources> LoadResources(const PipelineSpec& spec,
+                                         const ComponentRegistry& registry) {
+  auto resources = std::make_shared<Resources>(registry.resource_loaders());
   for (const auto& [kind, resource] : spec.resources) {
     try {
-      pipeline.resources_->SetDefault(kind, resource.path);
-      pipeline.resources_->LoadDefault(kind);
+      resources->SetDefault(kind, resource.path);
+      resources->LoadDefault(kind);
     } catch (const Error& error) {
       throw FileError(resource.file, resource.line, kind, error.what());
     }
   }
+  return resources;
+}
 
+// The file's components, created and configured in order.
+std::vector<std::unique_ptr<Component>> CreateComponents(
+    const PipelineSpec& spec, const ComponentRegistry& registry,
+    const std::shared_ptr<Resources>& resources) {
+  const std::string& file = spec.file;
   // Relative paths in params resolve against the pipeline file's folder.
   const std::string base_dir = std::filesystem::path(file).parent_path().string();
-  // Create and configure, in order.
-  for (std::size_t i = 0; i < n; ++i) {
+  std::vector<std::unique_ptr<Component>> components;
+  for (std::size_t i = 0; i < spec.components.size(); ++i) {
     const ComponentSpec& c = spec.components[i];
     // A hardware component's type and params come from its hardware file.
     const std::string& params_file = c.params_file.empty() ? file : c.params_file;
@@ -499,135 +536,214 @@ Pipeline Pipeline::Build(const PipelineSpec& spec, const ComponentRegistry& regi
                           c.params_file.empty()
                               ? base_dir
                               : std::filesystem::path(c.params_file).parent_path().string(),
-                          pipeline.resources_);
+                          resources);
     try {
       component->Configure(c.params);
     } catch (const std::exception& error) {
       throw FileError(params_file, c.params_line, params_key,
                       "component '" + c.name + "' (" + c.type + "): " + error.what());
     }
-    pipeline.components_.push_back(std::move(component));
+    components.push_back(std::move(component));
   }
+  return components;
+}
 
-  // Topic connections (the file comment): a reader component just before each consumer of a
-  // topic, and writers attached to the outputs that name one, through the registered transport.
-  bool has_topics = false;
-  for (const ComponentSpec& c : spec.components) {
-    has_topics = has_topics || !c.topic_outputs.empty() ||
-                 std::any_of(c.inputs.begin(), c.inputs.end(),
-                             [](const ConnectionSpec& x) { return !x.topic.empty(); });
-  }
-  const TopicTransport* transport = registry.topic_transport();
+bool HasTopics(const PipelineSpec& spec) {
+  return std::any_of(spec.components.begin(), spec.components.end(), [](const ComponentSpec& c) {
+    return !c.topic_outputs.empty() ||
+           std::any_of(c.inputs.begin(), c.inputs.end(),
+                       [](const ConnectionSpec& x) { return !x.topic.empty(); });
+  });
+}
+
+// The components as built: the file's, with a topic's reader just before each consumer of a
+// topic (the file comment).
+struct BuiltComponents {
+  PipelineSpec spec;  // the file's, with the readers and the connections to them
+  std::vector<std::unique_ptr<Component>> components;
+  std::vector<std::size_t> file_index;  // the file's index of each (a reader: its consumer's)
   std::vector<std::pair<TopicOutputSpec, std::size_t>> topic_writers;  // and their component
-  // The file's index of each built component (a topic's reader: its consumer's), for messages.
-  std::vector<std::size_t> file_index;
-  for (std::size_t i = 0; i < n; ++i) file_index.push_back(i);
-  if (has_topics) {
-    PipelineSpec expanded = spec;
-    expanded.components.clear();
-    file_index.clear();
-    std::vector<std::unique_ptr<Component>> components;
-    for (std::size_t i = 0; i < n; ++i) {
-      ComponentSpec c = spec.components[i];
-      for (std::size_t k = 0; k < c.inputs.size(); ++k) {
-        ConnectionSpec& connection = c.inputs[k];
-        if (connection.topic.empty()) continue;
-        const std::string key = ComponentKey(i) + ".inputs." + connection.to_input;
-        if (transport == nullptr) {
-          throw FileError(file, connection.line, key,
-                          "input '" + connection.to_input + "' reads the topic '" +
-                              connection.topic +
-                              "', but this program has no topic transport (DDS)");
-        }
-        const InputBase* input = pipeline.components_[i]->FindInput(connection.to_input);
-        if (input == nullptr) {
-          throw FileError(
-              file, connection.line, key,
-              fmt::format("component '{}' ({}) has no input '{}'; its inputs: {}", c.name, c.type,
-                          connection.to_input, PortNames(pipeline.components_[i]->inputs())));
-        }
-        ComponentSpec reader;
-        reader.name = c.name + "-" + connection.to_input + "-topic";
-        reader.type = transport->name + " reader of " + connection.topic;
-        reader.reads_for = c.name;
-        reader.line = reader.type_line = reader.params_line = connection.line;
-        TopicEndpoint endpoint{connection.topic, input->message_type(), connection.topic_options,
-                               &spec, c.name + "." + connection.to_input};
-        std::unique_ptr<Component> component;
-        try {
-          component = transport->make_reader(endpoint);
-        } catch (const std::exception& error) {
-          throw FileError(file, connection.line, key, error.what());
-        }
-        component->Initialise(reader.name, ComponentSeed(spec.seed, reader.name), base_dir,
-                              pipeline.resources_);
-        connection.from_component = reader.name;
-        connection.from_output = "message";
-        expanded.components.push_back(std::move(reader));
-        components.push_back(std::move(component));
-        file_index.push_back(i);
-      }
-      for (const TopicOutputSpec& out : c.topic_outputs) {
-        if (transport == nullptr) {
-          throw FileError(file, out.line, ComponentKey(i) + ".outputs." + out.output,
-                          "output '" + out.output + "' writes the topic '" + out.topic +
-                              "', but this program has no topic transport (DDS)");
-        }
-        topic_writers.emplace_back(out, expanded.components.size());
-      }
-      expanded.components.push_back(std::move(c));
-      components.push_back(std::move(pipeline.components_[i]));
-      file_index.push_back(i);
-    }
-    pipeline.spec_ = std::move(expanded);
-    pipeline.components_ = std::move(components);
+};
+
+// The reader of the topic that `connection` (of the file's component `i`, `c`) names; turns
+// the connection into one from the reader, whose spec goes to `built`.
+std::unique_ptr<Component> MakeTopicReader(const PipelineSpec& spec, std::size_t i,
+                                           const ComponentSpec& c, ConnectionSpec& connection,
+                                           const Component& consumer,
+                                           const TopicTransport* transport,
+                                           const std::shared_ptr<Resources>& resources,
+                                           BuiltComponents& built) {
+  const std::string& file = spec.file;
+  const std::string key = ComponentKey(i) + ".inputs." + connection.to_input;
+  if (transport == nullptr) {
+    throw FileError(file, connection.line, key,
+                    "input '" + connection.to_input + "' reads the topic '" + connection.topic +
+                        "', but this program has no topic transport (DDS)");
   }
-  const PipelineSpec& built = pipeline.spec_;
+  const InputBase* input = consumer.FindInput(connection.to_input);
+  if (input == nullptr) {
+    throw FileError(file, connection.line, key,
+                    fmt::format("component '{}' ({}) has no input '{}'; its inputs: {}", c.name,
+                                c.type, connection.to_input, PortNames(consumer.inputs())));
+  }
+  ComponentSpec reader;
+  reader.name = c.name + "-" + connection.to_input + "-topic";
+  reader.type = transport->name + " reader of " + connection.topic;
+  reader.reads_for = c.name;
+  reader.line = reader.type_line = reader.params_line = connection.line;
+  TopicEndpoint endpoint{connection.topic, input->message_type(), connection.topic_options, &spec,
+                         c.name + "." + connection.to_input};
+  std::unique_ptr<Component> component;
+  try {
+    component = transport->make_reader(endpoint);
+  } catch (const std::exception& error) {
+    throw FileError(file, connection.line, key, error.what());
+  }
+  component->Initialise(reader.name, ComponentSeed(spec.seed, reader.name),
+                        std::filesystem::path(file).parent_path().string(), resources);
+  connection.from_component = reader.name;
+  connection.from_output = "message";
+  built.spec.components.push_back(std::move(reader));
+  built.file_index.push_back(i);
+  return component;
+}
+
+// The file's components with the readers of its topic inputs, and the outputs that write a
+// topic; as they are when the file names no topic.
+BuiltComponents AddTopicReaders(const PipelineSpec& spec,
+                                std::vector<std::unique_ptr<Component>> components,
+                                const TopicTransport* transport,
+                                const std::shared_ptr<Resources>& resources) {
+  BuiltComponents built;
+  const std::size_t n = spec.components.size();
+  if (!HasTopics(spec)) {
+    built.spec = spec;
+    built.components = std::move(components);
+    for (std::size_t i = 0; i < n; ++i) built.file_index.push_back(i);
+    return built;
+  }
+  built.spec = spec;
+  built.spec.components.clear();
+  for (std::size_t i = 0; i < n; ++i) {
+    ComponentSpec c = spec.components[i];
+    for (ConnectionSpec& connection : c.inputs) {
+      if (connection.topic.empty()) continue;
+      built.components.push_back(
+          MakeTopicReader(spec, i, c, connection, *components[i], transport, resources, built));
+    }
+    for (const TopicOutputSpec& out : c.topic_outputs) {
+      if (transport == nullptr) {
+        throw FileError(spec.file, out.line, ComponentKey(i) + ".outputs." + out.output,
+                        "output '" + out.output + "' writes the topic '" + out.topic +
+                            "', but this program has no topic transport (DDS)");
+      }
+      built.topic_writers.emplace_back(out, built.spec.components.size());
+    }
+    built.spec.components.push_back(std::move(c));
+    built.components.push_back(std::move(components[i]));
+    built.file_index.push_back(i);
+  }
+  return built;
+}
+
+// The clock's source (`clock.source`): the reader of a topic input, whose stamps time the
+// steps; nullptr when the file names none.
+TimeSource* FindTimeSource(const BuiltComponents& b,
+                           const std::map<std::string, std::size_t>& index,
+                           const TopicTransport* transport) {
+  const PipelineSpec& built = b.spec;
+  if (built.clock.source.empty()) return nullptr;
+  const std::string& source = built.clock.source;
+  const auto Fail = [&](const std::string& what) {
+    throw FileError(built.file, built.clock.source_line, "clock.source", what);
+  };
+  if (built.clock.mode != ClockMode::kSimulated) {
+    Fail("'source' is for mode simulated: in real time the wall clock gives the time");
+  }
+  const std::string name = source.substr(0, source.find('.'));
+  const std::string input = source.substr(source.find('.') + 1);
+  const auto consumer = index.find(name);
+  if (consumer == index.end() || !built.components[consumer->second].reads_for.empty()) {
+    std::vector<std::string> names;
+    for (const ComponentSpec& c : built.components) {
+      if (c.reads_for.empty()) names.push_back(c.name);
+    }
+    Fail(fmt::format("unknown component '{}' in '{}'; components: {}", name, source, Join(names)));
+  }
+  const std::vector<ConnectionSpec>& inputs = built.components[consumer->second].inputs;
+  const auto connection = std::find_if(inputs.begin(), inputs.end(),
+                                       [&](const auto& c) { return c.to_input == input; });
+  if (connection == inputs.end()) {
+    Fail(fmt::format("component '{}' has no input '{}' connected in the file", name, input));
+  }
+  const auto reader = index.find(connection->from_component);
+  if (reader == index.end() || built.components[reader->second].reads_for != name) {
+    Fail(
+        fmt::format("input '{}' reads '{}.{}', not a topic: only a topic's stamps can time "
+                    "the steps",
+                    source, connection->from_component, connection->from_output));
+  }
+  auto* time_source = dynamic_cast<TimeSource*>(b.components[reader->second].get());
+  if (time_source == nullptr) {
+    Fail(fmt::format("the {} transport's reader of '{}' gives no time", transport->name, source));
+  }
+  return time_source;
+}
+
+// The message for an immediate connection from component j to component i (j >= i): the
+// cycle it closes, naming its components, or the order to change. `readers`: the immediate
+// edges producer -> consumers.
+std::string CycleMessage(const PipelineSpec& built, std::size_t i, std::size_t j,
+                         const std::vector<std::vector<std::size_t>>& readers,
+                         const std::string& from) {
   const std::size_t m = built.components.size();
-  if (has_topics) {
-    index.clear();
-    for (std::size_t i = 0; i < m; ++i) index.emplace(built.components[i].name, i);
-  }
-
-  // The clock's source: the reader of a topic input, whose stamps time the steps.
-  if (!built.clock.source.empty()) {
-    const std::string& source = built.clock.source;
-    const auto Fail = [&](const std::string& what) {
-      throw FileError(file, built.clock.source_line, "clock.source", what);
-    };
-    if (built.clock.mode != ClockMode::kSimulated) {
-      Fail("'source' is for mode simulated: in real time the wall clock gives the time");
-    }
-    const std::string name = source.substr(0, source.find('.'));
-    const std::string input = source.substr(source.find('.') + 1);
-    const auto consumer = index.find(name);
-    if (consumer == index.end() || !built.components[consumer->second].reads_for.empty()) {
-      std::vector<std::string> names;
-      for (const ComponentSpec& c : built.components) {
-        if (c.reads_for.empty()) names.push_back(c.name);
+  const std::string& consumer = built.components[i].name;
+  // The producer runs after (or is) the consumer: find the consumer's path to it.
+  std::vector<std::size_t> parent(m, m);
+  std::vector<std::size_t> queue{i};
+  std::vector<bool> seen(m, false);
+  seen[i] = true;
+  for (std::size_t q = 0; q < queue.size() && !seen[j]; ++q) {
+    for (std::size_t next : readers[queue[q]]) {
+      if (!seen[next]) {
+        seen[next] = true;
+        parent[next] = queue[q];
+        queue.push_back(next);
       }
-      Fail(
-          fmt::format("unknown component '{}' in '{}'; components: {}", name, source, Join(names)));
-    }
-    const std::vector<ConnectionSpec>& inputs = built.components[consumer->second].inputs;
-    const auto connection = std::find_if(inputs.begin(), inputs.end(),
-                                         [&](const auto& c) { return c.to_input == input; });
-    if (connection == inputs.end()) {
-      Fail(fmt::format("component '{}' has no input '{}' connected in the file", name, input));
-    }
-    const auto reader = index.find(connection->from_component);
-    if (reader == index.end() || built.components[reader->second].reads_for != name) {
-      Fail(
-          fmt::format("input '{}' reads '{}.{}', not a topic: only a topic's stamps can time "
-                      "the steps",
-                      source, connection->from_component, connection->from_output));
-    }
-    pipeline.time_source_ = dynamic_cast<TimeSource*>(pipeline.components_[reader->second].get());
-    if (pipeline.time_source_ == nullptr) {
-      Fail(fmt::format("the {} transport's reader of '{}' gives no time", transport->name, source));
     }
   }
+  if (j == i || seen[j]) {
+    std::string cycle = consumer;
+    if (j != i) {
+      std::vector<std::string> path;
+      for (std::size_t k = j; k != m; k = parent[k]) path.push_back(built.components[k].name);
+      std::reverse(path.begin(), path.end());
+      cycle.clear();
+      for (const std::string& name : path) cycle += name + " -> ";
+    } else {
+      cycle += " -> ";
+    }
+    cycle += consumer;
+    return fmt::format(
+        "cycle: {} without a delay; add 'delay: 1' to one of its connections, e.g. this one: "
+        "{{from: {}, delay: 1}}",
+        cycle, from);
+  }
+  const std::string& producer = built.components[j].name;
+  return fmt::format(
+      "'{}' runs after '{}' in execution order, so this connection closes a cycle: list '{}' "
+      "before '{}', or add 'delay: 1' to read the previous step's message ({{from: {}, delay: "
+      "1}})",
+      producer, consumer, producer, consumer, from);
+}
 
+// Connects every input of the built components to its producer's output, checking names,
+// types and order; then checks that the required inputs are connected.
+void ConnectInputs(const BuiltComponents& b, const std::map<std::string, std::size_t>& index,
+                   double* delivery_seconds) {
+  const PipelineSpec& built = b.spec;
+  const std::string& file = built.file;
+  const std::size_t m = built.components.size();
   // Immediate edges producer -> consumer, to name the components of a cycle.
   std::vector<std::vector<std::size_t>> readers(m);
   for (std::size_t i = 0; i < m; ++i) {
@@ -636,13 +752,11 @@ Pipeline Pipeline::Build(const PipelineSpec& spec, const ComponentRegistry& regi
       if (it != index.end() && connection.delay == 0) readers[it->second].push_back(i);
     }
   }
-
-  double* delivery_seconds = pipeline.delivery_seconds_.get();
   for (std::size_t i = 0; i < m; ++i) {
     const ComponentSpec& c = built.components[i];
-    Component& consumer = *pipeline.components_[i];
+    Component& consumer = *b.components[i];
     for (const ConnectionSpec& connection : c.inputs) {
-      const std::string key = ComponentKey(file_index[i]) + ".inputs." + connection.to_input;
+      const std::string key = ComponentKey(b.file_index[i]) + ".inputs." + connection.to_input;
       const std::string from = connection.from_component + "." + connection.from_output;
       const auto Fail = [&](const std::string& what) {
         throw FileError(file, connection.line, key, what);
@@ -660,7 +774,7 @@ Pipeline Pipeline::Build(const PipelineSpec& spec, const ComponentRegistry& regi
                          connection.from_component, from, Join(names)));
       }
       const std::size_t j = it->second;
-      const Component& producer = *pipeline.components_[j];
+      const Component& producer = *b.components[j];
       OutputBase* output = producer.FindOutput(connection.from_output);
       if (output == nullptr) {
         Fail(fmt::format("component '{}' ({}) has no output '{}'; its outputs: {}", producer.name(),
@@ -672,44 +786,7 @@ Pipeline Pipeline::Build(const PipelineSpec& spec, const ComponentRegistry& regi
                          output->message_type(), c.name, connection.to_input,
                          input->message_type()));
       }
-      if (j >= i && connection.delay == 0) {
-        // The producer runs after (or is) the consumer: find the consumer's path to it.
-        std::vector<std::size_t> parent(m, m);
-        std::vector<std::size_t> queue{i};
-        std::vector<bool> seen(m, false);
-        seen[i] = true;
-        for (std::size_t q = 0; q < queue.size() && !seen[j]; ++q) {
-          for (std::size_t next : readers[queue[q]]) {
-            if (!seen[next]) {
-              seen[next] = true;
-              parent[next] = queue[q];
-              queue.push_back(next);
-            }
-          }
-        }
-        if (j == i || seen[j]) {
-          std::string cycle = c.name;
-          if (j != i) {
-            std::vector<std::string> path;
-            for (std::size_t k = j; k != m; k = parent[k]) path.push_back(built.components[k].name);
-            std::reverse(path.begin(), path.end());
-            cycle.clear();
-            for (const std::string& name : path) cycle += name + " -> ";
-          } else {
-            cycle += " -> ";
-          }
-          cycle += c.name;
-          Fail(
-              fmt::format("cycle: {} without a delay; add 'delay: 1' to one of its connections, "
-                          "e.g. this one: {{from: {}, delay: 1}}",
-                          cycle, from));
-        }
-        Fail(
-            fmt::format("'{}' runs after '{}' in execution order, so this connection closes a "
-                        "cycle: list '{}' before '{}', or add 'delay: 1' to read the previous "
-                        "step's message ({{from: {}, delay: 1}})",
-                        producer.name(), c.name, producer.name(), c.name, from));
-      }
+      if (j >= i && connection.delay == 0) Fail(CycleMessage(built, i, j, readers, from));
       try {
         input->ConnectFrom(*output, connection.delay,
                            [delivery_seconds](double seconds) { *delivery_seconds += seconds; });
@@ -719,40 +796,64 @@ Pipeline Pipeline::Build(const PipelineSpec& spec, const ComponentRegistry& regi
     }
     for (const auto& input : consumer.inputs()) {
       if (input->required() && !input->connected()) {
-        throw FileError(file, c.line, ComponentKey(file_index[i]) + ".inputs",
+        throw FileError(file, c.line, ComponentKey(b.file_index[i]) + ".inputs",
                         fmt::format("required input '{}' ({}) of component '{}' ({}) is not "
                                     "connected",
                                     input->name(), input->message_type(), c.name, c.type));
       }
     }
   }
-  for (const auto& [out, i] : topic_writers) {
-    const std::string key = "components." + built.components[i].name + ".outputs." + out.output;
-    OutputBase* output = pipeline.components_[i]->FindOutput(out.output);
+}
+
+// Attaches the topic writers of the outputs that name a topic; returns their end-of-step work.
+std::vector<std::function<void(const StepContext&)>> AttachTopicWriters(
+    const PipelineSpec& spec, const BuiltComponents& b, const TopicTransport* transport) {
+  std::vector<std::function<void(const StepContext&)>> step_ends;
+  for (const auto& [out, i] : b.topic_writers) {
+    const ComponentSpec& c = b.spec.components[i];
+    const std::string key = "components." + c.name + ".outputs." + out.output;
+    OutputBase* output = b.components[i]->FindOutput(out.output);
     if (output == nullptr) {
-      throw FileError(file, out.line, key,
-                      fmt::format("component '{}' ({}) has no output '{}'; its outputs: {}",
-                                  built.components[i].name, built.components[i].type, out.output,
-                                  PortNames(pipeline.components_[i]->outputs())));
+      throw FileError(spec.file, out.line, key,
+                      fmt::format("component '{}' ({}) has no output '{}'; its outputs: {}", c.name,
+                                  c.type, out.output, PortNames(b.components[i]->outputs())));
     }
     try {
       auto step_end = transport->attach_writer(
           TopicEndpoint{out.topic, output->message_type(), out.topic_options, &spec,
-                        built.components[i].name + "." + out.output},
+                        c.name + "." + out.output},
           *output);
-      if (step_end) pipeline.step_ends_.push_back(std::move(step_end));
+      if (step_end) step_ends.push_back(std::move(step_end));
     } catch (const std::exception& error) {
-      throw FileError(file, out.line, key, error.what());
+      throw FileError(spec.file, out.line, key, error.what());
     }
   }
-  if (has_topics && transport->attach_pipeline) {
+  return step_ends;
+}
+
+}  // namespace
+
+Pipeline Pipeline::Build(const PipelineSpec& spec, const ComponentRegistry& registry) {
+  CheckUniqueNames(spec);
+  Pipeline pipeline;
+  pipeline.resources_ = LoadResources(spec, registry);
+  const TopicTransport* transport = registry.topic_transport();
+  BuiltComponents built = AddTopicReaders(
+      spec, CreateComponents(spec, registry, pipeline.resources_), transport, pipeline.resources_);
+  const std::map<std::string, std::size_t> index = NameIndex(built.spec);
+  pipeline.time_source_ = FindTimeSource(built, index, transport);
+  ConnectInputs(built, index, pipeline.delivery_seconds_.get());
+  pipeline.step_ends_ = AttachTopicWriters(spec, built, transport);
+  if (HasTopics(spec) && transport->attach_pipeline) {
     try {
       auto step_begin = transport->attach_pipeline(spec);
       if (step_begin) pipeline.step_begins_.push_back(std::move(step_begin));
     } catch (const std::exception& error) {
-      throw FileError(file, spec.transport_line, "transport", error.what());
+      throw FileError(spec.file, spec.transport_line, "transport", error.what());
     }
   }
+  pipeline.spec_ = std::move(built.spec);
+  pipeline.components_ = std::move(built.components);
   return pipeline;
 }
 

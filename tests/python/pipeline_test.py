@@ -130,6 +130,35 @@ components:
     pipeline.close()
 
 
+@pytest.mark.parametrize("on_error, threads, head_steps", [
+    ("stop", 1, 2),      # one after the other: the step ends at the failing component
+    ("stop", 2, 3),      # one level at the same time: head, beside it, finishes its step
+    ("continue", 1, 3),  # the step goes on; the failure is raised after it
+])
+def test_a_failing_step_ends_as_the_schedulers_does(on_error, threads, head_steps):
+    # Pipeline.step is the scheduler's step (runtime::Stepper): its threads and its on_error.
+    text = f"""
+clock: {{mode: simulated, step: 0.04, steps: 10}}
+on_error: {on_error}
+threads: {threads}
+scene: {SCENE}
+components:
+  - name: broken
+    type: test.failing
+  - name: head
+    type: sim.head
+"""
+    with saccade.runtime.Pipeline.from_yaml_string(text, "fail.yaml") as pipeline:
+        pipeline.watch("head.joints")
+        with pytest.raises(saccade.Error, match="component 'broken' failed at step 2:"):
+            pipeline.step(5)
+        assert pipeline.steps_done == 3
+        assert pipeline.count("head.joints") == head_steps
+        pipeline.step(2)  # a failed step does not end the pipeline
+        assert pipeline.steps_done == 5
+        assert pipeline.count("head.joints") == head_steps + 2
+
+
 def test_bad_pipeline_file_raises_file_error_with_line():
     text = loop(extra="  - name: extra\n    type: no.such_type\n")
     with pytest.raises(saccade.FileError) as error:

@@ -1,5 +1,5 @@
 // Running pipelines: order and delays, determinism, failures (stop / continue), real-time
-// pacing, and the timing summary.
+// pacing, and the timing summary; the single step (Stepper) that RunPipeline loops over.
 
 #include "saccade/runtime/scheduler.h"
 
@@ -8,6 +8,8 @@
 
 #include <atomic>
 #include <chrono>
+#include <optional>
+#include <stdexcept>
 #include <string>
 #include <thread>
 #include <utility>
@@ -505,6 +507,251 @@ components:
   const std::string report = summary.FullReport();
   EXPECT_NE(report.find("recorder"), std::string::npos);
   EXPECT_NE(report.find("(outside components)"), std::string::npos);
+}
+
+// The single step (Stepper) and the loop over it (RunPipeline) give the same run.
+
+// A pipeline with all the step has to get right: random sources (seeds), immediate and delayed
+// connections, two parallel branches, a component disabled for a while and one that fails at
+// steps 3 and 5 (on_error: continue).
+std::string EquivalencePipeline(int threads) {
+  return fmt::format(R"(clock: {{mode: simulated, step: 0.04, steps: 12}}
+seed: 7
+threads: {}
+on_error: continue
+components:
+  - {{name: a, type: test.random}}
+  - {{name: b, type: test.random}}
+  - {{name: ra, type: test.relay, inputs: {{in: a.out}}}}
+  - {{name: rb, type: test.relay, inputs: {{in: b.out}}}}
+  - {{name: rec_a, type: test.recorder, inputs: {{in: ra.out}}}}
+  - {{name: rec_b, type: test.recorder, inputs: {{in: rb.out}}}}
+  - {{name: rec_late, type: test.recorder, inputs: {{in: {{from: loop.out, delay: 1}}}}}}
+  - {{name: ra_relay, type: test.relay, inputs: {{in: ra.out}}}}
+  - {{name: loop, type: test.relay, inputs: {{in: ra_relay.out}}}}
+  - {{name: flaky, type: test.thrower, params: {{at: 3}}}}
+  - {{name: flakier, type: test.thrower, params: {{at: 5}}}}
+)",
+                     threads);
+}
+
+// What a run left: every recorder's records, the throwers' counts, and the summary's
+// deterministic part (not its timings).
+struct RunResult {
+  std::vector<std::vector<double>> records;
+  std::vector<int> thrower_counts;
+  int64_t steps = 0;
+  double sim_time = 0.0;
+  bool stopped_on_error = false;
+  std::vector<std::string> errors;
+  std::vector<std::pair<int64_t, int64_t>> component_steps_and_errors;
+  std::vector<double> step_times;  // after_step's (RunPipeline) or StepResult's (Stepper)
+  bool operator==(const RunResult&) const = default;
+};
+
+RunResult Collect(const Pipeline& pipeline, const RunSummary& summary,
+                  std::vector<double> step_times) {
+  RunResult result;
+  for (const char* name : {"rec_a", "rec_b", "rec_late"}) {
+    std::vector<double> values;
+    for (const Record& r : pipeline.Find<Recorder>(name)->records) {
+      values.insert(values.end(), {static_cast<double>(r.step), r.time, r.value,
+                                   r.has_value ? 1.0 : 0.0, r.fresh ? 1.0 : 0.0});
+    }
+    result.records.push_back(std::move(values));
+  }
+  for (const char* name : {"flaky", "flakier"}) {
+    const Thrower* t = pipeline.Find<Thrower>(name);
+    result.thrower_counts.insert(result.thrower_counts.end(), {t->starts, t->steps, t->stops});
+  }
+  result.steps = summary.steps;
+  result.sim_time = summary.sim_time;
+  result.stopped_on_error = summary.stopped_on_error;
+  for (const StepError& e : summary.errors) result.errors.push_back(e.ToString());
+  for (const ComponentTiming& c : summary.components) {
+    result.component_steps_and_errors.emplace_back(c.steps, c.errors);
+  }
+  result.step_times = std::move(step_times);
+  return result;
+}
+
+// `a` is switched off for steps 4 to 6, through after_step or between Stepper steps.
+void SwitchA(Pipeline& pipeline, int64_t step_done) {
+  pipeline.Find("a")->SetEnabled(step_done < 3 || step_done >= 6);
+}
+
+RunResult RunWithRunPipeline(const std::string& text, int64_t steps) {
+  Pipeline pipeline = Load(text);
+  RunOptions options;
+  options.steps = steps;
+  std::vector<double> times;
+  options.after_step = [&](const StepContext& context) {
+    times.push_back(context.time);
+    SwitchA(pipeline, context.step);
+  };
+  const RunSummary summary = RunPipeline(pipeline, options);
+  return Collect(pipeline, summary, times);
+}
+
+RunResult RunWithStepper(const std::string& text, int64_t steps) {
+  Pipeline pipeline = Load(text);
+  Stepper stepper(pipeline);
+  EXPECT_FALSE(stepper.Start().has_value());
+  std::vector<double> times;
+  for (int64_t k = 0; k < steps; ++k) {
+    const StepResult& result = stepper.Step();
+    EXPECT_EQ(result.context.step, k);
+    times.push_back(result.context.time);
+    SwitchA(pipeline, result.context.step);
+    if (result.stopped_on_error) break;
+  }
+  EXPECT_TRUE(stepper.Stop().empty());
+  return Collect(pipeline, stepper.Summary(), times);
+}
+
+TEST(StepperTest, StepsGiveRunPipelinesRunBitForBit) {
+  for (const int threads : {1, 2, 4}) {
+    const std::string text = EquivalencePipeline(threads);
+    const RunResult run = RunWithRunPipeline(text, 12);
+    const RunResult stepped = RunWithStepper(text, 12);
+    ASSERT_EQ(run.records[0].size(), 5u * 12u) << threads;
+    EXPECT_EQ(run.errors,
+              (std::vector<std::string>{"component 'flaky' failed at step 3: sensor unplugged",
+                                        "component 'flakier' failed at step 5: sensor unplugged"}));
+    EXPECT_EQ(run.component_steps_and_errors[0].first, 9) << "a: off for steps 4 to 6";
+    EXPECT_TRUE(run == stepped) << "threads " << threads;
+    // And whatever the threads, the serial run's values.
+    EXPECT_TRUE(stepped == RunWithStepper(EquivalencePipeline(1), 12)) << threads;
+  }
+}
+
+TEST(StepperTest, AFailureWithOnErrorStopEndsTheStepAsInRunPipeline) {
+  for (const int threads : {1, 2}) {
+    std::string text = EquivalencePipeline(threads);
+    text.replace(text.find("on_error: continue"), 18, "on_error: stop");
+    const RunResult run = RunWithRunPipeline(text, 12);
+    const RunResult stepped = RunWithStepper(text, 12);
+    EXPECT_EQ(run.steps, 4);  // 0 to 3, the failing step
+    EXPECT_TRUE(run.stopped_on_error);
+    EXPECT_TRUE(run == stepped) << "threads " << threads;
+  }
+}
+
+TEST(StepperTest, NextPreparesTheStepThatStepRuns) {
+  Pipeline pipeline = Load(R"(clock: {mode: simulated, step: 0.25, steps: 3}
+components:
+  - {name: source, type: test.source, params: {start: 100}}
+  - {name: recorder, type: test.recorder, inputs: {in: source.out}}
+)");
+  Stepper stepper(pipeline);
+  EXPECT_THROW(stepper.Step(), InvalidArgument);  // not started
+  ASSERT_FALSE(stepper.Start().has_value());
+  EXPECT_THROW(stepper.Start(), InvalidArgument);
+  for (int k = 0; k < 3; ++k) {
+    const StepContext next = stepper.Next();
+    EXPECT_EQ(next.step, k);
+    EXPECT_EQ(next.time, 0.25 * k);
+    EXPECT_EQ(next.dt, 0.25);
+    EXPECT_FALSE(next.realtime);
+    EXPECT_EQ(stepper.Next().step, k);  // prepared once
+    const StepResult& result = stepper.Step();
+    EXPECT_EQ(result.context.step, k);
+    EXPECT_EQ(result.context.time, next.time);
+    EXPECT_TRUE(result.errors.empty());
+    EXPECT_FALSE(result.stopped_on_error);
+    ASSERT_EQ(result.timing.own.size(), 2u);
+    EXPECT_GT(result.timing.finished[1], 0.0);
+    EXPECT_EQ(stepper.steps_done(), k + 1);
+  }
+  const auto& records = pipeline.Find<Recorder>("recorder")->records;
+  ASSERT_EQ(records.size(), 3u);
+  EXPECT_EQ(records[2].value, 102.0);
+  EXPECT_TRUE(stepper.Stop().empty());
+  EXPECT_THROW(stepper.Step(), InvalidArgument);  // stopped
+  const RunSummary summary = stepper.Summary();
+  EXPECT_EQ(summary.steps, 3);
+  EXPECT_EQ(summary.sim_time, 0.5);
+  EXPECT_GE(summary.wall_seconds, 0.0);
+  ASSERT_EQ(summary.components.size(), 2u);
+  EXPECT_EQ(summary.components[1].steps, 3);
+}
+
+TEST(StepperTest, SimulatedTimeOnARealTimePipelineIsTheCallersPace) {
+  // Python's Pipeline.step: step * dt and realtime false, however slowly the steps come.
+  Pipeline pipeline = Load(R"(clock: {mode: realtime, rate_hz: 4}
+components:
+  - {name: source, type: test.source}
+  - {name: recorder, type: test.recorder, inputs: {in: source.out}}
+)");
+  StepperOptions options;
+  options.simulated_time = true;
+  Stepper stepper(pipeline, options);
+  ASSERT_FALSE(stepper.Start().has_value());
+  for (int k = 0; k < 3; ++k) {
+    const StepResult& result = stepper.Step();
+    EXPECT_EQ(result.context.time, 0.25 * k);
+    EXPECT_EQ(result.context.dt, 0.25);
+    EXPECT_FALSE(result.context.realtime);
+  }
+  stepper.Stop();
+}
+
+TEST(StepperTest, AFailedStartIsReturnedAndStopStopsOnlyTheStarted) {
+  class BadStart : public Component {
+   public:
+    void Start() override { throw std::runtime_error("no device"); }
+    void Step(const StepContext&) override { ADD_FAILURE() << "stepped"; }
+  };
+  class BadStop : public Component {
+   public:
+    void Step(const StepContext&) override {}
+    void Stop() override { throw std::runtime_error("stuck"); }
+  };
+  ComponentRegistry registry = MakeTestRegistry();
+  registry.Register<BadStart>("test.bad_start");
+  registry.Register<BadStop>("test.bad_stop");
+  Pipeline pipeline = Pipeline::LoadString(R"(clock: {mode: simulated, step: 1, steps: 3}
+components:
+  - {name: a, type: test.thrower}
+  - {name: stuck, type: test.bad_stop}
+  - {name: device, type: test.bad_start}
+  - {name: c, type: test.thrower}
+)",
+                                           "run.yaml", registry);
+  std::vector<std::string> told;
+  StepperOptions options;
+  options.on_error = [&](const StepError& e) { told.push_back(e.ToString()); };
+  Stepper stepper(pipeline, options);
+  const std::optional<StepError> failure = stepper.Start();
+  ASSERT_TRUE(failure.has_value());
+  EXPECT_EQ(failure->ToString(), "component 'device' failed in start: no device");
+  EXPECT_THROW(stepper.Step(), InvalidArgument);
+  const std::vector<StepError> stop_errors = stepper.Stop();
+  ASSERT_EQ(stop_errors.size(), 1u);
+  EXPECT_EQ(stop_errors[0].ToString(), "component 'stuck' failed in stop: stuck");
+  EXPECT_TRUE(stepper.Stop().empty());  // once
+  EXPECT_EQ(pipeline.Find<Thrower>("a")->stops, 1);
+  EXPECT_EQ(pipeline.Find<Thrower>("c")->starts, 0);
+  EXPECT_EQ(pipeline.Find<Thrower>("c")->stops, 0);
+  EXPECT_EQ(told, (std::vector<std::string>{"component 'device' failed in start: no device",
+                                            "component 'stuck' failed in stop: stuck"}));
+  const RunSummary summary = stepper.Summary();
+  EXPECT_TRUE(summary.stopped_on_error);
+  EXPECT_EQ(summary.errors_total, 2);
+}
+
+TEST(StepperTest, TheDestructorStopsWhatIsStillStarted) {
+  Pipeline pipeline = Load(R"(clock: {mode: simulated, step: 1, steps: 3}
+components:
+  - {name: a, type: test.thrower}
+)");
+  {
+    Stepper stepper(pipeline);
+    ASSERT_FALSE(stepper.Start().has_value());
+    stepper.Step();
+  }
+  EXPECT_EQ(pipeline.Find<Thrower>("a")->steps, 1);
+  EXPECT_EQ(pipeline.Find<Thrower>("a")->stops, 1);
 }
 
 }  // namespace

@@ -1,5 +1,7 @@
 #pragma once
-// Runs a pipeline: Start every component, Step them in order each tick, Stop them.
+// Runs a pipeline: Start every component, Step them in order each tick, Stop them. One step is
+// written once, in Stepper (below): RunPipeline loops over it, adding the pacing, the run's
+// bounds and its callbacks; Python's Pipeline.step calls it too (docs/python.md).
 //
 // Each step runs in levels: a component's level is one past the highest of those it reads
 // without a delay, so the components of one level do not depend on each other in the step
@@ -19,6 +21,8 @@
 #include <atomic>
 #include <cstdint>
 #include <functional>
+#include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -120,8 +124,101 @@ struct RunOptions {
 /// A sender that restarted starts its stamps, and so the time, again.
 double SimulatedStepTime(const Pipeline& pipeline, int64_t step, double previous);
 
-/// Runs `pipeline` once. Component failures are reported in the summary, not thrown;
-/// throws InvalidArgument when neither steps nor a stop flag bound the run.
+/// How a Stepper steps. RunPipeline fills it from its RunOptions; Python's Pipeline.step sets
+/// simulated_time.
+struct StepperOptions {
+  /// The simulated clock's times (SimulatedStepTime: step * clock.step, or clock.source's
+  /// stamps) on either clock, for a caller that paces the steps itself (Python's
+  /// Pipeline.step). When false, a real-time pipeline's step time is the wall seconds since
+  /// Start, and its components see StepContext::realtime true.
+  bool simulated_time = false;
+  /// Components see StepContext::realtime true on simulated times (RunOptions::live).
+  bool live = false;
+  /// Told of each failure (start, step, stop) as it happens; may be empty.
+  std::function<void(const StepError&)> on_error;
+  /// Offered to a component that waits on a device (RunOptions::while_waiting); may be empty.
+  std::function<void()> while_waiting;
+};
+
+/// What one step did (Stepper::Step).
+struct StepResult {
+  /// The step's context: index, time, dt, realtime (the pipeline's, without a component's seed
+  /// or while_waiting), as RunOptions::after_step gets it.
+  StepContext context;
+  StepTiming timing;
+  /// The components that failed in the step, in execution order (also in the summary and told
+  /// to StepperOptions::on_error).
+  std::vector<StepError> errors;
+  /// A component failed and the pipeline's on_error is stop: the step ended early (below) and
+  /// the run should end.
+  bool stopped_on_error = false;
+};
+
+/// Runs a pipeline one step at a time: the step that RunPipeline loops over and that Python's
+/// Pipeline.step calls. Start once, then Step any number of times, then Stop (the destructor
+/// stops what is still started, its failures dropped).
+///
+/// One step:
+///   1. Its context (Next): step = the steps done before it; time = SimulatedStepTime on the
+///      simulated clock (taking clock.source's message, whose wait counts as the source
+///      reader's own time) or, on the real-time clock, the wall seconds since Start; dt =
+///      clock.step (1 / rate_hz in real time); realtime as StepperOptions says.
+///   2. Pipeline::DeliverDelayed, then Pipeline::BeginStep.
+///   3. The components level by level (the file comment): each enabled one Steps with its own
+///      seed; a level of several runs at the same time on the pipeline's threads, what they emit
+///      delivered after the level in execution order, a thread-affine one on the calling
+///      thread; StepperOptions::while_waiting is offered only where nothing else runs. After a
+///      component's step its inputs are marked seen; a disabled one is not stepped, and its
+///      inputs are marked seen all the same.
+///   4. A component's exception is caught, not thrown: it is told to on_error, kept in the
+///      summary and returned in StepResult::errors. With on_error: stop the step ends there:
+///      one after the other, the components after the failing one are not stepped; in a
+///      parallel level, the level's others finish and the later levels are skipped. With
+///      on_error: continue the step goes on.
+///   5. Pipeline::EndStep, a failed step included.
+///
+/// The pipeline must outlive the stepper. Not thread-safe: one thread calls it, and the
+/// thread-affine components run on that thread.
+class Stepper {
+ public:
+  explicit Stepper(Pipeline& pipeline, StepperOptions options = {});
+  ~Stepper();
+  Stepper(const Stepper&) = delete;
+  Stepper& operator=(const Stepper&) = delete;
+
+  /// Starts every component in execution order (and the pipeline's threads). Returns the first
+  /// failure ("start" phase; also told to on_error and kept in the summary), after which no
+  /// step may run and Stop stops those that started; std::nullopt when all started. Throws
+  /// InvalidArgument when called twice.
+  std::optional<StepError> Start();
+  /// The next step's context (1. above), prepared once: later calls return it again until Step
+  /// runs it. For a caller that looks at the time before the step (RunOptions::seconds). Throws
+  /// InvalidArgument unless started without failure and not stopped.
+  const StepContext& Next();
+  /// Runs the next step (Next's context, prepared now if Next was not called) and returns what
+  /// it did; valid until the next call. Never throws for a component's failure; throws
+  /// InvalidArgument unless started without failure and not stopped.
+  const StepResult& Step();
+  /// Stops every started component, the last started first; returns their failures ("stop"
+  /// phase; also told to on_error and kept in the summary). Only the first call stops.
+  std::vector<StepError> Stop();
+
+  /// Steps run so far.
+  int64_t steps_done() const;
+  /// What the stepper did so far, as RunPipeline reports it: steps, sim_time, stopped_on_error,
+  /// errors, the components' timings and the overhead; wall_seconds from Start to the end of
+  /// Stop (or to now, before Stop); overruns 0 (pacing is RunPipeline's).
+  RunSummary Summary() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+/// Runs `pipeline` once: a Stepper's Start, its steps until the run's bound (RunOptions::steps,
+/// seconds, stop, or a failure with on_error: stop), paced on the real-time clock, and Stop.
+/// Component failures are reported in the summary, not thrown; throws InvalidArgument when
+/// neither steps nor a stop flag bound the run.
 RunSummary RunPipeline(Pipeline& pipeline, const RunOptions& options = {});
 
 }  // namespace saccade::runtime
