@@ -365,7 +365,12 @@ void ApplyHardwareFile(const Entry& root, const std::string& hardware, PipelineS
     try {
       std::optional<ResourceSpec> scene;
       parts = LoadHardware(spec->hardware_file, &scene);
-      if (scene) spec->resources["scene"] = std::move(*scene);  // the hardware file's wins
+      // The hardware file's scene is a default: the pipeline's own `scene:` line wins over its
+      // `hardware:` line's file, and a hardware file given instead of that line (`--hardware`)
+      // wins over both, as the more specific choice in each case.
+      if (scene && (!hardware.empty() || spec->resources.count("scene") == 0)) {
+        spec->resources["scene"] = std::move(*scene);
+      }
     } catch (const FileError& error) {
       if (hardware.empty() && hardware_entry && error.line() == 0) {
         hardware_entry->Fail(error.what());  // a missing file: name the pipeline's line too

@@ -123,7 +123,7 @@ components:
   EXPECT_NE(NoteOf(pipeline, "first"), NoteOf(second, "first"));
 }
 
-TEST_F(ResourcesTest, TheHardwareFilesResourceWins) {
+TEST_F(ResourcesTest, ThePipelinesOwnResourceWinsOverItsHardwareLinesFile) {
   Write("hardware.yaml", "scene: b.txt\ncomponents:\n  reader: {type: test.note_reader}\n");
   const std::string file = Write("loop.yaml", R"(scene: a.txt
 hardware: hardware.yaml
@@ -132,8 +132,30 @@ components:
   - {name: plain, type: test.note_reader}
 )");
   const Pipeline pipeline = Pipeline::LoadFile(file, registry_);
-  EXPECT_EQ(NoteOf(pipeline, "reader")->text, "beta");
-  EXPECT_EQ(NoteOf(pipeline, "plain")->text, "beta");
+  EXPECT_EQ(NoteOf(pipeline, "reader")->text, "alpha");
+  EXPECT_EQ(NoteOf(pipeline, "plain")->text, "alpha");
+  // Without a line of its own the pipeline takes its hardware file's.
+  const std::string bare = Write("bare.yaml", R"(hardware: hardware.yaml
+components:
+  - {name: reader}
+)");
+  EXPECT_EQ(NoteOf(Pipeline::LoadFile(bare, registry_), "reader")->text, "beta");
+}
+
+TEST_F(ResourcesTest, AHardwareFileGivenInsteadOfThePipelinesLineWins) {
+  Write("hardware.yaml", "scene: b.txt\ncomponents:\n  reader: {type: test.note_reader}\n");
+  const std::string other = Write("other.yaml", "components:\n  reader: {type: test.note_reader}\n");
+  const std::string file = Write("loop.yaml", R"(scene: a.txt
+hardware: hardware.yaml
+components:
+  - {name: reader}
+)");
+  // As `--hardware FILE` gives it: its scene wins over the pipeline's line...
+  const PipelineSpec spec = LoadPipelineFile(file, (dir_ / "hardware.yaml").string());
+  EXPECT_EQ(spec.resources.at("scene").path, (dir_ / "b.txt").string());
+  // ...and one that names no scene leaves the pipeline's.
+  const PipelineSpec kept = LoadPipelineFile(file, other);
+  EXPECT_EQ(kept.resources.at("scene").path, (dir_ / "a.txt").string());
 }
 
 TEST_F(ResourcesTest, AMissingFileIsReportedAtTheLineThatNamesIt) {

@@ -8,11 +8,11 @@ run. Standard library only.
 demo: `saccade demo` for --steps steps of the loop (0.04 s each) with the soak configuration,
   pipelines/soak.yaml on scenes/soak.yaml (--pipeline another): the demo's loop with every
   component on (the renderer's distortion, motion blur and noise; undistortion, median and
-  sharpening besides the detectors, trackers, triangulation, attention and fixation) on 512 x 384
-  eye images, whose attention dwells on its first face for ever (fixation_time_s: 1e6), so that
-  the run never ends early ("every face fixated") and the loop keeps detecting, tracking and
-  pursuing the sliding portraits to the last step. The report (--json) must say that every step
-  ran.
+  sharpening besides the detectors, trackers, triangulation, attention and fixation) on 352 x 264
+  eye images, whose attention dwells on a face until its track is lost (fixation_time_s: 1e6), so
+  that the run does not end early ("every face fixated") and the loop keeps detecting, tracking
+  and pursuing the sliding portraits to the last step. The report (--json) must say that every
+  step ran.
 gui: `saccade gui --port 0 --no-token` on the same configuration, at --speed (1: real time), with
   --clients WebSocket clients of the browser
   protocol (docs/gui-protocol.md), written here on sockets: each reads every state and frame

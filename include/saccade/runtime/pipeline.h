@@ -35,7 +35,9 @@
 //     head: {type: sim.head}
 //
 // Shared resources (resources.h): `scene: FILE` at the top of a pipeline file or of its
-// hardware file (which then wins; relative to that file) names the scene once. The pipeline
+// hardware file (relative to that file) names the scene once: the pipeline's own line wins
+// over the file its `hardware:` line names, and a hardware file given in place of that line
+// (ParsePipeline's `hardware`, `--hardware`) wins over the pipeline's. The pipeline
 // loads it before building any component and hands it to those that ask
 // (Component::resources()); a component's own `scene` parameter, where it has one, names
 // another file of the same kind, loaded once per pipeline as well.
