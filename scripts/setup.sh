@@ -5,8 +5,8 @@
 #   bash scripts/setup.sh [--program] [BUILD_DIR] [extra cmake args...]
 #
 # --program (the README's first command, scripts/demo.sh): only what the programs need, to build
-#   and run them: their Debian packages, the GUI's npm packages, and the targets saccade and
-#   saccade-servo-emulator, without debug information. The tests' packages (Chromium, clang,
+#   and run them: their Debian packages, the GUI's three.js (fetched from the npm registry without
+#   Node.js), and the targets saccade and saccade-servo-emulator, without debug information. The tests' packages (Chromium, clang,
 #   GoogleTest, Python's, reference data ...) and targets come with the full setup (the second
 #   command, scripts/test.sh).
 # SACCADE_BUILD_TARGET=T builds only target T (e.g. tests_unit) instead of everything.
@@ -72,8 +72,12 @@ if ! $program_only; then
 fi
 
 # Node.js and npm install the GUI's three.js and the browser tests' playwright-core (web/):
-# Debian's packages, unless a Node.js with npm is already there.
-if ! command -v npm >/dev/null || ! command -v node >/dev/null; then
+# Debian's packages, unless a Node.js with npm is already there. --program needs neither (npm
+# and its Debian dependencies are 300-odd packages): it fetches three.js from the npm registry
+# with curl, checked against the lock file as npm ci checks it (below).
+if $program_only; then
+  packages+=(curl)
+elif ! command -v npm >/dev/null || ! command -v node >/dev/null; then
   packages+=(nodejs npm)
 fi
 
@@ -117,9 +121,54 @@ if [ ! -s assets/astronaut.png ] || [ ! -s assets/chelsea.png ]; then
 fi
 ln -sfn /usr/share/mujoco/model/mug assets/mug
 
+# The GUI's runtime npm packages (three.js), for --program: each tarball that web/package-lock.json
+# pins (its development dependencies left out) from the npm registry ($npm_config_registry, else
+# registry.npmjs.org), its SHA-512 checked against the lock's integrity, unpacked into
+# web/node_modules/ in place of the old one. Only when the lock file changed; the full setup's
+# npm ci replaces them all.
+fetch_npm_runtime_packages() {
+  local registry="${npm_config_registry:-https://registry.npmjs.org/}" tmp path name version
+  local integrity expected actual
+  registry="${registry%/}"
+  tmp=$(mktemp -d)
+  cmake -DLOCK=web/package-lock.json -P cmake/npm_lock_packages.cmake >"$tmp/list"
+  while read -r path name version integrity; do
+    if [ "${integrity#sha512-}" = "$integrity" ]; then
+      echo "setup: web/package-lock.json: $path: expected a sha512- integrity, got '$integrity'" >&2
+      rm -rf "$tmp"
+      return 1
+    fi
+    expected=$(printf %s "${integrity#sha512-}" | base64 -d | od -An -v -tx1 | tr -d ' \n')
+    if ! curl -fsSL --retry 3 -o "$tmp/package.tgz" "$registry/$name/-/${name##*/}-$version.tgz"; then
+      echo "setup: cannot fetch $name $version from $registry" >&2
+      rm -rf "$tmp"
+      return 1
+    fi
+    actual=$(sha512sum "$tmp/package.tgz" | cut -d' ' -f1)
+    if [ "$actual" != "$expected" ]; then
+      echo "setup: $name $version from $registry: SHA-512 $actual, the lock file says $expected" >&2
+      rm -rf "$tmp"
+      return 1
+    fi
+    rm -rf "web/$path.partial"
+    mkdir -p "web/$path.partial"
+    tar -xzf "$tmp/package.tgz" -C "web/$path.partial" --strip-components=1 --no-same-owner
+    rm -rf "web/$path"
+    mv "web/$path.partial" "web/$path"
+    echo "setup: $name $version (npm registry, SHA-512 as locked) in web/$path"
+  done <"$tmp/list"
+  rm -rf "$tmp"
+  cp web/package-lock.json web/node_modules/.saccade-runtime-lock
+}
+if $program_only; then
+  if ! cmp -s web/package-lock.json web/node_modules/.saccade-installed-lock 2>/dev/null &&
+    ! cmp -s web/package-lock.json web/node_modules/.saccade-runtime-lock 2>/dev/null; then
+    echo "setup: fetching the GUI's npm packages (web/package-lock.json, without its dev ones)"
+    fetch_npm_runtime_packages
+  fi
 # The GUI's npm packages (three.js for the page, playwright-core for its browser tests), exactly
 # as web/package-lock.json pins them; again only when the lock file changed.
-if ! cmp -s web/package-lock.json web/node_modules/.saccade-installed-lock 2>/dev/null; then
+elif ! cmp -s web/package-lock.json web/node_modules/.saccade-installed-lock 2>/dev/null; then
   echo "setup: installing the GUI's npm packages (web/package-lock.json)"
   (cd web && npm ci --no-audit --no-fund --loglevel=error)
   cp web/package-lock.json web/node_modules/.saccade-installed-lock
