@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # The README's second command: set up, build, and run every test.
-# Warnings are errors (scripts/setup.sh). With CI=true: every libFuzzer target (fuzz/run.sh:
+# Warnings are errors (scripts/setup.sh). With CI=true: the first command's unity build of the
+# programs (build-program/, as scripts/demo.sh builds them), every libFuzzer target (fuzz/run.sh:
 # scene, pipeline, hardware, head, calibration, GUI command, Dynamixel parser) is fuzzed
 # briefly, and the unit tests run a second time under AddressSanitizer and
 # UndefinedBehaviorSanitizer (build-asan/, which builds the unit tier only). Each phase's wall
@@ -56,6 +57,17 @@ begin "setup and build (build/)"
 bash scripts/setup.sh build
 cache_figures
 end
+
+if $ci; then
+  # The first command's build (scripts/setup.sh --program): a unity build, 8 sources a compile,
+  # where names in anonymous namespaces must differ between a library's sources (CMakeLists.txt).
+  # Compiled here so that a clash fails CI, not a newcomer's first command.
+  begin "the first command's unity build (build-program/)"
+  cmake -S . -B build-program -G Ninja -DSACCADE_WERROR=ON -DSACCADE_PROGRAM_ONLY=ON >/dev/null
+  cmake --build build-program --target saccade saccade-servo-emulator
+  cache_figures
+  end
+fi
 
 if $ci || [ "${SACCADE_FUZZ:-}" = "1" ]; then
   begin "fuzzing: seven targets (libFuzzer, ${SACCADE_FUZZ_SECONDS:-60} s)"

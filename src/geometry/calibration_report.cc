@@ -10,13 +10,13 @@
 #include <utility>
 
 #include "saccade/core/error.h"
+#include "saccade/core/units.h"
 #include "saccade/geometry/gl_projection.h"
 #include "saccade/geometry/stereo_rectification.h"
 
 namespace saccade::geometry {
 namespace {
 
-constexpr double kRadToDeg = 180.0 / M_PI;
 
 /// What both forms print of one camera, computed once.
 struct Described {

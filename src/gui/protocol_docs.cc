@@ -123,12 +123,12 @@ std::string Pretty(const ordered_json& j, int indent) {
 
 // ---- Markdown ----
 
-std::string Number(double x) { return fmt::format("{}", x); }
+std::string FormatNumber(double x) { return fmt::format("{}", x); }
 
 std::string Range(const Schema& s) {
-  if (s.min && s.max) return " in [" + Number(*s.min) + ", " + Number(*s.max) + "]";
-  if (s.min) return " ≥ " + Number(*s.min);
-  if (s.max) return " ≤ " + Number(*s.max);
+  if (s.min && s.max) return " in [" + FormatNumber(*s.min) + ", " + FormatNumber(*s.max) + "]";
+  if (s.min) return " ≥ " + FormatNumber(*s.min);
+  if (s.max) return " ≤ " + FormatNumber(*s.max);
   return "";
 }
 

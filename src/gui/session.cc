@@ -17,6 +17,7 @@
 #include "gui/internal_state_message.h"
 #include "saccade/core/error.h"
 #include "saccade/core/log.h"
+#include "saccade/core/units.h"
 #include "saccade/geometry/json.h"
 #include "saccade/gui/protocol.h"
 #include "saccade/head/json.h"
@@ -32,7 +33,6 @@ using components::JointCommand;
 using nlohmann::json;
 using server::CommandError;
 
-constexpr double kRadToDeg = 180.0 / M_PI;
 
 double WallNow() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();

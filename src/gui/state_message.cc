@@ -3,6 +3,7 @@
 
 #include "gui/internal_scene_document.h"
 #include "gui/internal_state_message.h"
+#include "saccade/core/units.h"
 #include "saccade/geometry/json.h"
 #include "saccade/head/json.h"
 
@@ -11,7 +12,6 @@ namespace {
 
 using nlohmann::json;
 
-constexpr double kRadToDeg = 180.0 / M_PI;
 
 double AxisErrorDeg(const geometry::Pose& X_WC, const Eigen::Vector3d& p_W) {
   const Eigen::Vector3d to = (p_W - X_WC.translation()).normalized();

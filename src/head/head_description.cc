@@ -14,12 +14,11 @@
 
 #include "core/internal_yaml.h"
 #include "saccade/core/error.h"
+#include "saccade/core/units.h"
 
 namespace saccade::head {
 namespace {
 
-constexpr double kDegToRad = std::numbers::pi / 180.0;
-constexpr double kRadToDeg = 180.0 / std::numbers::pi;
 // X_WB's rotation must be orthonormal to this (a pose built from rpy is, to ~1e-16).
 constexpr double kRotationTolerance = 1e-9;
 

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "saccade/core/error.h"
+#include "saccade/core/units.h"
 
 namespace saccade::head {
 namespace {
@@ -19,7 +20,6 @@ using Eigen::Vector3d;
 using geometry::Pose;
 
 constexpr double kPi = std::numbers::pi;
-constexpr double kRadToDeg = 180.0 / kPi;
 // Optical axes whose directions differ by less than this (sine of the angle) are parallel:
 // they would meet more than B / 1e-12 (1e11 m for B = 0.1 m) away.
 constexpr double kParallelSine = 1e-12;

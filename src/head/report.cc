@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "saccade/core/error.h"
+#include "saccade/core/units.h"
 #include "saccade/geometry/json.h"
 #include "saccade/head/json.h"
 
@@ -13,7 +14,6 @@ namespace saccade::head {
 namespace {
 
 using nlohmann::json;
-constexpr double kRadToDeg = 180.0 / M_PI;
 
 JointState Degrees(const JointState& q) {
   return {q.pan * kRadToDeg, q.tilt * kRadToDeg, q.left * kRadToDeg, q.right * kRadToDeg};

@@ -6,12 +6,12 @@
 #include <numbers>
 #include <utility>
 
+#include "saccade/core/units.h"
 #include "saccade/hw/hw_error.h"
 
 namespace saccade::hw {
 namespace {
 
-constexpr double kRadToDeg = 180.0 / std::numbers::pi;
 // A joint slower than this is at rest (HeadStatus::moving).
 constexpr double kMovingThreshold = 0.5 / kRadToDeg;
 

@@ -66,7 +66,7 @@ class ImageListReader final : public FrameReader {
   size_t current_ = 0;
 };
 
-std::string Lower(std::string s) {
+std::string LowerCase(std::string s) {
   std::transform(s.begin(), s.end(), s.begin(),
                  [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
   return s;
@@ -81,7 +81,7 @@ std::string_view Trim(std::string_view s) {
 
 // FileStorage by extension (.xml, .yml, .yaml, .json, also gzipped) or by its first bytes.
 bool IsFileStorage(const fs::path& path, const std::string& head) {
-  std::string name = Lower(path.filename().string());
+  std::string name = LowerCase(path.filename().string());
   if (name.ends_with(".gz")) name.resize(name.size() - 3);
   for (const char* extension : {".xml", ".yml", ".yaml", ".json"}) {
     if (name.ends_with(extension)) return true;

@@ -12,7 +12,7 @@
 namespace saccade::runtime {
 namespace {
 
-bool IsIdentifier(const std::string& name) {
+bool IsParamIdentifier(const std::string& name) {
   if (name.empty() || !(std::isalpha(static_cast<unsigned char>(name[0])) || name[0] == '_')) {
     return false;
   }
@@ -195,7 +195,7 @@ ParamDecl& ParamDecl::Path() {
 
 ParamDecl ParamTable::Add(Entry entry) {
   const std::string& name = entry.info.name;
-  if (!IsIdentifier(name)) {
+  if (!IsParamIdentifier(name)) {
     throw InvalidArgument("parameter name '" + name + "' is not an identifier");
   }
   for (const Entry& e : entries_) {

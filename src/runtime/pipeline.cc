@@ -284,7 +284,7 @@ ComponentSpec ParseComponent(const Entry& e) {
   return spec;
 }
 
-std::string Join(const std::vector<std::string>& names) {
+std::string JoinNames(const std::vector<std::string>& names) {
   std::string text;
   for (const std::string& name : names) text += (text.empty() ? "" : ", ") + name;
   return text.empty() ? "(none)" : text;
@@ -294,7 +294,7 @@ template <typename Ports>
 std::string PortNames(const Ports& ports) {
   std::vector<std::string> names;
   for (const auto& port : ports) names.push_back(port->name() + " (" + port->message_type() + ")");
-  return Join(names);
+  return JoinNames(names);
 }
 
 std::string ComponentKey(std::size_t index) { return fmt::format("components[{}]", index); }
@@ -534,7 +534,7 @@ std::vector<std::unique_ptr<Component>> CreateComponents(
     if (!registry.Has(c.type)) {
       throw FileError(params_file, c.type_line, type_key,
                       "unknown component type '" + c.type + "' for component '" + c.name +
-                          "'; known types: " + Join(registry.Types()));
+                          "'; known types: " + JoinNames(registry.Types()));
     }
     std::unique_ptr<Component> component = registry.Create(c.type);
     component->Initialise(c.name, ComponentSeed(spec.seed, c.name),
@@ -673,7 +673,7 @@ TimeSource* FindTimeSource(const BuiltComponents& b,
     for (const ComponentSpec& c : built.components) {
       if (c.reads_for.empty()) names.push_back(c.name);
     }
-    Fail(fmt::format("unknown component '{}' in '{}'; components: {}", name, source, Join(names)));
+    Fail(fmt::format("unknown component '{}' in '{}'; components: {}", name, source, JoinNames(names)));
   }
   const std::vector<ConnectionSpec>& inputs = built.components[consumer->second].inputs;
   const auto connection = std::find_if(inputs.begin(), inputs.end(),
@@ -776,7 +776,7 @@ void ConnectInputs(const BuiltComponents& b, const std::map<std::string, std::si
         std::vector<std::string> names;
         for (const ComponentSpec& other : built.components) names.push_back(other.name);
         Fail(fmt::format("unknown component '{}' in '{}'; components: {}",
-                         connection.from_component, from, Join(names)));
+                         connection.from_component, from, JoinNames(names)));
       }
       const std::size_t j = it->second;
       const Component& producer = *b.components[j];
@@ -901,7 +901,7 @@ nlohmann::json Pipeline::Call(const std::string& component, const std::string& m
     for (const auto& known : c->methods()) names.push_back(known->name());
     throw MethodError(component + "." + method,
                       "component '" + component + "' has no such method (it has: " +
-                          (names.empty() ? std::string("none") : Join(names)) + ")");
+                          (names.empty() ? std::string("none") : JoinNames(names)) + ")");
   }
   return m->CallJson(request);
 }

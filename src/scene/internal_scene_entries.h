@@ -13,13 +13,13 @@
 #include <vector>
 
 #include "core/internal_yaml.h"
+#include "saccade/core/units.h"
 #include "saccade/scene/scene.h"
 
 namespace saccade::scene::internal_reader {
 
 using saccade::internal::Entry;
 
-inline constexpr double kDegToRad = std::numbers::pi / 180.0;
 // Instance ids stay exact in a float (2^24) for renderers that pass them through one.
 inline constexpr int64_t kMaxId = (int64_t{1} << 24) - 1;
 // Default clip planes of every camera (metres): the robot's body is built for near = 0.05.

@@ -16,15 +16,15 @@ namespace saccade::scene {
 namespace {
 
 // A rotation must be orthonormal to this to be a pose (rpy-built ones are, to ~1e-16).
-constexpr double kRotationTolerance = 1e-9;
+constexpr double kRigidTolerance = 1e-9;
 
 [[noreturn]] void Invalid(const std::string& what) { throw InvalidArgument("Scene: " + what); }
 
-bool IsRigid(const geometry::Pose& X) {
+bool IsRigidPose(const geometry::Pose& X) {
   const Eigen::Matrix3d R = X.linear();
   return X.matrix().allFinite() &&
-         (R.transpose() * R).isApprox(Eigen::Matrix3d::Identity(), kRotationTolerance) &&
-         std::abs(R.determinant() - 1.0) <= kRotationTolerance;
+         (R.transpose() * R).isApprox(Eigen::Matrix3d::Identity(), kRigidTolerance) &&
+         std::abs(R.determinant() - 1.0) <= kRigidTolerance;
 }
 
 bool IsColor(const Eigen::Vector3f& c) {
@@ -121,7 +121,7 @@ Scene::Scene(Eigen::Vector3f background, std::vector<Light> lights, Ground groun
     for (std::size_t i = 0; i < robot_->parts.size(); ++i) {
       const RobotPart& part = robot_->parts[i];
       const std::string owner = fmt::format("robot.parts[{}]", i);
-      if (!IsRigid(part.X_LinkPart)) Invalid(owner + ": X_LinkPart must be a rigid transform");
+      if (!IsRigidPose(part.X_LinkPart)) Invalid(owner + ": X_LinkPart must be a rigid transform");
       if (!IsPositiveScale(part.scale)) Invalid(owner + ": scale must be finite and > 0");
       CheckModel(part.model, owner, checked);
       add_model(part.model);
@@ -138,7 +138,7 @@ Scene::Scene(Eigen::Vector3f background, std::vector<Light> lights, Ground groun
       Invalid(fmt::format("{}: clip planes must be 0 < near < far < inf, got near {}, far {}",
                           owner, camera.clip.near, camera.clip.far));
     }
-    if (camera.mount == CameraMount::kWorld && !IsRigid(camera.X_WC)) {
+    if (camera.mount == CameraMount::kWorld && !IsRigidPose(camera.X_WC)) {
       Invalid(owner + ": X_WC must be a finite rigid transform");
     }
     if (camera.mount != CameraMount::kWorld && !robot_) {

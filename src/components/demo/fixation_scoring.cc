@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "saccade/core/units.h"
 #include "saccade/geometry/json.h"
 #include "saccade/vision/image_camera.h"
 
@@ -12,7 +13,6 @@ namespace saccade::components::demo {
 namespace {
 
 using nlohmann::json;
-constexpr double kRadToDeg = 180.0 / M_PI;
 
 /// Angle (degrees) between a camera's optical axis and the direction to p_W.
 double AxisErrorDeg(const Image& image, const Eigen::Vector3d& p_W) {

@@ -8,7 +8,7 @@
 namespace saccade::render::gl {
 namespace {
 
-void CheckComplete(int width, int height, int samples) {
+void CheckTargetComplete(int width, int height, int samples) {
   const GLenum status = glCheckFramebufferStatus(GL_FRAMEBUFFER);
   if (status != GL_FRAMEBUFFER_COMPLETE) {
     throw Error(
@@ -38,14 +38,14 @@ CameraTarget::CameraTarget(int width, int height, int samples, GLenum readback_f
   glBindFramebuffer(GL_FRAMEBUFFER, draw_framebuffer_);
   glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, color_);
   glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, depth_);
-  CheckComplete(width, height, samples);
+  CheckTargetComplete(width, height, samples);
   if (samples > 0) {
     resolve_color_ = MakeRenderbuffer(GL_RGBA8, width, height, 0);
     glGenFramebuffers(1, &resolve_framebuffer_);
     glBindFramebuffer(GL_FRAMEBUFFER, resolve_framebuffer_);
     glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER,
                               resolve_color_);
-    CheckComplete(width, height, 0);
+    CheckTargetComplete(width, height, 0);
   } else {
     resolve_framebuffer_ = draw_framebuffer_;
   }
