@@ -17,7 +17,6 @@
 namespace saccade::geometry {
 namespace {
 
-
 /// What both forms print of one camera, computed once.
 struct Described {
   CameraCalibration calibration;

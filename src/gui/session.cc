@@ -33,7 +33,6 @@ using components::JointCommand;
 using nlohmann::json;
 using server::CommandError;
 
-
 double WallNow() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
 }

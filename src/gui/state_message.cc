@@ -12,7 +12,6 @@ namespace {
 
 using nlohmann::json;
 
-
 double AxisErrorDeg(const geometry::Pose& X_WC, const Eigen::Vector3d& p_W) {
   const Eigen::Vector3d to = (p_W - X_WC.translation()).normalized();
   return std::acos(std::clamp(X_WC.linear().col(2).dot(to), -1.0, 1.0)) * kRadToDeg;

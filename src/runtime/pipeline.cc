@@ -673,7 +673,8 @@ TimeSource* FindTimeSource(const BuiltComponents& b,
     for (const ComponentSpec& c : built.components) {
       if (c.reads_for.empty()) names.push_back(c.name);
     }
-    Fail(fmt::format("unknown component '{}' in '{}'; components: {}", name, source, JoinNames(names)));
+    Fail(fmt::format("unknown component '{}' in '{}'; components: {}", name, source,
+                     JoinNames(names)));
   }
   const std::vector<ConnectionSpec>& inputs = built.components[consumer->second].inputs;
   const auto connection = std::find_if(inputs.begin(), inputs.end(),

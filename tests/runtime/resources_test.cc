@@ -144,7 +144,8 @@ components:
 
 TEST_F(ResourcesTest, AHardwareFileGivenInsteadOfThePipelinesLineWins) {
   Write("hardware.yaml", "scene: b.txt\ncomponents:\n  reader: {type: test.note_reader}\n");
-  const std::string other = Write("other.yaml", "components:\n  reader: {type: test.note_reader}\n");
+  const std::string other =
+      Write("other.yaml", "components:\n  reader: {type: test.note_reader}\n");
   const std::string file = Write("loop.yaml", R"(scene: a.txt
 hardware: hardware.yaml
 components:
