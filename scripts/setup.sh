@@ -6,7 +6,8 @@
 #
 # --program (the README's first command, scripts/demo.sh): only what the programs need, to build
 #   and run them: their Debian packages, the GUI's three.js (fetched from the npm registry without
-#   Node.js), and the targets saccade and saccade-servo-emulator, without debug information. The tests' packages (Chromium, clang,
+#   Node.js), and the targets saccade and saccade-servo-emulator, without debug information, as a
+#   unity build (CMakeLists.txt). The tests' packages (Chromium, clang,
 #   GoogleTest, Python's, reference data ...) and targets come with the full setup (the second
 #   command, scripts/test.sh).
 # SACCADE_BUILD_TARGET=T builds only target T (e.g. tests_unit) instead of everything.
