@@ -48,6 +48,9 @@ packages=(
   # DDS beyond one process (ROS 2's wire): Cyclone DDS's C library (cyclonedds-dev), its IDL
   # compiler idlc and ddsperf, for the transport benchmark (cyclonedds-tools)
   cyclonedds-dev cyclonedds-tools
+  # any robot head from its URDF (issue 42): urdfdom parses URDF (it brings TinyXML, which also
+  # reads the URDF's <gazebo> camera blocks, and console_bridge, which carries its messages)
+  liburdfdom-dev
 )
 # What the tests, benchmarks and the Python package add (the full setup only).
 test_packages=(
@@ -67,6 +70,9 @@ test_packages=(
   python3-cloudpickle python3-typing-extensions
   # the reference of the Python tests for the camera model (cv2.projectPoints)
   python3-opencv
+  # the reference of the kinematics tests for any head: Orocos KDL's forward kinematics and
+  # Jacobians; urdfdom's check_urdf for the shipped heads' URDF files
+  liborocos-kdl-dev liburdfdom-tools
 )
 if ! $program_only; then
   packages+=("${test_packages[@]}")
