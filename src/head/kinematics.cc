@@ -448,6 +448,8 @@ const char* ToString(Reachability reachability) {
       return "joint limit";
     case Reachability::kDegenerate:
       return "degenerate";
+    case Reachability::kNotConverged:
+      return "not converged";
   }
   return "unknown";
 }

@@ -42,10 +42,11 @@ enum class VergenceMode {
 /// Why a target cannot be fixated exactly.
 enum class Reachability {
   kReachable,
-  kBehind,      ///< behind the head: would need pan beyond +-90 deg or the eyes to diverge
-  kTooClose,    ///< closer than the eyes can converge within their limits
-  kJointLimit,  ///< a joint would leave its limits
-  kDegenerate,  ///< at the cyclopean point or on an eye's rotation axis
+  kBehind,        ///< behind the head: would need pan beyond +-90 deg or the eyes to diverge
+  kTooClose,      ///< closer than the eyes can converge within their limits
+  kJointLimit,    ///< a joint would leave its limits
+  kDegenerate,    ///< at the cyclopean point or on an eye's rotation axis
+  kNotConverged,  ///< (any head's solver, fixation.h) no posture found that fixates it
 };
 const char* ToString(Reachability reachability);
 
