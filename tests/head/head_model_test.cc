@@ -72,6 +72,37 @@ TEST(HeadModel, PopeyesLegacyFileIsATreeWithAppendixAsForwardKinematics) {
   EXPECT_LE(WorstAgainstAppendixA(head, legacy), kMatrixTolerance);
 }
 
+TEST(HeadModel, PopeyesUrdfIsAppendixAsChainToo) {
+  const HeadDescription legacy = HeadDescription::FromYamlFile(kSource / "robots/popeye.yaml");
+  const HeadModel head = HeadModel::FromFile(kSource / "robots/popeye_urdf.yaml");
+  ASSERT_EQ(head.num_joints(), 4);
+  for (const Joint j : kAllJoints) EXPECT_EQ(head.joint_name(static_cast<int>(j)), JointName(j));
+  EXPECT_FALSE(head.appendix_a().has_value());
+  EXPECT_FALSE(head.visuals().empty());
+  EXPECT_LE(WorstAgainstAppendixA(head, legacy), kMatrixTolerance);
+}
+
+TEST(HeadModel, EveryShippedHeadFileLoadsWithItsMeshes) {
+  int heads = 0;
+  for (const auto& entry : fs::directory_iterator(kSource / "robots")) {
+    if (entry.path().extension() != ".yaml") continue;
+    const HeadModel head = HeadModel::FromFile(entry.path());
+    ++heads;
+    for (const UrdfVisual& visual : head.visuals()) {
+      if (visual.shape == UrdfVisual::Shape::kMesh) {
+        EXPECT_TRUE(fs::is_regular_file(visual.mesh_path)) << visual.mesh_uri;
+      }
+    }
+    // At home the cameras look along the world's +x (every shipped head faces the scenes).
+    std::vector<Pose> X_WL;
+    head.ForwardKinematics(head.HomePosture(), &X_WL);
+    for (int eye = 0; eye < 2; ++eye) {
+      EXPECT_GT(head.CameraPose(eye, X_WL).linear().col(2).x(), 0.99) << entry.path();
+    }
+  }
+  EXPECT_GE(heads, 5);
+}
+
 TEST(HeadModel, OffsetsOfTheGeneralAppendixAChainAreKept) {
   // D, H and the deltas move the frames (appendix A's extension): the tree follows them.
   HeadDescription base = HeadDescription::FromYamlFile(kSource / "robots/popeye.yaml");
