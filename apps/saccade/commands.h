@@ -10,7 +10,8 @@
 #include <string>
 #include <vector>
 
-#include "saccade/head/head_description.h"
+#include "saccade/head/head_model.h"
+#include "saccade/head/joint_state.h"
 #include "saccade/runtime/pipeline.h"
 
 namespace saccade::app {
@@ -34,8 +35,10 @@ inline constexpr double kDegToRad = M_PI / 180.0;
 /// data (share/saccade).
 std::string ShippedFile(const std::string& relative);
 
-/// Joint angles from 4 command-line values, radians or degrees.
-head::JointState JointsFromArgs(const std::vector<double>& values, bool degrees);
+/// A head's joints from command-line values, one per joint in its order, radians (m for a
+/// prismatic joint) or degrees. Throws InvalidArgument naming the joints when the count differs.
+head::JointState JointsFromArgs(const head::HeadModel& head, const std::vector<double>& values,
+                                bool degrees);
 
 /// The --dds-* options of the commands that run a pipeline with topics (run, gui): they
 /// override the pipeline file's `transport:` map (dds/transport.h).

@@ -1,6 +1,9 @@
 #include <filesystem>
 
+#include <fmt/format.h>
+
 #include "commands.h"
+#include "saccade/core/error.h"
 
 namespace saccade::app {
 
@@ -14,9 +17,20 @@ std::string ShippedFile(const std::string& relative) {
   return source.string();
 }
 
-head::JointState JointsFromArgs(const std::vector<double>& values, bool degrees) {
-  const double s = degrees ? kDegToRad : 1.0;
-  return {values[0] * s, values[1] * s, values[2] * s, values[3] * s};
+head::JointState JointsFromArgs(const head::HeadModel& head, const std::vector<double>& values,
+                                bool degrees) {
+  if (static_cast<int>(values.size()) != head.num_joints()) {
+    throw InvalidArgument(fmt::format("--joints: {} values for the {} joints of head '{}' ({})",
+                                      values.size(), head.num_joints(), head.name(),
+                                      head::ListNames(*head.joint_names())));
+  }
+  head::JointState q(head.joint_names());
+  for (int i = 0; i < head.num_joints(); ++i) {
+    const bool prismatic =
+        head.tree().joint(head.tree().variable_joint(i)).type == head::JointType::kPrismatic;
+    q[i] = values[i] * (degrees && !prismatic ? kDegToRad : 1.0);
+  }
+  return q;
 }
 
 void AddDdsOptions(CLI::App* command, DdsOverrides& o) {

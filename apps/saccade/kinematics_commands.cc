@@ -10,7 +10,9 @@
 #include "commands.h"
 #include "saccade/core/error.h"
 #include "saccade/geometry/calibration_report.h"
+#include "saccade/head/fixation.h"
 #include "saccade/head/head_description.h"
+#include "saccade/head/head_model.h"
 #include "saccade/head/kinematics.h"
 #include "saccade/head/report.h"
 
@@ -19,28 +21,51 @@ namespace {
 
 int RunFk(const std::string& head_path, const std::vector<double>& joint_values, bool degrees,
           bool as_json) {
-  const head::HeadDescription head = head::HeadDescription::FromYamlFile(head_path);
-  const head::JointState q = JointsFromArgs(joint_values, degrees);
+  const head::HeadModel model = head::HeadModel::FromFile(head_path);
+  const head::JointState q = JointsFromArgs(model, joint_values, degrees);
+  // POPEYE's legacy file: appendix A's chain and report, as always.
+  if (const std::optional<head::HeadDescription> head = model.AppendixAHead()) {
+    const head::PopeyeJoints p{q[0], q[1], q[2], q[3]};
+    if (as_json) {
+      std::cout << head::FkReportJson(*head, p).dump(2) << "\n";
+    } else {
+      fmt::print("{}", head::FkReportText(*head, p));
+    }
+    return 0;
+  }
   if (as_json) {
-    std::cout << head::FkReportJson(head, q).dump(2) << "\n";
+    std::cout << head::FkReportJson(model, q).dump(2) << "\n";
   } else {
-    fmt::print("{}", head::FkReportText(head, q));
+    fmt::print("{}", head::FkReportText(model, q));
   }
   return 0;
 }
 
 int RunIk(const std::string& head_path, const std::vector<double>& target, const std::string& mode,
           bool as_json) {
-  const head::HeadDescription head = head::HeadDescription::FromYamlFile(head_path);
+  const head::HeadModel model = head::HeadModel::FromFile(head_path);
   const Eigen::Vector3d p_W(target[0], target[1], target[2]);
-  head::IkOptions options;
-  options.mode =
-      mode == "independent" ? head::VergenceMode::kIndependent : head::VergenceMode::kSymmetric;
-  const head::IkResult result = head::SolveFixation(head, p_W, options);
+  if (const std::optional<head::HeadDescription> head = model.AppendixAHead()) {
+    head::IkOptions options;
+    options.mode =
+        mode == "independent" ? head::VergenceMode::kIndependent : head::VergenceMode::kSymmetric;
+    const head::IkResult result = head::SolveFixation(*head, p_W, options);
+    if (as_json) {
+      std::cout << head::IkReportJson(*head, p_W, mode, result).dump(2) << "\n";
+    } else {
+      fmt::print("{}", head::IkReportText(p_W, result));
+    }
+    return 0;
+  }
+  if (mode != "symmetric") {
+    throw InvalidArgument("ik: --mode applies to POPEYE's legacy head file; " + head_path +
+                          " fixates by its own rule (its `fixation:` block)");
+  }
+  const head::FixationResult result = head::SolveFixation(model, p_W);
   if (as_json) {
-    std::cout << head::IkReportJson(head, p_W, mode, result).dump(2) << "\n";
+    std::cout << head::IkReportJson(model, p_W, result).dump(2) << "\n";
   } else {
-    fmt::print("{}", head::IkReportText(p_W, result));
+    fmt::print("{}", head::IkReportText(model, p_W, result));
   }
   return 0;
 }
@@ -71,12 +96,15 @@ Runner AddFkCommand(CLI::App& app) {
   auto o = std::make_shared<Options>();
   auto* fk = app.add_subcommand("fk",
                                 "Forward kinematics: camera poses and fixation point for "
-                                "joint angles (seed appendix A, eqs. 4-9).");
-  fk->add_option("--head", o->head, "Head description YAML")
+                                "joint values (any head; POPEYE's: seed appendix A, eqs. 4-9).");
+  fk->add_option("--head", o->head,
+                 "Head file (robots/*.yaml: a URDF and what it lacks, or POPEYE's legacy file)")
       ->check(CLI::ExistingFile)
       ->capture_default_str();
-  fk->add_option("--joints", o->joints, "PAN TILT LEFT RIGHT (radians, or degrees with --deg)")
-      ->expected(4)
+  fk->add_option("--joints", o->joints,
+                 "One value per actuated joint, in the head's order (POPEYE: PAN TILT LEFT "
+                 "RIGHT); radians (m for prismatic joints), or degrees with --deg")
+      ->expected(1, 64)
       ->required();
   fk->add_flag("--deg", o->degrees, "Joint angles are in degrees");
   fk->add_flag("--json", o->json, "Print JSON (stable interface, docs/cli.md)");
@@ -93,14 +121,18 @@ Runner AddIkCommand(CLI::App& app) {
   auto o = std::make_shared<Options>();
   auto* ik = app.add_subcommand("ik",
                                 "Inverse kinematics: joint angles that fixate a 3D point "
-                                "with both optical axes (eqs. 10-13, general solver).");
-  ik->add_option("--head", o->head, "Head description YAML")
+                                "with both optical axes (any head by its fixation rule; "
+                                "POPEYE's legacy file: eqs. 10-13).");
+  ik->add_option("--head", o->head,
+                 "Head file (robots/*.yaml: a URDF and what it lacks, or POPEYE's legacy file)")
       ->check(CLI::ExistingFile)
       ->capture_default_str();
   ik->add_option("--target", o->target, "X Y Z of the point to fixate, in metres, world frame")
       ->expected(3)
       ->required();
-  ik->add_option("--mode", o->mode, "symmetric (left = -right) or independent (pan held at 0)")
+  ik->add_option("--mode", o->mode,
+                 "POPEYE's legacy file only: symmetric (left = -right) or independent (pan held "
+                 "at 0); other heads follow their file's fixation rule")
       ->check(CLI::IsMember({"symmetric", "independent"}))
       ->capture_default_str();
   ik->add_flag("--json", o->json, "Print JSON (stable interface, docs/cli.md)");

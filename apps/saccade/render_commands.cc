@@ -53,9 +53,9 @@ scene::SceneState StateFor(const scene::Scene& scene, const std::vector<double>&
                            bool degrees) {
   scene::SceneState state = scene.InitialState();
   if (!joints.empty()) {
-    state.joints = JointsFromArgs(joints, degrees);
     if (!scene.robot()) throw InvalidArgument("--joints: the scene has no robot");
-    scene.robot()->head.CheckLimits(state.joints);
+    state.joints = JointsFromArgs(scene.robot()->head, joints, degrees);
+    scene.robot()->head.CheckLimits(state.joints.values());
   }
   return state;
 }
@@ -185,9 +185,9 @@ Runner AddRenderCommand(CLI::App& app) {
       ->capture_default_str();
   render
       ->add_option("--joints", o->joints,
-                   "PAN TILT LEFT RIGHT of the head (radians, or degrees with --deg); "
-                   "default: the scene's")
-      ->expected(4);
+                   "One value per joint of the scene's head, in its order (POPEYE: PAN TILT LEFT "
+                   "RIGHT); radians, or degrees with --deg; default: the scene's")
+      ->expected(1, 64);
   render->add_flag("--deg", o->degrees, "--joints are in degrees");
   render->add_option("--camera", o->cameras, "Render only this camera (repeatable)");
   o->truth_option = render->add_option(

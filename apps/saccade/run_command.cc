@@ -51,24 +51,32 @@ struct RunCommandOptions {
 void LogJoints(runtime::Pipeline& pipeline, const RunCommandOptions& o, std::ofstream* csv,
                json* fixations) {
   auto was_arrived = std::make_shared<bool>(true);
+  auto header_written = std::make_shared<bool>(false);
   components::demo::Tap<components::JointStateMessage>(
       pipeline, [=, &o](const components::JointStateMessage& m) {
+        const head::JointState& q = m.positions;
         if (csv) {
-          *csv << fmt::format("{:.6f},{:.17g},{:.17g},{:.17g},{:.17g},{}\n", m.time,
-                              m.positions.pan, m.positions.tilt, m.positions.left,
-                              m.positions.right, m.arrived ? 1 : 0);
+          // time, one column per joint (the head's names: POPEYE's pan,tilt,left,right), arrived.
+          if (!*header_written) {
+            *csv << "time";
+            for (const std::string& name : q.names()) *csv << "," << name;
+            *csv << ",arrived\n";
+            *header_written = true;
+          }
+          *csv << fmt::format("{:.6f}", m.time);
+          for (int i = 0; i < q.size(); ++i) *csv << fmt::format(",{:.17g}", q[i]);
+          *csv << fmt::format(",{}\n", m.arrived ? 1 : 0);
         }
         if (m.arrived && !*was_arrived) {
-          fixations->push_back({{"time", m.time},
-                                {"pan", m.positions.pan},
-                                {"tilt", m.positions.tilt},
-                                {"left", m.positions.left},
-                                {"right", m.positions.right}});
+          json fixation = {{"time", m.time}};
+          std::string text;
+          for (int i = 0; i < q.size(); ++i) {
+            fixation[q.name(i)] = q[i];
+            text += fmt::format(" {} {:+.4f}", q.name(i), q[i]);
+          }
+          fixations->push_back(fixation);
           if (!o.json) {
-            fmt::print(
-                "t = {:6.2f} s  fixation: pan {:+.4f} tilt {:+.4f} left {:+.4f} right "
-                "{:+.4f} rad\n",
-                m.time, m.positions.pan, m.positions.tilt, m.positions.left, m.positions.right);
+            fmt::print("t = {:6.2f} s  fixation:{} rad\n", m.time, text);
             std::fflush(stdout);
           }
         }
@@ -151,7 +159,7 @@ int Run(const RunCommandOptions& o) {
   if (!o.joints_csv.empty()) {
     csv = std::make_unique<std::ofstream>(o.joints_csv);
     if (!*csv) throw InvalidArgument("run: cannot write --joints-csv " + o.joints_csv);
-    *csv << "time,pan,tilt,left,right,arrived\n";
+    // The header comes with the first joint state, which names the head's joints.
   }
   json fixations = json::array();
   LogJoints(pipeline, o, csv.get(), &fixations);

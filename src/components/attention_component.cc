@@ -1,5 +1,7 @@
 #include "saccade/components/attention_component.h"
 
+#include "saccade/head/fixation.h"
+
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -75,11 +77,13 @@ void AttentionComponent::Configured() {
 }
 
 void AttentionComponent::Step(const runtime::StepContext& context) {
-  const head::HeadDescription& head = scene_->robot()->head;
+  const head::HeadModel& head = scene_->robot()->head;
   const head::JointState joints =
       joints_.has_value() ? joints_.value().positions : scene_->robot()->initial_joints;
-  const head::HeadFrames frames = head::ForwardKinematics(head, joints);
-  const Eigen::Vector3d viewer = frames.X_WC.translation();
+  // The viewer: midway between the optical centres (POPEYE's cyclopean point).
+  const std::array<geometry::Pose, 2> cameras = head.CameraPoses(joints);
+  const Eigen::Vector3d viewer = 0.5 * (cameras[0].translation() + cameras[1].translation());
+  const std::optional<Eigen::Vector3d> p_WFixation = head::FixationPoint(cameras[0], cameras[1]);
 
   std::vector<Eigen::Vector3d> points;
   const CandidatesMessage* candidates = candidates_.fresh() ? &candidates_.value() : nullptr;
@@ -106,10 +110,10 @@ void AttentionComponent::Step(const runtime::StepContext& context) {
   // put the target, and the first sharp image may call for a corrective one.
   bool fixating = false;
   if (current_.valid && !current_.exploring && joints_.has_value() && joints_.value().arrived &&
-      frames.p_WFixation) {
-    fixating = (*frames.p_WFixation - current_.p_W).norm() <= fixation_tolerance_m_;
+      p_WFixation) {
+    fixating = (*p_WFixation - current_.p_W).norm() <= fixation_tolerance_m_;
     if (fixating && !current_.fixating) {
-      const Eigen::Vector3d to_fixation = *frames.p_WFixation - viewer;
+      const Eigen::Vector3d to_fixation = *p_WFixation - viewer;
       fixating = same.has_value() && std::atan2(to_fixation.cross(points[*same] - viewer).norm(),
                                                 to_fixation.dot(points[*same] - viewer)) <=
                                          onset_tolerance_deg_ * M_PI / 180.0;
@@ -143,7 +147,7 @@ void AttentionComponent::Step(const runtime::StepContext& context) {
       out.exploring = true;
       out.target_id = next_id_++;
       fixating = false;  // home is not a face
-      out.p_W = frames.X_WB * Eigen::Vector3d(home_distance_m_, 0.0, 0.0);
+      out.p_W = head.X_WB() * Eigen::Vector3d(home_distance_m_, 0.0, 0.0);
     }
   }
   if (chosen) {

@@ -21,15 +21,28 @@ FixationComponent::FixationComponent()
 void FixationComponent::Configured() {
   const internal::SceneRef scene = internal::SceneOf(*this, scene_param_);
   scene_ = scene.scene;
-  last_joints_ = internal::RobotOf(*scene_, scene.path).initial_joints;
+  const head::HeadModel& head = internal::RobotOf(*scene_, scene.path).head;
+  last_joints_ = scene_->robot()->initial_joints;
+  // POPEYE's legacy head keeps appendix A's solver (the fast path, kinematics.h); every other
+  // head the general one (fixation.h), with the head file's rule.
+  appendix_a_ = head.AppendixAHead();
+  solver_ = std::make_unique<head::FixationSolver>(head);
 }
 
 head::JointState FixationComponent::Solve(const Eigen::Vector3d& p_W,
                                           const head::JointState& seed) const {
-  head::IkOptions options;
-  options.seed = seed;
-  // Unreachable targets give the nearest angles within the limits (kinematics.h).
-  return head::SolveFixation(scene_->robot()->head, p_W, options).joints;
+  const head::HeadModel& head = scene_->robot()->head;
+  const head::JointState q = head.Arrange(seed);
+  // Unreachable targets give the nearest angles within the limits.
+  if (appendix_a_) {
+    head::IkOptions options;
+    options.seed = {q[0], q[1], q[2], q[3]};
+    const head::PopeyeJoints j = head::SolveFixation(*appendix_a_, p_W, options).joints;
+    return head.State(Eigen::Vector4d(j.pan, j.tilt, j.left, j.right));
+  }
+  head::FixationOptions options;
+  options.seed = q.values();
+  return head.State(solver_->Solve(p_W, options).joints);
 }
 
 void FixationComponent::Step(const runtime::StepContext& context) {
@@ -56,11 +69,9 @@ void FixationComponent::Step(const runtime::StepContext& context) {
     // Joint velocities by a finite difference of the IK along the target's motion.
     constexpr double kH = 0.02;  // s
     const head::JointState ahead = Solve(target.p_W + kH * velocity_W_, command.positions);
-    for (head::Joint joint : head::kAllJoints) {
-      command.velocities[joint] = (ahead[joint] - command.positions[joint]) / kH;
-    }
+    command.velocities = ahead.With((ahead.values() - command.positions.values()) / kH);
   } else {
-    command.velocities = {0.0, 0.0, 0.0, 0.0};
+    command.velocities = head::JointState(command.positions.shared_names());
   }
   last_joints_ = command.positions;
   command_.Emit(command);

@@ -64,7 +64,8 @@ void SetPose(Image& image, const geometry::Pose& X_WC, const head::JointState& j
   ImageMetadata& meta = image.metadata();
   geometry::SetCameraPose(meta, X_WC);
   meta.has_joints = true;
-  meta.joints = {joints.pan, joints.tilt, joints.left, joints.right};
+  meta.joints.assign(joints.values().data(), joints.values().data() + joints.size());
+  meta.joint_names = joints.shared_names();
 }
 
 }  // namespace
@@ -134,10 +135,11 @@ void HwCameras::Step(const runtime::StepContext& context) {
   const scene::Robot& robot = *scene_->robot();
   head::JointState joints = robot.initial_joints;
   if (const JointStateMessage* state = joints_.get()) joints = state->positions;
-  const head::HeadFrames frames = head::ForwardKinematics(robot.head, joints);
+  joints = robot.head.Arrange(joints);
+  const std::array<geometry::Pose, 2> cameras = robot.head.CameraPoses(joints);
   // The step's time and a per-pair index, as sim.cameras stamps its frames.
   for (const auto& [image, X_WC] :
-       {std::pair{pair->left, frames.X_WCamLeft}, std::pair{pair->right, frames.X_WCamRight}}) {
+       {std::pair{pair->left, cameras[0]}, std::pair{pair->right, cameras[1]}}) {
     SetPose(*image, X_WC, joints);
     image->metadata().time = context.time;
     image->metadata().frame_index = pairs_;

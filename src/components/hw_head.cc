@@ -92,11 +92,19 @@ void HwHead::Configured() {
   }
   scene_ = scene.scene;
   const scene::Robot& robot = internal::RobotOf(*scene_, path);
-  if (driver_kind_ == "dynamixel" && !robot.head.HasServos()) {
-    throw InvalidArgument(fmt::format(
-        "the dynamixel driver needs a servo mapping for every joint (joints.<joint>.servo in "
-        "the head description), and the head '{}' of {} has none for some joint",
-        robot.head.name(), path));
+  if (driver_kind_ == "dynamixel") {
+    std::vector<std::string> missing;
+    for (int j = 0; j < robot.head.num_joints(); ++j) {
+      if (robot.head.joint(j).driven && !robot.head.joint(j).servo) {
+        missing.push_back(robot.head.joint_name(j));
+      }
+    }
+    if (!missing.empty()) {
+      throw InvalidArgument(fmt::format(
+          "the dynamixel driver needs a servo mapping for every driven joint (joints.<joint>.servo "
+          "in the head file), and the head '{}' of {} has none for: {}",
+          robot.head.name(), path, head::ListNames(missing)));
+    }
   }
 }
 
@@ -115,10 +123,10 @@ void HwHead::Start() {
   reported_fault_.clear();
   if (mirror_) {
     // The virtual head starts where the device is (clamped into the limits).
-    head::JointState start = driver_->Read().positions;
-    for (const head::Joint joint : head::kAllJoints) {
-      start[joint] =
-          std::clamp(start[joint], robot.head.limits(joint).min, robot.head.limits(joint).max);
+    head::JointState start = robot.head.Arrange(driver_->Read().positions);
+    for (int joint = 0; joint < start.size(); ++joint) {
+      const head::JointSettings& s = robot.head.joint(joint);
+      start[joint] = s.driven ? std::clamp(start[joint], s.limits.min, s.limits.max) : s.hold;
     }
     virtual_ = std::make_unique<head::Motors>(robot.head, start);
   }
@@ -229,7 +237,7 @@ JointStateMessage HwHead::Joints(const hw::HeadStatus& status, double time) cons
   out.velocities = status.velocities;
   out.targets = status.targets;
   out.arrived = !status.moving;
-  for (const head::Joint joint : head::kAllJoints) {
+  for (int joint = 0; joint < status.targets.size() && joint < status.positions.size(); ++joint) {
     // Servos settle within a tick or two of their goal (0.088 deg per tick).
     out.arrived = out.arrived && std::abs(status.targets[joint] - status.positions[joint]) < 0.005;
   }

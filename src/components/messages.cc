@@ -7,8 +7,7 @@
 namespace saccade::components {
 
 bool JointCommand::pursuit() const {
-  return velocities.pan != 0.0 || velocities.tilt != 0.0 || velocities.left != 0.0 ||
-         velocities.right != 0.0;
+  return velocities.size() > 0 && (velocities.values().array() != 0.0).any();
 }
 
 void RegisterMessages() {

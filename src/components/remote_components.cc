@@ -40,15 +40,23 @@ JointStateMessage RemoteHead::HeadState() {
 }
 
 JointStateMessage RemoteHead::Move(const JointCommand& command) {
-  const head::HeadDescription& head = scene_->robot()->head;
+  const head::HeadModel& head = scene_->robot()->head;
   JointCommand clamped = command;
-  for (head::Joint j : head::kAllJoints) {
-    if (!std::isfinite(command.positions[j]) || !std::isfinite(command.velocities[j])) {
-      throw Error(
-          fmt::format("{}: the command's {} is not a finite number", name(), head::JointName(j)));
+  try {
+    clamped.positions = head.Arrange(command.positions);
+    clamped.velocities = command.velocities.empty() ? head::JointState(head.joint_names())
+                                                    : head.Arrange(command.velocities);
+  } catch (const InvalidArgument& error) {
+    throw Error(fmt::format("{}: {}", name(), error.what()));
+  }
+  for (int j = 0; j < head.num_joints(); ++j) {
+    if (!std::isfinite(clamped.positions[j]) || !std::isfinite(clamped.velocities[j])) {
+      throw Error(fmt::format("{}: the command's {} is not a finite number", name(),
+                              head.joint_name(j)));
     }
-    const head::JointLimits& l = head.limits(j);
-    clamped.positions[j] = std::clamp(command.positions[j], l.min, l.max);
+    const head::JointSettings& s = head.joint(j);
+    clamped.positions[j] = s.driven ? std::clamp(clamped.positions[j], s.limits.min, s.limits.max)
+                                    : s.hold;
   }
   clamped.time = time_;
   pending_ = clamped;

@@ -405,13 +405,17 @@ void FillJointState(double time, const head::JointState& positions,
   holder.string_pointers.clear();
   holder.doubles[0].clear();
   holder.doubles[1].clear();
-  for (const head::Joint joint : head::kAllJoints) {
-    holder.string_pointers.push_back(const_cast<char*>(head::JointName(joint)));
+  // The names live in the states' shared name lists, which outlive the write.
+  for (int joint = 0; joint < positions.size(); ++joint) {
+    holder.string_pointers.push_back(const_cast<char*>(positions.name(joint).c_str()));
     holder.doubles[0].push_back(positions[joint]);
-    if (velocities) holder.doubles[1].push_back((*velocities)[joint]);
+    if (velocities && velocities->size() == positions.size()) {
+      holder.doubles[1].push_back((*velocities)[joint]);
+    }
   }
-  out->name = {4, 4, holder.string_pointers.data(), false};
-  out->position = {4, 4, holder.doubles[0].data(), false};
+  const auto n = static_cast<uint32_t>(positions.size());
+  out->name = {n, n, n ? holder.string_pointers.data() : nullptr, false};
+  out->position = {n, n, n ? holder.doubles[0].data() : nullptr, false};
   const auto nv = static_cast<uint32_t>(holder.doubles[1].size());
   out->velocity = {nv, nv, nv ? holder.doubles[1].data() : nullptr, false};
   out->effort = {0, 0, nullptr, false};
@@ -420,9 +424,15 @@ void FillJointState(double time, const head::JointState& positions,
 bool ArrivedOn(const head::JointState& positions, const head::JointState& velocities,
                const head::JointState& targets, const head::JointState& target_velocities) {
   constexpr double kTolerance = 1e-4;  // sim.head's (SimHead::State)
-  for (const head::Joint joint : head::kAllJoints) {
+  const bool still = target_velocities.empty();  // empty: the targets stand still
+  if (targets.size() != positions.size() || velocities.size() != positions.size() ||
+      (!still && target_velocities.size() != positions.size())) {
+    return false;
+  }
+  for (int joint = 0; joint < positions.size(); ++joint) {
+    const double target_velocity = still ? 0.0 : target_velocities[joint];
     if (!(std::abs(positions[joint] - targets[joint]) <= kTolerance &&
-          std::abs(velocities[joint] - target_velocities[joint]) <= kTolerance)) {
+          std::abs(velocities[joint] - target_velocity) <= kTolerance)) {
       return false;
     }
   }
@@ -445,25 +455,24 @@ bool JointsOf(const sensor_msgs_msg_dds__JointState_& msg, head::JointState* pos
                          msg.velocity._length);
     return false;
   }
-  bool seen[4] = {false, false, false, false};
-  *velocities = head::JointState{};
+  // The message's names, in its order: the receiver arranges them in its head's order by name
+  // (HeadModel::Arrange), which names unknown and missing joints.
+  auto names = std::make_shared<head::JointNames>();
+  Eigen::VectorXd p(n), v = Eigen::VectorXd::Zero(n);
   for (uint32_t i = 0; i < n; ++i) {
     const std::string name = msg.name._buffer[i] ? msg.name._buffer[i] : "";
-    for (const head::Joint joint : head::kAllJoints) {
-      if (name == head::JointName(joint)) {
-        (*positions)[joint] = msg.position._buffer[i];
-        if (msg.velocity._length) (*velocities)[joint] = msg.velocity._buffer[i];
-        seen[static_cast<int>(joint)] = true;
-      }
-    }
-  }
-  for (const head::Joint joint : head::kAllJoints) {
-    if (!seen[static_cast<int>(joint)]) {
-      *error = fmt::format("joint '{}' is missing (expected names pan, tilt, left, right)",
-                           head::JointName(joint));
+    if (name.empty() || std::find(names->begin(), names->end(), name) != names->end()) {
+      *error = name.empty() ? std::string("a joint without a name")
+                            : fmt::format("joint '{}' named twice", name);
       return false;
     }
+    names->push_back(name);
+    p[i] = msg.position._buffer[i];
+    if (msg.velocity._length) v[i] = msg.velocity._buffer[i];
   }
+  std::shared_ptr<const head::JointNames> shared = std::move(names);
+  *positions = head::JointState(shared, std::move(p));
+  *velocities = head::JointState(shared, std::move(v));
   return true;
 }
 

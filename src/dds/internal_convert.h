@@ -105,12 +105,14 @@ class ImagePool {
 std::shared_ptr<Image> ImageOf(const sensor_msgs_msg_dds__Image_& msg, std::string* error,
                                ImagePool* pool = nullptr);
 
-/// The four joints as JointState (names pan, tilt, left, right).
+/// A head's joints as a sensor_msgs/JointState, with their names (POPEYE: pan, tilt, left,
+/// right); `velocities` may be null. The names point into the states' shared name lists.
 void FillJointState(double time, const head::JointState& positions,
                     const head::JointState* velocities, Holder& holder,
                     sensor_msgs_msg_dds__JointState_* out);
-/// Positions and velocities of a JointState by joint name; false (and `*error` says why) when
-/// a joint is missing or the lengths disagree. Velocities are zero when the message has none.
+/// Positions and velocities of a JointState, with the message's names in its order (the
+/// receiver arranges them in its head's order by name); false (and `*error` says why) when the
+/// lengths disagree, a name is empty or named twice. Velocities are zero when it has none.
 bool JointsOf(const sensor_msgs_msg_dds__JointState_& msg, head::JointState* positions,
               head::JointState* velocities, std::string* error);
 

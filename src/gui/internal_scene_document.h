@@ -7,14 +7,15 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
-#include "saccade/head/kinematics.h"
+#include "saccade/head/head_model.h"
 #include "saccade/scene/scene.h"
 #include "saccade/server/gui_server.h"
 
 namespace saccade::gui::internal {
 
-/// The state's "frames": X_WB, X_WN, X_WC, left_eye, right_eye, left, right.
-nlohmann::json FramesJson(const head::HeadFrames& frames);
+/// The state's "frames" at `joints`: X_WB (the root), X_WC (midway between the optical
+/// centres), links (every link by name), left and right (the optical frames).
+nlohmann::json FramesJson(const head::HeadModel& head, const head::JointState& joints);
 
 /// The state's "objects": the name and X_WO at time `t` (s) of each moving object.
 nlohmann::json MovingObjectsJson(const scene::Scene& scene, double t);

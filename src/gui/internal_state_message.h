@@ -7,7 +7,7 @@
 #include <optional>
 
 #include "saccade/components/messages.h"
-#include "saccade/head/kinematics.h"
+#include "saccade/head/head_model.h"
 #include "saccade/render/renderer.h"
 #include "saccade/scene/scene.h"
 
@@ -24,7 +24,7 @@ struct StateParts {
   std::optional<render::RendererOptions> effects;
   /// The head's joints, and its description for the frames; none without a head.
   std::optional<components::JointStateMessage> joints;
-  const head::HeadDescription* head = nullptr;
+  const head::HeadModel* head = nullptr;
   /// Perception's target (a valid one), only while perception commands the head.
   std::optional<components::TargetMessage> target;
   double step_ms = 0.0;          ///< wall time of the last step

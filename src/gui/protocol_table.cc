@@ -21,11 +21,18 @@ Schema Pose() {
   return Named("pose", Tuple({row, row, row, Tuple({Const(0), Const(0), Const(0), Const(1)})}));
 }
 Schema Point() { return Named("point", Array(Number(), 3)); }
+// Joint name -> value: every actuated joint of the head (`scene.head.joints`; POPEYE's are
+// pan, tilt, left and right).
 Schema Joints() {
-  return Named("joints",
-               Object({Required("pan", Number(), "pan"), Required("tilt", Number(), "tilt"),
-                       Required("left", Number(), "left eye (vergence)"),
-                       Required("right", Number(), "right eye (vergence)")}));
+  Schema joints = Object({});
+  joints.open = true;
+  return Named("joints", joints);
+}
+// Link name -> pose: every link of the head's tree (`scene.robot.links`).
+Schema LinkPoses() {
+  Schema links = Object({});
+  links.open = true;
+  return links;
 }
 Schema Rgb() { return Named("rgb", Array(Number(), 3)); }
 Schema Rgba() { return Named("rgba", Array(Number(), 4)); }
@@ -77,18 +84,23 @@ std::vector<Field> FlowReply() {
 
 void AddMotionCommands(std::vector<Message>& out) {
   Schema positions = Object(
-      {Optional("pan", Number(), "rad"), Optional("tilt", Number(), "rad"),
-       Optional("left", Number(), "rad"), Optional("right", Number(), "rad"),
-       Optional("vergence", Number(), "rad, symmetric: left = -v, right = +v; v > 0 converges")});
+      {Optional("vergence", Number(),
+                "rad, the head's symmetric pair (a, b, sign) of `scene.head.symmetric` (POPEYE: "
+                "left = -v, right = +v; v > 0 converges), unless the head has a joint of that "
+                "name")});
+  positions.open = true;  // any joint of `scene.head.joints`, by name
   positions.some = true;
   out.push_back(
       Command("joints", "direct kinematics: moves those joints (the others keep their targets)",
               {Required("positions", positions, "the joints to move and their targets")},
               {Required("targets", Joints(), "every joint's target now (rad)"), ManualReply()},
-              "Every value is checked against its joint's limits on the server: one outside them "
-              "refuses the whole command. Turns perception off (manual)."));
+              "`positions` names joints of `scene.head.joints` (rad, or m for a prismatic "
+              "joint); an unknown name, a joint the head does not drive, or a value outside its "
+              "limits refuses the whole command, checked on the server. Turns perception off "
+              "(manual)."));
   out.push_back(Command("fixate",
-                        "inverse kinematics (symmetric vergence): the head fixates the point",
+                        "inverse kinematics: both optical axes through the point, by the head's "
+                        "fixation rule",
                         {Required("p_W", Point(), "the point, metres in the world frame")},
                         {Required("targets", Joints(), "every joint's target now (rad)"),
                          Required("axis_error_deg", Number(0),
@@ -154,10 +166,9 @@ void AddConnectionCommands(std::vector<Message>& out) {
 
 Message State() {
   const Schema frames = Object(
-      {Required("X_WB", Pose(), "the head's base"), Required("X_WN", Pose(), "the neck, after pan"),
-       Required("X_WC", Pose(), "the cyclopean frame, after tilt"),
-       Required("left_eye", Pose(), "the left eye (robot parts hang from it)"),
-       Required("right_eye", Pose(), "the right eye"),
+      {Required("X_WB", Pose(), "the head's base (its tree's root link)"),
+       Required("X_WC", Pose(), "midway between the optical centres, the base's axes"),
+       Required("links", LinkPoses(), "every link of the tree by name (robot parts hang here)"),
        Required("left", Pose(), "the left camera's optical frame (OpenCV axes)"),
        Required("right", Pose(), "the right camera's optical frame")});
   const Schema target = Object({Required("valid", Const(true), "always true when present"),
@@ -269,11 +280,16 @@ Schema Cameras() {
 Schema SceneRobot() {
   return OrNull(Object(
       {Required("visible", Boolean(), "the robot's body is drawn"),
+       Required("links",
+                Array(Object({Required("name", String(), "the link (URDF's name)"),
+                              Required("parent", OrNull(String()), "its parent; null: the root"),
+                              Required("joint", OrNull(String()),
+                                       "the joint to its parent; null: the root")})),
+                "the head's kinematic tree, parents first"),
        Required(
            "parts",
            Array(Object(
-               {Required("link", String({"base", "neck", "cyclopean", "left_eye", "right_eye"}),
-                         "the head frame it hangs from (`state.frames`)"),
+               {Required("link", String(), "the link it hangs from (`state.frames.links`)"),
                 Required("model", Integer(-1), "index into `models`; -1: none"),
                 Required("X_LinkPart", Pose(), "the part in its link's frame"),
                 Required("scale", Point(), "per axis")})),
@@ -298,10 +314,16 @@ Message Scene() {
        Required("model", Integer(-1), "index into `models`; -1: none"),
        Required("scale", Point(), "per axis"), Required("X_WO", Pose(), "at `time`"),
        Required("moving", Boolean(), "its pose comes in every state")}));
-  const Schema joints =
-      Array(Object({Required("name", String({"pan", "tilt", "left", "right"}), "the joint"),
-                    Required("min", Number(), "rad"), Required("max", Number(), "rad"),
-                    Required("max_velocity", Number(0), "rad/s")}));
+  const Schema joints = Array(Object(
+      {Required("name", String(), "the joint (URDF's name)"),
+       Required("type", String({"revolute", "continuous", "prismatic"}), "its kind"),
+       Required("link", String(), "the link it moves (its child)"),
+       Required("axis", Point(), "its unit axis in the frame of the link it moves"),
+       Required("min", OrNull(Number()), "rad (m); null: unbounded"),
+       Required("max", OrNull(Number()), "rad (m); null: unbounded"),
+       Required("max_velocity", Number(0), "rad/s (m/s)"),
+       Required("driven", Boolean(), "saccade commands it (else held at its value)")}));
+  const Schema pair = Tuple({String(), String(), Number()});
   const Schema commands =
       Object({Required("effects", Boolean(), "`effects` (the cameras are simulated)"),
               Required("perception", Boolean(), "`perception` (components besides the robot)"),
@@ -317,13 +339,16 @@ Message Scene() {
        Required("lights", lights, "the lights"), Required("models", Models(), "each model once"),
        Required("objects", objects, "the scene's objects"),
        Required("robot", SceneRobot(), "the robot's body; null without a robot"),
-       Required("head", Object({Required("joints", joints, "pan, tilt, left, right")}),
+       Required("head",
+                Object({Required("name", String(), "the head's name (\"\" without a robot)"),
+                        Required("joints", joints, "the actuated joints, in the head's order"),
+                        Required("symmetric", Array(pair),
+                                 "pairs [a, b, sign] fixation holds at b = sign * a")}),
                 "the head's joints and limits (empty without a robot)"),
        Required("cameras", Cameras(), "every camera of the scene"),
        Required("commands", commands, "which commands this session offers")},
       "Model frames and object frames are z up like the world. Robot parts hang from the "
-      "head's frames (`state.frames`: base `X_WB`, neck `X_WN`, cyclopean `X_WC`, eyes "
-      "`left_eye`, `right_eye`).");
+      "links of the head's tree (`robot.links`), posed in every state (`state.frames.links`).");
   m.body.fields.erase(m.body.fields.begin());  // a document has no "type"
   return m;
 }

@@ -18,21 +18,6 @@ using nlohmann::json;
 json Vec(const Eigen::Vector3f& v) { return {v.x(), v.y(), v.z()}; }
 json Vec(const Eigen::Vector4f& v) { return {v.x(), v.y(), v.z(), v.w()}; }
 
-const char* LinkName(scene::RobotPart::Link link) {
-  switch (link) {
-    case scene::RobotPart::Link::kBase:
-      return "base";
-    case scene::RobotPart::Link::kNeck:
-      return "neck";
-    case scene::RobotPart::Link::kCyclopean:
-      return "cyclopean";
-    case scene::RobotPart::Link::kLeftEye:
-      return "left_eye";
-    case scene::RobotPart::Link::kRightEye:
-      return "right_eye";
-  }
-  return "base";
-}
 
 /// A texture as PNG bytes.
 std::string EncodePng(const Image& image) {
@@ -71,11 +56,21 @@ std::string ModelBinary(const scene::Model& model) {
 
 }  // namespace
 
-json FramesJson(const head::HeadFrames& frames) {
-  return {{"X_WB", ToJson(frames.X_WB)},        {"X_WN", ToJson(frames.X_WN)},
-          {"X_WC", ToJson(frames.X_WC)},        {"left_eye", ToJson(frames.X_WL)},
-          {"right_eye", ToJson(frames.X_WR)},   {"left", ToJson(frames.X_WCamLeft)},
-          {"right", ToJson(frames.X_WCamRight)}};
+json FramesJson(const head::HeadModel& head, const head::JointState& joints) {
+  std::vector<geometry::Pose> X_WL;
+  head.ForwardKinematics(joints.empty() ? head.HomePosture() : head.Arrange(joints).values(),
+                         &X_WL);
+  json links = json::object();
+  for (int l = 0; l < head.tree().num_links(); ++l) links[head.tree().link_name(l)] = ToJson(X_WL[l]);
+  const geometry::Pose left = head.CameraPose(0, X_WL);
+  const geometry::Pose right = head.CameraPose(1, X_WL);
+  geometry::Pose X_WC = head.X_WB();
+  X_WC.translation() = 0.5 * (left.translation() + right.translation());
+  return {{"X_WB", ToJson(X_WL[head.tree().root()])},
+          {"X_WC", ToJson(X_WC)},
+          {"links", links},
+          {"left", ToJson(left)},
+          {"right", ToJson(right)}};
 }
 
 json MovingObjectsJson(const scene::Scene& scene, double t) {
@@ -159,28 +154,47 @@ json ObjectsJson(const scene::Scene& scene, ModelCatalog& models) {
 
 json RobotJson(const scene::Scene& scene, ModelCatalog& models) {
   if (!scene.robot()) return nullptr;
+  const head::KinematicTree& tree = scene.robot()->head.tree();
+  json links = json::array();
+  links.push_back({{"name", tree.link_name(tree.root())}, {"parent", nullptr}, {"joint", nullptr}});
+  for (const int j : tree.joint_order()) {
+    const head::KinematicTree::Joint& joint = tree.joint(j);
+    links.push_back({{"name", tree.link_name(joint.child)},
+                     {"parent", tree.link_name(joint.parent)},
+                     {"joint", joint.name}});
+  }
   json parts = json::array();
   for (const scene::RobotPart& p : scene.robot()->parts) {
-    parts.push_back({{"link", LinkName(p.link)},
+    parts.push_back({{"link", tree.link_name(p.link)},
                      {"model", models.Add(p.model)},
                      {"X_LinkPart", ToJson(p.X_LinkPart)},
                      {"scale", ToJson(p.scale)}});
   }
-  return {{"visible", scene.robot()->visible}, {"parts", parts}};
+  return {{"visible", scene.robot()->visible}, {"links", links}, {"parts", parts}};
 }
 
 json HeadJson(const scene::Scene& scene) {
   json joints = json::array();
-  if (scene.robot()) {
-    for (head::Joint j : head::kAllJoints) {
-      const head::JointLimits& l = scene.robot()->head.limits(j);
-      joints.push_back({{"name", head::JointName(j)},
-                        {"min", l.min},
-                        {"max", l.max},
-                        {"max_velocity", l.max_velocity}});
-    }
+  json symmetric = json::array();
+  if (!scene.robot()) return {{"name", ""}, {"joints", joints}, {"symmetric", symmetric}};
+  const head::HeadModel& head = scene.robot()->head;
+  const auto bound = [](double v) { return std::isfinite(v) ? json(v) : json(nullptr); };
+  for (int i = 0; i < head.num_joints(); ++i) {
+    const head::KinematicTree::Joint& joint = head.tree().joint(head.tree().variable_joint(i));
+    const head::JointLimits& l = head.joint(i).limits;
+    joints.push_back({{"name", head.joint_name(i)},
+                      {"type", head::ToString(joint.type)},
+                      {"link", head.tree().link_name(joint.child)},
+                      {"axis", ToJson<Eigen::Vector3d>(joint.axis)},
+                      {"min", bound(l.min)},
+                      {"max", bound(l.max)},
+                      {"max_velocity", l.max_velocity},
+                      {"driven", head.joint(i).driven}});
   }
-  return {{"joints", joints}};
+  for (const head::FixationRule::Pair& p : head.fixation_rule().symmetric) {
+    symmetric.push_back({head.joint_name(p.a), head.joint_name(p.b), p.sign});
+  }
+  return {{"name", head.name()}, {"joints", joints}, {"symmetric", symmetric}};
 }
 
 json LightsJson(const scene::Scene& scene) {

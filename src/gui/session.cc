@@ -21,6 +21,7 @@
 #include "saccade/geometry/json.h"
 #include "saccade/gui/protocol.h"
 #include "saccade/head/json.h"
+#include "saccade/head/fixation.h"
 #include "saccade/head/kinematics.h"
 #include "saccade/vision/image_camera.h"
 
@@ -245,7 +246,7 @@ json GuiSession::Handle(const json& command, int64_t client) {
   return reply;
 }
 
-const head::HeadDescription& GuiSession::RequireHead(const std::string& type) const {
+const head::HeadModel& GuiSession::RequireHead(const std::string& type) const {
   if (!head_ || !scene_.robot()) throw CommandError(type + ": this pipeline has no head to move");
   return scene_.robot()->head;
 }
@@ -260,7 +261,7 @@ json GuiSession::MoveTo(const head::JointState& target, json reply) {
     JointCommand c;
     c.time = sim_time_;
     c.positions = target;
-    c.velocities = {0.0, 0.0, 0.0, 0.0};
+    c.velocities = head::JointState(target.shared_names());
     commanded_ = head_->Move(c);
   });
   reply["targets"] = ToJson(target);
@@ -269,46 +270,71 @@ json GuiSession::MoveTo(const head::JointState& target, json reply) {
 }
 
 json GuiSession::OnJoints(const json& command) {
-  const head::HeadDescription& head = RequireHead("joints");
-  head::JointState target = CurrentTargets();
-  // The table allows pan, tilt, left, right and vergence, numbers, at least one.
+  const head::HeadModel& head = RequireHead("joints");
+  head::JointState target = head.Arrange(CurrentTargets());
+  // Joint names of the head (the table checks the values are numbers, at least one), and
+  // "vergence" for the head's first symmetric pair unless a joint has that name.
   for (const auto& [name, value] : command["positions"].items()) {
+    if (!value.is_number()) {
+      throw CommandError(fmt::format("joints: positions.{} must be a number", name));
+    }
     const double x = value.get<double>();
-    if (name == "vergence") {
-      // Symmetric vergence (seed appendix A): > 0 converges, the left eye turning right.
-      target.left = -x;
-      target.right = x;
+    const int j = head.FindJoint(name);
+    if (j < 0 && name == "vergence" && !head.fixation_rule().symmetric.empty()) {
+      // Symmetric vergence (seed appendix A): > 0 converges, POPEYE's left eye turning right.
+      const head::FixationRule::Pair& pair = head.fixation_rule().symmetric.front();
+      target[pair.a] = -x;
+      target[pair.b] = pair.sign * -x;
       continue;
     }
-    for (head::Joint j : head::kAllJoints) {
-      if (name == head::JointName(j)) target[j] = x;
+    if (j < 0) {
+      throw CommandError(fmt::format("joints: the head has no joint '{}'; its joints are: {}",
+                                     name, head::ListNames(*head.joint_names())));
     }
+    if (!head.joint(j).driven) {
+      throw CommandError(fmt::format("joints: the head holds joint '{}' (not driven)", name));
+    }
+    target[j] = x;
   }
   // The server's check (docs/gui-protocol.md): a value outside the limits refuses the whole
   // command; the page's clamping is a convenience, never the safety.
-  for (head::Joint j : head::kAllJoints) {
-    const head::JointLimits& l = head.limits(j);
+  for (int j = 0; j < head.num_joints(); ++j) {
+    const head::JointLimits& l = head.joint(j).limits;
     if (!l.Contains(target[j])) {
       throw CommandError(fmt::format(
           "joints: {} {:.4f} rad ({:.2f} deg) is outside its limits [{:.4f}, {:.4f}] rad",
-          head::JointName(j), target[j], target[j] * kRadToDeg, l.min, l.max));
+          head.joint_name(j), target[j], target[j] * kRadToDeg, l.min, l.max));
     }
   }
   return MoveTo(target, json::object());
 }
 
 json GuiSession::OnFixate(const json& command) {
-  const head::HeadDescription& head = RequireHead("fixate");
+  const head::HeadModel& head = RequireHead("fixate");
   const json& p = command["p_W"];  // three numbers (the table's point)
   const Eigen::Vector3d p_W(p[0].get<double>(), p[1].get<double>(), p[2].get<double>());
-  head::IkOptions ik;
-  ik.seed = CurrentTargets();
-  const head::IkResult solution = head::SolveFixation(head, p_W, ik);
+  const head::JointState seed = head.Arrange(CurrentTargets());
+  // POPEYE's legacy head: appendix A's solver, as the loop's fixation; any other: fixation.h.
+  if (const std::optional<head::HeadDescription> legacy = head.AppendixAHead()) {
+    head::IkOptions ik;
+    ik.seed = {seed[0], seed[1], seed[2], seed[3]};
+    const head::IkResult solution = head::SolveFixation(*legacy, p_W, ik);
+    if (!solution.reachable()) {
+      throw CommandError(fmt::format("fixate: [{:.3f}, {:.3f}, {:.3f}] cannot be fixated: {}",
+                                     p_W.x(), p_W.y(), p_W.z(), solution.message));
+    }
+    const head::PopeyeJoints& q = solution.joints;
+    return MoveTo(head.State(Eigen::Vector4d(q.pan, q.tilt, q.left, q.right)),
+                  {{"axis_error_deg", solution.axis_error * kRadToDeg}});
+  }
+  head::FixationOptions options;
+  options.seed = seed.values();
+  const head::FixationResult solution = head::SolveFixation(head, p_W, options);
   if (!solution.reachable()) {
     throw CommandError(fmt::format("fixate: [{:.3f}, {:.3f}, {:.3f}] cannot be fixated: {}",
                                    p_W.x(), p_W.y(), p_W.z(), solution.message));
   }
-  return MoveTo(solution.joints, {{"axis_error_deg", solution.axis_error * kRadToDeg}});
+  return MoveTo(head.State(solution.joints), {{"axis_error_deg", solution.axis_error * kRadToDeg}});
 }
 
 json GuiSession::OnPerception(const json& command) {

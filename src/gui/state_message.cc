@@ -5,6 +5,7 @@
 #include "gui/internal_state_message.h"
 #include "saccade/core/units.h"
 #include "saccade/geometry/json.h"
+#include "saccade/head/fixation.h"
 #include "saccade/head/json.h"
 
 namespace saccade::gui::internal {
@@ -33,7 +34,7 @@ json StateJson(const StateParts& parts, const scene::Scene& scene) {
     state["effects"] = {
         {"distortion", o.distortion}, {"noise", o.noise}, {"motion_blur", o.motion_blur}};
   }
-  std::optional<head::HeadFrames> frames;
+  std::optional<std::array<geometry::Pose, 2>> cameras;
   state["joints"] = nullptr;
   state["frames"] = nullptr;
   state["fixation_W"] = nullptr;
@@ -43,18 +44,20 @@ json StateJson(const StateParts& parts, const scene::Scene& scene) {
                        {"targets", ToJson(j.targets)},
                        {"velocities", ToJson(j.velocities)},
                        {"arrived", j.arrived}};
-    frames = head::ForwardKinematics(*parts.head, j.positions);
-    state["frames"] = FramesJson(*frames);
-    if (frames->p_WFixation) state["fixation_W"] = ToJson(*frames->p_WFixation);
+    state["frames"] = FramesJson(*parts.head, j.positions);
+    cameras = parts.head->CameraPoses(j.positions);
+    if (const auto p = head::FixationPoint((*cameras)[0], (*cameras)[1])) {
+      state["fixation_W"] = ToJson(*p);
+    }
   }
   state["target"] = nullptr;
   state["fixation_error_deg"] = nullptr;
   if (parts.target) {
     const components::TargetMessage& target = *parts.target;
     state["target"] = {{"valid", true}, {"p_W", ToJson(target.p_W)}, {"id", target.target_id}};
-    if (frames) {
-      state["fixation_error_deg"] = {{"left", AxisErrorDeg(frames->X_WCamLeft, target.p_W)},
-                                     {"right", AxisErrorDeg(frames->X_WCamRight, target.p_W)}};
+    if (cameras) {
+      state["fixation_error_deg"] = {{"left", AxisErrorDeg((*cameras)[0], target.p_W)},
+                                     {"right", AxisErrorDeg((*cameras)[1], target.p_W)}};
     }
   }
   state["objects"] = MovingObjectsJson(scene, parts.time);

@@ -440,6 +440,20 @@ FixationResult FixationSolver::Solve(const Vector3d& p_W, const FixationOptions&
   return result;
 }
 
+std::optional<Vector3d> FixationPoint(const Pose& X_WLeft, const Pose& X_WRight) {
+  // o_l + s a_l and o_r + t a_r closest: the normal equations of |o_l + s a_l - o_r - t a_r|^2.
+  const Vector3d a = X_WLeft.linear().col(2);
+  const Vector3d b = X_WRight.linear().col(2);
+  const Vector3d w = X_WLeft.translation() - X_WRight.translation();
+  const double ab = a.dot(b);
+  const double denominator = 1.0 - ab * ab;  // sin^2 of the angle between the axes
+  if (!(denominator > 1e-24)) return std::nullopt;
+  const double s = (ab * b.dot(w) - a.dot(w)) / denominator;
+  const double t = (b.dot(w) - ab * a.dot(w)) / denominator;
+  if (!(s > 0.0) || !(t > 0.0)) return std::nullopt;
+  return 0.5 * (X_WLeft.translation() + s * a + X_WRight.translation() + t * b);
+}
+
 FixationResult SolveFixation(const HeadModel& head, const Vector3d& p_W,
                              const FixationOptions& options) {
   FixationSolver solver(head);

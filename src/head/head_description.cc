@@ -138,15 +138,15 @@ const char* JointName(Joint joint) {
   return "unknown";
 }
 
-double& JointState::operator[](Joint joint) {
+double& PopeyeJoints::operator[](Joint joint) {
   SACCADE_ASSERT(static_cast<int>(joint) >= 0 && static_cast<int>(joint) < 4,
-                 "JointState: invalid joint");
-  double JointState::*const kMembers[] = {&JointState::pan, &JointState::tilt, &JointState::left,
-                                          &JointState::right};
+                 "PopeyeJoints: invalid joint");
+  double PopeyeJoints::*const kMembers[] = {&PopeyeJoints::pan, &PopeyeJoints::tilt, &PopeyeJoints::left,
+                                          &PopeyeJoints::right};
   return this->*kMembers[static_cast<int>(joint)];
 }
 
-double JointState::operator[](Joint joint) const { return const_cast<JointState&>(*this)[joint]; }
+double PopeyeJoints::operator[](Joint joint) const { return const_cast<PopeyeJoints&>(*this)[joint]; }
 
 HeadDescription::HeadDescription(std::string name, const HeadGeometry& geometry,
                                  const std::array<JointLimits, 4>& limits,
@@ -264,14 +264,14 @@ bool HeadDescription::HasServos() const {
   return true;
 }
 
-bool HeadDescription::WithinLimits(const JointState& joints) const {
+bool HeadDescription::WithinLimits(const PopeyeJoints& joints) const {
   for (const Joint joint : kAllJoints) {
     if (!limits(joint).Contains(joints[joint])) return false;
   }
   return true;
 }
 
-void HeadDescription::CheckLimits(const JointState& joints) const {
+void HeadDescription::CheckLimits(const PopeyeJoints& joints) const {
   for (const Joint joint : kAllJoints) {
     const JointLimits& l = limits(joint);
     if (!l.Contains(joints[joint])) {

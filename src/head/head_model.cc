@@ -316,6 +316,20 @@ class HeadModelReader {
   fs::path base_dir_;
 };
 
+HeadModel::HeadModel(std::string name, KinematicTree tree)
+    : name_(std::move(name)), tree_(std::move(tree)) {
+  auto names = std::make_shared<JointNames>();
+  for (int i = 0; i < tree_.num_variables(); ++i) names->push_back(tree_.variable_name(i));
+  joint_names_ = std::move(names);
+}
+
+JointState HeadModel::Arrange(const JointState& joints) const {
+  if (joints.shared_names() == joint_names_ || joints.names() == *joint_names_) {
+    return State(joints.values());
+  }
+  return joints.ArrangedAs(joint_names_);
+}
+
 HeadModel HeadModel::FromDescription(const HeadDescription& legacy) {
   const HeadGeometry& g = legacy.geometry();
   const Eigen::Vector3d z = Eigen::Vector3d::UnitZ();
@@ -378,6 +392,36 @@ HeadModel HeadModel::FromYamlString(const std::string& text, const std::string& 
 HeadModel HeadModel::FromFile(const fs::path& path) {
   return FromYamlString(saccade::internal::ReadConfigFile(path, "head file"), path.string(),
                         path.parent_path());
+}
+
+std::optional<HeadDescription> HeadModel::AppendixAHead() const {
+  if (!appendix_a_) return std::nullopt;
+  std::array<JointLimits, 4> limits;
+  std::array<std::optional<ServoMapping>, 4> servos;
+  for (int i = 0; i < 4; ++i) {
+    limits[i] = joints_[i].limits;
+    servos[i] = joints_[i].servo;
+  }
+  return HeadDescription(name_, *appendix_a_, limits, X_WB_, cameras_[0].model, cameras_[1].model,
+                         servos);
+}
+
+std::array<geometry::Pose, 2> HeadModel::CameraPoses(const JointState& joints) const {
+  std::vector<geometry::Pose> X_WL;
+  ForwardKinematics(joints.empty() ? HomePosture() : Arrange(joints).values(), &X_WL);
+  return {CameraPose(0, X_WL), CameraPose(1, X_WL)};
+}
+
+HeadModel HeadModel::WithPose(const geometry::Pose& X_WB) const {
+  HeadModel head = *this;
+  head.X_WB_ = X_WB;
+  return head;
+}
+
+HeadModel HeadModel::WithCamera(int eye, const geometry::CameraModel& model) const {
+  HeadModel head = *this;
+  head.cameras_[eye].model = model;
+  return head;
 }
 
 Eigen::VectorXd HeadModel::HomePosture() const {

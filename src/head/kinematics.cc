@@ -106,11 +106,11 @@ std::optional<Vector3d> FixationInCyclopean(const HeadGeometry& g, double left, 
 // Inverse kinematics.
 
 // The unknowns of each mode as a vector, and back.
-Vector3d Unknowns(const JointState& q, VergenceMode mode) {
+Vector3d Unknowns(const PopeyeJoints& q, VergenceMode mode) {
   if (mode == VergenceMode::kSymmetric) return {q.pan, q.tilt, 0.5 * (q.right - q.left)};
   return {q.tilt, q.left, q.right};
 }
-JointState FromUnknowns(const Vector3d& x, VergenceMode mode, double pan) {
+PopeyeJoints FromUnknowns(const Vector3d& x, VergenceMode mode, double pan) {
   if (mode == VergenceMode::kSymmetric) return {x[0], x[1], -x[2], x[2]};
   return {pan, x[0], x[1], x[2]};
 }
@@ -130,7 +130,7 @@ struct Linearization {
 // Jacobian analytic: a revolute joint with world axis w through a turns the frames after it,
 // so the target in a camera frame moves by dt/dq = -R_WCam^T (w x (p - a)), and
 // du/dq = (I - u u^T) dt/dq / |t|.
-Linearization Linearize(const HeadDescription& head, const Vector3d& p_W, const JointState& q,
+Linearization Linearize(const HeadDescription& head, const Vector3d& p_W, const PopeyeJoints& q,
                         VergenceMode mode) {
   const HeadFrames f = ForwardKinematics(head, q);
   const HeadGeometry& g = head.geometry();
@@ -173,7 +173,7 @@ Linearization Linearize(const HeadDescription& head, const Vector3d& p_W, const 
 }
 
 struct NewtonOutcome {
-  JointState joints;
+  PopeyeJoints joints;
   bool converged = false;
   int iterations = 0;
 };
@@ -181,7 +181,7 @@ struct NewtonOutcome {
 // Gauss-Newton (a zero-residual problem: quadratic convergence near the solution) with the
 // minimum-norm step where the Jacobian is rank deficient (target on the pan axis), each step
 // capped and backtracked until the merit |residual|^2 decreases; stops early when it stagnates.
-NewtonOutcome Newton(const HeadDescription& head, const Vector3d& p_W, const JointState& start,
+NewtonOutcome Newton(const HeadDescription& head, const Vector3d& p_W, const PopeyeJoints& start,
                      const IkOptions& options) {
   NewtonOutcome out;
   Vector3d x = Unknowns(start, options.mode);
@@ -233,7 +233,7 @@ NewtonOutcome Newton(const HeadDescription& head, const Vector3d& p_W, const Joi
 // optical axes and do not move them). Used to pick the canonical branch, to restart Newton
 // when it leaves that branch, and as the nearest angles when no exact solution exists.
 struct Geometric {
-  JointState joints;
+  PopeyeJoints joints;
   bool exact = true;        // an exact solution exists (perhaps outside the limits)
   bool degenerate = false;  // at the cyclopean point or on an eye's rotation axis
   bool too_close = false;   // within H of the tilt axis: the eye plane cannot contain it
@@ -307,22 +307,22 @@ Geometric SolveGeometrically(const HeadDescription& head, const Vector3d& p_b,
   return out;
 }
 
-bool SameBranch(const JointState& a, const JointState& b) {
+bool SameBranch(const PopeyeJoints& a, const PopeyeJoints& b) {
   for (const Joint joint : kAllJoints) {
     if (!(std::abs(Wrap(a[joint] - b[joint])) <= kSameBranch)) return false;
   }
   return true;
 }
 
-double AxisError(const HeadDescription& head, const Vector3d& p_W, const JointState& q) {
+double AxisError(const HeadDescription& head, const Vector3d& p_W, const PopeyeJoints& q) {
   return AxisErrors(head, q, p_W).maxCoeff();
 }
 
 // Clamps the unconstrained solution to the limits and says why the target is not reachable.
-IkResult Finish(const HeadDescription& head, const Vector3d& p_W, const JointState& wanted,
+IkResult Finish(const HeadDescription& head, const Vector3d& p_W, const PopeyeJoints& wanted,
                 VergenceMode mode, bool degenerate, bool too_close, const std::string& note) {
   IkResult result;
-  JointState q = wanted;
+  PopeyeJoints q = wanted;
   std::string violations;
   bool behind = false;
   bool eyes_too_converged = false;
@@ -406,7 +406,7 @@ void CheckTarget(const char* function, const Vector3d& p_W) {
 
 }  // namespace
 
-HeadFrames ForwardKinematics(const HeadDescription& head, const JointState& joints) {
+HeadFrames ForwardKinematics(const HeadDescription& head, const PopeyeJoints& joints) {
   const HeadGeometry& g = head.geometry();
   HeadFrames f;
   f.X_WB = head.X_WB();
@@ -423,7 +423,7 @@ HeadFrames ForwardKinematics(const HeadDescription& head, const JointState& join
   return f;
 }
 
-Eigen::Vector2d AxisErrors(const HeadDescription& head, const JointState& joints,
+Eigen::Vector2d AxisErrors(const HeadDescription& head, const PopeyeJoints& joints,
                            const Eigen::Vector3d& p_W) {
   const HeadFrames f = ForwardKinematics(head, joints);
   Eigen::Vector2d errors;
@@ -469,7 +469,7 @@ IkResult SolveFixationClosedForm(const HeadDescription& head, const Eigen::Vecto
   const double yb = p_b.y();
   const double zb = p_b.z();
   const double rho = std::sqrt(xb * xb + zb * zb);
-  JointState q;
+  PopeyeJoints q;
   // Eq. 12: tan(pan) = xb / zb; atan2 keeps the quadrant, so a target behind needs |pan| > 90.
   q.pan = rho > 0.0 ? std::atan2(xb, zb) : 0.0;
   // Eq. 13: tan(tilt) = -yb / sqrt(xb^2 + zb^2).
@@ -502,12 +502,12 @@ IkResult SolveFixation(const HeadDescription& head, const Eigen::Vector3d& p_W,
   }
   const Vector3d p_b = PaperBase(head).inverse() * p_W;
   const Geometric geometric = SolveGeometrically(head, p_b, options);
-  JointState wanted = geometric.joints;
+  PopeyeJoints wanted = geometric.joints;
   int iterations = 0;
   if (geometric.exact) {
     // Newton from the seed; if it lands on another branch (or fails), again from the
     // geometric solution, where it only polishes.
-    JointState seed = options.seed;
+    PopeyeJoints seed = options.seed;
     if (options.mode == VergenceMode::kIndependent) seed.pan = geometric.joints.pan;
     NewtonOutcome newton = Newton(head, p_W, seed, options);
     iterations = newton.iterations;

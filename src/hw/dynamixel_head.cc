@@ -29,24 +29,40 @@ int32_t FromLe32(const std::vector<uint8_t>& data, std::size_t at) {
 
 class DynamixelHead final : public HeadDriver {
  public:
-  DynamixelHead(const head::HeadDescription& description, const std::string& port,
+  DynamixelHead(const head::HeadModel& description, const std::string& port,
                 const DynamixelOptions& options, SafetyOptions safety)
       : HeadDriver(description, safety),
         port_(port),
         bus_(port, options.baud,
              BusOptions{std::chrono::microseconds(static_cast<int64_t>(options.timeout_ms * 1000)),
                         options.retries}) {
-    for (const head::Joint joint : head::kAllJoints) {
-      if (!description.servo(joint)) {
-        throw InvalidArgument(
-            fmt::format("dynamixel head: joint {} has no servo mapping", head::JointName(joint)));
+    // Servos by joint name (the head file's servo blocks): every driven joint has one; a
+    // joint the head holds may have one (it is held at its hold value) or not (fixed).
+    const int n = description.num_joints();
+    servos_.resize(n);
+    tick_limits_.resize(n);
+    profile_acceleration_.resize(n);
+    std::vector<std::string> missing;
+    for (int joint = 0; joint < n; ++joint) {
+      const auto& servo = description.joint(joint).servo;
+      if (!servo) {
+        if (description.joint(joint).driven) missing.push_back(description.joint_name(joint));
+        continue;
       }
-      servos_[static_cast<int>(joint)] = *description.servo(joint);
-      ids_.push_back(static_cast<uint8_t>(servos_[static_cast<int>(joint)].id));
+      servos_[joint] = *servo;
+      joints_.push_back(joint);
+      ids_.push_back(static_cast<uint8_t>(servo->id));
+    }
+    if (!missing.empty()) {
+      throw InvalidArgument(fmt::format(
+          "dynamixel head: {}: the driven joint(s) {} have no servo block (joints: {{NAME: "
+          "{{servo: {{id: ...}}}}}} in the head file)",
+          description.source().empty() ? description.name() : description.source(),
+          head::ListNames(missing)));
     }
     // Every servo answers, and none reports a hardware error.
     std::string faults;
-    for (const head::Joint joint : head::kAllJoints) {
+    for (const int joint : joints_) {
       try {
         bus_.Ping(Id(joint));
       } catch (const Error& error) {
@@ -80,14 +96,16 @@ class DynamixelHead final : public HeadDriver {
     // Present Velocity and Present Position, 8 bytes from 128, of every servo in one packet.
     const auto replies = bus_.SyncRead(table::kPresentVelocity.address, 8, ids_);
     Measurement m;
+    m.positions = description().Home();  // a joint without a servo is held there
+    m.velocities = head::JointState(description().joint_names());
     m.torque = torque_;
     std::string faults;
-    for (const head::Joint joint : head::kAllJoints) {
+    for (const int joint : joints_) {
       const auto it = replies.find(Id(joint));
       if (it == replies.end()) {
         throw HardwareError(port_, Servo(joint) + ": no status in the sync read");
       }
-      const head::ServoMapping& servo = servos_[static_cast<int>(joint)];
+      const head::ServoMapping& servo = servos_[joint];
       const double servo_velocity =
           dxl::VelocityUnitsToRadiansPerSecond(FromLe32(it->second.data, 0));
       m.velocities[joint] = servo_velocity / (servo.direction * servo.gear_ratio);
@@ -114,18 +132,18 @@ class DynamixelHead final : public HeadDriver {
     // present position when at rest; a goal at the present position of a moving servo would
     // make it overshoot and come back). One answered write per servo that still answers: a
     // lost Sync Write would go unnoticed.
-    head::JointState hold;
-    for (const head::Joint joint : head::kAllJoints) {
+    head::JointState hold = description().Home();
+    for (const int joint : joints_) {
       try {
         const std::vector<uint8_t> state =
             bus_.Read(Id(joint), table::kPresentVelocity.address, 8).data;  // velocity, position
         const double v = dxl::VelocityUnitsToRadiansPerSecond(FromLe32(state, 0));  // servo rad/s
-        const double a = profile_acceleration_[static_cast<int>(joint)];            // rad/s^2
+        const double a = profile_acceleration_[joint];            // rad/s^2
         const double braking_rad = v * std::abs(v) / (2.0 * a);
         int32_t ticks = FromLe32(state, 4) + dxl::RadiansToTicks(braking_rad);
-        ticks = std::clamp(ticks, tick_limits_[static_cast<int>(joint)].first,
-                           tick_limits_[static_cast<int>(joint)].second);
-        hold[joint] = TicksToJoint(servos_[static_cast<int>(joint)], ticks);
+        ticks = std::clamp(ticks, tick_limits_[joint].first,
+                           tick_limits_[joint].second);
+        hold[joint] = TicksToJoint(servos_[joint], ticks);
         if (torque_) bus_.WriteItem(Id(joint), table::kGoalPosition, ticks);
       } catch (const Error&) {
         // A servo that does not answer cannot be held; the fault names it.
@@ -135,7 +153,7 @@ class DynamixelHead final : public HeadDriver {
   }
 
   void DoClearFault() override {
-    for (const head::Joint joint : head::kAllJoints) {
+    for (const int joint : joints_) {
       const uint8_t errors =
           bus_.Read(Id(joint), table::kHardwareErrorStatus.address, 1).data.at(0);
       if (errors == 0) continue;
@@ -162,19 +180,23 @@ class DynamixelHead final : public HeadDriver {
   }
 
  private:
-  uint8_t Id(head::Joint joint) const {
-    return static_cast<uint8_t>(servos_[static_cast<int>(joint)].id);
-  }
-  std::string Servo(head::Joint joint) const {
-    return fmt::format("servo {} ({})", Id(joint), head::JointName(joint));
+  uint8_t Id(int joint) const { return static_cast<uint8_t>(servos_[joint].id); }
+  std::string Servo(int joint) const {
+    return fmt::format("servo {} ({})", Id(joint), description().joint_name(joint));
   }
 
   // Torque off; position mode, position limits, profile velocity and acceleration.
   void Setup() {
     DoTorque(false);
-    for (const head::Joint joint : head::kAllJoints) {
-      const head::ServoMapping& servo = servos_[static_cast<int>(joint)];
-      const head::JointLimits& limits = description().limits(joint);
+    for (const int joint : joints_) {
+      const head::ServoMapping& servo = servos_[joint];
+      const head::JointSettings& settings = description().joint(joint);
+      // A held joint's servo stays at its hold value: its range is that one position.
+      const head::JointLimits limits =
+          settings.driven ? settings.limits
+                          : head::JointLimits{settings.hold, settings.hold,
+                                              settings.limits.max_velocity > 0 ? settings.limits.max_velocity : 1.0,
+                                              settings.limits.max_acceleration > 0 ? settings.limits.max_acceleration : 1.0};
       int32_t a = JointToTicks(servo, limits.min);
       int32_t b = JointToTicks(servo, limits.max);
       if (a > b) std::swap(a, b);
@@ -187,7 +209,7 @@ class DynamixelHead final : public HeadDriver {
       bus_.WriteItem(Id(joint), table::kOperatingMode, 3);  // position control
       bus_.WriteItem(Id(joint), table::kMinPositionLimit, a);
       bus_.WriteItem(Id(joint), table::kMaxPositionLimit, b);
-      tick_limits_[static_cast<int>(joint)] = {a, b};
+      tick_limits_[joint] = {a, b};
       const double servo_velocity = limits.max_velocity * servo.gear_ratio;
       const double servo_acceleration = limits.max_acceleration * servo.gear_ratio;
       // Round down (and at least 1: 0 means no limit): never faster than the description.
@@ -198,27 +220,28 @@ class DynamixelHead final : public HeadDriver {
       const int64_t acceleration_units =
           std::max<int64_t>(1, static_cast<int64_t>(servo_acceleration / acceleration_unit));
       bus_.WriteItem(Id(joint), table::kProfileAcceleration, acceleration_units);
-      profile_acceleration_[static_cast<int>(joint)] =
+      profile_acceleration_[joint] =
           dxl::AccelerationUnitsToRadiansPerSecond2(static_cast<double>(acceleration_units));
     }
   }
 
   void WriteGoals(const head::JointState& positions) {
     std::vector<std::pair<uint8_t, std::vector<uint8_t>>> data;
-    for (const head::Joint joint : head::kAllJoints) {
+    for (const int joint : joints_) {
       data.push_back(
-          {Id(joint), Le32(JointToTicks(servos_[static_cast<int>(joint)], positions[joint]))});
+          {Id(joint), Le32(JointToTicks(servos_[joint], positions[joint]))});
     }
     bus_.SyncWrite(table::kGoalPosition.address, 4, data);
   }
 
   std::string port_;
   DynamixelBus bus_;
-  std::array<head::ServoMapping, 4> servos_;
+  std::vector<head::ServoMapping> servos_;  // by joint; valid for the joints in joints_
+  std::vector<int> joints_;                // the joints with a servo, in the head's order
   std::vector<uint8_t> ids_;
   bool torque_ = false;
-  std::array<std::pair<int32_t, int32_t>, 4> tick_limits_{};  // the servos' position limits
-  std::array<double, 4> profile_acceleration_{};              // servo rad/s^2, as programmed
+  std::vector<std::pair<int32_t, int32_t>> tick_limits_;  // the servos' position limits
+  std::vector<double> profile_acceleration_;              // servo rad/s^2, as programmed
 };
 
 }  // namespace
@@ -231,7 +254,7 @@ double TicksToJoint(const head::ServoMapping& servo, int32_t ticks) {
   return servo.JointAngle(dxl::TicksToRadians(ticks));
 }
 
-std::unique_ptr<HeadDriver> OpenDynamixelHead(const head::HeadDescription& description,
+std::unique_ptr<HeadDriver> OpenDynamixelHead(const head::HeadModel& description,
                                               const std::string& port,
                                               const DynamixelOptions& options,
                                               SafetyOptions safety) {

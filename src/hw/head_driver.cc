@@ -18,13 +18,13 @@ constexpr double kMovingThreshold = 0.5 / kRadToDeg;
 }  // namespace
 
 bool CommandReport::any() const {
-  for (int i = 0; i < 4; ++i) {
+  for (size_t i = 0; i < position_clamped.size(); ++i) {
     if (position_clamped[i] || velocity_limited[i]) return true;
   }
   return false;
 }
 
-HeadDriver::HeadDriver(head::HeadDescription description, SafetyOptions options)
+HeadDriver::HeadDriver(head::HeadModel description, SafetyOptions options)
     : description_(std::move(description)),
       options_(options),
       start_(std::chrono::steady_clock::now()) {
@@ -41,20 +41,30 @@ double HeadDriver::Now() const {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
 }
 
-CommandReport HeadDriver::Command(const head::JointState& positions,
-                                  const head::JointState& velocities) {
+CommandReport HeadDriver::Command(const head::JointState& position_state,
+                                  const head::JointState& velocity_state) {
   std::lock_guard lock(mutex_);
   const auto reject = [this](const std::string& why) {
     ++status_.rejected_commands;
     throw CommandRejected("head command rejected: " + why);
   };
-  for (const head::Joint joint : head::kAllJoints) {
+  head::JointState positions, velocities;
+  try {
+    positions = description_.Arrange(position_state);
+    velocities = velocity_state.empty() ? head::JointState(description_.joint_names())
+                                        : description_.Arrange(velocity_state);
+  } catch (const InvalidArgument& error) {
+    reject(error.what());
+  }
+  const int n = description_.num_joints();
+  for (int joint = 0; joint < n; ++joint) {
+    const std::string& name = description_.joint_name(joint);
     if (!std::isfinite(positions[joint])) {
-      reject(fmt::format("joint {} position is {} (not a finite number)", head::JointName(joint),
+      reject(fmt::format("joint {} position is {} (not a finite number)", name,
                          positions[joint]));
     }
     if (!std::isfinite(velocities[joint])) {
-      reject(fmt::format("joint {} velocity is {} (not a finite number)", head::JointName(joint),
+      reject(fmt::format("joint {} velocity is {} (not a finite number)", name,
                          velocities[joint]));
     }
   }
@@ -65,16 +75,25 @@ CommandReport HeadDriver::Command(const head::JointState& positions,
   CommandReport report;
   report.sent_positions = positions;
   report.sent_velocities = velocities;
-  for (const head::Joint joint : head::kAllJoints) {
-    const int i = static_cast<int>(joint);
-    const head::JointLimits& limits = description_.limits(joint);
+  report.position_clamped.assign(n, false);
+  report.velocity_limited.assign(n, false);
+  for (int joint = 0; joint < n; ++joint) {
+    const int i = joint;
+    const head::JointSettings& settings = description_.joint(joint);
+    if (!settings.driven) {  // held: always sent its hold value, at rest
+      report.sent_positions[joint] = settings.hold;
+      report.sent_velocities[joint] = 0.0;
+      continue;
+    }
+    const head::JointLimits& limits = settings.limits;
+    const std::string& name = description_.joint_name(joint);
     const double p = positions[joint];
     if (p < limits.min || p > limits.max) {
       report.position_clamped[i] = true;
       report.sent_positions[joint] = std::clamp(p, limits.min, limits.max);
       report.description += fmt::format(
           "{}{} target {:.2f} deg clamped to {:.2f} deg", report.description.empty() ? "" : "; ",
-          head::JointName(joint), p * kRadToDeg, report.sent_positions[joint] * kRadToDeg);
+          name, p * kRadToDeg, report.sent_positions[joint] * kRadToDeg);
     }
     const double v = velocities[joint];
     if (std::abs(v) > limits.max_velocity) {
@@ -82,7 +101,7 @@ CommandReport HeadDriver::Command(const head::JointState& positions,
       report.sent_velocities[joint] = std::copysign(limits.max_velocity, v);
       report.description +=
           fmt::format("{}{} velocity {:.1f} deg/s limited to {:.1f} deg/s",
-                      report.description.empty() ? "" : "; ", head::JointName(joint), v * kRadToDeg,
+                      report.description.empty() ? "" : "; ", name, v * kRadToDeg,
                       report.sent_velocities[joint] * kRadToDeg);
     }
   }
@@ -114,7 +133,7 @@ HeadStatus HeadDriver::Read() {
     if (status_.fault.empty()) EnterFault(error.what());
   }
   status_.moving = false;
-  for (const head::Joint joint : head::kAllJoints) {
+  for (int joint = 0; joint < status_.velocities.size(); ++joint) {
     status_.moving = status_.moving || std::abs(status_.velocities[joint]) > kMovingThreshold;
   }
   return status_;
@@ -193,7 +212,7 @@ void HeadDriver::WatchdogLoop() {
   }
 }
 
-SimHeadDriver::SimHeadDriver(const head::HeadDescription& description, SafetyOptions options,
+SimHeadDriver::SimHeadDriver(const head::HeadModel& description, SafetyOptions options,
                              const head::JointState& initial)
     : HeadDriver(description, options),
       motors_(std::make_unique<head::Motors>(description, initial)) {

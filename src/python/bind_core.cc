@@ -170,10 +170,11 @@ void BindCore(py::module_& m) {
           [](const ImageRef& ref) -> py::object {
             const ImageMetadata& meta = ref.image->metadata();
             if (!meta.has_joints) return py::none();
-            return py::cast(
-                Eigen::Vector4d(meta.joints[0], meta.joints[1], meta.joints[2], meta.joints[3]));
+            return py::cast(Eigen::VectorXd(Eigen::Map<const Eigen::VectorXd>(
+                meta.joints.data(), static_cast<Eigen::Index>(meta.joints.size()))));
           },
-          "pan, tilt, left, right (rad) at capture; None when the camera is not on a head.")
+          "the head's joints at capture, in its order (POPEYE: pan, tilt, left, right; rad); None "
+          "when the camera is not on a head.")
       .def_property_readonly(
           "K",
           [](const ImageRef& ref) -> py::object {

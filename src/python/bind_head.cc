@@ -1,5 +1,5 @@
 // saccade.head: the stereo head's description, forward and inverse kinematics (paper
-// appendix A). Joint states are JointState or any sequence pan, tilt, left, right (rad).
+// appendix A). Joint states are PopeyeJoints or any sequence pan, tilt, left, right (rad).
 #include <pybind11/eigen.h>
 #include <pybind11/operators.h>
 #include <pybind11/stl.h>
@@ -14,41 +14,41 @@ namespace saccade::python {
 
 namespace {
 
-// JointState, and the sequences that convert to it.
+// PopeyeJoints, and the sequences that convert to it.
 void BindJointState(py::module_& m) {
   using namespace head;
-  py::class_<JointState>(m, "JointState", "Joint angles in radians: pan, tilt, left, right.")
+  py::class_<PopeyeJoints>(m, "JointState", "Joint angles in radians: pan, tilt, left, right.")
       .def(py::init<>())
       .def(py::init([](double pan, double tilt, double left, double right) {
-             return JointState{pan, tilt, left, right};
+             return PopeyeJoints{pan, tilt, left, right};
            }),
            "pan"_a, "tilt"_a, "left"_a, "right"_a)
       .def(py::init([](const Eigen::Vector4d& v) {
-             return JointState{v[0], v[1], v[2], v[3]};
+             return PopeyeJoints{v[0], v[1], v[2], v[3]};
            }),
            "values"_a, "From a sequence pan, tilt, left, right.")
-      .def_readwrite("pan", &JointState::pan)
-      .def_readwrite("tilt", &JointState::tilt)
-      .def_readwrite("left", &JointState::left)
-      .def_readwrite("right", &JointState::right)
+      .def_readwrite("pan", &PopeyeJoints::pan)
+      .def_readwrite("tilt", &PopeyeJoints::tilt)
+      .def_readwrite("left", &PopeyeJoints::left)
+      .def_readwrite("right", &PopeyeJoints::right)
       .def(
           "to_array",
-          [](const JointState& j) { return Eigen::Vector4d(j.pan, j.tilt, j.left, j.right); },
+          [](const PopeyeJoints& j) { return Eigen::Vector4d(j.pan, j.tilt, j.left, j.right); },
           "numpy array pan, tilt, left, right.")
       .def(
           "__array__",
-          [](const JointState& j, py::object /*dtype*/) {
+          [](const PopeyeJoints& j, py::object /*dtype*/) {
             return Eigen::Vector4d(j.pan, j.tilt, j.left, j.right);
           },
           "dtype"_a = py::none())
       .def(py::self == py::self)
-      .def("__repr__", [](const JointState& j) {
+      .def("__repr__", [](const PopeyeJoints& j) {
         return "JointState(pan=" + std::to_string(j.pan) + ", tilt=" + std::to_string(j.tilt) +
                ", left=" + std::to_string(j.left) + ", right=" + std::to_string(j.right) + ")";
       });
-  py::implicitly_convertible<py::list, JointState>();
-  py::implicitly_convertible<py::tuple, JointState>();
-  py::implicitly_convertible<py::array, JointState>();
+  py::implicitly_convertible<py::list, PopeyeJoints>();
+  py::implicitly_convertible<py::tuple, PopeyeJoints>();
+  py::implicitly_convertible<py::array, PopeyeJoints>();
 }
 
 // The head description: limits, geometry, the file.
@@ -134,7 +134,7 @@ void BindForwardKinematics(py::module_& m) {
           py::gil_scoped_release release;
           for (py::ssize_t i = 0; i < n; ++i) {
             const Eigen::Vector2d errors =
-                AxisErrors(head, JointState{q[4 * i], q[4 * i + 1], q[4 * i + 2], q[4 * i + 3]},
+                AxisErrors(head, PopeyeJoints{q[4 * i], q[4 * i + 1], q[4 * i + 2], q[4 * i + 3]},
                            Eigen::Vector3d(p[3 * i], p[3 * i + 1], p[3 * i + 2]));
             e[2 * i] = errors[0];
             e[2 * i + 1] = errors[1];
@@ -162,7 +162,7 @@ void BindInverseKinematics(py::module_& m) {
   m.def(
       "solve_fixation",
       [](const HeadDescription& head, const Eigen::Vector3d& p_W, const std::string& mode,
-         const JointState& seed) {
+         const PopeyeJoints& seed) {
         IkOptions options;
         if (mode == "independent") {
           options.mode = VergenceMode::kIndependent;
@@ -173,7 +173,7 @@ void BindInverseKinematics(py::module_& m) {
         options.seed = seed;
         return SolveFixation(head, p_W, options);
       },
-      "head"_a, "p_W"_a, "mode"_a = "symmetric", "seed"_a = JointState{},
+      "head"_a, "p_W"_a, "mode"_a = "symmetric", "seed"_a = PopeyeJoints{},
       "Inverse kinematics: the joints that bring p_W (world, metres) onto both optical axes.");
   m.def("solve_fixation_closed_form", &SolveFixationClosedForm, "head"_a, "p_W"_a,
         "Closed form of eqs. 10-13 (symmetric vergence, D = H = 0).");

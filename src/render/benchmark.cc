@@ -104,7 +104,12 @@ BenchReport Bench(const std::string& scene_path, const scene::Scene& scene,
   std::vector<EffectRun> runs;
   if (effect_table) {
     runs = EffectRuns(scene, options, main.cameras);
-    const head::JointState panning{kBenchPanRate, 0.0, 0.0, 0.0};
+    // The head's first joint (POPEYE's pan) turning, the others still.
+    head::JointState panning;
+    if (scene.robot()) {
+      panning = head::JointState(scene.robot()->head.joint_names());
+      panning[0] = kBenchPanRate;
+    }
     for (EffectRun& run : runs) {
       if (!run.unconfigured.empty()) continue;
       run.result = Measure(scene, run.options, run.moving ? panning : head::JointState{}, frames,

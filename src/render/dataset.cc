@@ -147,8 +147,11 @@ json FrameJson(int64_t index, double time, const std::vector<Frame>& frames,
     entry["X_WC"] = ToJson(*geometry::FindCameraPose(m));
     entry["exposure_samples"] = m.exposure_samples;
     if (m.has_joints) {
-      entry["joints"] =
-          ToJson(head::JointState{m.joints[0], m.joints[1], m.joints[2], m.joints[3]});
+      json joints = json::object();
+      for (size_t i = 0; i < m.joints.size() && m.joint_names; ++i) {
+        joints[(*m.joint_names)[i]] = m.joints[i];
+      }
+      entry["joints"] = joints;
     }
     if (truth.depth) entry["depth"] = DepthFile(m.camera, index);
     if (truth.ids) entry["ids"] = IdsFile(m.camera, index);

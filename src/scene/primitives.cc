@@ -71,6 +71,59 @@ std::shared_ptr<const Model> MakeBox(const Eigen::Vector4f& color) {
   return Finish(std::move(model));
 }
 
+std::shared_ptr<const Model> MakeCylinder(const Eigen::Vector4f& color, int segments) {
+  CheckColor("MakeCylinder", color);
+  if (segments < 3 || segments > kMaxSphereSegments) {
+    throw InvalidArgument(fmt::format("MakeCylinder: segments must be in [3, {}], got {}",
+                                      kMaxSphereSegments, segments));
+  }
+  Model model;
+  model.source = "cylinder";
+  model.materials.push_back(PlainMaterial(color, 0.1f));
+  Mesh mesh;
+  const auto vertex = [&mesh](const Eigen::Vector3d& p, const Eigen::Vector3d& n, float u,
+                              float v) {
+    mesh.positions.push_back(p.cast<float>());
+    mesh.normals.push_back(n.cast<float>());
+    mesh.uvs.emplace_back(u, v);
+    return static_cast<uint32_t>(mesh.positions.size() - 1);
+  };
+  // The side: a column of quads, counter-clockwise seen from outside.
+  for (int j = 0; j < segments; ++j) {
+    const double a0 = 2.0 * std::numbers::pi * j / segments;
+    const double a1 = 2.0 * std::numbers::pi * (j + 1) / segments;
+    const Eigen::Vector3d n0(std::cos(a0), std::sin(a0), 0), n1(std::cos(a1), std::sin(a1), 0);
+    const float u0 = static_cast<float>(j) / segments, u1 = static_cast<float>(j + 1) / segments;
+    const uint32_t a = vertex(0.5 * n0 - Eigen::Vector3d(0, 0, 0.5), n0, u0, 0.0f);
+    const uint32_t b = vertex(0.5 * n1 - Eigen::Vector3d(0, 0, 0.5), n1, u1, 0.0f);
+    const uint32_t c = vertex(0.5 * n1 + Eigen::Vector3d(0, 0, 0.5), n1, u1, 1.0f);
+    const uint32_t d = vertex(0.5 * n0 + Eigen::Vector3d(0, 0, 0.5), n0, u0, 1.0f);
+    mesh.indices.insert(mesh.indices.end(), {a, b, c, a, c, d});
+  }
+  // The caps: fans about their centres, facing +z and -z.
+  for (const double z : {0.5, -0.5}) {
+    const Eigen::Vector3d n(0, 0, z > 0 ? 1 : -1);
+    const uint32_t centre = vertex(Eigen::Vector3d(0, 0, z), n, 0.5f, 0.5f);
+    for (int j = 0; j < segments; ++j) {
+      const double a0 = 2.0 * std::numbers::pi * j / segments;
+      const double a1 = 2.0 * std::numbers::pi * (j + 1) / segments;
+      const uint32_t a = vertex(Eigen::Vector3d(0.5 * std::cos(a0), 0.5 * std::sin(a0), z), n,
+                                0.5f + 0.5f * static_cast<float>(std::cos(a0)),
+                                0.5f + 0.5f * static_cast<float>(std::sin(a0)));
+      const uint32_t b = vertex(Eigen::Vector3d(0.5 * std::cos(a1), 0.5 * std::sin(a1), z), n,
+                                0.5f + 0.5f * static_cast<float>(std::cos(a1)),
+                                0.5f + 0.5f * static_cast<float>(std::sin(a1)));
+      if (z > 0) {
+        mesh.indices.insert(mesh.indices.end(), {centre, a, b});
+      } else {
+        mesh.indices.insert(mesh.indices.end(), {centre, b, a});
+      }
+    }
+  }
+  model.meshes.push_back(std::move(mesh));
+  return Finish(std::move(model));
+}
+
 std::shared_ptr<const Model> MakeSphere(const Eigen::Vector4f& color, int segments) {
   CheckColor("MakeSphere", color);
   if (segments < 3 || segments > kMaxSphereSegments) {

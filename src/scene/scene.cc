@@ -117,10 +117,17 @@ Scene::Scene(Eigen::Vector3f background, std::vector<Light> lights, Ground groun
     if (!ids.insert(robot_->id).second) {
       Invalid(fmt::format("robot: id {} is already an object's", robot_->id));
     }
-    robot_->head.CheckLimits(robot_->initial_joints);  // InvalidArgument naming the joint
+    // In the head's order (a state by name may come in another), within the limits.
+    if (robot_->initial_joints.empty()) robot_->initial_joints = robot_->head.Home();
+    robot_->initial_joints = robot_->head.Arrange(robot_->initial_joints);
+    robot_->head.CheckLimits(robot_->initial_joints.values());  // names the joint
     for (std::size_t i = 0; i < robot_->parts.size(); ++i) {
       const RobotPart& part = robot_->parts[i];
       const std::string owner = fmt::format("robot.parts[{}]", i);
+      if (part.link < 0 || part.link >= robot_->head.tree().num_links()) {
+        Invalid(fmt::format("{}: link {} is not a link of the head ({} links)", owner, part.link,
+                            robot_->head.tree().num_links()));
+      }
       if (!IsRigidPose(part.X_LinkPart)) Invalid(owner + ": X_LinkPart must be a rigid transform");
       if (!IsPositiveScale(part.scale)) Invalid(owner + ": scale must be finite and > 0");
       CheckModel(part.model, owner, checked);
@@ -176,8 +183,10 @@ SceneState Scene::InitialState() const {
 
 geometry::Pose Scene::CameraPose(const CameraSpec& camera, const SceneState& state) const {
   if (camera.mount == CameraMount::kWorld || !robot_) return camera.X_WC;
-  const head::HeadFrames frames = head::ForwardKinematics(robot_->head, state.joints);
-  return camera.mount == CameraMount::kLeftEye ? frames.X_WCamLeft : frames.X_WCamRight;
+  std::vector<geometry::Pose> X_WL;
+  const head::HeadModel& head = robot_->head;
+  head.ForwardKinematics(state.joints.empty() ? head.HomePosture() : state.joints.values(), &X_WL);
+  return head.CameraPose(camera.mount == CameraMount::kLeftEye ? 0 : 1, X_WL);
 }
 
 geometry::Pose Scene::ObjectPose(const Object& object, const SceneState& state) const {

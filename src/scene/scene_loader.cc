@@ -497,21 +497,23 @@ class SceneReader {
     e.ExpectMap({"head", "id", "pose", "joints", "joints_deg", "visible", "cameras"},
                 "a robot {head, joints_deg, pose, visible, cameras}");
     const Entry head_entry = e.Get("head");
-    const fs::path head_path = ResolveFile(head_entry, "head description");
-    std::optional<head::HeadDescription> description;
+    const fs::path head_path = ResolveFile(head_entry, "head file");
+    std::optional<head::HeadModel> model;
     try {
-      description = head::HeadDescription::FromYamlFile(head_path);
+      model.emplace(head::HeadModel::FromFile(head_path));
     } catch (const Error& error) {
-      head_entry.Fail(fmt::format("cannot load head description '{}': {}", head_entry.AsString(),
-                                  error.what()));
+      head_entry.Fail(
+          fmt::format("cannot load head file '{}': {}", head_entry.AsString(), error.what()));
     }
-    geometry::Pose X_WB = description->X_WB();
-    if (const auto pose = e.Find("pose")) X_WB = ReadPose(*pose);
+    if (const auto pose = e.Find("pose")) model.emplace(model->WithPose(ReadPose(*pose)));
 
-    geometry::CameraModel left = description->left_camera();
-    geometry::CameraModel right = description->right_camera();
-    geometry::ClipPlanes clips[2] = {{kDefaultNear, kDefaultFar}, {kDefaultNear, kDefaultFar}};
+    geometry::ClipPlanes clips[2];
     SensorSpec sensors[2];
+    for (int i = 0; i < 2; ++i) {
+      const auto& clip = model->camera(i).clip;
+      clips[i] = clip ? geometry::ClipPlanes{clip->first, clip->second}
+                      : geometry::ClipPlanes{kDefaultNear, kDefaultFar};
+    }
     if (const auto c = e.Find("cameras")) {
       c->ExpectMap({"left", "right"}, "the eye cameras {left, right}");
       for (int i = 0; i < 2; ++i) {
@@ -520,55 +522,65 @@ class SceneReader {
         camera->ExpectMap({"calibration", "clip", "sensor"},
                           "an eye camera {calibration, clip, sensor}");
         if (const auto calibration = camera->Find("calibration")) {
-          (i == 0 ? left : right) = ReadCalibration(*calibration);
+          model.emplace(model->WithCamera(i, ReadCalibration(*calibration)));
         }
         if (const auto clip = camera->Find("clip")) clips[i] = ReadClip(*clip);
         if (const auto sensor = camera->Find("sensor")) sensors[i] = ReadSensor(*sensor);
       }
     }
-    // The description again, with the scene's pose and calibrations in place of its own (the
-    // servo mapping kept).
-    std::optional<head::HeadDescription> placed;
-    try {
-      placed.emplace(
-          description->name(), description->geometry(),
-          std::array<head::JointLimits, 4>{
-              description->limits(head::Joint::kPan), description->limits(head::Joint::kTilt),
-              description->limits(head::Joint::kLeft), description->limits(head::Joint::kRight)},
-          X_WB, left, right,
-          std::array<std::optional<head::ServoMapping>, 4>{
-              description->servo(head::Joint::kPan), description->servo(head::Joint::kTilt),
-              description->servo(head::Joint::kLeft), description->servo(head::Joint::kRight)});
-    } catch (const InvalidArgument& error) {
-      e.Fail(error.what());
-    }
-    Robot robot{*placed, {}, true, {}, 0};
-
-    const auto rad = e.Find("joints");
-    const auto deg = e.Find("joints_deg");
-    if (rad && deg) deg->Fail("give either 'joints' (radians) or 'joints_deg', not both");
-    if (rad || deg) {
-      const Entry& joints = rad ? *rad : *deg;
-      const std::vector<double> q = joints.AsDoubles(4, "[pan, tilt, left, right]");
-      const double k = deg ? kDegToRad : 1.0;
-      robot.initial_joints = {q[0] * k, q[1] * k, q[2] * k, q[3] * k};
-      try {
-        robot.head.CheckLimits(robot.initial_joints);
-      } catch (const InvalidArgument& error) {
-        joints.Fail(error.what());
-      }
-    }
+    Robot robot{*model, model->Home(), true, {}, 0};
+    ReadInitialJoints(e, &robot);
     if (const auto v = e.Find("visible")) robot.visible = v->AsBool();
     if (const auto id = e.Find("id")) {
       robot.id = static_cast<uint32_t>(id->AsInteger(1, kMaxId));
       *id_entry = id;
     }
-    robot.parts = internal::BuildRobotBody(robot.head);
-    cameras->push_back(CameraSpec{"left", left, CameraMount::kLeftEye, geometry::Pose::Identity(),
-                                  clips[0], sensors[0]});
-    cameras->push_back(CameraSpec{"right", right, CameraMount::kRightEye,
+    try {
+      robot.parts = robot.head.appendix_a() ? internal::BuildRobotBody(robot.head)
+                                            : internal::BuildUrdfVisuals(robot.head, cache_);
+    } catch (const Error& error) {
+      head_entry.Fail(fmt::format("cannot build the robot's body: {}", error.what()));
+    }
+    cameras->push_back(CameraSpec{"left", robot.head.camera(0).model, CameraMount::kLeftEye,
+                                  geometry::Pose::Identity(), clips[0], sensors[0]});
+    cameras->push_back(CameraSpec{"right", robot.head.camera(1).model, CameraMount::kRightEye,
                                   geometry::Pose::Identity(), clips[1], sensors[1]});
     return robot;
+  }
+
+  // `joints` (radians) or `joints_deg`: a list in the head's joint order, or a map of joint
+  // name to value where joints left out stay at home.
+  void ReadInitialJoints(const Entry& e, Robot* robot) {
+    const auto rad = e.Find("joints");
+    const auto deg = e.Find("joints_deg");
+    if (rad && deg) deg->Fail("give either 'joints' (radians) or 'joints_deg', not both");
+    if (!rad && !deg) return;
+    const Entry& joints = rad ? *rad : *deg;
+    const double k = deg ? kDegToRad : 1.0;
+    const head::HeadModel& head = robot->head;
+    head::JointState q = head.Home();
+    if (joints.IsMap()) {
+      for (const auto& item : joints.node()) {
+        const std::string name = item.first.as<std::string>();
+        const Entry value = joints.Get(name.c_str());
+        const int i = head.FindJoint(name);
+        if (i < 0) {
+          value.Fail(fmt::format("the head has no joint '{}'; its joints are: {}", name,
+                                 head::ListNames(*head.joint_names())));
+        }
+        q[i] = value.AsDouble() * k;
+      }
+    } else {
+      const std::string names = "[" + head::ListNames(*head.joint_names()) + "]";
+      const std::vector<double> values = joints.AsDoubles(head.num_joints(), names.c_str());
+      for (int i = 0; i < head.num_joints(); ++i) q[i] = values[i] * k;
+    }
+    try {
+      head.CheckLimits(q.values());
+    } catch (const InvalidArgument& error) {
+      joints.Fail(error.what());
+    }
+    robot->initial_joints = q;
   }
 
   // --- instance ids -------------------------------------------------------------------

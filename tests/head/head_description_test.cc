@@ -428,7 +428,7 @@ TEST_F(HeadDescriptionConstructorTest, RejectsBadFieldsNamingThem) {
 
 TEST_F(HeadDescriptionConstructorTest, JointStateAccessAndLimitChecks) {
   const HeadDescription head("h", geometry_, limits_, geometry::Pose::Identity(), camera_, camera_);
-  JointState q{0.1, 0.2, -0.3, 0.4};
+  PopeyeJoints q{0.1, 0.2, -0.3, 0.4};
   EXPECT_EQ(q[Joint::kPan], 0.1);
   EXPECT_EQ(q[Joint::kTilt], 0.2);
   EXPECT_EQ(q[Joint::kLeft], -0.3);

@@ -116,7 +116,7 @@ bool InFront(const geometry::Pose& X, const Vector3d& p) {
 
 // Random joint states inside the limits whose optical axes meet in front: symmetric vergence
 // between 0.5 and 45 degrees.
-JointState RandomSymmetric(std::mt19937& rng) {
+PopeyeJoints RandomSymmetric(std::mt19937& rng) {
   std::uniform_real_distribution<double> pan(-88 * kDeg, 88 * kDeg);
   std::uniform_real_distribution<double> tilt(-44 * kDeg, 44 * kDeg);
   std::uniform_real_distribution<double> vergence(0.5 * kDeg, 44 * kDeg);
@@ -137,7 +137,7 @@ TEST(ForwardKinematicsTest, MatchesPaperMatricesEq4To9) {
   std::mt19937 rng(4);
   double worst = 0.0;
   for (int i = 0; i < kRandomCases; ++i) {
-    const JointState q = RandomSymmetric(rng);
+    const PopeyeJoints q = RandomSymmetric(rng);
     const HeadFrames f = ForwardKinematics(head, q);
     const Matrix4d W_b = head.X_WB().matrix() * PaperAxesInBase();
     const Matrix4d W_n = W_b * PanMatrix(q.pan);
@@ -171,7 +171,7 @@ TEST(ForwardKinematicsTest, FixationMatchesEq10InPaperBaseFrame) {
   const double B = head.geometry().B;
   std::mt19937 rng(10);
   for (int i = 0; i < kRandomCases; ++i) {
-    const JointState q = RandomSymmetric(rng);
+    const PopeyeJoints q = RandomSymmetric(rng);
     const HeadFrames f = ForwardKinematics(head, q);
     ASSERT_TRUE(f.p_WFixation.has_value());
     const double t = std::tan(q.right);
@@ -186,7 +186,7 @@ TEST(ForwardKinematicsTest, FixationMatchesEq10InPaperBaseFrame) {
 
 TEST(ForwardKinematicsTest, SignConventionsOfTheHeader) {
   const HeadDescription head = MakeHead(HeadGeometry{}, geometry::Pose::Identity());
-  const auto fixation_in_base = [&](const JointState& q) {
+  const auto fixation_in_base = [&](const PopeyeJoints& q) {
     const auto p = ForwardKinematics(head, q).p_WFixation;
     EXPECT_TRUE(p.has_value());
     return p.value_or(Vector3d::Zero());
@@ -220,7 +220,7 @@ TEST(ForwardKinematicsTest, IndependentEyesMeetWhereBothAxesPass) {
   std::mt19937 rng(11);
   std::uniform_real_distribution<double> angle(-40 * kDeg, 40 * kDeg);
   for (int i = 0; i < kRandomCases; ++i) {
-    const JointState q{angle(rng), angle(rng), angle(rng), angle(rng)};
+    const PopeyeJoints q{angle(rng), angle(rng), angle(rng), angle(rng)};
     const HeadFrames f = ForwardKinematics(head, q);
     if (!f.p_WFixation) continue;
     EXPECT_LT(q.left, q.right);  // only converging eyes meet in front
@@ -249,19 +249,19 @@ TEST(ForwardKinematicsTest, AxisErrorsAreTheOpticalAxesAnglesToThePoint) {
   const HeadDescription head = HeadDescription::FromYamlFile(kPopeyePath);
   // Parallel eyes: a point 2 m along the left axis is on it; the right axis, parallel and one
   // baseline (2 B, appendix A) away, misses it by atan(2 B / 2 m).
-  const HeadFrames f = ForwardKinematics(head, JointState{});
+  const HeadFrames f = ForwardKinematics(head, PopeyeJoints{});
   const Vector3d p = f.X_WCamLeft * Vector3d(0.0, 0.0, 2.0);
   const double baseline = (f.X_WCamLeft.translation() - f.X_WCamRight.translation()).norm();
   EXPECT_NEAR(baseline, 2.0 * head.geometry().B, 1e-12);  // delta_l = delta_r = 0
-  const Eigen::Vector2d e = AxisErrors(head, JointState{}, p);
+  const Eigen::Vector2d e = AxisErrors(head, PopeyeJoints{}, p);
   EXPECT_LT(e[0], 1e-12);
   EXPECT_NEAR(e[1], std::atan2(baseline, 2.0), 1e-12);
   // A fixated point: both zero (to the solver's 1e-9 rad); a point behind: near pi.
-  const JointState verged{0.1, -0.05, -0.03, 0.03};
+  const PopeyeJoints verged{0.1, -0.05, -0.03, 0.03};
   const Vector3d fixated = ForwardKinematics(head, verged).p_WFixation.value();
   EXPECT_LT(AxisErrors(head, verged, fixated).maxCoeff(), 1e-9);
   const Vector3d behind = f.X_WCamLeft * Vector3d(0.0, 0.0, -2.0);
-  EXPECT_NEAR(AxisErrors(head, JointState{}, behind)[0], M_PI, 1e-9);
+  EXPECT_NEAR(AxisErrors(head, PopeyeJoints{}, behind)[0], M_PI, 1e-9);
 }
 
 TEST(InverseKinematicsTest, PopeyeRandomTargetsAreFixatedExactly) {
@@ -273,7 +273,7 @@ TEST(InverseKinematicsTest, PopeyeRandomTargetsAreFixatedExactly) {
   int total_iterations = 0;
   int max_iterations = 0;
   for (int i = 0; i < kRandomCases; ++i) {
-    const JointState truth = RandomSymmetric(rng);
+    const PopeyeJoints truth = RandomSymmetric(rng);
     const Vector3d target = ForwardKinematics(head, truth).p_WFixation.value();
     const IkResult ik = SolveFixation(head, target);
     ASSERT_TRUE(ik.reachable()) << "case " << i << ": " << ik.message;
@@ -339,7 +339,7 @@ TEST(InverseKinematicsTest, GeneralGeometryStillPutsBothAxesThroughTheTarget) {
   double worst_axis = 0.0;
   int total_iterations = 0;
   for (int i = 0; i < kRandomCases; ++i) {
-    const JointState truth = RandomSymmetric(rng);
+    const PopeyeJoints truth = RandomSymmetric(rng);
     const auto target = ForwardKinematics(head, truth).p_WFixation;
     ASSERT_TRUE(target.has_value());
     IkOptions options;
@@ -382,7 +382,7 @@ TEST(InverseKinematicsTest, IndependentModeKeepsPanAndFixates) {
     double worst_axis = 0.0;
     int cases = 0;
     while (cases < kRandomCases) {
-      JointState truth{pan(rng), tilt(rng), eye(rng), eye(rng)};
+      PopeyeJoints truth{pan(rng), tilt(rng), eye(rng), eye(rng)};
       if (truth.right - truth.left < 0.5 * kDeg) continue;  // axes must meet in front
       const auto target = ForwardKinematics(head, truth).p_WFixation;
       if (!target) continue;

@@ -32,7 +32,7 @@ constexpr double kFiniteDifferenceSlack = 1e-7;
 
 const std::string kPopeyePath = SACCADE_SOURCE_DIR "/robots/popeye.yaml";
 
-HeadDescription Popeye() { return HeadDescription::FromYamlFile(kPopeyePath); }
+HeadModel Popeye() { return HeadModel::FromFile(kPopeyePath); }
 
 // The classical time-optimal rest-to-rest duration, written independently of the planner.
 double ClassicalDuration(double d, double v, double a) {
@@ -42,30 +42,30 @@ double ClassicalDuration(double d, double v, double a) {
 }
 
 TEST(MotorsTest, StartsAtRestAtTheGivenPositions) {
-  const JointState start{0.1, -0.2, 0.3, -0.3};
+  const JointState start = head::JointState::Popeye(0.1, -0.2, 0.3, -0.3);
   const Motors motors(Popeye(), start);
   EXPECT_EQ(motors.positions(), start);
-  EXPECT_EQ(motors.velocities(), JointState{});
+  EXPECT_EQ(motors.velocities(), head::JointState::Popeye(0, 0, 0, 0));
   EXPECT_TRUE(motors.Arrived());
   EXPECT_EQ(motors.TimeToTarget(), 0.0);
 }
 
 TEST(MotorsTest, SaccadeOfEachJointTakesTheTimeOptimalDuration) {
-  const HeadDescription head = Popeye();
+  const HeadModel head = Popeye();
   // Short (triangle) and long (trapezoid) moves, both signs, for every joint.
-  for (Joint joint : kAllJoints) {
-    const JointLimits& l = head.limits(joint);
+  for (int joint = 0; joint < 4; ++joint) {
+    const JointLimits& l = head.joint(joint).limits;
     const double v = l.max_velocity;
     const double a = l.max_acceleration;
     // The eyes' range is too short to cruise from 0: long moves go from one side to the other.
     const double half_range = std::min(l.max, -l.min);
     const double short_move = 0.3 * v * v / a;
     const double long_move = 0.9 * half_range;
-    ASSERT_GT(2 * long_move, v * v / a) << JointName(joint) << ": the long move must cruise";
+    ASSERT_GT(2 * long_move, v * v / a) << head::JointState::PopeyeNames()->at(joint) << ": the long move must cruise";
     const std::vector<std::pair<double, double>> moves = {
         {0.0, short_move}, {0.0, -short_move}, {-long_move, long_move}, {long_move, -long_move}};
     for (const auto& [x0, x1] : moves) {
-      JointState start;
+      JointState start = head::JointState::Popeye(0, 0, 0, 0);
       start[joint] = x0;
       Motors motors(head, start);
       JointState target = start;
@@ -74,7 +74,7 @@ TEST(MotorsTest, SaccadeOfEachJointTakesTheTimeOptimalDuration) {
       EXPECT_FALSE(motors.SetTarget(target).any());
       const double expected = ClassicalDuration(d, v, a);
       EXPECT_NEAR(motors.CommandDuration(joint), expected, kDurationRelTolerance * expected)
-          << JointName(joint) << " d = " << d;
+          << head::JointState::PopeyeNames()->at(joint) << " d = " << d;
       EXPECT_NEAR(motors.TimeToTarget(), expected, kDurationRelTolerance * expected);
       // Just before the end it is still moving; at the end it is at rest on the target.
       motors.Step(expected * (1 - 1e-6));
@@ -93,19 +93,19 @@ TEST(MotorsTest, SaccadeOfEachJointTakesTheTimeOptimalDuration) {
 }
 
 TEST(MotorsTest, SaccadeReachesPeakVelocityOnlyWhenTheMoveIsLong) {
-  const HeadDescription head = Popeye();
-  const JointLimits& l = head.limits(Joint::kPan);
+  const HeadModel head = Popeye();
+  const JointLimits& l = head.joint(0).limits;
   Motors motors(head);
-  motors.SetJointTarget(Joint::kPan, 80 * kDeg);
+  motors.SetJointTarget(0, 80 * kDeg);
   const double ramp = l.max_velocity / l.max_acceleration;
   motors.Step(ramp + 1e-3);  // cruising
-  EXPECT_NEAR(motors.velocities().pan, l.max_velocity, 1e-9);
-  EXPECT_EQ(motors.accelerations().pan, 0.0);
+  EXPECT_NEAR(motors.velocities()[0], l.max_velocity, 1e-9);
+  EXPECT_EQ(motors.accelerations()[0], 0.0);
 }
 
 // Records a trajectory at a fixed step and checks every bound, pointwise and by finite
 // differences. Returns the positions.
-std::vector<double> RecordAndCheck(Motors& motors, Joint joint, double dt, int steps,
+std::vector<double> RecordAndCheck(Motors& motors, int joint, double dt, int steps,
                                    const std::string& what) {
   const JointLimits& l = motors.limits(joint);
   std::vector<double> x{motors.positions()[joint]};
@@ -134,18 +134,18 @@ std::vector<double> RecordAndCheck(Motors& motors, Joint joint, double dt, int s
 }
 
 TEST(MotorsTest, RandomSaccadesFromRandomVelocitiesStayWithinEveryLimit) {
-  const HeadDescription head = Popeye();
+  const HeadModel head = Popeye();
   std::mt19937 rng(20261122);
   std::uniform_real_distribution<double> unit(0.0, 1.0);
   for (int trial = 0; trial < 200; ++trial) {
-    const Joint joint = kAllJoints[trial % 4];
-    const JointLimits& l = head.limits(joint);
+    const int joint = trial % 4;
+    const JointLimits& l = head.joint(joint).limits;
     // A random start that can stop within the limits, at a random velocity.
     double x0 = l.min + (l.max - l.min) * unit(rng);
     double v0 = l.max_velocity * (2 * unit(rng) - 1);
     const double stop = x0 + v0 * std::abs(v0) / (2 * l.max_acceleration);
     if (!l.Contains(stop)) v0 = 0.0;
-    JointState positions, velocities;
+    JointState positions = head::JointState::Popeye(0, 0, 0, 0), velocities = head::JointState::Popeye(0, 0, 0, 0);
     positions[joint] = x0;
     velocities[joint] = v0;
     Motors motors(head);
@@ -166,15 +166,15 @@ TEST(MotorsTest, RandomSaccadesFromRandomVelocitiesStayWithinEveryLimit) {
 }
 
 TEST(MotorsTest, SaccadeFromRestNeverOvershootsItsTarget) {
-  const HeadDescription head = Popeye();
+  const HeadModel head = Popeye();
   std::mt19937 rng(7);
   std::uniform_real_distribution<double> unit(0.0, 1.0);
   for (int trial = 0; trial < 100; ++trial) {
-    const Joint joint = kAllJoints[trial % 4];
-    const JointLimits& l = head.limits(joint);
+    const int joint = trial % 4;
+    const JointLimits& l = head.joint(joint).limits;
     const double x0 = l.min + (l.max - l.min) * unit(rng);
     const double target = l.min + (l.max - l.min) * unit(rng);
-    JointState start;
+    JointState start = head::JointState::Popeye(0, 0, 0, 0);
     start[joint] = x0;
     Motors motors(head, start);
     motors.SetJointTarget(joint, target);
@@ -192,10 +192,10 @@ TEST(MotorsTest, SaccadeFromRestNeverOvershootsItsTarget) {
 }
 
 TEST(MotorsTest, ReversingMidFlightStaysWithinLimitsAndEndsOnTheNewTarget) {
-  const HeadDescription head = Popeye();
-  for (Joint joint : kAllJoints) {
-    const JointLimits& l = head.limits(joint);
-    JointState start;
+  const HeadModel head = Popeye();
+  for (int joint = 0; joint < 4; ++joint) {
+    const JointLimits& l = head.joint(joint).limits;
+    JointState start = head::JointState::Popeye(0, 0, 0, 0);
     start[joint] = 0.8 * l.min;
     Motors motors(head, start);
     motors.SetJointTarget(joint, 0.8 * l.max);
@@ -209,7 +209,7 @@ TEST(MotorsTest, ReversingMidFlightStaysWithinLimitsAndEndsOnTheNewTarget) {
     EXPECT_EQ(motors.accelerations()[joint], -l.max_acceleration);
     const std::vector<double> x = RecordAndCheck(
         motors, joint, 1e-3, static_cast<int>(motors.CommandDuration(joint) / 1e-3) + 10,
-        JointName(joint));
+        head::JointState::PopeyeNames()->at(joint));
     EXPECT_NEAR(*std::max_element(x.begin(), x.end()), stop, 1e-6) << "overshoot = braking";
     EXPECT_EQ(motors.positions()[joint], 0.8 * l.min);
     EXPECT_EQ(motors.velocities()[joint], 0.0);
@@ -222,10 +222,10 @@ TEST(MotorsTest, ReversingMidFlightStaysWithinLimitsAndEndsOnTheNewTarget) {
 }
 
 TEST(MotorsTest, StateDoesNotDependOnTheStepSize) {
-  const HeadDescription head = Popeye();
-  const JointState start{0.1, 0.2, -0.1, 0.05};
-  const JointState target{-1.2, 0.5, 0.4, -0.6};
-  const JointState velocity{0.3, -0.2, 0.0, 1.0};
+  const HeadModel head = Popeye();
+  const JointState start = head::JointState::Popeye(0.1, 0.2, -0.1, 0.05);
+  const JointState target = head::JointState::Popeye(-1.2, 0.5, 0.4, -0.6);
+  const JointState velocity = head::JointState::Popeye(0.3, -0.2, 0.0, 1.0);
   for (bool pursuit : {false, true}) {
     for (double t_end : {0.05, 0.123, 0.4, 1.0, 3.0}) {
       Motors fine(head, start), coarse(head, start), once(head, start);
@@ -238,9 +238,9 @@ TEST(MotorsTest, StateDoesNotDependOnTheStepSize) {
       for (int k = 0; k < m10; ++k) coarse.Step(1e-2);
       coarse.Step(std::max(0.0, t_end - coarse.time()));
       once.Step(t_end);
-      for (Joint joint : kAllJoints) {
+      for (int joint = 0; joint < 4; ++joint) {
         EXPECT_NEAR(fine.positions()[joint], once.positions()[joint], kDtIndependenceTolerance)
-            << JointName(joint) << " t=" << t_end << " pursuit=" << pursuit;
+            << head::JointState::PopeyeNames()->at(joint) << " t=" << t_end << " pursuit=" << pursuit;
         EXPECT_NEAR(coarse.positions()[joint], once.positions()[joint], kDtIndependenceTolerance);
         EXPECT_NEAR(fine.velocities()[joint], once.velocities()[joint], kDtIndependenceTolerance);
         EXPECT_NEAR(coarse.velocities()[joint], once.velocities()[joint], kDtIndependenceTolerance);
@@ -252,43 +252,43 @@ TEST(MotorsTest, StateDoesNotDependOnTheStepSize) {
 TEST(MotorsTest, RepeatingTheSameCommandEveryStepDoesNotChangeTheMotion) {
   // A closed loop re-sends its target every frame: re-planning from the current state must
   // continue the same time-optimal motion, for saccades and for pursuits.
-  const HeadDescription head = Popeye();
-  const JointState start{0.3, -0.2, 0.2, -0.1};
-  const JointState target{-1.0, 0.4, -0.3, 0.5};
-  const JointState velocity{0.4, -0.3, 0.5, 0.2};
+  const HeadModel head = Popeye();
+  const JointState start = head::JointState::Popeye(0.3, -0.2, 0.2, -0.1);
+  const JointState target = head::JointState::Popeye(-1.0, 0.4, -0.3, 0.5);
+  const JointState velocity = head::JointState::Popeye(0.4, -0.3, 0.5, 0.2);
   for (bool pursuit : {false, true}) {
     Motors once(head, start), every_frame(head, start);
     pursuit ? once.SetTarget(target, velocity) : once.SetTarget(target);
     for (int k = 0; k < 150; ++k) {  // 1.5 s at 100 Hz
       JointState now = target;
-      for (Joint joint : kAllJoints) {
+      for (int joint = 0; joint < 4; ++joint) {
         now[joint] += pursuit ? velocity[joint] * every_frame.time() : 0.0;
       }
       pursuit ? every_frame.SetTarget(now, velocity) : every_frame.SetTarget(now);
       every_frame.Step(0.01);
       once.Step(0.01);
-      for (Joint joint : kAllJoints) {
+      for (int joint = 0; joint < 4; ++joint) {
         ASSERT_NEAR(every_frame.positions()[joint], once.positions()[joint],
                     kDtIndependenceTolerance)
-            << JointName(joint) << " k=" << k << " pursuit=" << pursuit;
+            << head::JointState::PopeyeNames()->at(joint) << " k=" << k << " pursuit=" << pursuit;
         ASSERT_NEAR(every_frame.velocities()[joint], once.velocities()[joint],
                     kDtIndependenceTolerance)
-            << JointName(joint) << " k=" << k << " pursuit=" << pursuit;
+            << head::JointState::PopeyeNames()->at(joint) << " k=" << k << " pursuit=" << pursuit;
       }
     }
   }
 }
 
 TEST(MotorsTest, PursuitConvergesThenTracksWithZeroLag) {
-  const HeadDescription head = Popeye();
-  for (Joint joint : kAllJoints) {
-    const JointLimits& l = head.limits(joint);
+  const HeadModel head = Popeye();
+  for (int joint = 0; joint < 4; ++joint) {
+    const JointLimits& l = head.joint(joint).limits;
     for (double sign : {1.0, -1.0}) {
       // A target ahead and moving at a quarter of the velocity limit, from a joint moving the
       // other way: it must turn, catch up and lock on.
       const double vt = sign * 0.25 * l.max_velocity;
       const double p0 = -sign * 0.4 * std::min(l.max, -l.min);
-      JointState start, start_v;
+      JointState start = head::JointState::Popeye(0, 0, 0, 0), start_v = head::JointState::Popeye(0, 0, 0, 0);
       start[joint] = -sign * 0.5 * std::min(l.max, -l.min);
       start_v[joint] = -0.5 * vt;
       Motors motors(head);
@@ -299,13 +299,13 @@ TEST(MotorsTest, PursuitConvergesThenTracksWithZeroLag) {
       // The target reaches the braking point later than the joint meets it.
       const double limit = sign > 0 ? l.max : l.min;
       const double t_brake = (limit - sign * vt * vt / (2 * l.max_acceleration) - p0) / vt;
-      ASSERT_LT(meet, t_brake) << JointName(joint);
-      RecordAndCheck(motors, joint, 1e-3, static_cast<int>(meet / 1e-3) + 1, JointName(joint));
+      ASSERT_LT(meet, t_brake) << head::JointState::PopeyeNames()->at(joint);
+      RecordAndCheck(motors, joint, 1e-3, static_cast<int>(meet / 1e-3) + 1, head::JointState::PopeyeNames()->at(joint));
       // From the meeting time until the braking point: exact tracking.
       double t = motors.command_time(joint);
       while (t < t_brake - 1e-3) {
         EXPECT_NEAR(motors.positions()[joint], p0 + vt * t, kTrackingTolerance)
-            << JointName(joint) << " t=" << t;
+            << head::JointState::PopeyeNames()->at(joint) << " t=" << t;
         EXPECT_NEAR(motors.velocities()[joint], vt, kTrackingTolerance);
         EXPECT_TRUE(motors.Arrived(joint));
         // The target the joint is on, and how fast it moves (what a joint state sends).
@@ -315,7 +315,7 @@ TEST(MotorsTest, PursuitConvergesThenTracksWithZeroLag) {
         t = motors.command_time(joint);
       }
       // Then it stops on the limit the target runs into, never past it.
-      RecordAndCheck(motors, joint, 1e-3, 1000, JointName(joint));
+      RecordAndCheck(motors, joint, 1e-3, 1000, head::JointState::PopeyeNames()->at(joint));
       EXPECT_EQ(motors.positions()[joint], limit);
       EXPECT_EQ(motors.velocities()[joint], 0.0);
     }
@@ -325,13 +325,13 @@ TEST(MotorsTest, PursuitConvergesThenTracksWithZeroLag) {
 TEST(MotorsTest, PursuitInterceptIsTimeOptimalFromRest) {
   // From rest at 0, a target at p moving away at vt. Checked against an independent
   // criterion: the furthest the joint can get by time T while ending at velocity vt.
-  const HeadDescription head = Popeye();
-  const JointLimits& l = head.limits(Joint::kLeft);
+  const HeadModel head = Popeye();
+  const JointLimits& l = head.joint(2).limits;
   const double p = 0.05;
   const double vt = 0.3 * l.max_velocity;
   Motors motors(head);
-  motors.SetJointTarget(Joint::kLeft, p, vt);
-  const double meet = motors.CommandDuration(Joint::kLeft);
+  motors.SetJointTarget(2, p, vt);
+  const double meet = motors.CommandDuration(2);
   // Feasibility of meeting at T from rest under a bang-bang profile with at most one switch
   // and |v| <= vmax: the furthest position reachable at time T while ending at velocity vt.
   auto reachable = [&](double T) {
@@ -349,34 +349,34 @@ TEST(MotorsTest, PursuitInterceptIsTimeOptimalFromRest) {
 }
 
 TEST(MotorsTest, TargetsBeyondTheLimitsAreClampedAndNeverExceeded) {
-  const HeadDescription head = Popeye();
+  const HeadModel head = Popeye();
   Motors motors(head);
-  const JointState far{200 * kDeg, -100 * kDeg, 60 * kDeg, -1e6};
+  const JointState far = head::JointState::Popeye(200 * kDeg, -100 * kDeg, 60 * kDeg, -1e6);
   const ClampReport report = motors.SetTarget(far);
   EXPECT_TRUE(report.any());
-  for (Joint joint : kAllJoints) EXPECT_TRUE(report[joint]) << JointName(joint);
+  for (int joint = 0; joint < 4; ++joint) EXPECT_TRUE(report[joint]) << head::JointState::PopeyeNames()->at(joint);
   EXPECT_EQ(motors.clamped_commands(), 4);
-  const JointState expected{head.limits(Joint::kPan).max, head.limits(Joint::kTilt).min,
-                            head.limits(Joint::kLeft).max, head.limits(Joint::kRight).min};
+  const JointState expected = head::JointState::Popeye(head.joint(0).limits.max, head.joint(1).limits.min,
+                            head.joint(2).limits.max, head.joint(3).limits.min);
   EXPECT_EQ(motors.targets(), expected);
-  for (Joint joint : kAllJoints) {
+  for (int joint = 0; joint < 4; ++joint) {
     Motors copy = motors;
-    RecordAndCheck(copy, joint, 1e-3, 2000, JointName(joint));
+    RecordAndCheck(copy, joint, 1e-3, 2000, head::JointState::PopeyeNames()->at(joint));
   }
   motors.Step(10.0);
   EXPECT_EQ(motors.positions(), expected);
   // Too fast a pursuit is clamped to the velocity limit, and reported.
-  EXPECT_TRUE(motors.SetJointTarget(Joint::kPan, 0.0, 2 * head.limits(Joint::kPan).max_velocity));
+  EXPECT_TRUE(motors.SetJointTarget(0, 0.0, 2 * head.joint(0).limits.max_velocity));
   EXPECT_EQ(motors.clamped_commands(), 5);
-  RecordAndCheck(motors, Joint::kPan, 1e-3, 3000, "fast pursuit");
-  EXPECT_FALSE(motors.SetJointTarget(Joint::kPan, 0.1));
+  RecordAndCheck(motors, 0, 1e-3, 3000, "fast pursuit");
+  EXPECT_FALSE(motors.SetJointTarget(0, 0.1));
   EXPECT_EQ(motors.clamped_commands(), 5);
 }
 
 TEST(MotorsTest, NonFiniteTargetsThrowNamingTheJointAndChangeNothing) {
-  const HeadDescription head = Popeye();
+  const HeadModel head = Popeye();
   Motors motors(head);
-  motors.SetTarget(JointState{0.5, 0.2, -0.1, 0.1});
+  motors.SetTarget(head::JointState::Popeye(0.5, 0.2, -0.1, 0.1));
   motors.Step(0.05);
   const JointState x = motors.positions(), v = motors.velocities(), t = motors.targets();
   const double remaining = motors.TimeToTarget();
@@ -396,39 +396,39 @@ TEST(MotorsTest, NonFiniteTargetsThrowNamingTheJointAndChangeNothing) {
   };
   expect_throw(
       [&] {
-        motors.SetTarget(JointState{0.0, 0.0, nan, 0.0});
+        motors.SetTarget(head::JointState::Popeye(0.0, 0.0, nan, 0.0));
       },
       "left target position = nan");
   expect_throw(
       [&] {
-        motors.SetTarget(JointState{0.0, 0.0, 0.0, 0.0}, JointState{0, inf, 0, 0});
+        motors.SetTarget(head::JointState::Popeye(0.0, 0.0, 0.0, 0.0), head::JointState::Popeye(0, inf, 0, 0));
       },
       "tilt target velocity = inf");
-  expect_throw([&] { motors.SetJointTarget(Joint::kRight, -inf); }, "right target position = -inf");
+  expect_throw([&] { motors.SetJointTarget(3, -inf); }, "right target position = -inf");
   expect_throw([&] { motors.Step(nan); }, "Motors::Step: dt = nan");
   expect_throw([&] { motors.Step(-1.0); }, "dt = -1");
-  expect_throw([&] { motors.Reset(JointState{0, 0, 0, 2.0}); }, "right position = 2");
-  expect_throw([&] { motors.Reset(JointState{}, JointState{100, 0, 0, 0}); }, "pan velocity = 100");
+  expect_throw([&] { motors.Reset(head::JointState::Popeye(0, 0, 0, 2.0)); }, "right position = 2");
+  expect_throw([&] { motors.Reset(head::JointState::Popeye(0, 0, 0, 0), head::JointState::Popeye(100, 0, 0, 0)); }, "pan velocity = 100");
   // pan at 89 deg moving at 300 deg/s towards 90: needs 15 deg to stop.
   expect_throw(
       [&] {
-        motors.Reset(JointState{89 * kDeg, 0, 0, 0}, JointState{300 * kDeg, 0, 0, 0});
+        motors.Reset(head::JointState::Popeye(89 * kDeg, 0, 0, 0), head::JointState::Popeye(300 * kDeg, 0, 0, 0));
       },
       "cannot stop before its limit");
   EXPECT_EQ(motors.clamped_commands(), 0);
 }
 
 TEST(MotorsTest, ResetWithVelocityBrakesToRest) {
-  const HeadDescription head = Popeye();
+  const HeadModel head = Popeye();
   Motors motors(head);
-  const JointLimits& l = head.limits(Joint::kTilt);
-  motors.Reset(JointState{0, 0.1, 0, 0}, JointState{0, -l.max_velocity, 0, 0});
+  const JointLimits& l = head.joint(1).limits;
+  motors.Reset(head::JointState::Popeye(0, 0.1, 0, 0), head::JointState::Popeye(0, -l.max_velocity, 0, 0));
   const double stop = 0.1 - l.max_velocity * l.max_velocity / (2 * l.max_acceleration);
-  EXPECT_NEAR(motors.targets().tilt, stop, kRoundingSlack);
-  EXPECT_NEAR(motors.TimeToTarget(Joint::kTilt), l.max_velocity / l.max_acceleration,
+  EXPECT_NEAR(motors.targets()[1], stop, kRoundingSlack);
+  EXPECT_NEAR(motors.TimeToTarget(1), l.max_velocity / l.max_acceleration,
               kRoundingSlack);
   motors.Step(1.0);
-  EXPECT_NEAR(motors.positions().tilt, stop, kRoundingSlack);
+  EXPECT_NEAR(motors.positions()[1], stop, kRoundingSlack);
   EXPECT_TRUE(motors.Arrived());
 }
 

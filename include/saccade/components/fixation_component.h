@@ -11,6 +11,8 @@
 #include <string>
 
 #include "saccade/components/messages.h"
+#include "saccade/head/fixation.h"
+#include "saccade/head/head_description.h"
 #include "saccade/runtime/component.h"
 #include "saccade/scene/scene.h"
 
@@ -38,6 +40,8 @@ class FixationComponent : public runtime::Component {
   std::optional<TargetMessage> previous_;
   Eigen::Vector3d velocity_W_ = Eigen::Vector3d::Zero();
   head::JointState last_joints_;
+  std::optional<head::HeadDescription> appendix_a_;      // POPEYE's legacy head: appendix A
+  mutable std::unique_ptr<head::FixationSolver> solver_;  // any other head
 };
 
 }  // namespace saccade::components

@@ -66,8 +66,11 @@ struct ImageMetadata {
   int64_t frame_index = 0;         ///< 0, 1, 2, ... per camera
   TypedValues typed;               ///< the camera model and pose
   int exposure_samples = 1;        ///< sub-frames the exposure was drawn in (motion blur)
-  bool has_joints = false;         ///< whether the camera rides on a head
-  std::array<double, 4> joints{};  ///< pan, tilt, left, right (rad) at capture
+  bool has_joints = false;  ///< whether the camera rides on a head
+  /// The head's joint values at capture (rad, or m for a prismatic joint), named by
+  /// `joint_names` in the same order (shared by every image of the head).
+  std::vector<double> joints;
+  std::shared_ptr<const std::vector<std::string>> joint_names;
 };
 
 /// A borrowed, read-only image: pointer, size, format, row stride. Cheap to copy.

@@ -95,7 +95,7 @@ class GuiSession {
   nlohmann::json OnSpeed(const nlohmann::json& command);
   nlohmann::json OnHeadStop(const nlohmann::json& command);  // stop, estop, clear
   nlohmann::json OnPing(const nlohmann::json& command);
-  const head::HeadDescription& RequireHead(const std::string& type) const;
+  const head::HeadModel& RequireHead(const std::string& type) const;
   // Sets the targets, queues the motion (perception off) and completes `reply` with them.
   nlohmann::json MoveTo(const head::JointState& target, nlohmann::json reply);
   void Enqueue(std::function<void()> action);

@@ -83,6 +83,12 @@ class FixationSolver {
   std::unique_ptr<Impl> impl_;
 };
 
+/// Where two cameras' optical axes meet: the midpoint of their common perpendicular (their
+/// intersection when they cross, as POPEYE's eq. 9). std::nullopt when they are parallel
+/// (|sin| < 1e-12) or meet behind either optical centre.
+std::optional<Eigen::Vector3d> FixationPoint(const geometry::Pose& X_WLeft,
+                                             const geometry::Pose& X_WRight);
+
 /// One solve with a solver of its own.
 FixationResult SolveFixation(const HeadModel& head, const Eigen::Vector3d& p_W,
                              const FixationOptions& options = {});

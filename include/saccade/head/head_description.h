@@ -1,6 +1,6 @@
 #pragma once
 // The stereo head's description: geometry (seed appendix A), joint limits, cameras, pose.
-// Immutable once loaded; joint angles live apart in JointState (description vs state).
+// Immutable once loaded; joint angles live apart in PopeyeJoints (description vs state).
 //
 // Frames. W: world, z up. B: head base (REP 103: x forward, y left, z up), placed in W by
 // X_WB. The paper's frames {b, n, c, l, r} use x left, y up, z forward; saccade keeps the
@@ -30,14 +30,14 @@ inline constexpr std::array<Joint, 4> kAllJoints = {Joint::kPan, Joint::kTilt, J
 const char* JointName(Joint joint);
 
 /// Joint angles in radians.
-struct JointState {
+struct PopeyeJoints {
   double pan = 0.0;
   double tilt = 0.0;
   double left = 0.0;
   double right = 0.0;
   double& operator[](Joint joint);
   double operator[](Joint joint) const;
-  bool operator==(const JointState&) const = default;
+  bool operator==(const PopeyeJoints&) const = default;
 };
 
 /// Range of one joint: position (rad), velocity (rad/s) and acceleration (rad/s^2) limits.
@@ -116,10 +116,10 @@ class HeadDescription {
   bool HasServos() const;
 
   /// Whether every joint is within its limits.
-  bool WithinLimits(const JointState& joints) const;
+  bool WithinLimits(const PopeyeJoints& joints) const;
   /// Throws InvalidArgument naming the first joint outside its limits, its value and range
   /// (in degrees). For commands from users before they reach a motor.
-  void CheckLimits(const JointState& joints) const;
+  void CheckLimits(const PopeyeJoints& joints) const;
 
  private:
   std::string name_;

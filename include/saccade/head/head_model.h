@@ -20,6 +20,7 @@
 #include "saccade/geometry/camera_model.h"
 #include "saccade/geometry/pose.h"
 #include "saccade/head/head_description.h"
+#include "saccade/head/joint_state.h"
 #include "saccade/head/kinematic_tree.h"
 #include "saccade/head/urdf.h"
 
@@ -83,6 +84,15 @@ class HeadModel {
   /// The number of actuated joints (the size of q).
   int num_joints() const { return tree_.num_variables(); }
   const std::string& joint_name(int joint) const { return tree_.variable_name(joint); }
+  /// The actuated joints' names, shared by every JointState of this head.
+  const std::shared_ptr<const JointNames>& joint_names() const { return joint_names_; }
+  /// A JointState of this head's joints with these values (size num_joints()).
+  JointState State(Eigen::VectorXd values) const { return JointState(joint_names_, std::move(values)); }
+  /// HomePosture() as a JointState.
+  JointState Home() const { return State(HomePosture()); }
+  /// `joints` in this head's order, by name (a state decoded from JSON has its keys' order).
+  /// Throws InvalidArgument naming unknown and missing joints.
+  JointState Arrange(const JointState& joints) const;
   /// The variable of that name; -1 when the head has no such actuated joint.
   int FindJoint(const std::string& name) const { return tree_.FindVariable(name); }
   const JointSettings& joint(int joint) const { return joints_[joint]; }
@@ -95,6 +105,18 @@ class HeadModel {
   const std::string& source() const { return source_; }
   /// POPEYE's appendix-A geometry when the head was loaded from the legacy format.
   const std::optional<HeadGeometry>& appendix_a() const { return appendix_a_; }
+
+  /// The same head placed elsewhere in the world (a scene's `robot.pose`).
+  HeadModel WithPose(const geometry::Pose& X_WB) const;
+  /// The same head with another camera model for an eye (a scene's calibration file).
+  HeadModel WithCamera(int eye, const geometry::CameraModel& model) const;
+
+  /// For a legacy POPEYE head (appendix_a()), the same head as a HeadDescription, for appendix
+  /// A's closed-form and Newton solvers (kinematics.h): its pose, limits, cameras and servos.
+  /// std::nullopt for any other head.
+  std::optional<HeadDescription> AppendixAHead() const;
+  /// Both eye cameras' optical frames in the world at `joints` (empty: home).
+  std::array<geometry::Pose, 2> CameraPoses(const JointState& joints) const;
 
   /// Driven joints at 0 (clamped into their limits), the others at their hold value.
   Eigen::VectorXd HomePosture() const;
@@ -112,11 +134,11 @@ class HeadModel {
   void CheckLimits(const Eigen::Ref<const Eigen::VectorXd>& q) const;
 
  private:
-  HeadModel(std::string name, KinematicTree tree)
-      : name_(std::move(name)), tree_(std::move(tree)) {}
+  HeadModel(std::string name, KinematicTree tree);
 
   std::string name_;
   KinematicTree tree_;
+  std::shared_ptr<const JointNames> joint_names_;
   geometry::Pose X_WB_ = geometry::Pose::Identity();
   std::vector<JointSettings> joints_;
   std::array<EyeCamera, 2> cameras_;

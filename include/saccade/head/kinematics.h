@@ -27,11 +27,11 @@ struct HeadFrames {
 
 /// Forward kinematics: the chain X_WB * R_paper * Ry(pan) * eq.4 * eq.5/6 * eq.7/8.
 /// Does not check joint limits (the state may come from anywhere); never throws.
-HeadFrames ForwardKinematics(const HeadDescription& head, const JointState& joints);
+HeadFrames ForwardKinematics(const HeadDescription& head, const PopeyeJoints& joints);
 
 /// The angle (rad, in [0, pi]) between each camera's optical axis and the ray from it to p_W:
 /// (left, right); 0 for both means p_W is fixated. atan2(|a x t|, a . t), exact near 0.
-Eigen::Vector2d AxisErrors(const HeadDescription& head, const JointState& joints,
+Eigen::Vector2d AxisErrors(const HeadDescription& head, const PopeyeJoints& joints,
                            const Eigen::Vector3d& p_W);
 
 enum class VergenceMode {
@@ -52,7 +52,7 @@ const char* ToString(Reachability reachability);
 
 struct IkOptions {
   VergenceMode mode = VergenceMode::kSymmetric;
-  JointState seed;           ///< start of the iteration; pan comes from here in kIndependent
+  PopeyeJoints seed;           ///< start of the iteration; pan comes from here in kIndependent
   double tolerance = 1e-12;  ///< on the joint update (rad); the result is within 1e-9 rad
   int max_iterations = 100;
 };
@@ -60,7 +60,7 @@ struct IkOptions {
 struct IkResult {
   /// The solution; always within the joint limits. When !reachable, the nearest reachable
   /// angles: each joint clamped to its limits after the unconstrained solution.
-  JointState joints;
+  PopeyeJoints joints;
   Reachability reachability = Reachability::kReachable;
   bool reachable() const { return reachability == Reachability::kReachable; }
   /// Largest angle (rad) between an optical axis and the direction from that camera to the

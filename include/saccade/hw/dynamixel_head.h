@@ -34,7 +34,7 @@ struct DynamixelOptions {
 
 /// Opens the serial port, checks and sets up the servos. Throws HardwareError naming the port
 /// and the servo (and InvalidArgument when the description lacks a servo mapping).
-std::unique_ptr<HeadDriver> OpenDynamixelHead(const head::HeadDescription& description,
+std::unique_ptr<HeadDriver> OpenDynamixelHead(const head::HeadModel& description,
                                               const std::string& port,
                                               const DynamixelOptions& options = {},
                                               SafetyOptions safety = {});

@@ -31,7 +31,8 @@
 #include <thread>
 
 #include "saccade/core/error.h"
-#include "saccade/head/head_description.h"
+#include "saccade/head/head_model.h"
+#include "saccade/head/joint_state.h"
 #include "saccade/head/motors.h"
 
 namespace saccade::hw {
@@ -50,8 +51,8 @@ struct SafetyOptions {
 
 /// What the driver changed in a command before sending it.
 struct CommandReport {
-  std::array<bool, 4> position_clamped{};  ///< indexed by head::Joint
-  std::array<bool, 4> velocity_limited{};
+  std::vector<bool> position_clamped;  ///< indexed by joint, in the head's order
+  std::vector<bool> velocity_limited;
   head::JointState sent_positions;   ///< rad, as sent
   head::JointState sent_velocities;  ///< rad/s, as sent
   bool any() const;
@@ -82,19 +83,21 @@ struct HeadStatus {
 class HeadDriver {
  public:
   /// Throws InvalidArgument when watchdog_s is negative or not finite.
-  HeadDriver(head::HeadDescription description, SafetyOptions options);
+  HeadDriver(head::HeadModel head, SafetyOptions options);
   virtual ~HeadDriver();
   HeadDriver(const HeadDriver&) = delete;
   HeadDriver& operator=(const HeadDriver&) = delete;
 
   /// What kind of head ("simulated", "dynamixel on /dev/ttyUSB0").
   virtual std::string name() const = 0;
-  const head::HeadDescription& description() const { return description_; }
+  const head::HeadModel& description() const { return description_; }
   const SafetyOptions& options() const { return options_; }
 
   /// Sends joint targets (rad): a saccade, or smooth pursuit when `velocities` (rad/s) are not
-  /// all zero. Checked, clamped and limited as above. Throws CommandRejected (nothing sent)
-  /// for non-finite values, with the torque off, after an emergency stop or a fault.
+  /// all zero; empty: zero). By joint name: a state in another order is arranged in the
+  /// head's; a joint the head holds (not driven) is sent its hold value. Checked, clamped and
+  /// limited as above. Throws CommandRejected (nothing sent) for non-finite values, unknown or
+  /// missing joints, with the torque off, after an emergency stop or a fault.
   CommandReport Command(const head::JointState& positions, const head::JointState& velocities = {});
   /// Reads the joints. Never throws for a device fault: the status reports it (and the head
   /// goes to its safe state).
@@ -140,7 +143,7 @@ class HeadDriver {
   void HoldBestEffort();                      // mutex held
   void WatchdogLoop();
 
-  head::HeadDescription description_;
+  head::HeadModel description_;
   SafetyOptions options_;
   std::chrono::steady_clock::time_point start_;
 
@@ -160,7 +163,7 @@ class SimHeadDriver final : public HeadDriver {
  public:
   /// The head at rest at `initial` (rad), torque on. Throws InvalidArgument for positions
   /// outside the limits.
-  explicit SimHeadDriver(const head::HeadDescription& description, SafetyOptions options = {},
+  explicit SimHeadDriver(const head::HeadModel& description, SafetyOptions options = {},
                          const head::JointState& initial = {});
   ~SimHeadDriver() override;
   std::string name() const override { return "simulated"; }

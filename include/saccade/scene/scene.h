@@ -21,8 +21,8 @@
 #include "saccade/geometry/camera_model.h"
 #include "saccade/geometry/gl_projection.h"
 #include "saccade/geometry/pose.h"
-#include "saccade/head/head_description.h"
-#include "saccade/head/kinematics.h"
+#include "saccade/head/head_model.h"
+#include "saccade/head/joint_state.h"
 
 namespace saccade::scene {
 
@@ -164,10 +164,9 @@ struct CameraSpec {
   SensorSpec sensor;
 };
 
-/// A piece of the robot's drawn body, rigidly attached to one frame of the head.
+/// A piece of the robot's drawn body, rigidly attached to one link of the head's tree.
 struct RobotPart {
-  enum class Link { kBase, kNeck, kCyclopean, kLeftEye, kRightEye };
-  Link link = Link::kBase;
+  int link = 0;  ///< the link's index in the head's KinematicTree
   geometry::Pose X_LinkPart = geometry::Pose::Identity();
   std::shared_ptr<const Model> model;
   Eigen::Vector3d scale{1.0, 1.0, 1.0};
@@ -175,10 +174,11 @@ struct RobotPart {
 
 /// The head placed in the world (its description's pose), its initial joints and its body.
 struct Robot {
-  head::HeadDescription head;
-  head::JointState initial_joints;
+  head::HeadModel head;
+  head::JointState initial_joints;  ///< the head's joints, in its order
   bool visible = true;
-  std::vector<RobotPart> parts;  ///< built from primitives by the loader
+  /// Built by the loader: a URDF's visuals, or POPEYE's body from primitives.
+  std::vector<RobotPart> parts;
   /// Instance id of every robot part (one id for the whole robot), >= 1.
   uint32_t id = 0;
 };
@@ -186,10 +186,11 @@ struct Robot {
 /// What changes while the description stays: time and joint angles.
 struct SceneState {
   double time = 0.0;  ///< seconds
-  head::JointState joints;
+  head::JointState joints;  ///< the robot's joints (empty without a robot)
   /// Joint velocities (rad/s) at `time`: during a camera's exposure the joints move at this
-  /// constant rate, which blurs the eye cameras' images (SensorSpec::exposure). Zero: still.
-  head::JointState joint_velocities{0.0, 0.0, 0.0, 0.0};
+  /// constant rate, which blurs the eye cameras' images (SensorSpec::exposure). Empty or
+  /// zero: still.
+  head::JointState joint_velocities;
 };
 
 /// A loaded, validated world. Immutable; cheap to share by reference.
@@ -241,6 +242,8 @@ class Scene {
 /// 1 x 1 plane z = 0 facing +z. `color` is the material's base colour.
 std::shared_ptr<const Model> MakeBox(const Eigen::Vector4f& color);
 std::shared_ptr<const Model> MakeSphere(const Eigen::Vector4f& color, int segments = 32);
+/// A cylinder of radius 0.5 and length 1 along z, centred on the origin (URDF's <cylinder>).
+std::shared_ptr<const Model> MakeCylinder(const Eigen::Vector4f& color, int segments = 32);
 std::shared_ptr<const Model> MakePlane(const Eigen::Vector4f& color);
 /// A picture: the image on a plane `height` metres high, width from the image's aspect,
 /// standing upright in its frame: it lies in the plane x = 0, faces +x, its top edge towards

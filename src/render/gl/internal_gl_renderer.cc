@@ -415,8 +415,8 @@ void GlRenderer::SetLights(const LightUniforms& uniforms, const Eigen::Isometry3
 }
 
 void GlRenderer::UpdatePoses(const scene::SceneState& state) {
-  std::optional<head::HeadFrames> frames;
-  if (draw_robot_) frames = head::ForwardKinematics(scene_.robot()->head, state.joints);
+  std::optional<LinkPoses> frames;
+  if (draw_robot_) frames = RobotLinkPoses(*scene_.robot(), state.joints);
   for (std::size_t i = 0; i < items_.size(); ++i) {
     const DrawItem& item = items_[i];
     if (item.object >= 0) {
@@ -499,7 +499,7 @@ void GlRenderer::Submit(const scene::SceneState& state, int64_t frame_index) {
 }
 
 geometry::Pose GlRenderer::ItemPose(const DrawItem& item, const scene::SceneState& state,
-                                    const std::optional<head::HeadFrames>& frames) const {
+                                    const std::optional<LinkPoses>& frames) const {
   if (item.object >= 0) return scene_.ObjectPose(scene_.objects()[item.object], state);
   const scene::RobotPart& part = scene_.robot()->parts[item.part];
   return LinkPose(*frames, part.link) * part.X_LinkPart;
@@ -521,10 +521,9 @@ geometry::Pose ViewPose(const ViewSetup& view, const geometry::Pose& X_WC) {
 scene::SceneState StateAfter(const scene::SceneState& state, double dt) {
   scene::SceneState sub = state;
   sub.time += dt;
-  sub.joints.pan += state.joint_velocities.pan * dt;
-  sub.joints.tilt += state.joint_velocities.tilt * dt;
-  sub.joints.left += state.joint_velocities.left * dt;
-  sub.joints.right += state.joint_velocities.right * dt;
+  if (!state.joint_velocities.empty() && !sub.joints.empty()) {
+    sub.joints.values() += state.joint_velocities.values() * dt;
+  }
   return sub;
 }
 
@@ -675,10 +674,10 @@ double GlRenderer::ImageMotionPx(int camera, const scene::SceneState& s0,
   if (camera_px != nullptr) *camera_px = px;
   double off_turn =
       gains.ParallaxPx(motion.X_WC0.linear().transpose() * motion.shift, ground_depth);
-  std::optional<head::HeadFrames> frames0, frames1;
+  std::optional<LinkPoses> frames0, frames1;
   if (draw_robot_) {
-    frames0 = head::ForwardKinematics(scene_.robot()->head, s0.joints);
-    frames1 = head::ForwardKinematics(scene_.robot()->head, s1.joints);
+    frames0 = RobotLinkPoses(*scene_.robot(), s0.joints);
+    frames1 = RobotLinkPoses(*scene_.robot(), s1.joints);
   }
   motion.X_CW0 = motion.X_WC0.inverse();
   motion.X_CW1 = motion.X_WC1.inverse();
@@ -748,10 +747,10 @@ std::optional<double> GlRenderer::ItemMotionPx(const DrawItem& item, const geome
 
 GlRenderer::MovingPoses GlRenderer::MovingItems(const std::vector<scene::SceneState>& subs,
                                                 const std::vector<double>& item_px) const {
-  std::vector<std::optional<head::HeadFrames>> frames(subs.size());
+  std::vector<std::optional<LinkPoses>> frames(subs.size());
   if (draw_robot_) {
     for (std::size_t k = 0; k < subs.size(); ++k) {
-      frames[k] = head::ForwardKinematics(scene_.robot()->head, subs[k].joints);
+      frames[k] = RobotLinkPoses(*scene_.robot(), subs[k].joints);
     }
   }
   MovingPoses moving;

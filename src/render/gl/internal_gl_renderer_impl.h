@@ -45,22 +45,17 @@ inline constexpr double kPerVertexMaxEdgePx = 2.0;
 // page faults per frame in steady state).
 inline constexpr std::size_t kPooledImagesPerCamera = 4;
 
-// The pose of a robot part's link in a state.
-inline const geometry::Pose& LinkPose(const head::HeadFrames& frames, scene::RobotPart::Link link) {
-  switch (link) {
-    case scene::RobotPart::Link::kBase:
-      return frames.X_WB;
-    case scene::RobotPart::Link::kNeck:
-      return frames.X_WN;
-    case scene::RobotPart::Link::kCyclopean:
-      return frames.X_WC;
-    case scene::RobotPart::Link::kLeftEye:
-      return frames.X_WL;
-    case scene::RobotPart::Link::kRightEye:
-      return frames.X_WR;
-  }
-  return frames.X_WB;
+// Every link of the robot's tree in the world for a state's joints (the home posture when the
+// state has none).
+using LinkPoses = std::vector<geometry::Pose>;
+inline LinkPoses RobotLinkPoses(const scene::Robot& robot, const head::JointState& joints) {
+  LinkPoses X_WL;
+  robot.head.ForwardKinematics(joints.empty() ? robot.head.HomePosture() : joints.values(), &X_WL);
+  return X_WL;
 }
+
+// The pose of a robot part's link in a state.
+inline const geometry::Pose& LinkPose(const LinkPoses& X_WL, int link) { return X_WL[link]; }
 
 // Uniform locations of the lights, common to every program.
 struct LightUniforms {
@@ -287,7 +282,7 @@ class GlRenderer final : public Renderer {
   MovingPoses MovingItems(const std::vector<scene::SceneState>& subs,
                           const std::vector<double>& item_px) const;
   geometry::Pose ItemPose(const DrawItem& item, const scene::SceneState& state,
-                          const std::optional<head::HeadFrames>& frames) const;
+                          const std::optional<LinkPoses>& frames) const;
   // Eye frame from world, and the pixels per model unit at an item's nearest point.
   static Eigen::Isometry3d EyeFromWorld(const geometry::Pose& X_WV);
   void SortItems(const Eigen::Isometry3d& X_EW);

@@ -171,10 +171,13 @@ void GlRenderer::Describe(int camera_index, const Pending& pending, ImageMetadat
   geometry::SetCameraPose(meta, pending.X_WC[i]);
   meta.exposure_samples = pending.exposure_samples[i];
   meta.has_joints = camera.mount != scene::CameraMount::kWorld;
-  meta.joints = meta.has_joints
-                    ? std::array<double, 4>{pending.state.joints.pan, pending.state.joints.tilt,
-                                            pending.state.joints.left, pending.state.joints.right}
-                    : std::array<double, 4>{};
+  meta.joints.clear();
+  meta.joint_names.reset();
+  if (meta.has_joints) {
+    const head::JointState& q = pending.state.joints;
+    meta.joints.assign(q.values().data(), q.values().data() + q.size());
+    meta.joint_names = q.shared_names();
+  }
 }
 
 }  // namespace saccade::render::gl

@@ -43,8 +43,7 @@ void GlRenderer::FillTruth(int camera, const Pending& pending, int slot, Frame* 
     ObjectTruth truth;
     truth.id = scene_.robot()->id;
     truth.name = "robot";
-    const geometry::Pose X_WB =
-        head::ForwardKinematics(scene_.robot()->head, pending.state.joints).X_WB;
+    const geometry::Pose X_WB = scene_.robot()->head.X_WB();
     truth.X_WO = X_WB.matrix();
     truth.X_CO = (X_CW * X_WB).matrix();
     index.emplace(truth.id, frame->objects.size());

@@ -1,4 +1,5 @@
-// The robot in the world: its parts hung from the head's frames (state.frames), each eye
+// The robot in the world: its parts hung from the links of the head's tree (doc.robot.links,
+// posed by state.frames.links), each eye
 // camera's frustum with its live image on a plane inside it (in front of the optical centre
 // or behind it, flipped, as a real image plane), the rays from both optical centres to the
 // fixation point and to the triangulated target, the clicked point, and the dome a click
@@ -6,10 +7,6 @@
 import * as THREE from 'three';
 import { instantiate, matrixFrom, positionOf, scaledMatrix } from './scene.js';
 
-/** The state.frames entry each robot link hangs from. */
-export const kLinkFrames = {
-  base: 'X_WB', neck: 'X_WN', cyclopean: 'X_WC', left_eye: 'left_eye', right_eye: 'right_eye',
-};
 
 const kFrustumDepth = 0.25;  // metres: how far the frustum's lines reach at least
 const kDomeRadius = 4.0;     // metres around the cyclopean point
@@ -123,14 +120,20 @@ class CameraRig {
 export class Head {
   constructor(scene, doc, models, views) {
     this.scene = scene;
-    this.links = new Map();       // link name -> Group posed by state.frames
+    this.links = new Map();       // link name -> Group posed by state.frames.links
     this.draggables = [];         // meshes of the links a drag moves
-    for (const link of Object.keys(kLinkFrames)) {
+    // The links a joint moves: below some joint other than a fixed one (the root never is).
+    const moved = new Set();
+    const jointOf = new Map((doc.head?.joints ?? []).map((j) => [j.link, j.name]));
+    for (const link of doc.robot?.links ?? []) {
+      if (jointOf.has(link.name) || (link.parent && moved.has(link.parent))) moved.add(link.name);
+    }
+    for (const link of doc.robot?.links ?? []) {
       const group = new THREE.Group();
-      group.name = link;
+      group.name = link.name;
       group.matrixAutoUpdate = false;
       group.visible = false;  // until the first state
-      this.links.set(link, group);
+      this.links.set(link.name, group);
       scene.add(group);
     }
     if (doc.robot?.visible !== false) {
@@ -142,7 +145,7 @@ export class Head {
         mesh.matrix.copy(scaledMatrix(part.X_LinkPart, part.scale));
         mesh.traverse((m) => { m.userData.link = part.link; });
         group.add(mesh);
-        if (part.link !== 'base') this.draggables.push(...mesh.children);
+        if (moved.has(part.link)) this.draggables.push(...mesh.children);
       }
     }
     // The eye cameras (those with a pose in the state: left and right).
@@ -173,10 +176,10 @@ export class Head {
   /** Poses links, cameras, rays and markers from a state message. */
   update(state) {
     const f = state.frames ?? {};
-    for (const [link, key] of Object.entries(kLinkFrames)) {
-      const group = this.links.get(link);
-      if (!f[key]) continue;
-      group.matrix.copy(matrixFrom(f[key]));
+    for (const [link, group] of this.links) {
+      const pose = f.links?.[link];
+      if (!pose) continue;
+      group.matrix.copy(matrixFrom(pose));
       group.matrixWorldNeedsUpdate = true;
       group.visible = true;
     }

@@ -1,10 +1,14 @@
-// The mouse on the 3D view. Direct kinematics: dragging a part of the head turns its joint
-// (neck: pan, cyclopean: tilt, an eye: vergence, symmetric) by kDragGainDegPerPx per pixel,
-// clamped to the joint's limits, sending at most one command per kSendIntervalMs. Inverse
-// kinematics: a click (no drag) on an object, the ground or the dome fixates that point.
+// The mouse on the 3D view. Direct kinematics: dragging a part of the head turns the nearest
+// driven joint above the part's link (any head: scene.robot.links and scene.head.joints) by
+// kDragGainDegPerPx per pixel (a prismatic one by a millimetre per pixel), clamped to the
+// joint's limits, sending at most one command per kSendIntervalMs. A joint whose axis stands
+// upright on the screen turns with a sideways drag, one lying across it with an up-down drag;
+// a joint of a symmetric pair (scene.head.symmetric: POPEYE's eyes) moves its partner with it.
+// Inverse kinematics: a click (no drag) on an object, the ground or the dome fixates that point.
 import * as THREE from 'three';
 
 export const kDragGainDegPerPx = 0.5;
+const kDragGainMetresPerPx = 0.001;
 const kSendIntervalMs = 50;   // at most ~20 commands per second while dragging
 const kClickSlopPx = 4;       // a press that moves less than this is a click
 
@@ -32,7 +36,26 @@ export function installInteraction(canvas, app) {
 
   const clamp = (joint, value) => {
     const l = app.limits[joint];
-    return l ? Math.min(l.max, Math.max(l.min, value)) : value;
+    if (!l) return value;
+    return Math.min(l.max ?? Infinity, Math.max(l.min ?? -Infinity, value));
+  };
+
+  // The driven joint a drag on `link` turns: its own joint, else its parent's, up the tree.
+  const links = new Map((app.doc?.robot?.links ?? []).map((l) => [l.name, l]));
+  const joints = new Map((app.doc?.head?.joints ?? []).map((j) => [j.name, j]));
+  const jointAbove = (link) => {
+    for (let l = links.get(link); l; l = links.get(l.parent)) {
+      const j = l.joint && joints.get(l.joint);
+      if (j && j.driven) return j;
+    }
+    return null;
+  };
+  const partnerOf = (name) => {
+    for (const [a, b, sign] of app.doc?.head?.symmetric ?? []) {
+      if (a === name) return { name: b, sign };
+      if (b === name) return { name: a, sign: 1 / sign };
+    }
+    return null;
   };
 
   const flush = () => {
@@ -50,15 +73,27 @@ export function installInteraction(canvas, app) {
     else if (!pendingTimer) pendingTimer = setTimeout(flush, wait);
   };
 
-  // Which way a drag to the right turns the head: seen from behind the head (the camera
-  // looking along the neck's x), dragging right turns it right (pan decreases).
-  const viewSign = () => {
+  // How a drag turns `joint`: its axis (now, in the world) seen on the screen. Upright on the
+  // screen: a sideways drag, the side that the axis's rotation carries the part towards; else
+  // an up-down drag. Returns {along: 'x' | 'y', sign}.
+  const dragRule = (joint) => {
     const state = app.latestState();
-    const n = state?.frames?.X_WN;
-    if (!n) return 1;
-    const forward = new THREE.Vector3();
-    app.camera.getWorldDirection(forward);
-    return forward.x * n[0][0] + forward.y * n[1][0] >= 0 ? 1 : -1;  // the neck's x axis
+    const pose = state?.frames?.links?.[joint.link];
+    // The axis is fixed in the link it moves: in the world, the link's rotation now.
+    const axis = new THREE.Vector3(...(joint.axis ?? [0, 0, 1]));
+    if (pose) axis.applyMatrix4(new THREE.Matrix4().extractRotation(new THREE.Matrix4().set(...pose.flat())));
+    const view = new THREE.Vector3();
+    app.camera.getWorldDirection(view);
+    const up = app.camera.up.clone();
+    const right = new THREE.Vector3().crossVectors(view, up).normalize();
+    const screenUp = new THREE.Vector3().crossVectors(right, view).normalize();
+    const upright = Math.abs(axis.dot(screenUp)) >= Math.abs(axis.dot(right));
+    if (joint.type === 'prismatic') return { along: upright ? 'y' : 'x', sign: 1, prismatic: true };
+    // A positive turn about an upright axis pointing up moves the near side of the part to the
+    // left as seen from the camera: drag right = negative turn (for the camera in front of it,
+    // the other way round).
+    if (upright) return { along: 'x', sign: axis.dot(screenUp) >= 0 ? -1 : 1 };
+    return { along: 'y', sign: axis.dot(right) >= 0 ? 1 : -1 };
   };
 
   canvas.addEventListener('pointerdown', (event) => {
@@ -67,30 +102,29 @@ export function installInteraction(canvas, app) {
     const hit = ray(event).intersectObjects(app.head.draggables, false)[0];
     const link = hit?.object.userData.link;
     if (!link) return;
+    const joint = jointAbove(link);
+    if (!joint) return;
     const state = app.latestState();
-    const joints = state?.joints?.targets ?? state?.joints?.positions;
-    if (!joints) return;
-    press.drag = { link, start: { ...joints }, sign: viewSign() };
+    const targets = state?.joints?.targets ?? state?.joints?.positions;
+    if (!targets) return;
+    press.drag = { link, joint, start: { ...targets }, rule: dragRule(joint) };
     app.controls.enabled = false;  // OrbitControls must not rotate while a joint is dragged
     canvas.setPointerCapture(event.pointerId);
   });
 
   canvas.addEventListener('pointermove', (event) => {
     if (!press?.drag) return;
-    const { link, start, sign } = press.drag;
-    const dx = event.clientX - press.x;
-    const dy = event.clientY - press.y;
-    const g = kDragGainDegPerPx * kDeg;
-    if (link === 'neck') {
-      queue({ pan: clamp('pan', start.pan - sign * g * dx) });
-    } else if (link === 'cyclopean') {
-      queue({ tilt: clamp('tilt', start.tilt + g * dy) });  // dragging down looks down
-    } else if (link === 'left_eye' || link === 'right_eye') {
-      // Symmetric vergence: the left eye turns by v, the right by -v.
-      let v = start.left - sign * g * dx;
-      v = clamp('left', v);
-      v = -clamp('right', -v);
-      queue({ left: v, right: -v });
+    const { joint, start, rule } = press.drag;
+    const pixels = rule.along === 'x' ? event.clientX - press.x : event.clientY - press.y;
+    const gain = rule.prismatic ? kDragGainMetresPerPx : kDragGainDegPerPx * kDeg;
+    let v = clamp(joint.name, start[joint.name] + rule.sign * gain * pixels);
+    const partner = partnerOf(joint.name);
+    if (partner) {
+      // Both within their limits: the partner's clamp limits this joint too.
+      v = clamp(partner.name, partner.sign * v) / partner.sign;
+      queue({ [joint.name]: v, [partner.name]: partner.sign * v });
+    } else {
+      queue({ [joint.name]: v });
     }
   });
 

@@ -6,13 +6,15 @@ import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
 import { AccessError, Connection, fetchApi, token } from './connection.js';
 import { checkSceneDocument } from './protocol.js';
 import { buildWorld, loadModels, updateObjects } from './scene.js';
-import { Head, kLinkFrames } from './head.js';
+import { Head } from './head.js';
 import { installInteraction, kDragGainDegPerPx } from './interact.js';
 import { CameraView, Controls, log } from './views.js';
 import { Plot } from './plots.js';
 
 const $ = (id) => document.getElementById(id);
 const kDeg = 180 / Math.PI;
+// The joints' plot colours, in the head's joint order (POPEYE's pan, tilt, left, right first).
+const kJointColors = ['#d03030', '#2a8a2a', '#2050e0', '#c07000', '#803090', '#108080', '#806000'];
 
 // The test hooks (see the file comment).
 const gui = window.saccadeGui = {
@@ -84,7 +86,7 @@ async function start() {
     return reply;
   };
   const app = {
-    camera, head, limits, pickables: world.pickables,
+    camera, head, limits, pickables: world.pickables, doc,
     latestState: () => latest,
     send,
     onClick: (p) => {
@@ -126,9 +128,12 @@ async function start() {
 
   // Plots: joints, fixation error, rates, step time.
   const plots = {
-    joints: new Plot($('plot-joints'), 'joints', [
-      { key: 'pan', label: 'pan', color: '#d03030' }, { key: 'tilt', label: 'tilt', color: '#2a8a2a' },
-      { key: 'left', label: 'L', color: '#2050e0' }, { key: 'right', label: 'R', color: '#c07000' }], '°'),
+    // One series per joint of the head, in its order (POPEYE: pan, tilt, L, R).
+    joints: new Plot($('plot-joints'), 'joints', (doc.head?.joints ?? []).map((j, i) => ({
+      key: j.name,
+      label: { left: 'L', right: 'R' }[j.name] ?? j.name,
+      color: kJointColors[i % kJointColors.length],
+    })), '°'),
     error: new Plot($('plot-error'), 'fixation error', [
       { key: 'left', label: 'L', color: '#2050e0' }, { key: 'right', label: 'R', color: '#c07000' }], '°'),
     rate: new Plot($('plot-rate'), 'rates', [
@@ -262,7 +267,7 @@ async function start() {
   // the object nearest to it (a grid of rays over its projected box). {x, y, visible}.
   gui.screenPointOf = (name) => {
     render();
-    const root = world.objects.get(name) ?? (name in kLinkFrames ? head.links.get(name) : null);
+    const root = world.objects.get(name) ?? (head.links.get(name) ?? null);
     if (!root) throw new Error(`screenPointOf: no object or link named '${name}'`);
     root.updateMatrixWorld(true);
     const box = new THREE.Box3().setFromObject(root);
@@ -310,7 +315,7 @@ async function start() {
   // The matrix the page placed an object or a head link with, row by row (the protocol's
   // form of a pose; an object's includes its scale): for the browser test.
   gui.placementOf = (name) => {
-    const root = world.objects.get(name) ?? (name in kLinkFrames ? head.links.get(name) : null);
+    const root = world.objects.get(name) ?? (head.links.get(name) ?? null);
     if (!root) throw new Error(`placementOf: no object or link named '${name}'`);
     const e = root.matrix.elements;  // column-major
     return [0, 1, 2, 3].map((r) => [0, 1, 2, 3].map((c) => e[4 * c + r]));
