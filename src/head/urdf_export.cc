@@ -27,8 +27,9 @@ constexpr double kPixelTolerance = 1e-9;
 constexpr double kDefaultNear = 0.02;
 constexpr double kDefaultFar = 50.0;
 
-// The shortest text that reads back as the same double ("0.1", "1e-05", "-1.5707963267948966").
-std::string Number(double value) { return fmt::format("{}", value); }
+// The shortest text that reads back as the same double ("0.1", "1e-05", "-1.5707963267948966");
+// -0 as 0.
+std::string Number(double value) { return fmt::format("{}", value + 0.0); }
 std::string Numbers(const Eigen::Vector3d& v) {
   return fmt::format("{} {} {}", Number(v.x()), Number(v.y()), Number(v.z()));
 }
