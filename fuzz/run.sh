@@ -3,13 +3,15 @@
 # against the project's own sources, then fuzzes every target for a share of SECONDS (default
 # 60, CI's budget), each from a copy of its seeds in fuzz/corpus/<target>/ (the committed
 # seeds never grow):
-#   scene_fuzzer        scene YAML (Scene::FromYamlString)                          15/60
-#   pipeline_fuzzer     pipeline YAML, parsed and built (runtime/pipeline.h)         8/60
-#   hardware_fuzzer     hardware files, with the pipeline that names them            8/60
-#   head_fuzzer         head descriptions (HeadDescription::FromYamlString)          8/60
-#   calibration_fuzzer  OpenCV YAML/XML and ROS CameraInfo files, read and re-read   8/60
-#   command_fuzzer      the GUI protocol's command envelope (server/internal_command.h) 7/60
-#   dynamixel_fuzzer    bytes from a servo bus in any split (hw/dynamixel_protocol.h)  6/60
+#   scene_fuzzer        scene YAML (Scene::FromYamlString)                          12/60
+#   pipeline_fuzzer     pipeline YAML, parsed and built (runtime/pipeline.h)         7/60
+#   hardware_fuzzer     hardware files, with the pipeline that names them            7/60
+#   urdf_fuzzer         URDF text with Gazebo cameras (head::ParseUrdf)              7/60
+#   head_fuzzer         legacy head descriptions (HeadDescription::FromYamlString)   6/60
+#   head_model_fuzzer   head files of both formats (HeadModel::FromYamlString)       6/60
+#   calibration_fuzzer  OpenCV YAML/XML and ROS CameraInfo files, read and re-read   6/60
+#   command_fuzzer      the GUI protocol's command envelope (server/internal_command.h) 5/60
+#   dynamixel_fuzzer    bytes from a servo bus in any split (hw/dynamixel_protocol.h)  4/60
 # Each fuzz/<target>.cc says what it checks beyond "no crash". Exits non-zero when a fuzzer
 # finds a crash, a failed check, a sanitizer report, a leak or a hang; the reproducer is left
 # in build-fuzz/ (crash-*, leak-*, timeout-*). Reproduce one with
@@ -20,8 +22,8 @@
 #                                            SECONDS shared among them by the same weights;
 #   SACCADE_FUZZ_BUILD_ONLY=1                builds the fuzzers and stops.
 # Needs (Debian 12): clang, libclang-rt-14-dev, libyaml-cpp-dev, libassimp-dev, libeigen3-dev,
-# libfmt-dev, libpng-dev, libstb-dev, nlohmann-json3-dev; the scenes' assets (see
-# scenes/portraits.yaml) are not needed: the seeds use robots/popeye.yaml and
+# libfmt-dev, libpng-dev, libstb-dev, nlohmann-json3-dev, liburdfdom-dev, libtinyxml-dev; the
+# scenes' assets (see scenes/portraits.yaml) are not needed: the seeds use robots/popeye.yaml and
 # assimp-testmodels' small files when present.
 set -euo pipefail
 
@@ -40,7 +42,10 @@ flags=(-std=c++20 -O1 -g -fno-omit-frame-pointer
        -fsanitize=fuzzer-no-link,address,undefined -fno-sanitize-recover=all
        -Iinclude -Isrc -I/usr/include/stb
        $(pkg-config --cflags eigen3 libpng))
-libs=($(pkg-config --libs yaml-cpp assimp libpng fmt) -lstb -lpthread)
+# urdfdom (and the TinyXML 1 and console_bridge it reads and reports with): every target that
+# compiles src/head/ (the URDF loader, issue 42).
+libs=($(pkg-config --libs yaml-cpp assimp libpng fmt) -lstb -lurdfdom_model -ltinyxml
+      -lconsole_bridge -lpthread)
 
 # Each target: its sources, its weight in the time budget, its longest input.
 declare -A target_sources target_weight target_max_len
@@ -52,14 +57,17 @@ target_sources[scene]="${head[*]} src/scene/*.cc fuzz/scene_fuzzer.cc"
 target_sources[pipeline]="${runtime[*]} fuzz/pipeline_fuzzer.cc"
 target_sources[hardware]="${runtime[*]} fuzz/hardware_fuzzer.cc"
 target_sources[head]="${head[*]} fuzz/head_fuzzer.cc"
+target_sources[head_model]="${head[*]} fuzz/head_model_fuzzer.cc"
+target_sources[urdf]="${head[*]} fuzz/urdf_fuzzer.cc"
 target_sources[calibration]="${geometry[*]} fuzz/calibration_fuzzer.cc"
 target_sources[command]="src/server/internal_command.cc fuzz/command_fuzzer.cc"
 target_sources[dynamixel]="${core[*]} src/hw/dynamixel_protocol.cc fuzz/dynamixel_fuzzer.cc"
-target_weight=([scene]=15 [pipeline]=8 [hardware]=8 [head]=8 [calibration]=8 [command]=7
-               [dynamixel]=6)
-target_max_len=([scene]=4096 [pipeline]=4096 [hardware]=4096 [head]=4096 [calibration]=4096
-                [command]=1024 [dynamixel]=1024)
-all_targets=(scene pipeline hardware head calibration command dynamixel)
+target_weight=([scene]=12 [pipeline]=7 [hardware]=7 [urdf]=7 [head]=6 [head_model]=6
+               [calibration]=6 [command]=5 [dynamixel]=4)
+# The URDF and head-file seeds are the shipped heads (humanoid.urdf is 9 KB).
+target_max_len=([scene]=4096 [pipeline]=4096 [hardware]=4096 [urdf]=16384 [head]=4096
+                [head_model]=8192 [calibration]=4096 [command]=1024 [dynamixel]=1024)
+all_targets=(scene pipeline hardware urdf head head_model calibration command dynamixel)
 read -r -a targets <<< "${SACCADE_FUZZ_TARGETS:-${all_targets[*]}}"
 for target in "${targets[@]}"; do
   if [[ -z "${target_weight[$target]:-}" ]]; then
@@ -133,7 +141,8 @@ for target in "${targets[@]}"; do
   [[ -f "fuzz/$target.dict" ]] && dict=(-dict="fuzz/$target.dict")
   echo "fuzz: $target, ${share}s over $(ls "$corpus" | wc -l) seeds"
   status=0
-  TMPDIR="$work" SACCADE_FUZZ_BASE_DIR="$root/scenes" "$out/${target}_fuzzer" \
+  TMPDIR="$work" SACCADE_FUZZ_BASE_DIR="$root/scenes" SACCADE_FUZZ_ROBOTS_DIR="$root/robots" \
+    "$out/${target}_fuzzer" \
     -max_total_time="$share" -timeout=10 -rss_limit_mb=4096 -max_len="${target_max_len[$target]}" \
     "${dict[@]}" -artifact_prefix="$out/" -print_final_stats=1 "$corpus" || status=$?
   if ((status != 0)); then

@@ -26,6 +26,7 @@ Runner AddRenderCommand(CLI::App& app);
 Runner AddBenchCommand(CLI::App& app);
 Runner AddGuiCommand(CLI::App& app);
 Runner AddRunCommand(CLI::App& app);
+Runner AddUrdfCommand(CLI::App& app);
 
 // Shared helpers.
 inline constexpr double kDegToRad = M_PI / 180.0;

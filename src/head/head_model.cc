@@ -99,15 +99,17 @@ class HeadModelReader {
     head.urdf_xml_ = urdf.xml;
     head.visuals_ = urdf.visuals;
     if (const auto pose = top.Find("pose")) head.X_WB_ = internal::ReadPose(*pose);
-    ReadJoints(top.Find("joints"), top, &head);
+    ReadJoints(top.Find("joints"), top, urdf.source, &head);
     ReadCameras(top.Get("cameras"), urdf, &head);
     ReadRule(top.Find("fixation"), &head);
     return head;
   }
 
  private:
-  // The URDF's limits, a mimic's own limits folded into its source's.
-  static std::vector<JointSettings> UrdfSettings(const KinematicTree& tree) {
+  // The URDF's limits, a mimic's own limits folded into its source's. Throws FileError naming the
+  // URDF and the mimic when that leaves its source no value (no posture would respect both).
+  static std::vector<JointSettings> UrdfSettings(const KinematicTree& tree,
+                                                 const std::string& urdf_source) {
     std::vector<JointSettings> settings(tree.num_variables());
     for (int i = 0; i < tree.num_variables(); ++i) {
       const KinematicTree::Joint& joint = tree.joint(tree.variable_joint(i));
@@ -122,15 +124,26 @@ class HeadModelReader {
       double a = (joint.lower - joint.offset) / joint.multiplier;
       double b = (joint.upper - joint.offset) / joint.multiplier;
       if (a > b) std::swap(a, b);
+      if (a > limits.max || b < limits.min) {
+        const std::string& source_name = tree.variable_name(joint.variable);
+        throw FileError(
+            urdf_source, 0, fmt::format("joint {}", joint.name),
+            fmt::format("its limits [{}, {}] as a mimic of '{}' (multiplier {}, offset {}) allow "
+                        "'{}' only [{}, {}], outside its own limits [{}, {}]; expected ranges "
+                        "that overlap",
+                        joint.lower, joint.upper, source_name, joint.multiplier, joint.offset,
+                        source_name, a, b, limits.min, limits.max));
+      }
       limits.min = std::max(limits.min, a);
       limits.max = std::min(limits.max, b);
     }
     return settings;
   }
 
-  void ReadJoints(const std::optional<Entry>& joints, const Entry& top, HeadModel* head) const {
+  void ReadJoints(const std::optional<Entry>& joints, const Entry& top,
+                  const std::string& urdf_source, HeadModel* head) const {
     const KinematicTree& tree = head->tree_;
-    head->joints_ = UrdfSettings(tree);
+    head->joints_ = UrdfSettings(tree, urdf_source);
     std::map<int, std::string> servo_ids;
     if (joints) {
       RequireMap(*joints, "a map of joint name to settings");

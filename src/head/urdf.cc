@@ -6,6 +6,7 @@
 #include <urdf_parser/urdf_parser.h>
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
@@ -54,6 +55,11 @@ struct ElementLines {
   std::vector<int> link_lines;
   std::vector<std::string> joints;
   std::map<std::string, int> joint_lines;
+  /// The joints' edges: joint, parent link, child link.
+  struct Edge {
+    std::string joint, parent, child;
+  };
+  std::vector<Edge> edges;
   int Line(const std::string& joint) const {
     const auto it = joint_lines.find(joint);
     return it == joint_lines.end() ? 0 : it->second;
@@ -71,6 +77,11 @@ ElementLines ScanElements(const TiXmlElement& robot) {
     } else if (e->ValueStr() == "joint") {
       lines.joints.emplace_back(name);
       lines.joint_lines.emplace(name, e->Row());
+      const TiXmlElement* parent = e->FirstChildElement("parent");
+      const TiXmlElement* child = e->FirstChildElement("child");
+      const char* parent_link = parent ? parent->Attribute("link") : nullptr;
+      const char* child_link = child ? child->Attribute("link") : nullptr;
+      if (parent_link && child_link) lines.edges.push_back({name, parent_link, child_link});
     }
   }
   return lines;
@@ -111,6 +122,46 @@ JointSpec ToJointSpec(const urdf::Joint& joint, const std::string& source, int l
     spec.mimic = MimicSpec{joint.mimic->joint_name, joint.mimic->multiplier, joint.mimic->offset};
   }
   return spec;
+}
+
+// urdfdom links a cycle of joints into a cycle of shared pointers that it never frees (a leak
+// per parse), and reports it only as "no root link": a cycle is refused before urdfdom reads it,
+// naming its joints.
+void RefuseCycles(const std::string& source, const ElementLines& lines) {
+  std::map<std::string, std::vector<const ElementLines::Edge*>> out;
+  for (const ElementLines::Edge& e : lines.edges) out[e.parent].push_back(&e);
+  // Depth-first, iterative (a fuzzed file may chain thousands of links): 1 on the path, 2 done.
+  std::map<std::string, int> state;
+  for (const auto& [start, ignored] : out) {
+    if (state[start] != 0) continue;
+    std::vector<std::pair<const ElementLines::Edge*, size_t>> path = {{nullptr, 0}};
+    std::vector<std::string> nodes = {start};
+    state[start] = 1;
+    while (!path.empty()) {
+      auto& [edge, next] = path.back();
+      const auto& children = out[nodes.back()];
+      if (next == children.size()) {
+        state[nodes.back()] = 2;
+        path.pop_back();
+        nodes.pop_back();
+        continue;
+      }
+      const ElementLines::Edge* e = children[next++];
+      if (state[e->child] == 1) {
+        const auto first = std::find(nodes.begin(), nodes.end(), e->child);
+        std::vector<std::string> cycle(first, nodes.end());
+        cycle.push_back(e->child);
+        throw FileError(source, lines.Line(e->joint), fmt::format("joint {}", e->joint),
+                        fmt::format("the joints form a cycle of links ({}); expected a tree",
+                                    fmt::join(cycle, " -> ")));
+      }
+      if (state[e->child] == 0) {
+        state[e->child] = 1;
+        path.push_back({e, 0});
+        nodes.push_back(e->child);
+      }
+    }
+  }
 }
 
 // urdfdom's messages name the element as "joint [NAME]" or "link [NAME]" but give no line: the
@@ -428,6 +479,7 @@ UrdfModel ParseUrdf(const std::string& xml, const std::string& source, const fs:
                                 robot ? robot->ValueStr() : std::string()));
   }
   const ElementLines lines = ScanElements(*robot);
+  RefuseCycles(source, lines);
 
   urdf::ModelInterfaceSharedPtr model;
   {

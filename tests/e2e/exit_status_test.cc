@@ -41,7 +41,8 @@ void ExpectStatusOne(const std::vector<Case>& cases) {
 
 TEST(ExitStatus, UsageErrorsOfEverySubcommandExitOne) {
   std::vector<Case> cases;
-  for (const std::string sub : {"fk", "ik", "camera", "render", "bench", "demo", "gui", "run"}) {
+  for (const std::string sub :
+       {"fk", "ik", "camera", "render", "bench", "demo", "gui", "run", "urdf"}) {
     cases.push_back({sub + " --no-such-option", "--no-such-option"});
   }
   // Values out of range or of the wrong type, one per subcommand (CLI11's checks).
@@ -68,6 +69,7 @@ TEST(ExitStatus, MissingFilesOfEverySubcommandExitOneNamingTheFile) {
       {"demo --scene " + missing, missing},
       {"gui --scene " + missing, missing},
       {"run " + missing, missing},
+      {"urdf --head " + missing, missing},
   });
 }
 

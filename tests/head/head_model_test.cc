@@ -226,5 +226,19 @@ TEST_F(HeadFileTest, BadHeadFilesNameTheKeyAndWhatWasExpected) {
   EXPECT_THAT(ErrorOf(kCameras + kJoints + "colour: red\n"), HasSubstr("colour"));
 }
 
+TEST_F(HeadFileTest, AMimicWhoseLimitsLeaveItsSourceNoValueIsRefused) {
+  // vergence = -2 * yaw within [2.5, 3] needs yaw in [-1.5, -1.25], outside yaw's [-1, 1]: no
+  // posture respects both (the limits folded to min > max before, and HomePosture clamped
+  // into an empty range).
+  std::ifstream in(folder_ / "head.urdf");
+  std::string urdf((std::istreambuf_iterator<char>(in)), {});
+  const std::string range = R"(lower="-0.6" upper="0.6")";
+  urdf.replace(urdf.find(range), range.size(), R"(lower="2.5" upper="3")");
+  std::ofstream(folder_ / "head.urdf") << urdf;
+  EXPECT_THAT(ErrorOf(kCameras + kJoints),
+              AllOf(HasSubstr("head.urdf"), HasSubstr("joint vergence"),
+                    HasSubstr("as a mimic of 'yaw'"), HasSubstr("expected ranges that overlap")));
+}
+
 }  // namespace
 }  // namespace saccade::head
