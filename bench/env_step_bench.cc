@@ -75,7 +75,7 @@ void BM_FixationEnvStep(benchmark::State& bench) {
   const Eigen::Vector3d target = batch.object_poses[0]->translation();
   const double dt = 0.04;
   const Eigen::Vector4d action(0.1, -0.05, 0.02, -0.02);  // rad/s
-  JointState joints;
+  JointState joints = head.Home();
   int64_t step = 0;
   double error_sum = 0.0;
   // Outside the timing, as the env's reset: the first batch makes the framebuffer of tiles
@@ -85,16 +85,16 @@ void BM_FixationEnvStep(benchmark::State& bench) {
   for (auto _ : bench) {
     // The action: finite and within the velocity limits (refused otherwise in the env).
     for (int j = 0; j < 4; ++j) {
-      const auto& limits = head.limits(saccade::head::kAllJoints[j]);
+      const auto& limits = head.joint(j).limits;
       if (!std::isfinite(action[j]) || std::abs(action[j]) > limits.max_velocity) {
         bench.SkipWithError("bad action");
         return;
       }
-      double& q = joints[saccade::head::kAllJoints[j]];
+      double& q = joints[j];
       q = std::clamp(q + action[j] * dt, limits.min, limits.max);
     }
-    const auto frames = saccade::head::ForwardKinematics(head, joints);
-    for (const auto* X : {&frames.X_WCamLeft, &frames.X_WCamRight}) {
+    const auto cameras = head.CameraPoses(joints);
+    for (const auto* X : {&cameras[0], &cameras[1]}) {
       const Eigen::Vector3d ray = (target - X->translation()).normalized();
       error_sum += std::acos(std::clamp(X->linear().col(2).dot(ray), -1.0, 1.0));
     }
@@ -154,9 +154,9 @@ void BM_RenderBatch(benchmark::State& bench) {
   const double dt = 0.04;
   int64_t step = 0;
   const auto pose = [&](int k) {
-    JointState joints;
-    const auto& pan = head.limits(saccade::head::Joint::kPan);
-    joints[saccade::head::Joint::kPan] =
+    JointState joints = head.Home();
+    const auto& pan = head.joint(0).limits;
+    joints[0] =
         std::clamp(0.002 * (k % 64) * static_cast<double>(step % 100), pan.min, pan.max);
     return joints;
   };

@@ -177,7 +177,10 @@ void SensorSpec::Validate() const {
 
 SceneState Scene::InitialState() const {
   SceneState state;
-  if (robot_) state.joints = robot_->initial_joints;
+  if (robot_) {
+    state.joints = robot_->initial_joints;
+    state.joint_velocities = head::JointState(robot_->head.joint_names());  // still
+  }
   return state;
 }
 

@@ -108,7 +108,7 @@ TEST(PerceptionComponents, FromRenderedImagesToACommandThatFixatesTheFace) {
   const scene::Scene& scene = Scene();
   const Eigen::Vector3d face = FaceCentreAt(scene, Astronaut(), 0.0);
   const head::IkResult look =
-      head::SolveFixation(scene.robot()->head, face + Eigen::Vector3d(0, 0.1, -0.05));
+      head::SolveFixation(*scene.robot()->head.AppendixAHead(), face + Eigen::Vector3d(0, 0.1, -0.05));
   ASSERT_TRUE(look.reachable());
 
   auto cameras = Make("sim.cameras", {{"scene", kScene}});
@@ -134,13 +134,14 @@ TEST(PerceptionComponents, FromRenderedImagesToACommandThatFixatesTheFace) {
   cameras->Start();
   for (int64_t step = 0; step < 3; ++step) {
     JointStateMessage joints;
+    joints.positions = joints.velocities = joints.targets = joints.target_velocities = head::JointState::Popeye(0, 0, 0, 0);
     joints.time = At(step).time;
     joints.positions = look.joints;
     In<JointStateMessage>(*cameras, "joints").Deliver(joints);
     cameras->Step(At(step));
     ASSERT_TRUE(*left && *right);
     EXPECT_EQ((*left)->image->metadata().frame_index, step);
-    EXPECT_EQ((*left)->image->metadata().joints[0], look.joints.pan);  // rendered at the joints
+    EXPECT_EQ((*left)->image->metadata().joints[0], look.joints[0]);  // rendered at the joints
     In<runtime::ImageMessage>(*faces_left, "image").Deliver(**left);
     In<runtime::ImageMessage>(*faces_right, "image").Deliver(**right);
     faces_left->Step(At(step));
@@ -183,7 +184,7 @@ TEST(PerceptionComponents, FromRenderedImagesToACommandThatFixatesTheFace) {
   EXPECT_LT(((*target)->p_W - face).norm(), kTriangulationToleranceM);
   // The command fixates the target exactly: both optical axes meet on it.
   const head::HeadFrames frames =
-      head::ForwardKinematics(scene.robot()->head, (*command)->positions);
+      head::ForwardKinematics(*scene.robot()->head.AppendixAHead(), head::PopeyeJoints::From((*command)->positions));
   ASSERT_TRUE(frames.p_WFixation);
   EXPECT_LT((*frames.p_WFixation - (*target)->p_W).norm(), kIkToleranceM);
   EXPECT_FALSE((*command)->pursuit());  // a still face: a saccade
@@ -198,6 +199,7 @@ std::shared_ptr<const Image> RenderOne(const std::string& scene_file, const std:
   auto image = Capture<runtime::ImageMessage>(*cameras, camera);
   cameras->Start();
   JointStateMessage state;
+  state.positions = state.velocities = state.targets = state.target_velocities = head::JointState::Popeye(0, 0, 0, 0);
   state.positions = joints;
   state.velocities = velocities;
   In<JointStateMessage>(*cameras, "joints").Deliver(state);
@@ -232,8 +234,9 @@ TEST(SimCameras, PipelinedCaptureEmitsThePreviousStepsFrameUnchanged) {
   std::shared_ptr<const Image> previous;
   for (int64_t step = 0; step < 4; ++step) {
     JointStateMessage joints;
+    joints.positions = joints.velocities = joints.targets = joints.target_velocities = head::JointState::Popeye(0, 0, 0, 0);
     joints.time = At(step).time;
-    joints.positions = {0.05 * step, -0.02 * step, 0.0, 0.0};
+    joints.positions = head::JointState::Popeye(0.05 * step, -0.02 * step, 0.0, 0.0);
     In<JointStateMessage>(*pipelined, "joints").Deliver(joints);
     In<JointStateMessage>(*plain, "joints").Deliver(joints);
     pipelined->Step(At(step));
@@ -291,7 +294,7 @@ TEST(SimCameras, WhileWaitingRunsOnTheStepsThreadWhileTheRendererDraws) {
 std::shared_ptr<const Image> LeftEyeOnTheAstronaut() {
   const scene::Scene& scene = Scene();
   const head::IkResult look =
-      head::SolveFixation(scene.robot()->head, FaceCentreAt(scene, Astronaut(), 0.0));
+      head::SolveFixation(*scene.robot()->head.AppendixAHead(), FaceCentreAt(scene, Astronaut(), 0.0));
   EXPECT_TRUE(look.reachable());
   if (!look.reachable()) return nullptr;
   return RenderOne(kScene, "left", look.joints, {});
@@ -414,10 +417,10 @@ TEST(FaceDetectorComponent, WithThePartnersFacesSearchesTheirEpipolarBandsNotThe
   const scene::Scene& scene = Scene();
   const Eigen::Vector3d her_W = FaceCentreAt(scene, Astronaut(), 0.0);
   const Eigen::Vector3d base_W =
-      head::ForwardKinematics(scene.robot()->head, scene.robot()->initial_joints)
+      head::ForwardKinematics(*scene.robot()->head.AppendixAHead(), head::PopeyeJoints::From(scene.robot()->initial_joints))
           .X_WC.translation();
   const head::IkResult look =
-      head::SolveFixation(scene.robot()->head, her_W + 5.0 * (her_W - base_W).normalized());
+      head::SolveFixation(*scene.robot()->head.AppendixAHead(), her_W + 5.0 * (her_W - base_W).normalized());
   ASSERT_TRUE(look.reachable());
   const std::shared_ptr<const Image> left = RenderOne(kScene, "left", look.joints, {});
   const std::shared_ptr<const Image> right = RenderOne(kScene, "right", look.joints, {});
@@ -656,7 +659,7 @@ TEST(FaceDetectorComponent, KeepingVerdictsAndBoundingSizesGivesTheSameFaces) {
 TEST(TriangulateComponent, UntilTheTracksAreAnchoredToADetectionItsPointStands) {
   const scene::Scene& scene = Scene();
   const Eigen::Vector3d face = FaceCentreAt(scene, Astronaut(), 0.0);
-  const head::IkResult look = head::SolveFixation(scene.robot()->head, face);
+  const head::IkResult look = head::SolveFixation(*scene.robot()->head.AppendixAHead(), face);
   ASSERT_TRUE(look.reachable());
   const auto at_frame = [](const std::shared_ptr<const Image>& image, int64_t frame) {
     auto copy = std::make_shared<Image>(*image);
@@ -843,9 +846,9 @@ TEST(FaceDetectorComponent, OnItsOwnThreadSearchesTheWholeImageAtTheLanesLevel) 
 
 TEST(SimCameras, TheHeadsMotionBlursTheEyeImages) {
   const std::string portraits = std::string(SACCADE_SOURCE_DIR) + "/scenes/portraits.yaml";
-  const head::JointState still{0.0, 0.0, 0.0, 0.0};
+  const head::JointState still = head::JointState::Popeye(0.0, 0.0, 0.0, 0.0);
   const auto sharp = RenderOne(portraits, "left", still, still);
-  const auto blurred = RenderOne(portraits, "left", still, {3.0, 0.0, 0.0, 0.0});  // 170 deg/s
+  const auto blurred = RenderOne(portraits, "left", still, head::JointState::Popeye(3.0, 0.0, 0.0, 0.0));  // 170 deg/s
   EXPECT_EQ(blurred->metadata().joints[0], 0.0);
   // 3 rad/s over 8 ms sweeps 0.024 rad, ~31 px: the edges' energy falls several-fold.
   EXPECT_LT(Sharpness(*blurred), 0.5 * Sharpness(*sharp));
@@ -856,7 +859,7 @@ TEST(SimCameras, TheHeadsMotionBlursTheEyeImages) {
 TEST(PreprocessingComponents, GiveWhatTheVisionClassesGive) {
   // The bench scene's eye cameras have a radtan lens (k1 = -0.2), so undistortion has work.
   const std::string bench = std::string(SACCADE_SOURCE_DIR) + "/scenes/bench.yaml";
-  const head::JointState still{0.0, 0.0, 0.0, 0.0};
+  const head::JointState still = head::JointState::Popeye(0.0, 0.0, 0.0, 0.0);
   const auto image = RenderOne(bench, "left", still, still);
   ASSERT_EQ(testing_helpers::DistortionName(image->metadata()), "radtan");
   const auto run = [&](const std::string& type, const json& params) {
@@ -909,7 +912,8 @@ TEST(AttentionComponent, VisitsTheClosestFirstThenTheNextThenGoesHome) {
     // The head is on whatever was selected last (as if the motors were instant).
     if (*selection && (*selection)->valid) {
       JointStateMessage joints;
-      joints.positions = head::SolveFixation(scene.robot()->head, (*selection)->p_W).joints;
+      joints.positions = joints.velocities = joints.targets = joints.target_velocities = head::JointState::Popeye(0, 0, 0, 0);
+      joints.positions = head::SolveFixation(*scene.robot()->head.AppendixAHead(), (*selection)->p_W).joints;
       joints.arrived = true;
       In<JointStateMessage>(*attention, "joints").Deliver(joints);
     }
@@ -939,7 +943,7 @@ TEST(AttentionComponent, AFixationBeginsWhereThisStepsSightingAgreesWithTheEyes)
   // A point `deg` degrees beside the face, seen from the head (a turn about the vertical).
   const auto beside = [&](double deg) {
     const Eigen::Vector3d viewer =
-        head::ForwardKinematics(scene.robot()->head, scene.robot()->initial_joints)
+        head::ForwardKinematics(*scene.robot()->head.AppendixAHead(), head::PopeyeJoints::From(scene.robot()->initial_joints))
             .X_WC.translation();
     return Eigen::Vector3d(
         viewer + Eigen::AngleAxisd(deg * M_PI / 180.0, Eigen::Vector3d::UnitZ()) * (face - viewer));
@@ -953,7 +957,8 @@ TEST(AttentionComponent, AFixationBeginsWhereThisStepsSightingAgreesWithTheEyes)
     std::vector<bool> fixating;
     for (std::size_t step = 0; step < steps.size(); ++step) {
       JointStateMessage joints;
-      joints.positions = head::SolveFixation(scene.robot()->head, steps[step].first).joints;
+      joints.positions = joints.velocities = joints.targets = joints.target_velocities = head::JointState::Popeye(0, 0, 0, 0);
+      joints.positions = head::SolveFixation(*scene.robot()->head.AppendixAHead(), steps[step].first).joints;
       joints.arrived = true;
       In<JointStateMessage>(*attention, "joints").Deliver(joints);
       In<CandidatesMessage>(*attention, "candidates")
@@ -983,23 +988,24 @@ TEST(SimHead, CommandsBeyondTheLimitsAreClampedAndCountedNeverExceeded) {
   auto joints = Capture<JointStateMessage>(*head_component, "joints");
   head_component->Start();
   JointCommand command;
-  command.positions = {3.0, -2.0, 0.0, 0.0};  // pan 172 deg, tilt -115 deg: beyond the limits
+  command.positions = command.velocities = head::JointState::Popeye(0, 0, 0, 0);
+  command.positions = head::JointState::Popeye(3.0, -2.0, 0.0, 0.0);  // pan 172 deg, tilt -115 deg: beyond the limits
   In<JointCommand>(*head_component, "command").Deliver(command);
   const auto& limits = scene.robot()->head;
   for (int64_t step = 0; step < 100; ++step) {
     head_component->Step(At(step));
     head_component->inputs()[0]->MarkSeen();
-    EXPECT_LE((*joints)->positions.pan, limits.limits(head::Joint::kPan).max + 1e-12);
-    EXPECT_GE((*joints)->positions.tilt, limits.limits(head::Joint::kTilt).min - 1e-12);
-    EXPECT_LE(std::abs((*joints)->velocities.pan),
-              limits.limits(head::Joint::kPan).max_velocity + 1e-9);
+    EXPECT_LE((*joints)->positions[0], limits.joint(0).limits.max + 1e-12);
+    EXPECT_GE((*joints)->positions[1], limits.joint(1).limits.min - 1e-12);
+    EXPECT_LE(std::abs((*joints)->velocities[0]),
+              limits.joint(0).limits.max_velocity + 1e-9);
   }
   EXPECT_TRUE((*joints)->arrived);
-  EXPECT_DOUBLE_EQ((*joints)->positions.pan, limits.limits(head::Joint::kPan).max);
+  EXPECT_DOUBLE_EQ((*joints)->positions[0], limits.joint(0).limits.max);
   EXPECT_EQ((*joints)->clamped_commands, 2);        // pan and tilt
   EXPECT_NEAR((*joints)->time, 100 * 0.04, 1e-12);  // the state at the next step's time
 
-  command.positions.tilt = std::nan("");
+  command.positions[1] = std::nan("");
   In<JointCommand>(*head_component, "command").Deliver(command);
   try {
     head_component->Step(At(100));
@@ -1025,7 +1031,7 @@ TEST(SimHead, MethodsReadMoveAndStopTheHead) {
                      {"target_id", -1}});
   EXPECT_DOUBLE_EQ(moved["targets"]["pan"].get<double>(), 0.5);
   EXPECT_DOUBLE_EQ(moved["targets"]["tilt"].get<double>(),
-                   Scene().robot()->head.limits(head::Joint::kTilt).max);  // clamped
+                   Scene().robot()->head.joint(1).limits.max);  // clamped
   EXPECT_EQ(moved["clamped_commands"], 1);
   const json stopped = pipeline.Call("head", "stop", json::object());
   EXPECT_EQ(stopped["targets"], stopped["positions"]);  // at rest: holds where it is
@@ -1060,9 +1066,9 @@ TEST(FixationComponent, AMovingTargetGetsPursuitVelocitiesThatFollowIt) {
   // Pan rate of a point 2 m ahead moving sideways at 0.2 m/s: ~0.1 rad/s (to the left, > 0).
   const double t = At(4).time;
   const double expected = 0.2 * 2.0 / (4.0 + std::pow(0.2 * t, 2));
-  EXPECT_NEAR((*command)->velocities.pan, expected, 0.01 * expected);
+  EXPECT_NEAR((*command)->velocities[0], expected, 0.01 * expected);
   const auto& head = scene.robot()->head;
-  const head::HeadFrames frames = head::ForwardKinematics(head, (*command)->positions);
+  const head::HeadFrames frames = head::ForwardKinematics(*head.AppendixAHead(), head::PopeyeJoints::From((*command)->positions));
   ASSERT_TRUE(frames.p_WFixation);
   EXPECT_LT((*frames.p_WFixation - (Eigen::Vector3d(2.0, 0.0, 1.2) + v * t)).norm(), kIkToleranceM);
 }
@@ -1122,7 +1128,7 @@ TEST(ComponentParams, PipelineErrorsNameTheFileLineAndComponent) {
   const std::string wrong =
       error(head +
             "  - {name: c, type: sim.cameras, params: {scene: ../scenes/astronaut_and_cat.yaml}}\n"
-            "  - {name: d, type: vision.face_detector, inputs: {image: c.left}}\n"
+            "  - {name: d, type: vision.face_detector, inputs: {image: c[2]}}\n"
             "  - {name: e, type: vision.face_detector, inputs: {image: d.faces}}\n");
   EXPECT_NE(wrong.find(":5:"), std::string::npos) << wrong;
   EXPECT_NE(wrong.find("vision.faces"), std::string::npos) << wrong;

@@ -95,7 +95,8 @@ components:
   runtime::Pipeline pipeline = runtime::Pipeline::LoadString(text, (dir_ / "p.yaml").string());
   const auto images = CaptureAll<runtime::ImageMessage>(pipeline);
   JointCommand look;
-  look.positions = {20 * kDeg, -5 * kDeg, -2 * kDeg, 2 * kDeg};
+  look.positions = look.velocities = head::JointState::Popeye(0, 0, 0, 0);
+  look.positions = head::JointState::Popeye(20 * kDeg, -5 * kDeg, -2 * kDeg, 2 * kDeg);
   // Move the head, so that X_WC must follow the joints.
   runtime::RunOptions run;
   run.after_step = [&](const runtime::StepContext& context) {
@@ -109,7 +110,7 @@ components:
   ASSERT_EQ(images->size(), 26u);
   const std::shared_ptr<const scene::Scene> scene =
       std::make_shared<const scene::Scene>(scene::Scene::Load(kScene));
-  const head::HeadDescription& head = scene->robot()->head;
+  const head::HeadModel& head = scene->robot()->head;
   for (std::size_t i = 0; i < images->size(); i += 2) {
     const Image& left = *(*images)[i].image;
     const Image& right = *(*images)[i + 1].image;
@@ -126,7 +127,8 @@ components:
     // X_WC: the head's forward kinematics at the joints the image was taken at.
     ASSERT_TRUE(left.metadata().has_joints);
     const auto& q = left.metadata().joints;
-    const head::HeadFrames frames = head::ForwardKinematics(head, {q[0], q[1], q[2], q[3]});
+    const head::HeadFrames frames =
+        head::ForwardKinematics(*head.AppendixAHead(), head::PopeyeJoints{q[0], q[1], q[2], q[3]});
     EXPECT_TRUE(vision::CameraPoseOf(left).matrix().isApprox(frames.X_WCamLeft.matrix(), 1e-12));
     EXPECT_TRUE(vision::CameraPoseOf(right).matrix().isApprox(frames.X_WCamRight.matrix(), 1e-12));
   }
@@ -166,10 +168,10 @@ components:
         right: {uri: right.png, calibration: right.yml, loop: true}
   - name: faces_left
     type: vision.face_detector
-    inputs: {image: cameras.left}
+    inputs: {image: cameras[2]}
   - name: faces_right
     type: vision.face_detector
-    inputs: {image: cameras.right}
+    inputs: {image: cameras[3]}
   - name: stereo
     type: vision.stereo_faces
     inputs: {left: faces_left.faces, right: faces_right.faces}
@@ -218,9 +220,9 @@ TEST_F(HwComponentsTest, CameraParamsErrorsNameTheField) {
   expect(error("{left: {uri: a.png}}"), "parameter 'cameras': missing camera 'right'");
   expect(error("{left: {uri: a.png}, right: {uri: b.png}, middle: {uri: c.png}}"),
          "unknown camera 'middle'");
-  expect(error("{left: {url: a.png}, right: {uri: b.png}}"), "parameter 'cameras.left.");
+  expect(error("{left: {url: a.png}, right: {uri: b.png}}"), "parameter 'cameras[2].");
   expect(error("{left: {uri: a.png, every: 0}, right: {uri: b.png}}"),
-         "parameter 'cameras.left.every'");
+         "parameter 'cameras[2].every'");
   // A missing file fails when the pipeline starts, naming the camera and the file.
   expect(error("{left: {uri: nowhere.png}, right: {uri: nowhere.png}}"), "nowhere.png");
 }
@@ -240,12 +242,14 @@ components:
   run.after_step = [&](const runtime::StepContext& context) {
     if (context.step != 0) return;
     JointCommand far;
-    far.positions.pan = 150 * kDeg;  // beyond the 90 deg limit
+    far.positions = far.velocities = head::JointState::Popeye(0, 0, 0, 0);
+    far.positions[0] = 150 * kDeg;  // beyond the 90 deg limit
     const json reply =
         pipeline.Call("head", "move", runtime::MessageTraits<JointCommand>::ToJson(far));
     EXPECT_NEAR(reply["targets"]["pan"].get<double>(), 90 * kDeg, 1e-12);
     JointCommand nan;
-    nan.positions.tilt = std::nan("");
+    nan.positions = nan.velocities = head::JointState::Popeye(0, 0, 0, 0);
+    nan.positions[1] = std::nan("");
     const auto* move = pipeline.Find("head")->FindMethod<JointCommand, JointStateMessage>("move");
     ASSERT_NE(move, nullptr);
     try {
@@ -267,7 +271,7 @@ components:
   EXPECT_TRUE(last.emergency_stopped);
   EXPECT_NE(last.last_limit.find("pan target 150.00 deg clamped to 90.00 deg"), std::string::npos)
       << last.last_limit;
-  EXPECT_LE(joints->back().positions.pan, 90 * kDeg);
+  EXPECT_LE(joints->back().positions[0], 90 * kDeg);
 }
 
 }  // namespace

@@ -28,17 +28,17 @@ void ExpectRoundTrip(const T& message) {
 TEST(Messages, EveryTypeRoundTripsThroughJson) {
   JointStateMessage joints;
   joints.time = 1.25;
-  joints.positions = {0.1, -0.2, -0.03, 0.03};
-  joints.velocities = {1.0, 0.0, -0.5, 0.5};
-  joints.targets = {0.2, -0.2, -0.04, 0.04};
+  joints.positions = head::JointState::Popeye(0.1, -0.2, -0.03, 0.03);
+  joints.velocities = head::JointState::Popeye(1.0, 0.0, -0.5, 0.5);
+  joints.targets = head::JointState::Popeye(0.2, -0.2, -0.04, 0.04);
   joints.arrived = false;
   joints.clamped_commands = 2;
   ExpectRoundTrip(joints);
 
   JointCommand command;
   command.time = 0.5;
-  command.positions = {0.3, 0.1, -0.05, 0.05};
-  command.velocities = {0.1, 0.0, 0.0, 0.0};
+  command.positions = head::JointState::Popeye(0.3, 0.1, -0.05, 0.05);
+  command.velocities = head::JointState::Popeye(0.1, 0.0, 0.0, 0.0);
   command.target_id = 4;
   EXPECT_TRUE(command.pursuit());
   ExpectRoundTrip(command);
@@ -46,7 +46,7 @@ TEST(Messages, EveryTypeRoundTripsThroughJson) {
   HeadStatusMessage status;
   status.time = 3.5;
   status.driver = "dynamixel on /tmp/saccade-servos";
-  status.positions = {0.1, 0.0, -0.02, 0.02};
+  status.positions = head::JointState::Popeye(0.1, 0.0, -0.02, 0.02);
   status.torque = true;
   status.holding = true;
   status.fault = "servo 2 (tilt): overload";

@@ -34,7 +34,7 @@ components:
     inputs: {joints: {from: robot_head.joints, delay: 1}}
   - name: cameras
     type: remote.cameras
-    inputs: {left: robot_cameras.left, right: robot_cameras.right}
+    inputs: {left: robot_cameras[2], right: robot_cameras[3]}
   - name: head
     type: remote.head
     inputs: {state: robot_head.joints}
@@ -53,18 +53,20 @@ TEST(RemoteComponents, TheHeadSendsClampedCommandsAndReportsTheRobotsState) {
     EXPECT_NE(std::string(e.what()).find("no joint state"), std::string::npos) << e.what();
   }
   const scene::Scene scene = scene::Scene::Load(kScene);
-  const double pan_max = scene.robot()->head.limits(head::Joint::kPan).max;
+  const double pan_max = scene.robot()->head.joint(0).limits.max;
   int64_t images = 0;
   runtime::RunOptions run;
   run.steps = 30;
   run.after_step = [&](const runtime::StepContext& context) {
     if (context.step == 1) {
-      EXPECT_EQ(head->HeadState().positions.pan, 0.0);
+      EXPECT_EQ(head->HeadState().positions[0], 0.0);
       JointCommand far;
-      far.positions.pan = 10.0;  // beyond the limit: clamped here
-      EXPECT_DOUBLE_EQ(head->Move(far).targets.pan, pan_max);
+      far.positions = far.velocities = head::JointState::Popeye(0, 0, 0, 0);
+      far.positions[0] = 10.0;  // beyond the limit: clamped here
+      EXPECT_DOUBLE_EQ(head->Move(far).targets[0], pan_max);
       JointCommand bad;
-      bad.positions.tilt = std::numeric_limits<double>::quiet_NaN();
+      bad.positions = bad.velocities = head::JointState::Popeye(0, 0, 0, 0);
+      bad.positions[1] = std::numeric_limits<double>::quiet_NaN();
       EXPECT_THROW(head->Move(bad), Error);
     }
   };
@@ -77,7 +79,7 @@ TEST(RemoteComponents, TheHeadSendsClampedCommandsAndReportsTheRobotsState) {
   const runtime::RunSummary summary = runtime::RunPipeline(pipeline, run);
   EXPECT_TRUE(summary.errors.empty());
   // The robot went to the clamped target, and the remote state says so.
-  EXPECT_NEAR(head->HeadState().positions.pan, pan_max, 1e-6);
+  EXPECT_NEAR(head->HeadState().positions[0], pan_max, 1e-6);
   EXPECT_EQ(images, 2 * 30);  // every image of both eyes passed on
   EXPECT_NE(pipeline.Find<RemoteCameras>("cameras")->Describe().find("30 + 30"), std::string::npos);
 }

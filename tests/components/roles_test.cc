@@ -50,9 +50,10 @@ TEST(RolesTest, APipelineHandsOutItsHeadAndCamerasByInterface) {
   // The simulated head: typed commands, clamped to the limits; no emergency stop.
   pipeline.Find("neck")->Start();
   JointCommand far;
-  far.positions.pan = 150 * kDeg;  // beyond the 90 deg limit
-  EXPECT_NEAR(head->Move(far).targets.pan, 90 * kDeg, 1e-12);
-  EXPECT_NEAR(head->HeadState().targets.pan, 90 * kDeg, 1e-12);
+  far.positions = far.velocities = head::JointState::Popeye(0, 0, 0, 0);
+  far.positions[0] = 150 * kDeg;  // beyond the 90 deg limit
+  EXPECT_NEAR(head->Move(far).targets[0], 90 * kDeg, 1e-12);
+  EXPECT_NEAR(head->HeadState().targets[0], 90 * kDeg, 1e-12);
   EXPECT_FALSE(head->has_emergency_stop());
   try {
     head->EmergencyStop();
@@ -61,7 +62,7 @@ TEST(RolesTest, APipelineHandsOutItsHeadAndCamerasByInterface) {
     EXPECT_THAT(e.what(), HasSubstr("no emergency stop"));
   }
   head->StopHead();  // brakes where it is: at rest, the target is the position
-  EXPECT_NEAR(head->HeadState().targets.pan, head->HeadState().positions.pan, 1e-12);
+  EXPECT_NEAR(head->HeadState().targets[0], head->HeadState().positions[0], 1e-12);
 }
 
 TEST(RolesTest, AHardwareHeadStopsLatchesAndClearsThroughTheSameInterface) {
@@ -72,13 +73,14 @@ TEST(RolesTest, AHardwareHeadStopsLatchesAndClearsThroughTheSameInterface) {
   runtime::Component* component = pipeline.Find("neck");
   component->Start();
   JointCommand look;
-  look.positions.pan = 10 * kDeg;
-  EXPECT_NEAR(head->Move(look).targets.pan, 10 * kDeg, 1e-12);
+  look.positions = look.velocities = head::JointState::Popeye(0, 0, 0, 0);
+  look.positions[0] = 10 * kDeg;
+  EXPECT_NEAR(head->Move(look).targets[0], 10 * kDeg, 1e-12);
   head->EmergencyStop();
-  look.positions.pan = 20 * kDeg;
+  look.positions[0] = 20 * kDeg;
   EXPECT_THROW(head->Move(look), Error);  // latched until cleared
   head->ClearFault();
-  EXPECT_NEAR(head->Move(look).targets.pan, 20 * kDeg, 1e-12);
+  EXPECT_NEAR(head->Move(look).targets[0], 20 * kDeg, 1e-12);
   component->Stop();
 }
 

@@ -83,10 +83,10 @@ TEST_F(PipelineTopics, PlainPublisherOfJointStateCommandsMovesTheHead) {
   ASSERT_TRUE(last.has_value());
   // 2 s is ample for sim.head's motors to get there (they move at rad/s).
   constexpr double kArrived = 1e-3;  // rad
-  EXPECT_NEAR(last->positions.pan, 0.2, kArrived);
-  EXPECT_NEAR(last->positions.tilt, -0.1, kArrived);
-  EXPECT_NEAR(last->positions.left, 0.05, kArrived);
-  EXPECT_NEAR(last->positions.right, -0.05, kArrived);
+  EXPECT_NEAR(last->positions.at("pan"), 0.2, kArrived);
+  EXPECT_NEAR(last->positions.at("tilt"), -0.1, kArrived);
+  EXPECT_NEAR(last->positions.at("left"), 0.05, kArrived);
+  EXPECT_NEAR(last->positions.at("right"), -0.05, kArrived);
 
   // And the head's state went out on joint_states, as ROS 2's JointState.
   ref_sensor_msgs_msg_dds__JointState_ state{};
@@ -127,7 +127,7 @@ TEST_F(PipelineTopics, ClockSourceStepsOnTheReceivedStamps) {
   std::vector<double> times;
   std::vector<double> targets;  // the head's pan target after each step
   components::demo::Tap<components::JointStateMessage>(
-      pipeline, [&](const components::JointStateMessage& m) { targets.push_back(m.targets.pan); });
+      pipeline, [&](const components::JointStateMessage& m) { targets.push_back(m.targets.at("pan")); });
   runtime::RunOptions options;
   options.after_step = [&](const runtime::StepContext& context) {
     times.push_back(context.time);

@@ -129,8 +129,8 @@ json ExpectedTf(const Image& image) {
 json ExpectedJoints(double time, const head::JointState& p, const head::JointState& v) {
   return {{"header", Header(time, "")},
           {"name", {"pan", "tilt", "left", "right"}},
-          {"position", {p.pan, p.tilt, p.left, p.right}},
-          {"velocity", {v.pan, v.tilt, v.left, v.right}},
+          {"position", {p[0], p[1], p[2], p[3]}},
+          {"velocity", {v[0], v[1], v[2], v[3]}},
           {"effort", json::array()}};
 }
 
@@ -233,13 +233,15 @@ TEST_F(WireTest, BytesEqualAnIndependentRos2Serializer) {
       MakeImage(7, 2, PixelFormat::kGray8, 2, geometry::Distortion::RadialTangential(plumb));
   gray->metadata().time = 0.04 * 3;
   JointStateMessage state;
+  state.positions = state.velocities = state.targets = state.target_velocities = head::JointState::Popeye(0, 0, 0, 0);
   state.time = 7.04;
-  state.positions = {0.1, -0.2, 0.3125, -0.0625};
-  state.velocities = {1.5, 0, -2.25, 1e-9};
+  state.positions = head::JointState::Popeye(0.1, -0.2, 0.3125, -0.0625);
+  state.velocities = head::JointState::Popeye(1.5, 0, -2.25, 1e-9);
   JointCommand command;
+  command.positions = command.velocities = head::JointState::Popeye(0, 0, 0, 0);
   command.time = 7.08;
-  command.positions = {-0.4, 0.25, 0.05, -0.05};
-  command.velocities = {0.0, 0.0, 0.0, 0.0};
+  command.positions = head::JointState::Popeye(-0.4, 0.25, 0.05, -0.05);
+  command.velocities = head::JointState::Popeye(0.0, 0.0, 0.0, 0.0);
   TargetMessage target;
   target.time = 7.12;
   target.valid = true;
@@ -287,9 +289,10 @@ TEST_F(WireTest, LateJoiningSubscriberGetsTheNewestJointState) {
   auto writer =
       Writer::Create(participant, "head.joints", Topic("/saccade/joint_states", Qos::Latched()));
   JointStateMessage state;
+  state.positions = state.velocities = state.targets = state.target_velocities = head::JointState::Popeye(0, 0, 0, 0);
   for (int i = 1; i <= 3; ++i) {
     state.time = 0.04 * i;
-    state.positions.pan = 0.1 * i;
+    state.positions[0] = 0.1 * i;
     writer->Write(state);
   }
   // The subscriber joins after the three states: transient local gives it the newest.
@@ -394,6 +397,7 @@ TEST_F(WireTest, ReaderCountsLateWaitsAndSkippedMessages) {
   auto writer = Writer::Create(participant, "head.command", Topic("/saccade/head/command"));
   ASSERT_TRUE(writer->WaitForReaders(1, 10));
   JointCommand command;
+  command.positions = command.velocities = head::JointState::Popeye(0, 0, 0, 0);
   for (int i = 0; i < 3; ++i) {
     command.time = i;
     writer->Write(command);
@@ -423,9 +427,10 @@ TEST_F(WireTest, ReaderHandsOverTheMessageOfTheAskedTimeAndKeepsLaterOnes) {
   ASSERT_TRUE(writer->WaitForReaders(1, 10));
   // The sender runs ahead: four states before the receiver's first step.
   JointStateMessage state;
+  state.positions = state.velocities = state.targets = state.target_velocities = head::JointState::Popeye(0, 0, 0, 0);
   for (const double t : {0.04, 0.08, 0.12, 0.16}) {
     state.time = t;
-    state.positions.pan = t;
+    state.positions[0] = t;
     writer->Write(state);
   }
   ASSERT_TRUE(reader->WaitForWriters(1, 5));
@@ -499,8 +504,9 @@ TEST_F(WireTest, LockstepReaderWaitsForTheStepOfLockstepWritersOnly) {
   EXPECT_EQ(reader->lockstep_writers(), 0);
   EXPECT_TRUE(reader->WaitForStep(0.0, 30.0));  // at once: nobody to wait for
   JointCommand command;
+  command.positions = command.velocities = head::JointState::Popeye(0, 0, 0, 0);
   command.time = 5.0;
-  command.positions.pan = 0.3;
+  command.positions[0] = 0.3;
   gui->Write(command);
 
   // Perception's writer, in its own participant, announces lockstep in its user data.
@@ -513,7 +519,7 @@ TEST_F(WireTest, LockstepReaderWaitsForTheStepOfLockstepWritersOnly) {
   // The GUI's command came meanwhile: handed over as ever.
   auto got = reader->Take<JointCommand>(1.0);
   ASSERT_NE(got, nullptr);
-  EXPECT_EQ(got->positions.pan, 0.3);
+  EXPECT_EQ(got->positions[0], 0.3);
 
   // A plain subscriber sees what the lockstep writer sends, as ROS 2 would.
   Raw raw(RawParticipant(kDomain));
@@ -532,13 +538,13 @@ TEST_F(WireTest, LockstepReaderWaitsForTheStepOfLockstepWritersOnly) {
   EXPECT_EQ(reader->stats().lost, 0);
   // Step 0.08: the command is the answer; the mark adds nothing after it.
   command.time = 0.08;
-  command.positions.pan = -0.2;
+  command.positions[0] = -0.2;
   answer->Write(command);
   answer->MarkStep(0.08);
   EXPECT_TRUE(reader->WaitForStep(0.08, 30.0));
   got = reader->Take<JointCommand>(0.0);
   ASSERT_NE(got, nullptr);
-  EXPECT_EQ(got->positions.pan, -0.2);
+  EXPECT_EQ(got->positions[0], -0.2);
   // An answer of an earlier step does not answer a later one (stamps are the steps' times).
   answer->MarkStep(0.08);
   EXPECT_FALSE(reader->WaitForStep(0.12, 0.3));
@@ -591,18 +597,19 @@ TEST_F(WireTest, JointStatesBringTheirTargetsAndArrivalAsTheSenderSaysIt) {
 
   // Pursuit, on its target: sim.head says arrived while every joint moves at 0.02 rad/s.
   JointStateMessage pursuit;
+  pursuit.positions = pursuit.velocities = pursuit.targets = pursuit.target_velocities = head::JointState::Popeye(0, 0, 0, 0);
   pursuit.time = 0.04;
-  pursuit.positions = {0.2, -0.1, 0.05, -0.05};
-  pursuit.velocities = {0.02, 0.0, 0.01, -0.01};
-  pursuit.targets = {0.20005, -0.1, 0.05, -0.05};
-  pursuit.target_velocities = {0.02, 0.0, 0.01, -0.01};
+  pursuit.positions = head::JointState::Popeye(0.2, -0.1, 0.05, -0.05);
+  pursuit.velocities = head::JointState::Popeye(0.02, 0.0, 0.01, -0.01);
+  pursuit.targets = head::JointState::Popeye(0.20005, -0.1, 0.05, -0.05);
+  pursuit.target_velocities = head::JointState::Popeye(0.02, 0.0, 0.01, -0.01);
   pursuit.arrived = true;
   writer->Write(pursuit);
   auto got = reader->Take<JointStateMessage>(5.0);
   ASSERT_NE(got, nullptr);
   EXPECT_TRUE(got->arrived);
-  EXPECT_EQ(got->targets.pan, 0.20005);
-  EXPECT_EQ(got->target_velocities.pan, 0.02);
+  EXPECT_EQ(got->targets[0], 0.20005);
+  EXPECT_EQ(got->target_velocities[0], 0.02);
   auto old = plain->Take<JointStateMessage>(5.0);
   ASSERT_NE(old, nullptr);
   EXPECT_FALSE(old->arrived);               // moving: what the velocities alone say
@@ -612,14 +619,14 @@ TEST_F(WireTest, JointStatesBringTheirTargetsAndArrivalAsTheSenderSaysIt) {
   JointStateMessage turning = pursuit;
   turning.time = 0.08;
   turning.velocities = {};
-  turning.targets.pan = 0.3;
+  turning.targets[0] = 0.3;
   turning.target_velocities = {};
   turning.arrived = false;
   writer->Write(turning);
   got = reader->Take<JointStateMessage>(5.0);
   ASSERT_NE(got, nullptr);
   EXPECT_FALSE(got->arrived);
-  EXPECT_EQ(got->targets.pan, 0.3);
+  EXPECT_EQ(got->targets[0], 0.3);
   old = plain->Take<JointStateMessage>(5.0);
   ASSERT_NE(old, nullptr);
   EXPECT_TRUE(old->arrived);  // at rest: the velocities alone are wrong again
@@ -628,7 +635,7 @@ TEST_F(WireTest, JointStatesBringTheirTargetsAndArrivalAsTheSenderSaysIt) {
   // target sent is where it is, so the reader says so too.
   JointStateMessage servo = turning;
   servo.time = 0.12;
-  servo.targets.pan = servo.positions.pan + 0.003;
+  servo.targets[0] = servo.positions[0] + 0.003;
   servo.arrived = true;
   writer->Write(servo);
   got = reader->Take<JointStateMessage>(5.0);

@@ -167,24 +167,23 @@ TEST_F(PoseJsonTest, SceneDocumentWritesTheCodecsForm) {
 }
 
 TEST_F(PoseJsonTest, StateWritesTheCodecsForm) {
-  // The same pose in every frame of the state: each key must give the codec's text.
-  const geometry::Pose X = Rig(scene_).X_WC;
-  head::HeadFrames same{X, X, X, X, X, X, X, std::nullopt};
-  const json frames = gui::internal::FramesJson(same);
-  ASSERT_EQ(frames.size(), 7u);
-  for (const auto& [key, pose] : frames.items()) ExpectOneForm(pose, X, "state frames " + key);
-
-  // The head's own frames, each under its documented key.
+  // The head's frames, each under its documented key: the root, the cameras, every link.
+  const head::HeadModel& head = scene_.robot()->head;
+  const head::JointState q = head::JointState::Popeye(0.1, -0.2, 0.03, -0.04);
   const head::HeadFrames fk =
-      head::ForwardKinematics(scene_.robot()->head, head::JointState{0.1, -0.2, 0.03, -0.04});
-  const json live = gui::internal::FramesJson(fk);
+      head::ForwardKinematics(*head.AppendixAHead(), head::PopeyeJoints::From(q));
+  const json live = gui::internal::FramesJson(head, q);
+  ASSERT_EQ(live.size(), 5u);
   ExpectOneForm(live.at("X_WB"), fk.X_WB, "state frames X_WB");
-  ExpectOneForm(live.at("X_WN"), fk.X_WN, "state frames X_WN");
-  ExpectOneForm(live.at("X_WC"), fk.X_WC, "state frames X_WC");
-  ExpectOneForm(live.at("left_eye"), fk.X_WL, "state frames left_eye");
-  ExpectOneForm(live.at("right_eye"), fk.X_WR, "state frames right_eye");
   ExpectOneForm(live.at("left"), fk.X_WCamLeft, "state frames left");
   ExpectOneForm(live.at("right"), fk.X_WCamRight, "state frames right");
+  std::vector<geometry::Pose> X_WL;
+  head.ForwardKinematics(q.values(), &X_WL);
+  ASSERT_EQ(live.at("links").size(), X_WL.size());
+  for (int l = 0; l < head.tree().num_links(); ++l) {
+    ExpectOneForm(live.at("links").at(head.tree().link_name(l)), X_WL[l],
+                  "state frames links " + head.tree().link_name(l));
+  }
 
   const double t = 0.7;
   const json objects = gui::internal::MovingObjectsJson(scene_, t);

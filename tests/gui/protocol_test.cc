@@ -102,8 +102,8 @@ TEST_F(GuiProtocolMessages, TheStateConformsInEachOfItsForms) {
   full.perception = true;
   full.effects = render::RendererOptions{};
   components::JointStateMessage joints;
-  joints.positions = {0.1, -0.05, 0.03, -0.03};
-  joints.targets = {0.2, -0.05, 0.03, -0.03};
+  joints.positions = head::JointState::Popeye(0.1, -0.05, 0.03, -0.03);
+  joints.targets = head::JointState::Popeye(0.2, -0.05, 0.03, -0.03);
   joints.arrived = false;
   full.joints = joints;
   full.head = &scene_.robot()->head;

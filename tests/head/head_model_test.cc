@@ -48,7 +48,7 @@ double WorstAgainstAppendixA(const HeadModel& head, const HeadDescription& legac
   for (int n = 0; n < kConfigurations; ++n) {
     const Eigen::VectorXd q = RandomPosture(head, &random);
     head.ForwardKinematics(q, &X_WL);
-    const HeadFrames f = ForwardKinematics(legacy, JointState{q[0], q[1], q[2], q[3]});
+    const HeadFrames f = ForwardKinematics(legacy, PopeyeJoints{q[0], q[1], q[2], q[3]});
     worst = std::max(worst, PoseDifference(head.CameraPose(0, X_WL), f.X_WCamLeft));
     worst = std::max(worst, PoseDifference(head.CameraPose(1, X_WL), f.X_WCamRight));
     const int left_eye = head.tree().FindLink("left_eye_link");

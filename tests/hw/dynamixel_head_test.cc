@@ -26,7 +26,8 @@ using testing::Sleep;
 constexpr double kTick = 360.0 / 4096.0;  // deg
 
 head::JointState Joints(double pan_deg, double tilt_deg, double left_deg, double right_deg) {
-  return {pan_deg * kDeg, tilt_deg * kDeg, left_deg * kDeg, right_deg * kDeg};
+  return head::JointState::Popeye(pan_deg * kDeg, tilt_deg * kDeg, left_deg * kDeg,
+                                 right_deg * kDeg);
 }
 
 class DynamixelHeadTest : public ::testing::Test {
@@ -46,7 +47,7 @@ class DynamixelHeadTest : public ::testing::Test {
     driver_.reset();
     if (emulator_) emulator_->Stop();
   }
-  const head::HeadDescription head_ = head::HeadDescription::FromYamlFile(kPopeye);
+  const head::HeadModel head_ = head::HeadModel::FromFile(kPopeye);
   std::unique_ptr<ServoEmulator> emulator_;
   std::string port_;
   std::unique_ptr<HeadDriver> driver_;
@@ -76,7 +77,7 @@ TEST_F(DynamixelHeadTest, OpeningProgramsTheServosFromTheHeadDescription) {
   const HeadStatus status = driver_->Read();
   EXPECT_TRUE(status.ready());
   EXPECT_EQ(driver_->name(), "dynamixel on " + port_);
-  for (const head::Joint joint : head::kAllJoints) EXPECT_NEAR(status.positions[joint], 0.0, 1e-12);
+  for (int joint = 0; joint < 4; ++joint) EXPECT_NEAR(status.positions[joint], 0.0, 1e-12);
 }
 
 TEST_F(DynamixelHeadTest, CommandsBecomeGoalTicksWithTheMapping) {
@@ -89,11 +90,11 @@ TEST_F(DynamixelHeadTest, CommandsBecomeGoalTicksWithTheMapping) {
   EXPECT_EQ(emulator_->last_accepted_goal(3), 2048 - std::lround(5 / kTick));
   EXPECT_EQ(emulator_->last_accepted_goal(4), 2048 + std::lround(5 / kTick));
   const HeadStatus arrived = ReadUntil(driver_.operator*(), [](const HeadStatus& s) {
-    return !s.moving && std::abs(s.positions.pan - 30 * kDeg) < 0.1 * kDeg;
+    return !s.moving && std::abs(s.positions[0] - 30 * kDeg) < 0.1 * kDeg;
   });
-  EXPECT_NEAR(arrived.positions.pan, 30 * kDeg, kTick * kDeg);
-  EXPECT_NEAR(arrived.positions.tilt, 10 * kDeg, kTick * kDeg);
-  EXPECT_NEAR(arrived.positions.left, -5 * kDeg, kTick * kDeg);
+  EXPECT_NEAR(arrived.positions[0], 30 * kDeg, kTick * kDeg);
+  EXPECT_NEAR(arrived.positions[1], 10 * kDeg, kTick * kDeg);
+  EXPECT_NEAR(arrived.positions[2], -5 * kDeg, kTick * kDeg);
 }
 
 TEST_F(DynamixelHeadTest, LimitsAreNeverSentAndTheMotionIsNeverFasterThanTheDescription) {
@@ -105,11 +106,11 @@ TEST_F(DynamixelHeadTest, LimitsAreNeverSentAndTheMotionIsNeverFasterThanTheDesc
   double fastest = 0.0;
   double lowest = 0.0;
   const HeadStatus end = ReadUntil(driver_.operator*(), [&](const HeadStatus& s) {
-    fastest = std::max(fastest, std::abs(s.velocities.pan));
-    lowest = std::min(lowest, s.positions.pan);
-    return !s.moving && s.positions.pan < -89.9 * kDeg;
+    fastest = std::max(fastest, std::abs(s.velocities[0]));
+    lowest = std::min(lowest, s.positions[0]);
+    return !s.moving && s.positions[0] < -89.9 * kDeg;
   });
-  EXPECT_NEAR(end.positions.pan, -90 * kDeg, kTick * kDeg);
+  EXPECT_NEAR(end.positions[0], -90 * kDeg, kTick * kDeg);
   EXPECT_GE(lowest, -90 * kDeg - 1e-9);
   // The profile velocity is the joint's 300 deg/s, rounded down to the servo's unit.
   EXPECT_GT(fastest, 250 * kDeg);
@@ -128,7 +129,7 @@ TEST_F(DynamixelHeadTest, NonFiniteCommandsSendNothing) {
   Sync();
   const int64_t received = emulator_->counters().instructions_received;
   head::JointState bad = Joints(20, 0, 0, 0);
-  bad.left = std::numeric_limits<double>::infinity();
+  bad[2] = std::numeric_limits<double>::infinity();
   EXPECT_THROW(driver_->Command(bad), CommandRejected);
   EXPECT_EQ(emulator_->counters().instructions_received, received);
   EXPECT_EQ(emulator_->last_accepted_goal(1), 2048 + std::lround(10 / kTick));
@@ -139,15 +140,15 @@ TEST_F(DynamixelHeadTest, WatchdogHoldsTheServosWhenCommandsStop) {
   driver_->Command(Joints(90, 0, 0, 0));  // 0.4 s of motion
   // Held: the goal is where the servo stops braking, short of 90 deg, and it settles there.
   const HeadStatus held = ReadUntil(driver_.operator*(), [](const HeadStatus& s) {
-    return s.holding && !s.moving && std::abs(s.positions.pan - s.targets.pan) < 2 * kTick * kDeg;
+    return s.holding && !s.moving && std::abs(s.positions[0] - s.targets[0]) < 2 * kTick * kDeg;
   });
   ASSERT_TRUE(held.holding);
   EXPECT_EQ(held.watchdog_trips, 1);
-  EXPECT_NEAR(held.positions.pan, held.targets.pan, 2 * kTick * kDeg);
+  EXPECT_NEAR(held.positions[0], held.targets[0], 2 * kTick * kDeg);
   const ServoSnapshot pan = emulator_->Snapshot(1);
   EXPECT_LT(pan.goal, 2048 + 1024 - 50) << "the goal was pulled back from 90 deg";
   EXPECT_NEAR(pan.position, pan.goal, 2);
-  EXPECT_LT(held.positions.pan, 85 * kDeg);
+  EXPECT_LT(held.positions[0], 85 * kDeg);
 }
 
 TEST_F(DynamixelHeadTest, OverloadIsReportedAndTheHeadIsSafeUntilCleared) {
@@ -250,7 +251,7 @@ TEST_F(DynamixelHeadTest, EmergencyStopHoldsTheServos) {
   const HeadStatus stopped =
       ReadUntil(driver_.operator*(), [](const HeadStatus& s) { return !s.moving; });
   EXPECT_TRUE(stopped.emergency_stopped);
-  EXPECT_GT(stopped.positions.pan, -85 * kDeg);
+  EXPECT_GT(stopped.positions[0], -85 * kDeg);
   EXPECT_THROW(driver_->Command(Joints(0, 0, 0, 0)), CommandRejected);
   driver_->ClearFault();
   EXPECT_NO_THROW(driver_->Command(Joints(0, 0, 0, 0)));
@@ -264,7 +265,7 @@ TEST(DynamixelHeadOpenTest, AMissingServoIsNamed) {
   DynamixelOptions options;
   options.timeout_ms = 5;
   try {
-    OpenDynamixelHead(head::HeadDescription::FromYamlFile(kPopeye), port, options);
+    OpenDynamixelHead(head::HeadModel::FromFile(kPopeye), port, options);
     FAIL() << "opened a head without its right-eye servo";
   } catch (const HardwareError& error) {
     EXPECT_NE(std::string(error.what()).find("servo 4 (right) does not answer a ping"),
@@ -273,7 +274,7 @@ TEST(DynamixelHeadOpenTest, AMissingServoIsNamed) {
     EXPECT_NE(std::string(error.what()).find(port), std::string::npos) << error.what();
   }
   try {
-    OpenDynamixelHead(head::HeadDescription::FromYamlFile(kPopeye), "/dev/no-such-port");
+    OpenDynamixelHead(head::HeadModel::FromFile(kPopeye), "/dev/no-such-port");
     FAIL() << "opened a missing port";
   } catch (const HardwareError& error) {
     EXPECT_NE(std::string(error.what()).find("/dev/no-such-port"), std::string::npos);

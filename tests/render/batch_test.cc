@@ -48,7 +48,7 @@ TEST(RenderBatch, EachHeadEqualsASingleRenderOfItsState) {
   std::vector<BatchHead> heads(6);
   for (BatchHead& head : heads) {
     head.state = scene.InitialState();
-    head.state.joints = {angle(rng), angle(rng), angle(rng), angle(rng)};
+    head.state.joints = head::JointState::Popeye(angle(rng), angle(rng), angle(rng), angle(rng));
   }
   const int w = scene.FindCamera("left")->model.intrinsics().width();
   const int h = scene.FindCamera("left")->model.intrinsics().height();
@@ -81,7 +81,7 @@ TEST(RenderBatch, EachHeadEqualsItselfAloneToTheBitWhateverItsPlace) {
   std::vector<BatchHead> heads(5);
   for (BatchHead& head : heads) {
     head.state = scene.InitialState();
-    head.state.joints = {angle(rng), angle(rng), angle(rng), angle(rng)};
+    head.state.joints = head::JointState::Popeye(angle(rng), angle(rng), angle(rng), angle(rng));
   }
   const int w = scene.FindCamera("left")->model.intrinsics().width();
   const int h = scene.FindCamera("left")->model.intrinsics().height();
@@ -148,7 +148,7 @@ objects:
   std::vector<BatchHead> heads(3);
   for (std::size_t i = 0; i < heads.size(); ++i) {
     heads[i].state = scene.InitialState();
-    heads[i].state.joints = {0.01 * static_cast<double>(i), -0.1, 0.02, -0.02};
+    heads[i].state.joints = head::JointState::Popeye(0.01 * static_cast<double>(i), -0.1, 0.02, -0.02);
   }
   const std::size_t tile_bytes = 48 * 4096 * 3;
   std::vector<uint8_t> images[2], again[2];

@@ -589,7 +589,7 @@ TEST(MotionBlurTest, ASaccadeDuringTheExposureBlursTheEyesAStillHeadDoesNot) {
   // ~60 px at f = 1290 px. The blurred image differs from the sharp one of the same instant,
   // and is smoother: its mean absolute horizontal gradient falls.
   scene::SceneState moving = still;
-  moving.joint_velocities.pan = 5.0;
+  moving.joint_velocities[0] = 5.0;
   const std::vector<Frame> blurred = renderer->Render(moving, 1);
   const std::vector<Frame> sharp = reference->Render(moving, 1);
   for (int i = 0; i < 2; ++i) {
@@ -622,7 +622,7 @@ TEST(MotionBlurTest, ASaccadeDuringTheExposureBlursTheEyesAStillHeadDoesNot) {
   for (const auto& [centre_px, least, most] : {std::tuple{0.33, 1, 1}, std::tuple{4.0, 4, 7}}) {
     SCOPED_TRACE("image motion at the centre " + std::to_string(centre_px) + " px");
     scene::SceneState panning = still;
-    panning.joint_velocities.pan = centre_px / (f * exposure);
+    panning.joint_velocities[0] = centre_px / (f * exposure);
     const std::vector<Frame> got = renderer->Render(panning, 2);
     const std::vector<Frame> instant = reference->Render(panning, 2);
     for (int i = 0; i < 2; ++i) {
@@ -666,8 +666,8 @@ TEST(MotionBlurTest, ATurningCameraBlursThroughItsTurnAsDrawingEverySubFrameDoes
 
   // Both eyes turning at 2 rad/s (115 deg/s) over 10 ms: ~26 px of image motion.
   scene::SceneState turning = world.InitialState();
-  turning.joint_velocities.left = 2.0;
-  turning.joint_velocities.right = -2.0;
+  turning.joint_velocities[2] = 2.0;
+  turning.joint_velocities[3] = -2.0;
   const std::vector<Frame> want = reference->Render(turning, 0);
   const std::vector<Frame> got = renderer->Render(turning, 0);
   for (int i = 0; i < 2; ++i) {
@@ -695,7 +695,7 @@ TEST(MotionBlurTest, ATurningCameraBlursThroughItsTurnAsDrawingEverySubFrameDoes
   for (const double pan : {1.0, 5.0}) {
     SCOPED_TRACE("neck pan " + std::to_string(pan) + " rad/s");
     scene::SceneState panning = world.InitialState();
-    panning.joint_velocities.pan = pan;
+    panning.joint_velocities[0] = pan;
     const std::vector<Frame> all = reference->Render(panning, 1);
     const std::vector<Frame> bounded = renderer->Render(panning, 1);
     const std::vector<Frame> zero = exact_renderer->Render(panning, 1);
@@ -712,7 +712,7 @@ TEST(MotionBlurTest, ATurningCameraBlursThroughItsTurnAsDrawingEverySubFrameDoes
   // the top, as the scene passes draw), which a turn about a vertical axis alone would not show.
   {
     scene::SceneState tilting = world.InitialState();
-    tilting.joint_velocities.tilt = 1.0;
+    tilting.joint_velocities[1] = 1.0;
     const std::vector<Frame> all = reference->Render(tilting, 2);
     const std::vector<Frame> got_tilt = renderer->Render(tilting, 2);
     for (int i = 0; i < 2; ++i) {
@@ -797,8 +797,8 @@ TEST(MotionBlurTest, TheTurnFetchedOnTheCpuIsTheFinalPassWithinADn) {
     const scene::Scene world = SceneFrom(yaml);
     ASSERT_EQ(world.FindCamera("left")->sensor.read_noise_dn, noise ? 2.0 : 0.0);
     scene::SceneState turning = world.InitialState();
-    turning.joint_velocities.left = 2.0;
-    turning.joint_velocities.right = -2.0;
+    turning.joint_velocities[2] = 2.0;
+    turning.joint_velocities[3] = -2.0;
     RendererOptions options;
     options.noise = noise;
     options.turn_blur_on_cpu = false;
@@ -1103,7 +1103,7 @@ robot:
                                        "\n    right: " + camera + "\n");
   scene::SceneState state = world.InitialState();
   state.time = 0.1;
-  state.joint_velocities.pan = 2.0;
+  state.joint_velocities[0] = 2.0;
 
   std::unique_ptr<Renderer> switched = MakeRenderer(world);
   int64_t frame = 0;

@@ -299,10 +299,10 @@ TEST(RendererTest, ObjectsPartlyInViewAreDrawn) {
 // A scene with the head (robots/popeye.yaml), its two eye cameras, a world camera with lens
 // distortion, a checker ground, textures, a shiny sphere and every kind of light.
 scene::Scene RichScene() {
-  const head::HeadDescription head =
-      head::HeadDescription::FromYamlFile(SACCADE_SOURCE_DIR "/robots/popeye.yaml");
-  scene::Robot robot{head, head::JointState{}, true, {}, 100};
-  robot.parts.push_back(scene::RobotPart{scene::RobotPart::Link::kBase, At(Vector3d(0, 0, -0.3)),
+  const head::HeadModel head =
+      head::HeadModel::FromFile(SACCADE_SOURCE_DIR "/robots/popeye.yaml");
+  scene::Robot robot{head, head::JointState::Popeye(0, 0, 0, 0), true, {}, 100};
+  robot.parts.push_back(scene::RobotPart{head.tree().root(), At(Vector3d(0, 0, -0.3)),
                                          scene::MakeBox(Vector4f(0.2f, 0.2f, 0.2f, 1)),
                                          Vector3d(0.1, 0.1, 0.3)});
   auto texture = std::make_shared<scene::Texture>();
@@ -330,9 +330,9 @@ scene::Scene RichScene() {
                  At(Vector3d(2.0, 0.2, 1.1)), Vector3d::Constant(0.3));
   const std::vector<double> radtan = {-0.1, 0.01, 0.001, -0.002, 0.0};
   std::vector<scene::CameraSpec> cameras = {
-      {"left", head.left_camera(), scene::CameraMount::kLeftEye, geometry::Pose::Identity(),
+      {"left", head.camera(0).model, scene::CameraMount::kLeftEye, geometry::Pose::Identity(),
        geometry::ClipPlanes{0.05, 50.0}, scene::SensorSpec{}},
-      {"right", head.right_camera(), scene::CameraMount::kRightEye, geometry::Pose::Identity(),
+      {"right", head.camera(1).model, scene::CameraMount::kRightEye, geometry::Pose::Identity(),
        geometry::ClipPlanes{0.05, 50.0}, scene::SensorSpec{}},
       WorldCamera(
           "rig", geometry::Intrinsics(320, 240, 260.0, 255.0, 161.0, 118.0),
@@ -354,7 +354,7 @@ TEST(RendererTest, SubmitAndRetrieveReturnFramesInOrderWithTheirMetadata) {
   std::vector<scene::SceneState> states(3);
   for (int i = 0; i < 3; ++i) {
     states[i].time = 0.5 * i;
-    states[i].joints = head::JointState{0.1 * i, -0.05 * i, -0.02 * i, 0.03 * i};
+    states[i].joints = head::JointState::Popeye(0.1 * i, -0.05 * i, -0.02 * i, 0.03 * i);
   }
   EXPECT_EQ(renderer->InFlight(), 0);
   renderer->Submit(states[0], 10);
@@ -402,8 +402,10 @@ TEST(RendererTest, SubmitAndRetrieveReturnFramesInOrderWithTheirMetadata) {
       EXPECT_EQ(meta.has_joints, eye);
       if (eye) {
         EXPECT_EQ(meta.joints,
-                  (std::array<double, 4>{states[i].joints.pan, states[i].joints.tilt,
-                                         states[i].joints.left, states[i].joints.right}));
+                  (std::vector<double>{states[i].joints[0], states[i].joints[1],
+                                       states[i].joints[2], states[i].joints[3]}));
+        ASSERT_TRUE(meta.joint_names);
+        EXPECT_EQ(*meta.joint_names, *head::JointState::PopeyeNames());
       }
       EXPECT_EQ(got[i][c].color->width(), camera.model.intrinsics().width());
       EXPECT_EQ(got[i][c].color->height(), camera.model.intrinsics().height());
@@ -426,7 +428,7 @@ TEST(RendererTest, SameStateRendersBitIdenticalImages) {
   options.msaa_samples = 4;
   const std::unique_ptr<Renderer> renderer = MakeRenderer(world, options);
   scene::SceneState state = world.InitialState();
-  state.joints.pan = 0.2;
+  state.joints[0] = 0.2;
   const std::vector<Frame> first = renderer->Render(state, 0);
   const std::vector<Frame> second = renderer->Render(state, 1);
   const std::vector<Frame> other = MakeRenderer(world, options)->Render(state, 0);
@@ -454,7 +456,7 @@ TEST(RendererTest, FramesStayValidWhileTheRendererGoesOn) {
   const std::vector<uint8_t> copy(kept[0].color->data(),
                                   kept[0].color->data() + kept[0].color->size_bytes());
   for (int i = 1; i < 6; ++i) {
-    state.joints.pan = 0.1 * i;
+    state.joints[0] = 0.1 * i;
     const std::vector<Frame> frames = renderer->Render(state, i);
     EXPECT_NE(frames[0].color.get(), kept[0].color.get());
     EXPECT_EQ(frames[0].color->metadata().frame_index, i);

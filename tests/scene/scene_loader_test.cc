@@ -204,16 +204,16 @@ TEST_F(SceneLoaderTest, ValidSceneLoadsEverySection) {
 
   // The robot.
   EXPECT_FALSE(scene.robot()->visible);
-  EXPECT_NEAR(scene.robot()->initial_joints.pan, 10 * kDeg, kParseTolerance);
-  EXPECT_NEAR(scene.robot()->initial_joints.tilt, -5 * kDeg, kParseTolerance);
-  EXPECT_NEAR(scene.robot()->initial_joints.left, -3 * kDeg, kParseTolerance);
-  EXPECT_NEAR(scene.robot()->initial_joints.right, 3 * kDeg, kParseTolerance);
+  EXPECT_NEAR(scene.robot()->initial_joints[0], 10 * kDeg, kParseTolerance);
+  EXPECT_NEAR(scene.robot()->initial_joints[1], -5 * kDeg, kParseTolerance);
+  EXPECT_NEAR(scene.robot()->initial_joints[2], -3 * kDeg, kParseTolerance);
+  EXPECT_NEAR(scene.robot()->initial_joints[3], 3 * kDeg, kParseTolerance);
   EXPECT_EQ(scene.InitialState().joints, scene.robot()->initial_joints);
   EXPECT_EQ(scene.InitialState().time, 0.0);
   EXPECT_FALSE(scene.robot()->parts.empty());
   // The description's servo mapping survives the scene's pose and calibrations (hw.head).
-  ASSERT_TRUE(scene.robot()->head.HasServos());
-  EXPECT_EQ(scene.robot()->head.servo(head::Joint::kTilt)->direction, -1);
+  for (int j = 0; j < 4; ++j) ASSERT_TRUE(scene.robot()->head.joint(j).servo.has_value());
+  EXPECT_EQ(scene.robot()->head.joint(1).servo->direction, -1);
 
   // Cameras: the eyes first, then the file's, in order.
   ASSERT_EQ(scene.cameras().size(), 4u);
@@ -221,7 +221,7 @@ TEST_F(SceneLoaderTest, ValidSceneLoadsEverySection) {
   EXPECT_EQ(scene.cameras()[0].mount, CameraMount::kLeftEye);
   EXPECT_EQ(scene.cameras()[1].name, "right");
   EXPECT_EQ(scene.cameras()[1].mount, CameraMount::kRightEye);
-  EXPECT_EQ(scene.cameras()[0].model, scene.robot()->head.left_camera());
+  EXPECT_EQ(scene.cameras()[0].model, scene.robot()->head.camera(0).model);
   const CameraSpec* rig = scene.FindCamera("rig");
   ASSERT_NE(rig, nullptr);
   EXPECT_EQ(rig->mount, CameraMount::kWorld);
@@ -553,9 +553,9 @@ TEST_F(SceneLoaderTest, CalibrationsFromFilesInEveryFormat) {
     const CameraSpec* right = scene.FindCamera("right");
     ASSERT_NE(right, nullptr);
     EXPECT_EQ(right->model.intrinsics(), model.intrinsics());
-    EXPECT_EQ(scene.robot()->head.right_camera().intrinsics(), model.intrinsics());
+    EXPECT_EQ(scene.robot()->head.camera(1).model.intrinsics(), model.intrinsics());
     EXPECT_EQ(right->clip.near, 0.02);
-    EXPECT_EQ(scene.FindCamera("left")->model, scene.robot()->head.left_camera());
+    EXPECT_EQ(scene.FindCamera("left")->model, scene.robot()->head.camera(0).model);
   }
 }
 
@@ -570,7 +570,7 @@ TEST_F(SceneLoaderTest, RobotPoseReplacesTheDescriptions) {
   EXPECT_TRUE(Load(kValid).robot()->head.X_WB().translation().isApprox(Eigen::Vector3d(0, 0, 1.2)));
 }
 
-// A sensor block on a world camera and on an eye camera (robot.cameras.left).
+// A sensor block on a world camera and on an eye camera (robot.cameras[2]).
 std::string WithSensors(const std::string& world_sensor, const std::string& eye_sensor) {
   std::string text = Replace(kValid, "    clip: {near: 0.1, far: 20}\n",
                              "    clip: {near: 0.1, far: 20}\n    sensor:\n" + world_sensor);
@@ -666,23 +666,23 @@ TEST_F(SceneLoaderTest, BadSensorsNameTheFileLineAndKey) {
   ExpectError(WithSensors("      [1, 2]\n", kEyeSensor), "[1, 2]", "cameras[0].sensor",
               {"expected a sensor {exposure | exposure_ms", "got a list of 2"});
 
-  // Eye camera: robot.cameras.left.sensor.
+  // Eye camera: robot.cameras[2].sensor.
   const auto eye = [&](const std::string& from, const std::string& to) {
     return WithSensors(kWorldSensor, Replace(kEyeSensor, from, to));
   };
   ExpectError(eye("exposure_ms: 8", "exposure_ms: -8"), "exposure_ms: -8",
-              "robot.cameras.left.sensor.exposure_ms",
+              "robot.cameras[2].sensor.exposure_ms",
               {"expected an exposure in milliseconds in [0, 1000]", "got '-8'"});
   ExpectError(eye("exposure_ms: 8\n", "exposure_ms: 8\n        exposure: 0.008\n"),
-              "exposure_ms: 8", "robot.cameras.left.sensor.exposure_ms", {"not both"});
+              "exposure_ms: 8", "robot.cameras[2].sensor.exposure_ms", {"not both"});
   ExpectError(eye("read_noise_dn: 2", "read_noise_dn: .NaN"), "read_noise_dn: .NaN",
-              "robot.cameras.left.sensor.read_noise_dn", {"expected a finite number"});
-  ExpectError(eye("seed: 42", "seed: -42"), "seed: -42", "robot.cameras.left.sensor.seed",
+              "robot.cameras[2].sensor.read_noise_dn", {"expected a finite number"});
+  ExpectError(eye("seed: 42", "seed: -42"), "seed: -42", "robot.cameras[2].sensor.seed",
               {"expected an integer in [0, 18446744073709551615]", "got '-42'"});
   ExpectError(eye("seed: 42", "seed: 42\n        noise: 1"), "noise: 1",
-              "robot.cameras.left.sensor.noise", {"unknown key 'noise'"});
+              "robot.cameras[2].sensor.noise", {"unknown key 'noise'"});
   ExpectError(eye("exposure_ms: 8", "exposure_ms: 8\n        blur_samples: 0"), "blur_samples: 0",
-              "robot.cameras.left.sensor.blur_samples", {"expected an integer in [1, 64]"});
+              "robot.cameras[2].sensor.blur_samples", {"expected an integer in [1, 64]"});
 }
 
 }  // namespace

@@ -142,7 +142,7 @@ TEST(ShippedScenes, BenchLoadsAndSharesTheMugModel) {
     EXPECT_TRUE(camera.sensor.HasBlur()) << camera.name;
   }
   // The eye cameras' calibrations replace the description's, with its intrinsics.
-  const auto popeye = head::HeadDescription::FromYamlFile(testing::kPopeye);
+  const auto popeye = head::HeadDescription::FromYamlFile(testing::kPopeye);  // its own file
   EXPECT_EQ(scene.cameras()[0].model.intrinsics(), popeye.left_camera().intrinsics());
   EXPECT_EQ(scene.cameras()[1].model.intrinsics(), popeye.right_camera().intrinsics());
   EXPECT_EQ(scene.ground().pattern, Ground::Pattern::kChecker);
@@ -168,7 +168,7 @@ TEST(ShippedScenes, BenchLoadsAndSharesTheMugModel) {
 TEST(ShippedScenes, BenchPortraitsAndMugsAreInViewOfBothEyesAtRest) {
   const Scene& scene = Bench();
   const SceneState state = scene.InitialState();
-  EXPECT_EQ(state.joints, head::JointState{});
+  EXPECT_EQ(state.joints, head::JointState::Popeye(0, 0, 0, 0));
   for (const CameraSpec& camera : scene.cameras()) {
     for (const Object& object : scene.objects()) {
       const geometry::Pose X_WO = scene.ObjectPose(object, state);
@@ -198,8 +198,10 @@ TEST(CameraPose, EyeCamerasFollowForwardKinematics) {
   for (int i = 0; i < 20; ++i) {
     SceneState state;
     state.time = i;
-    state.joints = {angle(rng), angle(rng), angle(rng), angle(rng)};
-    const head::HeadFrames frames = head::ForwardKinematics(scene.robot()->head, state.joints);
+    state.joints = head::JointState::Popeye(angle(rng), angle(rng), angle(rng), angle(rng));
+    const head::PopeyeJoints q{state.joints[0], state.joints[1], state.joints[2], state.joints[3]};
+    const head::HeadFrames frames =
+        head::ForwardKinematics(*scene.robot()->head.AppendixAHead(), q);
     EXPECT_TRUE(scene.CameraPose(left, state).isApprox(frames.X_WCamLeft, kTolerance));
     EXPECT_TRUE(scene.CameraPose(right, state).isApprox(frames.X_WCamRight, kTolerance));
   }
@@ -233,21 +235,11 @@ TEST(CameraPose, LookAtPointsTheOpticalAxisAtTheTarget) {
             overview.model.intrinsics().cx());
 }
 
-// The pose of a robot part's frame in the world.
-geometry::Pose LinkPose(const head::HeadFrames& f, RobotPart::Link link) {
-  switch (link) {
-    case RobotPart::Link::kBase:
-      return f.X_WB;
-    case RobotPart::Link::kNeck:
-      return f.X_WN;
-    case RobotPart::Link::kCyclopean:
-      return f.X_WC;
-    case RobotPart::Link::kLeftEye:
-      return f.X_WL;
-    case RobotPart::Link::kRightEye:
-      return f.X_WR;
-  }
-  return geometry::Pose::Identity();
+// The pose of a robot part's link in the world.
+geometry::Pose LinkPose(const head::HeadModel& head, const head::JointState& q, int link) {
+  std::vector<geometry::Pose> X_WL;
+  head.ForwardKinematics(q.empty() ? head.HomePosture() : q.values(), &X_WL);
+  return X_WL[link];
 }
 
 TEST(RobotBody, EyesCannotSeeTheirOwnEyeNorTheHeadAnywhereWithinTheLimits) {
@@ -259,20 +251,21 @@ TEST(RobotBody, EyesCannotSeeTheirOwnEyeNorTheHeadAnywhereWithinTheLimits) {
     return std::uniform_real_distribution<double>(l.min, l.max)(rng);
   };
   for (int trial = 0; trial < 200; ++trial) {
-    head::JointState q;
-    for (const head::Joint joint : head::kAllJoints) q[joint] = uniform(robot.head.limits(joint));
-    if (trial == 0) q = {};
-    SceneState state{0.0, q};
-    const head::HeadFrames frames = head::ForwardKinematics(robot.head, q);
+    head::JointState q = head::JointState::Popeye(0, 0, 0, 0);
+    for (int joint = 0; joint < 4; ++joint) q[joint] = uniform(robot.head.joint(joint).limits);
+    if (trial == 0) q = head::JointState::Popeye(0, 0, 0, 0);
+    SceneState state{0.0, q, {}};
+    const int left_eye = robot.head.tree().FindLink("left_eye_link");
+    const int right_eye = robot.head.tree().FindLink("right_eye_link");
     for (const RobotPart& part : robot.parts) {
-      const geometry::Pose X_WPart = LinkPose(frames, part.link) * part.X_LinkPart;
+      const geometry::Pose X_WPart = LinkPose(robot.head, q, part.link) * part.X_LinkPart;
       for (const Eigen::Vector3d& p : GridPoints(part.model->bounds)) {
         const Eigen::Vector3d p_W = X_WPart * Eigen::Vector3d(p.cwiseProduct(part.scale));
         for (const char* name : {"left", "right"}) {
           const CameraSpec& camera = *scene.FindCamera(name);
           const bool own_eye =
-              (part.link == RobotPart::Link::kLeftEye && camera.mount == CameraMount::kLeftEye) ||
-              (part.link == RobotPart::Link::kRightEye && camera.mount == CameraMount::kRightEye);
+              (part.link == left_eye && camera.mount == CameraMount::kLeftEye) ||
+              (part.link == right_eye && camera.mount == CameraMount::kRightEye);
           const Eigen::Vector3d p_C = scene.CameraPose(camera, state).inverse() * p_W;
           // Its own eye lies behind its optical centre: never in the view, whatever the near
           // plane.
@@ -281,7 +274,7 @@ TEST(RobotBody, EyesCannotSeeTheirOwnEyeNorTheHeadAnywhereWithinTheLimits) {
           }
           EXPECT_FALSE(SeenAt(scene, camera, state, p_W))
               << name << " sees part of the robot (link " << static_cast<int>(part.link)
-              << ") at joints " << q.pan << " " << q.tilt << " " << q.left << " " << q.right;
+              << ") at joints " << q[0] << " " << q[1] << " " << q[2] << " " << q[3];
         }
       }
     }
@@ -311,11 +304,11 @@ TEST(RobotBody, IsSizedFromTheHalfBaseline) {
 
 class SceneConstructorTest : public ::testing::Test {
  protected:
-  SceneConstructorTest() : head_(head::HeadDescription::FromYamlFile(testing::kPopeye)) {
+  SceneConstructorTest() : head_(head::HeadModel::FromFile(testing::kPopeye)) {
     objects_.push_back(Object{"a", 1, MakeBox({1, 0, 0, 1}), {1, 1, 1}, Motion()});
     objects_.push_back(Object{"b", 2, MakeSphere({0, 1, 0, 1}), {1, 1, 1}, Motion()});
     cameras_.push_back(CameraSpec{"rig",
-                                  head_.left_camera(),
+                                  head_.camera(0).model,
                                   CameraMount::kWorld,
                                   geometry::Pose::Identity(),
                                   {0.05, 50.0},
@@ -325,7 +318,7 @@ class SceneConstructorTest : public ::testing::Test {
     return Scene({0.5f, 0.5f, 0.5f}, lights_, ground_, objects_, cameras_, robot_);
   }
 
-  head::HeadDescription head_;
+  head::HeadModel head_;
   std::vector<Light> lights_{Light{}};
   Ground ground_;
   std::vector<Object> objects_;
@@ -336,7 +329,7 @@ class SceneConstructorTest : public ::testing::Test {
 TEST_F(SceneConstructorTest, ValidSceneBuilds) {
   const Scene scene = Make();
   EXPECT_EQ(scene.models().size(), 2u);
-  EXPECT_EQ(scene.InitialState().joints, head::JointState{});
+  EXPECT_EQ(scene.InitialState().joints, head::JointState::Popeye(0, 0, 0, 0));
   EXPECT_TRUE(
       scene.CameraPose(cameras_[0], scene.InitialState()).isApprox(geometry::Pose::Identity()));
 }
@@ -403,12 +396,12 @@ TEST_F(SceneConstructorTest, RejectsBadCameras) {
   cameras_[0].X_WC = geometry::Pose::Identity();
   cameras_[0].mount = CameraMount::kLeftEye;  // no robot
   EXPECT_THROW(Make(), InvalidArgument);
-  robot_.emplace(Robot{head_, {}, true, {}, 3});
+  robot_.emplace(Robot{head_, head_.Home(), true, {}, 3});
   EXPECT_NO_THROW(Make());
   robot_->id = 2;  // an object's
   EXPECT_THROW(Make(), InvalidArgument);
   robot_->id = 3;
-  robot_->initial_joints.pan = 10.0;  // beyond its limits
+  robot_->initial_joints[0] = 10.0;  // beyond its limits
   EXPECT_THROW(Make(), InvalidArgument);
 }
 

@@ -45,11 +45,11 @@ FaceDetection DetectAstronaut(const Image& image) {
 
 // The scene's initial state, the head fixating the astronaut's face.
 scene::SceneState FixatingTheAstronaut() {
-  const head::IkResult ik =
-      head::SolveFixation(Portraits().robot()->head, FaceCentreWorld("astronaut"));
+  const head::HeadModel& head = Portraits().robot()->head;
+  const head::IkResult ik = head::SolveFixation(*head.AppendixAHead(), FaceCentreWorld("astronaut"));
   EXPECT_TRUE(ik.reachable());
   scene::SceneState state = Portraits().InitialState();
-  state.joints = ik.joints;
+  state.joints = head.State(ik.joints);
   return state;
 }
 
@@ -65,8 +65,8 @@ TEST(CamShiftTracker, KeepsTheFaceWhileTheHeadPans) {
   // in all) and tilting 0.2 degrees a frame.
   for (int i = 1; i <= 10; ++i) {
     state.time = i / 30.0;
-    state.joints.pan = start.pan + 0.6 * kDeg * i;
-    state.joints.tilt = start.tilt + 0.2 * kDeg * i;
+    state.joints[0] = start[0] + 0.6 * kDeg * i;
+    state.joints[1] = start[1] + 0.2 * kDeg * i;
     frame = RenderState(state, i);
     const TrackState track = tracker.Update(frame.left);
     const cv::Point2d truth = ProjectTruth(frame.left, face);
@@ -149,7 +149,7 @@ TEST(CamShiftTracker, TracksAsOpenCvsCamShiftOverTheWholeImage) {
   // The head panning: the face ~13 px a frame, once ~50.
   for (int i = 1; i <= 6; ++i) {
     state.time = i / 30.0;
-    state.joints.pan = start.pan + (i + (i >= 4 ? 3 : 0)) * 0.6 * kDeg;
+    state.joints[0] = start[0] + (i + (i >= 4 ? 3 : 0)) * 0.6 * kDeg;
     frame = RenderState(state, i);
     const TrackState track = tracker.Update(frame.left);
     const auto [centre, window, mass] = reference.Update(frame.left);
@@ -201,7 +201,7 @@ TEST(CamShiftTracker, ReportsTheLossWhenTheFaceLeavesTheView) {
   CamShiftTracker tracker;
   ASSERT_TRUE(tracker.Start(frame.left, DetectAstronaut(frame.left).box));
   // A saccade far up: the face is out of the image (the sky fills it).
-  state.joints.tilt = start.tilt + 30 * kDeg;
+  state.joints[1] = start[1] + 30 * kDeg;
   frame = RenderState(state, 1);
   const TrackState track = tracker.Update(frame.left);
   std::cout << "after the saccade: " << track.reason << "\n";

@@ -70,11 +70,12 @@ inline StereoFrame RenderState(const scene::SceneState& state, int64_t frame_ind
 /// Renders with the head fixating p_W (symmetric vergence IK); the IK must succeed.
 inline StereoFrame RenderFixating(const Eigen::Vector3d& p_W, double time = 0.0,
                                   int64_t frame_index = 0) {
-  const head::IkResult ik = head::SolveFixation(Portraits().robot()->head, p_W);
+  const head::HeadModel& head = Portraits().robot()->head;
+  const head::IkResult ik = head::SolveFixation(*head.AppendixAHead(), p_W);
   EXPECT_TRUE(ik.reachable()) << ik.message;
   scene::SceneState state = Portraits().InitialState();
   state.time = time;
-  state.joints = ik.joints;
+  state.joints = head.State(ik.joints);
   return RenderState(state, frame_index);
 }
 

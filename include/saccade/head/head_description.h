@@ -20,6 +20,7 @@
 
 #include "saccade/geometry/camera_model.h"
 #include "saccade/geometry/pose.h"
+#include "saccade/head/joint_state.h"
 
 namespace saccade::head {
 
@@ -37,6 +38,14 @@ struct PopeyeJoints {
   double right = 0.0;
   double& operator[](Joint joint);
   double operator[](Joint joint) const;
+  double& operator[](int joint) { return (*this)[static_cast<Joint>(joint)]; }
+  double operator[](int joint) const { return (*this)[static_cast<Joint>(joint)]; }
+  /// POPEYE's joints of a JointState, by name (throws InvalidArgument when one is missing).
+  static PopeyeJoints From(const JointState& q) {
+    return {q.at("pan"), q.at("tilt"), q.at("left"), q.at("right")};
+  }
+  /// As a JointState named pan, tilt, left, right (POPEYE's legacy code and tests).
+  operator JointState() const { return JointState::Popeye(pan, tilt, left, right); }
   bool operator==(const PopeyeJoints&) const = default;
 };
 
