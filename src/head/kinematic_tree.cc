@@ -157,6 +157,19 @@ KinematicTree KinematicTree::Build(const std::vector<std::string>& links,
     tree.joints_.push_back(joint);
   }
 
+  tree.OrderFromTheRoot(source, link_lines);
+  tree.AssignVariables(joints, source);
+  return tree;
+}
+
+// Exactly one root, every link reachable from it, and the joints parents first.
+void KinematicTree::OrderFromTheRoot(const std::string& source,
+                                     const std::vector<int>& link_lines) {
+  KinematicTree& tree = *this;
+  const std::vector<std::string>& links = links_;
+  const auto link_line = [&](int link) {
+    return link < static_cast<int>(link_lines.size()) ? link_lines[link] : 0;
+  };
   // Exactly one root, and every link reachable from it (a cycle leaves its links unreached:
   // each has a parent, so they are not roots).
   std::vector<int> roots;
@@ -200,7 +213,15 @@ KinematicTree KinematicTree::Build(const std::vector<std::string>& links,
   std::stable_sort(tree.order_.begin(), tree.order_.end(), [&](int a, int b) {
     return depth[tree.joints_[a].child] < depth[tree.joints_[b].child];
   });
+}
 
+// The actuated joints' variables, then each mimic resolved to the variable it follows.
+void KinematicTree::AssignVariables(const std::vector<JointSpec>& joints,
+                                    const std::string& source) {
+  KinematicTree& tree = *this;
+  const TreeChecker check(source, joints);
+  std::map<std::string, int> joint_index;
+  for (int j = 0; j < static_cast<int>(joints.size()); ++j) joint_index.emplace(joints[j].name, j);
   // Variables, then mimics resolved to them.
   for (int j = 0; j < tree.num_joints(); ++j) {
     Joint& joint = tree.joints_[j];
@@ -238,7 +259,6 @@ KinematicTree KinematicTree::Build(const std::vector<std::string>& links,
     joint.multiplier = multiplier;
     joint.offset = offset;
   }
-  return tree;
 }
 
 int KinematicTree::FindLink(const std::string& name) const {

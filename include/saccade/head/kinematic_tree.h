@@ -136,6 +136,9 @@ class KinematicTree {
 
  private:
   KinematicTree() = default;
+  // Build's steps (kinematic_tree.cc).
+  void OrderFromTheRoot(const std::string& source, const std::vector<int>& link_lines);
+  void AssignVariables(const std::vector<JointSpec>& joints, const std::string& source);
 
   std::vector<std::string> links_;
   std::vector<int> parent_joint_;
