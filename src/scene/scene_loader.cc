@@ -497,13 +497,13 @@ class SceneReader {
     e.ExpectMap({"head", "id", "pose", "joints", "joints_deg", "visible", "cameras"},
                 "a robot {head, joints_deg, pose, visible, cameras}");
     const Entry head_entry = e.Get("head");
-    const fs::path head_path = ResolveFile(head_entry, "head file");
+    const fs::path head_path = ResolveFile(head_entry, "head description");
     std::optional<head::HeadModel> model;
     try {
       model.emplace(head::HeadModel::FromFile(head_path));
     } catch (const Error& error) {
       head_entry.Fail(
-          fmt::format("cannot load head file '{}': {}", head_entry.AsString(), error.what()));
+          fmt::format("cannot load head description '{}': {}", head_entry.AsString(), error.what()));
     }
     if (const auto pose = e.Find("pose")) model.emplace(model->WithPose(ReadPose(*pose)));
 

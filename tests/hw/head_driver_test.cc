@@ -80,7 +80,7 @@ TEST(HeadDriverTest, PursuitFasterThanTheVelocityLimitIsLimited) {
   SimHeadDriver driver(head, {.watchdog_s = 0});
   head::JointState velocity = head::JointState::Popeye(0, 0, 0, 0);
   velocity[0] = -1000 * kDeg;
-  const CommandReport report = driver.Command({}, velocity);
+  const CommandReport report = driver.Command(head.Home(), velocity);
   EXPECT_TRUE(report.velocity_limited[0]);
   EXPECT_DOUBLE_EQ(report.sent_velocities[0], -head.joint(0).limits.max_velocity);
   EXPECT_NE(report.description.find("pan velocity -1000.0 deg/s limited to -300.0 deg/s"),
