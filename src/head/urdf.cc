@@ -11,7 +11,6 @@
 #include <cstdlib>
 #include <fstream>
 #include <mutex>
-#include <regex>
 #include <sstream>
 
 #include "saccade/core/error.h"
@@ -172,10 +171,21 @@ void RefuseCycles(const std::string& source, const ElementLines& lines) {
       fmt::format("urdfdom cannot read it: {}", errors.empty() ? "no reason given" : errors);
   // The joint first: "child link [skull] of joint [tilt] not found" is the joint's fault.
   for (const std::string kind : {"joint", "link"}) {
-    const std::regex element(kind + R"( \[([^\]]+)\])", std::regex::icase);
-    std::smatch match;
-    if (!std::regex_search(errors, match, element)) continue;
-    const std::string name = match[1].str();
+    // "<kind> [NAME]", either case of the kind's first letter (urdfdom writes both). Plain
+    // string search: std::regex trips GCC 12's -Wmaybe-uninitialized under the sanitizers.
+    std::string name;
+    const std::string capital =
+        std::string(1, static_cast<char>(kind[0] - 'a' + 'A')) + kind.substr(1);
+    for (const std::string& prefix : {kind + " [", capital + " ["}) {
+      const size_t at = errors.find(prefix);
+      if (at == std::string::npos) continue;
+      const size_t end = errors.find(']', at + prefix.size());
+      if (end != std::string::npos) {
+        name = errors.substr(at + prefix.size(), end - at - prefix.size());
+      }
+      break;
+    }
+    if (name.empty()) continue;
     int line = kind == "joint" ? lines.Line(name) : 0;
     if (kind == "link") {
       for (size_t l = 0; l < lines.links.size(); ++l) {
