@@ -15,6 +15,7 @@
 #include <optional>
 #include <string>
 
+#include "fuzz_checks.h"
 #include "saccade/core/error.h"
 #include "saccade/head/head_description.h"
 #include "saccade/head/kinematics.h"
@@ -25,17 +26,8 @@ namespace {
 
 constexpr std::size_t kMaxInput = 16 * 1024;
 
-void Check(bool condition) {
-  if (!condition) std::abort();  // libFuzzer reports it with the input
-}
-
-// Finite, with a rotation whose columns are orthonormal (to what double rounding allows).
-void CheckPose(const saccade::geometry::Pose& X) {
-  const Eigen::Matrix4d m = X.matrix();
-  Check(m.allFinite());
-  const Eigen::Matrix3d R = m.topLeftCorner<3, 3>();
-  Check((R.transpose() * R - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff() < 1e-9);
-}
+using saccade::fuzz::Check;
+using saccade::fuzz::CheckPose;
 
 }  // namespace
 

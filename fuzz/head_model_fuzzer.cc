@@ -19,6 +19,7 @@
 #include <string>
 #include <vector>
 
+#include "fuzz_checks.h"
 #include "saccade/core/error.h"
 #include "saccade/core/log.h"
 #include "saccade/head/head_model.h"
@@ -29,16 +30,8 @@ namespace {
 
 constexpr std::size_t kMaxInput = 16 * 1024;
 
-void Check(bool condition) {
-  if (!condition) std::abort();  // libFuzzer reports it with the input
-}
-
-void CheckPose(const saccade::geometry::Pose& X) {
-  const Eigen::Matrix4d m = X.matrix();
-  Check(m.allFinite());
-  const Eigen::Matrix3d R = m.topLeftCorner<3, 3>();
-  Check((R.transpose() * R - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff() < 1e-9);
-}
+using saccade::fuzz::Check;
+using saccade::fuzz::CheckPose;
 
 std::filesystem::path RobotsDir() {
   const char* env = std::getenv("SACCADE_FUZZ_ROBOTS_DIR");

@@ -18,6 +18,7 @@
 #include <string>
 #include <vector>
 
+#include "fuzz_checks.h"
 #include "saccade/core/error.h"
 #include "saccade/core/log.h"
 #include "saccade/head/urdf.h"
@@ -28,16 +29,8 @@ namespace {
 
 constexpr std::size_t kMaxInput = 32 * 1024;
 
-void Check(bool condition) {
-  if (!condition) std::abort();  // libFuzzer reports it with the input
-}
-
-void CheckPose(const saccade::geometry::Pose& X) {
-  const Eigen::Matrix4d m = X.matrix();
-  Check(m.allFinite());
-  const Eigen::Matrix3d R = m.topLeftCorner<3, 3>();
-  Check((R.transpose() * R - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff() < 1e-9);
-}
+using saccade::fuzz::Check;
+using saccade::fuzz::CheckPose;
 
 }  // namespace
 
