@@ -106,7 +106,7 @@ class geometry:
     @staticmethod
     def triangulate_dlt(view_a: Matrix, xy_a: Vector, view_b: Matrix, xy_b: Vector) -> "geometry.TriangulationResult": ...
 
-JointsLike = Union["head.JointState", Sequence[float], npt.NDArray[np.float64]]
+JointsLike = Union["head.JointState", Dict[str, float], Sequence[float], npt.NDArray[np.float64]]
 
 class head:
     class JointState:
@@ -167,6 +167,39 @@ class head:
                        seed: JointsLike = ...) -> "head.IkResult": ...
     @staticmethod
     def solve_fixation_closed_form(head: "head.HeadDescription", p_W: Vector) -> "head.IkResult": ...
+    class FixationResult:
+        joints: npt.NDArray[np.float64]
+        reachability: str
+        reachable: bool
+        axis_error: float
+        iterations: int
+        mid_axis: bool
+        message: str
+    class Head:
+        @staticmethod
+        def from_file(path: Any) -> "head.Head": ...
+        @staticmethod
+        def from_yaml_string(text: str, source: str = "<string>", folder: Any = ".") -> "head.Head": ...
+        name: str
+        joint_names: List[str]
+        num_joints: int
+        driven_joints: List[str]
+        limits_min: npt.NDArray[np.float64]
+        limits_max: npt.NDArray[np.float64]
+        max_velocity: npt.NDArray[np.float64]
+        X_WB: Matrix
+        left_camera: "geometry.CameraModel"
+        right_camera: "geometry.CameraModel"
+        urdf: str
+        can_verge: bool
+        def joint(self, name: str) -> Dict[str, Any]: ...
+        def home(self) -> npt.NDArray[np.float64]: ...
+        def within_limits(self, joints: JointsLike) -> bool: ...
+        def check_limits(self, joints: JointsLike) -> None: ...
+        def link_poses(self, joints: Optional[JointsLike] = None) -> Dict[str, Matrix]: ...
+        def camera_poses(self, joints: Optional[JointsLike] = None) -> Tuple[Matrix, Matrix]: ...
+        def fixate(self, p_W: Vector, seed: Optional[JointsLike] = None) -> "head.FixationResult": ...
+        def axis_errors(self, joints: npt.ArrayLike, p_W: npt.ArrayLike) -> npt.NDArray[np.float64]: ...
 
 class scene:
     class SceneState:
@@ -192,7 +225,7 @@ class scene:
         objects: List["scene.Object"]
         cameras: List["scene.CameraSpec"]
         background: npt.NDArray[np.float32]
-        head: Optional["head.HeadDescription"]
+        head: Optional["head.Head"]
         robot_id: int
         def initial_state(self) -> "scene.SceneState": ...
         def camera_pose(self, camera: str, state: "scene.SceneState") -> Matrix: ...

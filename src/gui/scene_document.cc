@@ -58,7 +58,7 @@ std::string ModelBinary(const scene::Model& model) {
 
 json FramesJson(const head::HeadModel& head, const head::JointState& joints) {
   std::vector<geometry::Pose> X_WL;
-  head.ForwardKinematics(joints.empty() ? head.HomePosture() : head.Arrange(joints).values(),
+  head.ForwardKinematics(head.Posture(joints),
                          &X_WL);
   json links = json::object();
   for (int l = 0; l < head.tree().num_links(); ++l) links[head.tree().link_name(l)] = ToJson(X_WL[l]);

@@ -343,6 +343,14 @@ JointState HeadModel::Arrange(const JointState& joints) const {
   return joints.ArrangedAs(joint_names_);
 }
 
+Eigen::VectorXd HeadModel::Posture(const JointState& joints) const {
+  if (joints.empty()) return HomePosture();
+  if (joints.shared_names() == joint_names_ || joints.names() == *joint_names_) {
+    return joints.values();
+  }
+  return joints.ArrangedAs(joint_names_).values();
+}
+
 HeadModel HeadModel::FromDescription(const HeadDescription& legacy) {
   const HeadGeometry& g = legacy.geometry();
   const Eigen::Vector3d z = Eigen::Vector3d::UnitZ();
@@ -421,7 +429,7 @@ std::optional<HeadDescription> HeadModel::AppendixAHead() const {
 
 std::array<geometry::Pose, 2> HeadModel::CameraPoses(const JointState& joints) const {
   std::vector<geometry::Pose> X_WL;
-  ForwardKinematics(joints.empty() ? HomePosture() : Arrange(joints).values(), &X_WL);
+  ForwardKinematics(Posture(joints), &X_WL);
   return {CameraPose(0, X_WL), CameraPose(1, X_WL)};
 }
 

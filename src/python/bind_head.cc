@@ -1,5 +1,9 @@
-// saccade.head: the stereo head's description, forward and inverse kinematics (paper
-// appendix A). Joint states are PopeyeJoints or any sequence pan, tilt, left, right (rad).
+// saccade.head: any stereo head (Head: a head file, with or without a URDF; its forward
+// kinematics and fixation) and POPEYE's description with the kinematics of the paper's
+// appendix A. POPEYE's joint states are PopeyeJoints or any sequence pan, tilt, left, right
+// (rad); any head's are a dict of joint name to value, or a sequence in the head's order.
+#include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <pybind11/eigen.h>
 #include <pybind11/operators.h>
 #include <pybind11/stl.h>
@@ -7,7 +11,9 @@
 
 #include "python/internal_bindings.h"
 #include "saccade/core/error.h"
+#include "saccade/head/fixation.h"
 #include "saccade/head/head_description.h"
+#include "saccade/head/head_model.h"
 #include "saccade/head/kinematics.h"
 
 namespace saccade::python {
@@ -179,6 +185,211 @@ void BindInverseKinematics(py::module_& m) {
         "Closed form of eqs. 10-13 (symmetric vergence, D = H = 0).");
 }
 
+
+// A joint state for `head` from Python: a dict by name, a saccade.JointState (POPEYE), or a
+// sequence of num_joints values in the head's order.
+Eigen::VectorXd PostureOf(const head::HeadModel& head, const py::handle& joints,
+                          const char* who) {
+  if (joints.is_none()) return head.HomePosture();
+  if (py::isinstance<py::dict>(joints) || py::isinstance<head::PopeyeJoints>(joints)) {
+    return head.Arrange(joints.cast<head::JointState>()).values();
+  }
+  const auto q = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(joints);
+  if (!q || q.ndim() != 1 || q.shape(0) != head.num_joints()) {
+    throw InvalidArgument(std::string(who) + ": expected a dict of joint name to value or " +
+                          std::to_string(head.num_joints()) + " values in the order " +
+                          fmt::format("{}", fmt::join(*head.joint_names(), ", ")));
+  }
+  return Eigen::Map<const Eigen::VectorXd>(q.data(), q.shape(0));
+}
+
+py::dict JointInfo(const head::HeadModel& h, int j) {
+  const head::JointSettings& s = h.joint(j);
+  py::dict info;
+  info["name"] = h.joint_name(j);
+  info["min"] = s.limits.min;
+  info["max"] = s.limits.max;
+  info["max_velocity"] = s.limits.max_velocity;
+  info["max_acceleration"] = s.limits.max_acceleration;
+  info["driven"] = s.driven;
+  info["hold"] = s.hold;
+  return info;
+}
+
+// Any head: the head file (with or without a URDF), its joints, frames and fixation.
+void BindHeadModel(py::module_& m) {
+  using namespace head;
+  py::class_<FixationResult>(m, "FixationResult", "A fixation of any head (Head.fixate).")
+      .def_readonly("joints", &FixationResult::joints,
+                    "The posture (head order), finite and within the limits.")
+      .def_property_readonly("reachability",
+                             [](const FixationResult& r) { return ToString(r.reachability); })
+      .def_property_readonly("reachable", &FixationResult::reachable)
+      .def_readonly("axis_error", &FixationResult::axis_error,
+                    "Largest angle (rad) between an optical axis (or the mid-axis) and the "
+                    "target.")
+      .def_readonly("iterations", &FixationResult::iterations)
+      .def_readonly("mid_axis", &FixationResult::mid_axis,
+                    "The head cannot verge: the axis midway between its cameras was pointed.")
+      .def_readonly("message", &FixationResult::message);
+
+  py::class_<HeadModel>(m, "Head",
+                        "Any stereo head: a head file naming a URDF, or POPEYE's legacy file "
+                        "(docs/formats.md).")
+      .def_static("from_file", &HeadModel::FromFile, "path"_a,
+                  "Loads a head file (and its URDF); raises FileError naming the file, line "
+                  "and element.")
+      .def_static(
+          "from_yaml_string",
+          [](const std::string& text, const std::string& source,
+             const std::filesystem::path& folder) {
+            return HeadModel::FromYamlString(text, source, folder);
+          },
+          "text"_a, "source"_a = "<string>", "folder"_a = std::filesystem::path("."))
+      .def_property_readonly("name", &HeadModel::name)
+      .def_property_readonly("joint_names", [](const HeadModel& h) { return *h.joint_names(); },
+                             "The actuated joints, in the head's order (the URDF's).")
+      .def_property_readonly("num_joints", &HeadModel::num_joints)
+      .def_property_readonly(
+          "driven_joints",
+          [](const HeadModel& h) {
+            std::vector<std::string> names;
+            for (int j = 0; j < h.num_joints(); ++j) {
+              if (h.joint(j).driven) names.push_back(h.joint_name(j));
+            }
+            return names;
+          },
+          "The joints saccade commands; the others are held.")
+      .def(
+          "joint",
+          [](const HeadModel& h, const std::string& name) {
+            const int j = h.FindJoint(name);
+            if (j < 0) {
+              throw InvalidArgument(fmt::format("Head.joint: no joint '{}'; the joints are: {}",
+                                                name, fmt::join(*h.joint_names(), ", ")));
+            }
+            return JointInfo(h, j);
+          },
+          "name"_a, "min, max (rad or m), max_velocity, max_acceleration, driven, hold.")
+      .def_property_readonly(
+          "limits_min",
+          [](const HeadModel& h) {
+            Eigen::VectorXd v(h.num_joints());
+            for (int j = 0; j < h.num_joints(); ++j) v[j] = h.joint(j).limits.min;
+            return v;
+          })
+      .def_property_readonly(
+          "limits_max",
+          [](const HeadModel& h) {
+            Eigen::VectorXd v(h.num_joints());
+            for (int j = 0; j < h.num_joints(); ++j) v[j] = h.joint(j).limits.max;
+            return v;
+          })
+      .def_property_readonly("max_velocity",
+                             [](const HeadModel& h) {
+                               Eigen::VectorXd v(h.num_joints());
+                               for (int j = 0; j < h.num_joints(); ++j) {
+                                 v[j] = h.joint(j).limits.max_velocity;
+                               }
+                               return v;
+                             })
+      .def("home", &HeadModel::HomePosture, "The home posture (head order).")
+      .def_property_readonly("X_WB", [](const HeadModel& h) { return PoseToMatrix(h.X_WB()); })
+      .def_property_readonly("left_camera",
+                             [](const HeadModel& h) { return h.camera(0).model; })
+      .def_property_readonly("right_camera",
+                             [](const HeadModel& h) { return h.camera(1).model; })
+      .def_property_readonly("urdf", &HeadModel::urdf_xml,
+                             "The URDF's text ('' for a head file without one).")
+      .def_property_readonly(
+          "can_verge", [](const HeadModel& h) { return FixationSolver(h).can_verge(); },
+          "Whether some joint turns one camera without the other.")
+      .def(
+          "within_limits",
+          [](const HeadModel& h, const py::object& joints) {
+            return h.WithinLimits(PostureOf(h, joints, "Head.within_limits"));
+          },
+          "joints"_a)
+      .def(
+          "check_limits",
+          [](const HeadModel& h, const py::object& joints) {
+            h.CheckLimits(PostureOf(h, joints, "Head.check_limits"));
+          },
+          "joints"_a, "Raises InvalidArgument naming the first joint outside its limits.")
+      .def(
+          "link_poses",
+          [](const HeadModel& h, const py::object& joints) {
+            std::vector<geometry::Pose> X_WL;
+            h.ForwardKinematics(PostureOf(h, joints, "Head.link_poses"), &X_WL);
+            py::dict out;
+            for (size_t l = 0; l < X_WL.size(); ++l) {
+              out[py::str(h.tree().link_name(static_cast<int>(l)))] = PoseToMatrix(X_WL[l]);
+            }
+            return out;
+          },
+          "joints"_a = py::none(), "Every link's pose in the world (4x4), by link name.")
+      .def(
+          "camera_poses",
+          [](const HeadModel& h, const py::object& joints) {
+            const Eigen::VectorXd q = PostureOf(h, joints, "Head.camera_poses");
+            const auto X = h.CameraPoses(h.State(q));
+            return py::make_tuple(PoseToMatrix(X[0]), PoseToMatrix(X[1]));
+          },
+          "joints"_a = py::none(),
+          "The left and right cameras' optical frames (OpenCV axes) in the world, 4x4.")
+      .def(
+          "fixate",
+          [](const HeadModel& h, const Eigen::Vector3d& p_W, const py::object& seed) {
+            FixationOptions options;
+            if (!seed.is_none()) options.seed = PostureOf(h, seed, "Head.fixate");
+            py::gil_scoped_release release;
+            return SolveFixation(h, p_W, options);
+          },
+          "p_W"_a, "seed"_a = py::none(),
+          "The posture that puts both optical axes through p_W (world, m), by the head "
+          "file's fixation rule; an unreachable target is a result with the reason.")
+      .def(
+          "axis_errors",
+          [](const HeadModel& h,
+             const py::array_t<double, py::array::c_style | py::array::forcecast>& joints,
+             const py::array_t<double, py::array::c_style | py::array::forcecast>& p_W) {
+            const py::ssize_t n_joints = h.num_joints();
+            const bool one = joints.ndim() == 1;
+            if (!(one ? joints.shape(0) == n_joints
+                      : joints.ndim() == 2 && joints.shape(1) == n_joints) ||
+                !(p_W.ndim() == joints.ndim() && p_W.shape(p_W.ndim() - 1) == 3 &&
+                  (one || p_W.shape(0) == joints.shape(0)))) {
+              throw InvalidArgument(fmt::format(
+                  "Head.axis_errors: expected joints ({0},) and p_W (3,), or joints (n, {0}) "
+                  "and p_W (n, 3)",
+                  n_joints));
+            }
+            const py::ssize_t n = one ? 1 : joints.shape(0);
+            py::array_t<double> out = one ? py::array_t<double>(std::vector<py::ssize_t>{2})
+                                          : py::array_t<double>(std::vector<py::ssize_t>{n, 2});
+            const double* q = joints.data();
+            const double* p = p_W.data();
+            double* e = out.mutable_data();
+            {
+              py::gil_scoped_release release;
+              for (py::ssize_t i = 0; i < n; ++i) {
+                const Eigen::Vector2d errors =
+                    AxisErrors(h, Eigen::Map<const Eigen::VectorXd>(q + n_joints * i, n_joints),
+                               Eigen::Vector3d(p[3 * i], p[3 * i + 1], p[3 * i + 2]));
+                e[2 * i] = errors[0];
+                e[2 * i + 1] = errors[1];
+              }
+            }
+            return out;
+          },
+          "joints"_a, "p_W"_a,
+          "Angle (rad) between each camera's optical axis and the ray to p_W: (left, right); "
+          "for joints (n, num_joints) and points (n, 3), an (n, 2) array.")
+      .def("__repr__", [](const HeadModel& h) {
+        return fmt::format("<Head '{}': {}>", h.name(), fmt::join(*h.joint_names(), ", "));
+      });
+}
+
 }  // namespace
 
 void BindHead(py::module_& m) {
@@ -186,6 +397,7 @@ void BindHead(py::module_& m) {
   BindHeadDescription(m);
   BindForwardKinematics(m);
   BindInverseKinematics(m);
+  BindHeadModel(m);
 }
 
 }  // namespace saccade::python

@@ -188,7 +188,7 @@ geometry::Pose Scene::CameraPose(const CameraSpec& camera, const SceneState& sta
   if (camera.mount == CameraMount::kWorld || !robot_) return camera.X_WC;
   std::vector<geometry::Pose> X_WL;
   const head::HeadModel& head = robot_->head;
-  head.ForwardKinematics(state.joints.empty() ? head.HomePosture() : state.joints.values(), &X_WL);
+  head.ForwardKinematics(head.Posture(state.joints), &X_WL);
   return head.CameraPose(camera.mount == CameraMount::kLeftEye ? 0 : 1, X_WL);
 }
 

@@ -80,7 +80,7 @@ def test_fixating_with_ik_is_rewarded_and_terminates():
     e = FixationEnv(image_size=SIZE, action_mode="target", success_deg=1.0)
     obs, info = e.reset(seed=7)
     head = e._heads.head
-    ik = saccade.head.solve_fixation(head, info["target_W"])
+    ik = head.fixate(info["target_W"])
     assert ik.reachable, ik.message
     target = np.asarray(ik.joints, dtype=np.float32)
     rewards = []
@@ -169,3 +169,41 @@ def test_vector_env_autoreset_same_step():
     assert infos["_final_obs"].all() and infos["final_obs"][0]["left"].shape == (SIZE, SIZE, 3)
     assert np.all(venv._heads.steps == 0)
     venv.close()
+
+
+# Issue 42: the env takes any head; its joints are the head's driven joints, by name.
+@pytest.mark.parametrize("name", ["humanoid", "pan_tilt_vergence", "popeye_urdf"])
+def test_any_head_fixates_its_target_with_its_own_joints(name):
+    e = FixationEnv(image_size=SIZE, action_mode="target", success_deg=1.0, head=name)
+    head = saccade.head.Head.from_file(saccade.envs.fixation.head_file(name))
+    assert e.joint_names == head.driven_joints
+    obs, info = e.reset(seed=7)
+    assert obs["joints"].shape == (len(head.driven_joints),)
+    assert e.action_space.shape == (len(head.driven_joints),)
+    ik = head.fixate(info["target_W"])
+    assert ik.reachable, ik.message
+    driven = [head.joint_names.index(n) for n in e.joint_names]
+    target = ik.joints[driven].astype(np.float32)
+    start = np.abs(obs["joints"] - target).max()
+    terminated = False
+    for _ in range(60):
+        obs, reward, terminated, truncated, info = e.step(target)
+        if terminated:
+            break
+    assert terminated and info["is_success"], info["axis_error"]
+    # The joints went toward the solution: nearer it than at the start.
+    assert np.abs(obs["joints"] - target).max() < start
+    # The target is in both eyes' images near their centres: the view changed with the head.
+    assert obs["left"].std() > 0 and obs["right"].std() > 0
+
+
+def test_an_action_of_popeyes_size_on_another_head_names_its_joints():
+    e = FixationEnv(image_size=SIZE, head="pan_tilt_vergence")
+    e.reset(seed=1)
+    with pytest.raises(saccade.InvalidArgument, match=r"shape \(3,\) \(pan, tilt, vergence\)"):
+        e.step(np.zeros(4, np.float32))
+
+
+def test_an_unknown_head_lists_the_shipped_ones():
+    with pytest.raises(saccade.InvalidArgument, match="shipped: .*humanoid"):
+        FixationEnv(image_size=SIZE, head="octopus")

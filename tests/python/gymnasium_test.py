@@ -89,6 +89,10 @@ CONSTRUCTIONS = [
     dict(image_size=SIZE, action_mode="target"),
     dict(image_size=(48, SIZE), render_mode="rgb_array"),
     dict(image_size=SIZE, action_mode="target", render_mode="rgb_array", max_episode_steps=None),
+    # Any head (issue 42): six joints, a mimic vergence, a camera pair that cannot verge.
+    dict(image_size=SIZE, head="humanoid"),
+    dict(image_size=SIZE, action_mode="target", head="pan_tilt_vergence"),
+    dict(image_size=SIZE, head="pan_tilt_fixed"),
 ]
 
 

@@ -570,7 +570,7 @@ TEST_F(SceneLoaderTest, RobotPoseReplacesTheDescriptions) {
   EXPECT_TRUE(Load(kValid).robot()->head.X_WB().translation().isApprox(Eigen::Vector3d(0, 0, 1.2)));
 }
 
-// A sensor block on a world camera and on an eye camera (robot.cameras[2]).
+// A sensor block on a world camera and on an eye camera (robot.cameras.left).
 std::string WithSensors(const std::string& world_sensor, const std::string& eye_sensor) {
   std::string text = Replace(kValid, "    clip: {near: 0.1, far: 20}\n",
                              "    clip: {near: 0.1, far: 20}\n    sensor:\n" + world_sensor);
@@ -666,23 +666,23 @@ TEST_F(SceneLoaderTest, BadSensorsNameTheFileLineAndKey) {
   ExpectError(WithSensors("      [1, 2]\n", kEyeSensor), "[1, 2]", "cameras[0].sensor",
               {"expected a sensor {exposure | exposure_ms", "got a list of 2"});
 
-  // Eye camera: robot.cameras[2].sensor.
+  // Eye camera: robot.cameras.left.sensor.
   const auto eye = [&](const std::string& from, const std::string& to) {
     return WithSensors(kWorldSensor, Replace(kEyeSensor, from, to));
   };
   ExpectError(eye("exposure_ms: 8", "exposure_ms: -8"), "exposure_ms: -8",
-              "robot.cameras[2].sensor.exposure_ms",
+              "robot.cameras.left.sensor.exposure_ms",
               {"expected an exposure in milliseconds in [0, 1000]", "got '-8'"});
   ExpectError(eye("exposure_ms: 8\n", "exposure_ms: 8\n        exposure: 0.008\n"),
-              "exposure_ms: 8", "robot.cameras[2].sensor.exposure_ms", {"not both"});
+              "exposure_ms: 8", "robot.cameras.left.sensor.exposure_ms", {"not both"});
   ExpectError(eye("read_noise_dn: 2", "read_noise_dn: .NaN"), "read_noise_dn: .NaN",
-              "robot.cameras[2].sensor.read_noise_dn", {"expected a finite number"});
-  ExpectError(eye("seed: 42", "seed: -42"), "seed: -42", "robot.cameras[2].sensor.seed",
+              "robot.cameras.left.sensor.read_noise_dn", {"expected a finite number"});
+  ExpectError(eye("seed: 42", "seed: -42"), "seed: -42", "robot.cameras.left.sensor.seed",
               {"expected an integer in [0, 18446744073709551615]", "got '-42'"});
   ExpectError(eye("seed: 42", "seed: 42\n        noise: 1"), "noise: 1",
-              "robot.cameras[2].sensor.noise", {"unknown key 'noise'"});
+              "robot.cameras.left.sensor.noise", {"unknown key 'noise'"});
   ExpectError(eye("exposure_ms: 8", "exposure_ms: 8\n        blur_samples: 0"), "blur_samples: 0",
-              "robot.cameras[2].sensor.blur_samples", {"expected an integer in [1, 64]"});
+              "robot.cameras.left.sensor.blur_samples", {"expected an integer in [1, 64]"});
 }
 
 }  // namespace

@@ -97,6 +97,9 @@ class HeadModel {
   /// `joints` in this head's order, by name (a state decoded from JSON has its keys' order).
   /// Throws InvalidArgument naming unknown and missing joints.
   JointState Arrange(const JointState& joints) const;
+  /// The posture of `joints` in the head's order (size num_joints): the home posture when
+  /// `joints` is empty. Throws InvalidArgument naming unknown or missing joints.
+  Eigen::VectorXd Posture(const JointState& joints) const;
   /// The variable of that name; -1 when the head has no such actuated joint.
   int FindJoint(const std::string& name) const { return tree_.FindVariable(name); }
   const JointSettings& joint(int joint) const { return joints_[joint]; }

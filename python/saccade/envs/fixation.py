@@ -15,14 +15,20 @@ their constructor arguments, then their state):
 - the vector env: ``num_envs``, ``single_observation_space``, ``single_action_space``,
   batched spaces, ``metadata["autoreset_mode"]`` (next step by default, same step, disabled).
 
-Observations: ``{"left": HxWx3 uint8, "right": HxWx3 uint8, "joints": 4 float32}`` (pan, tilt,
-left, right in rad). Actions (4 float32): joint velocities in rad/s (``action_mode="velocity"``,
-within each joint's velocity limit) or joint targets in rad (``"target"``, within the joint
-limits, approached at the joints' maximum velocity). An action outside the action space, of
+The head is POPEYE unless ``head=`` names another: a shipped head (``"humanoid"``,
+``"pan_tilt_vergence"``, ``"pan_tilt_fixed"``, ``"popeye_urdf"``: ``robots/<name>.yaml``) or the
+path of any head file (docs/formats.md). The env's joints are the head's driven joints, in its
+order (``env.joint_names``); joints the head file holds stay at their value.
+
+Observations: ``{"left": HxWx3 uint8, "right": HxWx3 uint8, "joints": K float32}``, K driven
+joints (POPEYE: pan, tilt, left, right in rad). Actions (K float32): joint velocities in rad/s
+(``action_mode="velocity"``, within each joint's velocity limit) or joint targets in rad
+(``"target"``, within the joint limits, approached at the joints' maximum velocity). An action outside the action space, of
 another shape, or not finite is refused with saccade.InvalidArgument (a ValueError).
 
 Reward: minus the mean angle (rad) between each camera's optical axis and the ray from that
-camera to the target's centre; +1 and ``terminated`` once both angles are below
+camera to the target's centre (a head that cannot verge scores each camera's axis too, so its
+best is pointing midway); +1 and ``terminated`` once both angles are below
 ``success_deg``. ``truncated`` after ``max_episode_steps``.
 
 Scenes are randomised from the seed at each reset: which of a pool of objects appear
@@ -51,7 +57,26 @@ except ImportError:
     _EnvBase = object
     _VectorEnvBase = object
 
-JOINTS = ("pan", "tilt", "left", "right")
+JOINTS = ("pan", "tilt", "left", "right")  # POPEYE's, the default head's
+
+
+def head_file(head: Optional[str]) -> str:
+    """The head file of ``head=``: None (POPEYE), a shipped head's name, or a path."""
+    robots = os.path.join(saccade.source_dir(), "robots")
+    if head is None:
+        return os.path.join(robots, "popeye.yaml")
+    head = os.fspath(head)
+    if os.sep not in head and not head.endswith((".yaml", ".yml")):
+        path = os.path.join(robots, head + ".yaml")
+        if not os.path.isfile(path):
+            shipped = sorted(f[:-5] for f in os.listdir(robots) if f.endswith(".yaml"))
+            raise saccade.InvalidArgument(
+                f"head={head!r}: no shipped head of that name; shipped: {', '.join(shipped)} "
+                "(or give a head file's path)")
+        return path
+    if not os.path.isfile(head):
+        raise saccade.InvalidArgument(f"head={head!r}: no such head file")
+    return os.path.abspath(head)
 
 
 class EpisodeEnded(saccade.Error, AssertionError):
@@ -88,12 +113,11 @@ class _Pool:
         (0.8, 0.3, 0.8), (0.1, 0.8, 0.8),
     ]
 
-    def __init__(self, image_size: Tuple[int, int], fov_deg: float, scene_seed: int):
+    def __init__(self, image_size: Tuple[int, int], fov_deg: float, scene_seed: int, head: str):
         width, height = image_size
         rng = np.random.default_rng(scene_seed)
         f = 0.5 * width / math.tan(math.radians(fov_deg) / 2)
         camera = f"{{calibration: {{width: {width}, height: {height}, fx: {f:.6f}, fy: {f:.6f}}}}}"
-        head = os.path.join(saccade.source_dir(), "robots", "popeye.yaml")
         light_dir = [float(rng.uniform(-0.6, 0.6)), float(rng.uniform(-0.6, 0.6)), -1.0]
         lines = [
             "background: [0.62, 0.72, 0.82]",
@@ -139,7 +163,8 @@ class _Heads:
     """N heads' state, their randomisation, dynamics and rewards (numpy, vectorised)."""
 
     def __init__(self, n: int, image_size, action_mode: str, max_episode_steps: int,
-                 success_deg: float, dt: float, fov_deg: float, scene_seed: int):
+                 success_deg: float, dt: float, fov_deg: float, scene_seed: int,
+                 head: Optional[str]):
         if action_mode not in ("velocity", "target"):
             raise saccade.InvalidArgument(
                 f"action_mode must be 'velocity' or 'target', got {action_mode!r}")
@@ -165,18 +190,25 @@ class _Heads:
         self.step_limit = math.inf if max_episode_steps is None else int(max_episode_steps)
         self.success = math.radians(success_deg)
         self.dt = float(dt)
-        self.pool = _Pool(image_size, fov_deg, scene_seed)
+        self.pool = _Pool(image_size, fov_deg, scene_seed, head_file(head))
         self.scene = self.pool.scene
         self.head = self.scene.head
-        limits = [self.head.limits(j) for j in JOINTS]
-        self.joint_min = np.array([l.min for l in limits])
-        self.joint_max = np.array([l.max for l in limits])
-        self.max_velocity = np.array([l.max_velocity for l in limits])
+        # The env's joints: the head's driven ones; the held ones stay at home in `posture`.
+        driven = set(self.head.driven_joints)
+        self.driven = np.array([j for j, name in enumerate(self.head.joint_names) if name in driven])
+        self.joint_names = [self.head.joint_names[j] for j in self.driven]
+        self.joint_min = self.head.limits_min[self.driven]
+        self.joint_max = self.head.limits_max[self.driven]
+        self.max_velocity = self.head.max_velocity[self.driven]
+        self.posture = np.tile(self.head.home(), (n, 1))
+        self.all_driven = len(self.driven) == self.head.num_joints
+        # POPEYE's four joints go to C++ as a sequence; any other head's by name.
+        self.by_name = self.head.joint_names != list(JOINTS)
         self.renderer = saccade.render.Renderer(
             self.scene, cameras=["left", "right"], draw_robot=False, distortion=False,
             noise=False, motion_blur=False)
         self.X_WB = self.head.X_WB
-        self.joints = np.zeros((n, 4))
+        self.joints = np.zeros((n, len(self.driven)))
         self.steps = np.zeros(n, dtype=np.int64)
         self.object_poses: List[List[Optional[np.ndarray]]] = [[None] * self.pool.count for _ in range(n)]
         self.hidden = [[True] * self.pool.count for _ in range(n)]
@@ -249,7 +281,7 @@ class _Heads:
         self.target[i] = poses[target][:3, 3]
         if self.pool.kinds[target] == "mug":
             self.target[i][2] += 0.05  # the mug's origin is its base
-        start = rng.uniform(-0.15, 0.15, size=4) * (self.joint_max - self.joint_min) / 2
+        start = rng.uniform(-0.15, 0.15, size=len(self.driven)) * (self.joint_max - self.joint_min) / 2
         self.joints[i] = np.clip(start, self.joint_min, self.joint_max)
         self.steps[i] = 0
         self.update_errors(i)
@@ -260,10 +292,11 @@ class _Heads:
         except (TypeError, ValueError):
             raise saccade.InvalidArgument(
                 f"{who}: the action must be numbers, got {type(actions).__name__}") from None
-        shape = (self.n, 4) if who.startswith("Vector") else (4,)
+        k = len(self.driven)
+        shape = (self.n, k) if who.startswith("Vector") else (k,)
         if a.shape != shape:
             raise saccade.InvalidArgument(
-                f"{who}: the action must have shape {shape} ({', '.join(JOINTS)}"
+                f"{who}: the action must have shape {shape} ({', '.join(self.joint_names)}"
                 f"{' per env' if len(shape) == 2 else ''}), got {a.shape}")
         low, high = self.action_bounds()
         if self._bounds_tolerant is None:
@@ -277,9 +310,9 @@ class _Heads:
             joint = int(index[-1])
             unit = "rad/s" if self.action_mode == "velocity" else "rad"
             raise saccade.InvalidArgument(
-                f"{who}: action for joint '{JOINTS[joint]}' is {a[tuple(index)]:.6g} {unit}; "
+                f"{who}: action for joint '{self.joint_names[joint]}' is {a[tuple(index)]:.6g} {unit}; "
                 f"expected [{low[joint]:.6g}, {high[joint]:.6g}] ({self.action_mode} mode)")
-        return a.reshape(-1, 4)
+        return a.reshape(-1, k)
 
     def apply(self, rows, actions: np.ndarray):
         """Moves heads `rows` (an index array, or one index) by their actions over dt (joint
@@ -297,8 +330,17 @@ class _Heads:
 
     def update_errors(self, rows):
         """The optical axes' angles to the targets of heads `rows` (an index or an array)."""
-        self.axis_error[rows] = saccade.head.axis_errors(self.head, self.joints[rows],
-                                                         self.target[rows])
+        self.axis_error[rows] = self.head.axis_errors(self.postures(rows), self.target[rows])
+
+    def postures(self, rows) -> np.ndarray:
+        """The whole postures (every joint of the head) of heads `rows`."""
+        if self.all_driven:
+            return self.joints[rows]
+        if np.ndim(rows) == 0:
+            self.posture[rows, self.driven] = self.joints[rows]
+        else:
+            self.posture[np.ix_(np.asarray(rows), self.driven)] = self.joints[rows]
+        return self.posture[rows]
 
     def outcome(self, i: int) -> Tuple[float, bool, bool]:
         left, right = self.axis_error[i].tolist()  # Python floats: numpy on two values costs more
@@ -310,7 +352,10 @@ class _Heads:
         heads = []
         for i in rows:
             head = self.batch[i]
-            head.state = saccade.scene.SceneState(float(self.steps[i]) * self.dt, self.joints[i])
+            q = self.postures(i)
+            if self.by_name:
+                q = dict(zip(self.head.joint_names, q.tolist()))
+            head.state = saccade.scene.SceneState(float(self.steps[i]) * self.dt, q)
             heads.append(head)
         return self.renderer.render_batch(heads, out=out)
 
@@ -359,6 +404,8 @@ class FixationEnv(_EnvBase):
         dt: seconds per step (render_fps = 1 / dt).
         fov_deg: the eyes' horizontal field of view.
         scene_seed: the lights (fixed for the env's life).
+        head: None (POPEYE), a shipped head's name (``robots/<name>.yaml``) or a head file's
+            path (module docstring); ``joint_names`` lists the env's joints.
     """
 
     metadata = {"render_modes": ["rgb_array"], "render_fps": 25}
@@ -366,16 +413,17 @@ class FixationEnv(_EnvBase):
     def __init__(self, render_mode: Optional[str] = None, image_size: Union[int, Tuple[int, int]] = 64,
                  action_mode: str = "velocity", max_episode_steps: Optional[int] = 200,
                  success_deg: float = 1.0, dt: float = 0.04, fov_deg: float = 60.0,
-                 scene_seed: int = 0):
+                 scene_seed: int = 0, head: Optional[str] = None):
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
             raise saccade.InvalidArgument(
                 f"render_mode must be None or one of {self.metadata['render_modes']}, got {render_mode!r}")
         self._kwargs = dict(render_mode=render_mode, image_size=image_size, action_mode=action_mode,
                             max_episode_steps=max_episode_steps, success_deg=success_deg, dt=dt,
-                            fov_deg=fov_deg, scene_seed=scene_seed)
+                            fov_deg=fov_deg, scene_seed=scene_seed, head=head)
         self.render_mode = render_mode
         self._heads = _Heads(1, image_size, action_mode, max_episode_steps, success_deg, dt,
-                             fov_deg, scene_seed)
+                             fov_deg, scene_seed, head)
+        self.joint_names = list(self._heads.joint_names)
         self.metadata = dict(self.metadata, render_fps=int(round(1.0 / dt)))
         self.observation_space = self._heads.observation_space()
         self.action_space = self._heads.action_space()
@@ -495,7 +543,7 @@ class VectorFixationEnv(_VectorEnvBase):
                  image_size: Union[int, Tuple[int, int]] = 64, action_mode: str = "velocity",
                  max_episode_steps: Optional[int] = 200, success_deg: float = 1.0,
                  dt: float = 0.04, fov_deg: float = 60.0, scene_seed: int = 0,
-                 autoreset_mode: Union[AutoresetMode, str] = AutoresetMode.NEXT_STEP):
+                 head: Optional[str] = None, autoreset_mode: Union[AutoresetMode, str] = AutoresetMode.NEXT_STEP):
         if not (isinstance(num_envs, (int, np.integer)) and num_envs >= 1):
             raise saccade.InvalidArgument(f"num_envs must be an integer >= 1, got {num_envs!r}")
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
@@ -510,12 +558,13 @@ class VectorFixationEnv(_VectorEnvBase):
         self._kwargs = dict(num_envs=num_envs, render_mode=render_mode, image_size=image_size,
                             action_mode=action_mode, max_episode_steps=max_episode_steps,
                             success_deg=success_deg, dt=dt, fov_deg=fov_deg,
-                            scene_seed=scene_seed, autoreset_mode=mode.value)
+                            scene_seed=scene_seed, head=head, autoreset_mode=mode.value)
         self.num_envs = int(num_envs)
         self.render_mode = render_mode
         self.autoreset_mode = mode
         self._heads = _Heads(self.num_envs, image_size, action_mode, max_episode_steps,
-                             success_deg, dt, fov_deg, scene_seed)
+                             success_deg, dt, fov_deg, scene_seed, head)
+        self.joint_names = list(self._heads.joint_names)
         self.metadata = dict(self.metadata, render_fps=int(round(1.0 / dt)),
                              autoreset_mode=_gymnasium_autoreset(mode))
         self.single_observation_space = self._heads.observation_space()

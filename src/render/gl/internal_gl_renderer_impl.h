@@ -50,7 +50,7 @@ inline constexpr std::size_t kPooledImagesPerCamera = 4;
 using LinkPoses = std::vector<geometry::Pose>;
 inline LinkPoses RobotLinkPoses(const scene::Robot& robot, const head::JointState& joints) {
   LinkPoses X_WL;
-  robot.head.ForwardKinematics(joints.empty() ? robot.head.HomePosture() : joints.values(), &X_WL);
+  robot.head.ForwardKinematics(robot.head.Posture(joints), &X_WL);
   return X_WL;
 }
 
