@@ -111,7 +111,9 @@ std::string CheckObject(const Schema& schema, const json& value, const std::stri
   if (schema.some && value.empty()) {
     std::vector<std::string> names;
     for (const Field& f : schema.fields) names.push_back(f.name);
-    return Where(path) + " must name at least one of " + Join(names);
+    std::string what = Join(names);
+    if (!schema.others.empty()) what += (what.empty() ? "" : " or ") + schema.others;
+    return Where(path) + " must name at least one of " + what;
   }
   for (const Field& f : schema.fields) {
     const auto it = value.find(f.name);
@@ -122,7 +124,17 @@ std::string CheckObject(const Schema& schema, const json& value, const std::stri
     std::string problem = CheckValue(f.schema, *it, Child(path, f.name));
     if (!problem.empty()) return problem;
   }
-  if (schema.open) return "";
+  if (schema.open) {
+    if (schema.items.empty()) return "";
+    for (const auto& [key, item] : value.items()) {  // in name order (a std::map)
+      const auto known = std::find_if(schema.fields.begin(), schema.fields.end(),
+                                      [&key](const Field& f) { return f.name == key; });
+      if (known != schema.fields.end()) continue;
+      std::string problem = CheckValue(schema.items[0], item, Child(path, key));
+      if (!problem.empty()) return problem;
+    }
+    return "";
+  }
   for (const auto& [key, unused] : value.items()) {  // in name order (a std::map)
     const auto known = std::find_if(schema.fields.begin(), schema.fields.end(),
                                     [&key](const Field& f) { return f.name == key; });

@@ -84,6 +84,7 @@ ordered_json SchemaJson(const Schema& s, bool define) {
   if (s.length) out["length"] = *s.length;
   if (s.kind == Kind::kObject) out["fields"] = FieldsJson(s.fields);
   if (s.open) out["open"] = true;
+  if (!s.others.empty()) out["others"] = s.others;
   if (s.some) out["some"] = true;
   return out;
 }
@@ -156,7 +157,12 @@ std::string TypeText(const Schema& s) {
     out = s.length ? fmt::format("{} × {}", item, *s.length)
                    : "array of " + item + (plural ? "s" : "");
   } else if (s.kind == Kind::kObject) {
-    out = s.open ? "object (any fields)" : s.some ? "object (at least one field)" : "object";
+    if (s.open && !s.others.empty()) {
+      out = "object (" + s.others + (s.items.empty() ? "" : ": " + TypeText(s.items[0])) +
+            (s.some ? ", at least one" : "") + ")";
+    } else {
+      out = s.open ? "object (any fields)" : s.some ? "object (at least one field)" : "object";
+    }
   } else {
     out = std::string(KindName(s.kind)) + Range(s);
   }

@@ -21,11 +21,15 @@ Schema Pose() {
   return Named("pose", Tuple({row, row, row, Tuple({Const(0), Const(0), Const(0), Const(1)})}));
 }
 Schema Point() { return Named("point", Array(Number(), 3)); }
+constexpr const char* kAnyJoint = "a joint (scene.head.joints)";
+
 // Joint name -> value: every actuated joint of the head (`scene.head.joints`; POPEYE's are
 // pan, tilt, left and right).
 Schema Joints() {
   Schema joints = Object({});
   joints.open = true;
+  joints.others = kAnyJoint;
+  joints.items = {Number()};
   return Named("joints", joints);
 }
 // Link name -> pose: every link of the head's tree (`scene.robot.links`).
@@ -89,6 +93,8 @@ void AddMotionCommands(std::vector<Message>& out) {
                 "left = -v, right = +v; v > 0 converges), unless the head has a joint of that "
                 "name")});
   positions.open = true;  // any joint of `scene.head.joints`, by name
+  positions.others = kAnyJoint;
+  positions.items = {Number()};
   positions.some = true;
   out.push_back(
       Command("joints", "direct kinematics: moves those joints (the others keep their targets)",
@@ -286,14 +292,13 @@ Schema SceneRobot() {
                               Required("joint", OrNull(String()),
                                        "the joint to its parent; null: the root")})),
                 "the head's kinematic tree, parents first"),
-       Required(
-           "parts",
-           Array(Object(
-               {Required("link", String(), "the link it hangs from (`state.frames.links`)"),
-                Required("model", Integer(-1), "index into `models`; -1: none"),
-                Required("X_LinkPart", Pose(), "the part in its link's frame"),
-                Required("scale", Point(), "per axis")})),
-           "the body's parts")}));
+       Required("parts",
+                Array(Object(
+                    {Required("link", String(), "the link it hangs from (`state.frames.links`)"),
+                     Required("model", Integer(-1), "index into `models`; -1: none"),
+                     Required("X_LinkPart", Pose(), "the part in its link's frame"),
+                     Required("scale", Point(), "per axis")})),
+                "the body's parts")}));
 }
 
 Message Scene() {
@@ -314,15 +319,15 @@ Message Scene() {
        Required("model", Integer(-1), "index into `models`; -1: none"),
        Required("scale", Point(), "per axis"), Required("X_WO", Pose(), "at `time`"),
        Required("moving", Boolean(), "its pose comes in every state")}));
-  const Schema joints = Array(Object(
-      {Required("name", String(), "the joint (URDF's name)"),
-       Required("type", String({"revolute", "continuous", "prismatic"}), "its kind"),
-       Required("link", String(), "the link it moves (its child)"),
-       Required("axis", Point(), "its unit axis in the frame of the link it moves"),
-       Required("min", OrNull(Number()), "rad (m); null: unbounded"),
-       Required("max", OrNull(Number()), "rad (m); null: unbounded"),
-       Required("max_velocity", Number(0), "rad/s (m/s)"),
-       Required("driven", Boolean(), "saccade commands it (else held at its value)")}));
+  const Schema joints = Array(
+      Object({Required("name", String(), "the joint (URDF's name)"),
+              Required("type", String({"revolute", "continuous", "prismatic"}), "its kind"),
+              Required("link", String(), "the link it moves (its child)"),
+              Required("axis", Point(), "its unit axis in the frame of the link it moves"),
+              Required("min", OrNull(Number()), "rad (m); null: unbounded"),
+              Required("max", OrNull(Number()), "rad (m); null: unbounded"),
+              Required("max_velocity", Number(0), "rad/s (m/s)"),
+              Required("driven", Boolean(), "saccade commands it (else held at its value)")}));
   const Schema pair = Tuple({String(), String(), Number()});
   const Schema commands =
       Object({Required("effects", Boolean(), "`effects` (the cameras are simulated)"),
@@ -377,7 +382,9 @@ const std::vector<NamedType>& Types() {
        "a pose: its 4x4 matrix, row by row, `[[r00, r01, r02, x], [r10, r11, r12, y], [r20, r21, "
        "r22, z], [0, 0, 0, 1]]` (metres)"},
       {Point(), "`[x, y, z]`: a point or a vector (metres)"},
-      {Joints(), "one number per joint: `{pan, tilt, left, right}` (rad, or rad/s)"},
+      {Joints(),
+       "one number per joint of `scene.head.joints`, by name (POPEYE: `{pan, tilt, left, right}`; "
+       "rad or m, or rad/s)"},
       {Rgb(), "a linear colour `[r, g, b]`, 0 to 1"},
       {Rgba(), "a linear colour with opacity `[r, g, b, a]`, 0 to 1"},
       {Effects(), "the simulated cameras' effects: `{distortion, noise, motion_blur}`, booleans"},

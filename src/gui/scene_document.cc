@@ -18,7 +18,6 @@ using nlohmann::json;
 json Vec(const Eigen::Vector3f& v) { return {v.x(), v.y(), v.z()}; }
 json Vec(const Eigen::Vector4f& v) { return {v.x(), v.y(), v.z(), v.w()}; }
 
-
 /// A texture as PNG bytes.
 std::string EncodePng(const Image& image) {
   cv::Mat bgr;
@@ -58,10 +57,10 @@ std::string ModelBinary(const scene::Model& model) {
 
 json FramesJson(const head::HeadModel& head, const head::JointState& joints) {
   std::vector<geometry::Pose> X_WL;
-  head.ForwardKinematics(head.Posture(joints),
-                         &X_WL);
+  head.ForwardKinematics(head.Posture(joints), &X_WL);
   json links = json::object();
-  for (int l = 0; l < head.tree().num_links(); ++l) links[head.tree().link_name(l)] = ToJson(X_WL[l]);
+  for (int l = 0; l < head.tree().num_links(); ++l)
+    links[head.tree().link_name(l)] = ToJson(X_WL[l]);
   const geometry::Pose left = head.CameraPose(0, X_WL);
   const geometry::Pose right = head.CameraPose(1, X_WL);
   geometry::Pose X_WC = head.X_WB();

@@ -20,8 +20,8 @@
 #include "saccade/core/units.h"
 #include "saccade/geometry/json.h"
 #include "saccade/gui/protocol.h"
-#include "saccade/head/json.h"
 #include "saccade/head/fixation.h"
+#include "saccade/head/json.h"
 #include "saccade/head/kinematics.h"
 #include "saccade/vision/image_camera.h"
 
@@ -288,8 +288,8 @@ json GuiSession::OnJoints(const json& command) {
       continue;
     }
     if (j < 0) {
-      throw CommandError(fmt::format("joints: the head has no joint '{}'; its joints are: {}",
-                                     name, head::ListNames(*head.joint_names())));
+      throw CommandError(fmt::format("joints: the head has no joint '{}'; its joints are: {}", name,
+                                     head::ListNames(*head.joint_names())));
     }
     if (!head.joint(j).driven) {
       throw CommandError(fmt::format("joints: the head holds joint '{}' (not driven)", name));

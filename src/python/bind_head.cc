@@ -185,11 +185,9 @@ void BindInverseKinematics(py::module_& m) {
         "Closed form of eqs. 10-13 (symmetric vergence, D = H = 0).");
 }
 
-
 // A joint state for `head` from Python: a dict by name, a saccade.JointState (POPEYE), or a
 // sequence of num_joints values in the head's order.
-Eigen::VectorXd PostureOf(const head::HeadModel& head, const py::handle& joints,
-                          const char* who) {
+Eigen::VectorXd PostureOf(const head::HeadModel& head, const py::handle& joints, const char* who) {
   if (joints.is_none()) return head.HomePosture();
   if (py::isinstance<py::dict>(joints) || py::isinstance<head::PopeyeJoints>(joints)) {
     return head.Arrange(joints.cast<head::JointState>()).values();
@@ -216,6 +214,8 @@ py::dict JointInfo(const head::HeadModel& h, int j) {
   return info;
 }
 
+void AddHeadKinematics(py::class_<head::HeadModel>& head_class);
+
 // Any head: the head file (with or without a URDF), its joints, frames and fixation.
 void BindHeadModel(py::module_& m) {
   using namespace head;
@@ -233,9 +233,11 @@ void BindHeadModel(py::module_& m) {
                     "The head cannot verge: the axis midway between its cameras was pointed.")
       .def_readonly("message", &FixationResult::message);
 
-  py::class_<HeadModel>(m, "Head",
-                        "Any stereo head: a head file naming a URDF, or POPEYE's legacy file "
-                        "(docs/formats.md).")
+  py::class_<HeadModel> head_class(m, "Head",
+                                   "Any stereo head: a head file naming a URDF, or POPEYE's "
+                                   "legacy file (docs/formats.md).");
+  AddHeadKinematics(head_class);
+  head_class
       .def_static("from_file", &HeadModel::FromFile, "path"_a,
                   "Loads a head file (and its URDF); raises FileError naming the file, line "
                   "and element.")
@@ -247,8 +249,9 @@ void BindHeadModel(py::module_& m) {
           },
           "text"_a, "source"_a = "<string>", "folder"_a = std::filesystem::path("."))
       .def_property_readonly("name", &HeadModel::name)
-      .def_property_readonly("joint_names", [](const HeadModel& h) { return *h.joint_names(); },
-                             "The actuated joints, in the head's order (the URDF's).")
+      .def_property_readonly(
+          "joint_names", [](const HeadModel& h) { return *h.joint_names(); },
+          "The actuated joints, in the head's order (the URDF's).")
       .def_property_readonly("num_joints", &HeadModel::num_joints)
       .def_property_readonly(
           "driven_joints",
@@ -271,20 +274,20 @@ void BindHeadModel(py::module_& m) {
             return JointInfo(h, j);
           },
           "name"_a, "min, max (rad or m), max_velocity, max_acceleration, driven, hold.")
-      .def_property_readonly(
-          "limits_min",
-          [](const HeadModel& h) {
-            Eigen::VectorXd v(h.num_joints());
-            for (int j = 0; j < h.num_joints(); ++j) v[j] = h.joint(j).limits.min;
-            return v;
-          })
-      .def_property_readonly(
-          "limits_max",
-          [](const HeadModel& h) {
-            Eigen::VectorXd v(h.num_joints());
-            for (int j = 0; j < h.num_joints(); ++j) v[j] = h.joint(j).limits.max;
-            return v;
-          })
+      .def_property_readonly("limits_min",
+                             [](const HeadModel& h) {
+                               Eigen::VectorXd v(h.num_joints());
+                               for (int j = 0; j < h.num_joints(); ++j)
+                                 v[j] = h.joint(j).limits.min;
+                               return v;
+                             })
+      .def_property_readonly("limits_max",
+                             [](const HeadModel& h) {
+                               Eigen::VectorXd v(h.num_joints());
+                               for (int j = 0; j < h.num_joints(); ++j)
+                                 v[j] = h.joint(j).limits.max;
+                               return v;
+                             })
       .def_property_readonly("max_velocity",
                              [](const HeadModel& h) {
                                Eigen::VectorXd v(h.num_joints());
@@ -295,15 +298,19 @@ void BindHeadModel(py::module_& m) {
                              })
       .def("home", &HeadModel::HomePosture, "The home posture (head order).")
       .def_property_readonly("X_WB", [](const HeadModel& h) { return PoseToMatrix(h.X_WB()); })
-      .def_property_readonly("left_camera",
-                             [](const HeadModel& h) { return h.camera(0).model; })
-      .def_property_readonly("right_camera",
-                             [](const HeadModel& h) { return h.camera(1).model; })
+      .def_property_readonly("left_camera", [](const HeadModel& h) { return h.camera(0).model; })
+      .def_property_readonly("right_camera", [](const HeadModel& h) { return h.camera(1).model; })
       .def_property_readonly("urdf", &HeadModel::urdf_xml,
                              "The URDF's text ('' for a head file without one).")
       .def_property_readonly(
           "can_verge", [](const HeadModel& h) { return FixationSolver(h).can_verge(); },
-          "Whether some joint turns one camera without the other.")
+          "Whether some joint turns one camera without the other.");
+}
+
+// Head: its limits, poses and fixation.
+void AddHeadKinematics(py::class_<head::HeadModel>& head_class) {
+  using namespace head;
+  head_class
       .def(
           "within_limits",
           [](const HeadModel& h, const py::object& joints) {

@@ -1128,7 +1128,7 @@ TEST(ComponentParams, PipelineErrorsNameTheFileLineAndComponent) {
   const std::string wrong =
       error(head +
             "  - {name: c, type: sim.cameras, params: {scene: ../scenes/astronaut_and_cat.yaml}}\n"
-            "  - {name: d, type: vision.face_detector, inputs: {image: c[2]}}\n"
+            "  - {name: d, type: vision.face_detector, inputs: {image: c.left}}\n"
             "  - {name: e, type: vision.face_detector, inputs: {image: d.faces}}\n");
   EXPECT_NE(wrong.find(":5:"), std::string::npos) << wrong;
   EXPECT_NE(wrong.find("vision.faces"), std::string::npos) << wrong;

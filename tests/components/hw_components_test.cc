@@ -168,10 +168,10 @@ components:
         right: {uri: right.png, calibration: right.yml, loop: true}
   - name: faces_left
     type: vision.face_detector
-    inputs: {image: cameras[2]}
+    inputs: {image: cameras.left}
   - name: faces_right
     type: vision.face_detector
-    inputs: {image: cameras[3]}
+    inputs: {image: cameras.right}
   - name: stereo
     type: vision.stereo_faces
     inputs: {left: faces_left.faces, right: faces_right.faces}
@@ -220,9 +220,9 @@ TEST_F(HwComponentsTest, CameraParamsErrorsNameTheField) {
   expect(error("{left: {uri: a.png}}"), "parameter 'cameras': missing camera 'right'");
   expect(error("{left: {uri: a.png}, right: {uri: b.png}, middle: {uri: c.png}}"),
          "unknown camera 'middle'");
-  expect(error("{left: {url: a.png}, right: {uri: b.png}}"), "parameter 'cameras[2].");
+  expect(error("{left: {url: a.png}, right: {uri: b.png}}"), "parameter 'cameras.left.");
   expect(error("{left: {uri: a.png, every: 0}, right: {uri: b.png}}"),
-         "parameter 'cameras[2].every'");
+         "parameter 'cameras.left.every'");
   // A missing file fails when the pipeline starts, naming the camera and the file.
   expect(error("{left: {uri: nowhere.png}, right: {uri: nowhere.png}}"), "nowhere.png");
 }

@@ -34,7 +34,7 @@ components:
     inputs: {joints: {from: robot_head.joints, delay: 1}}
   - name: cameras
     type: remote.cameras
-    inputs: {left: robot_cameras[2], right: robot_cameras[3]}
+    inputs: {left: robot_cameras.left, right: robot_cameras.right}
   - name: head
     type: remote.head
     inputs: {state: robot_head.joints}

@@ -269,7 +269,7 @@ TEST(Cli, HugeInputsAreRefusedWithAClearErrorAndExitOne) {
        "huge.stl: the binary STL header declares 50000000 triangles"},
       // A device never ends: configuration files are read only when regular, and bounded.
       {"fk --head /dev/zero --joints 0 0 0 0",
-       "/dev/zero: not a regular file (a folder, device or pipe); expected a head description"},
+       "/dev/zero: not a regular file (a folder, device or pipe); expected a head file"},
       {"camera --calibration /dev/zero",
        "/dev/zero: not a regular file (a device or pipe), expected a calibration file"},
       {"demo --pipeline /dev/zero",

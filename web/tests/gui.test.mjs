@@ -330,8 +330,8 @@ describe('saccade gui (portraits.yaml)', () => {
         frames: s.frames,
         stateObjects: s.objects,
         placed: {
-          neck: g.placementOf('neck'),
-          left_eye: g.placementOf('left_eye'),
+          neck: g.placementOf('neck_link'),
+          left_eye: g.placementOf('left_eye_link'),
           objects: Object.fromEntries(g.scene.objects.map((o) => [o.name, g.placementOf(o.name)])),
         },
       };
@@ -344,11 +344,14 @@ describe('saccade gui (portraits.yaml)', () => {
       ...seen.scene.objects.map((o) => [`scene objects ${o.name} X_WO`, o.X_WO]),
       ...seen.scene.parts.map((X, i) => [`scene robot part ${i} X_LinkPart`, X]),
       ...seen.scene.cameras.map((X, i) => [`scene camera ${i} X_WC`, X]),
-      ...Object.entries(seen.frames).map(([k, X]) => [`state frames ${k}`, X]),
+      ...Object.entries(seen.frames).filter(([k]) => k !== 'links')
+        .map(([k, X]) => [`state frames ${k}`, X]),
+      ...Object.entries(seen.frames.links).map(([k, X]) => [`state frames links ${k}`, X]),
       ...seen.stateObjects.map((o) => [`state objects ${o.name} X_WO`, o.X_WO]),
     ];
     assert.ok(seen.scene.objects.length > 0 && seen.scene.parts.length > 0 &&
-      Object.keys(seen.frames).length === 7, JSON.stringify(seen.scene));
+      Object.keys(seen.frames).length === 5 && Object.keys(seen.frames.links).length >= 7,
+      JSON.stringify(seen.frames));
     for (const [where, X] of poses) assert.ok(isPose(X), `${where}: ${JSON.stringify(X)}`);
     // The page puts each link at its frame and each object at X_WO * diag(scale): the page
     // reads the rows as rows (a transposed read would move every part).
@@ -361,8 +364,8 @@ describe('saccade gui (portraits.yaml)', () => {
         }
       }
     };
-    near(seen.placed.neck, seen.frames.X_WN, 'neck');
-    near(seen.placed.left_eye, seen.frames.left_eye, 'left_eye');
+    near(seen.placed.neck, seen.frames.links.neck_link, 'neck_link');
+    near(seen.placed.left_eye, seen.frames.links.left_eye_link, 'left_eye_link');
     const moving = new Map(seen.stateObjects.map((o) => [o.name, o.X_WO]));
     for (const o of seen.scene.objects) {
       const X = moving.get(o.name) ?? o.X_WO;
@@ -423,7 +426,7 @@ describe('saccade gui (portraits.yaml)', () => {
       { timeout: kMoveTimeoutMs });
     const imageBefore = await grabGrey(page, 'left');
 
-    const p = await page.evaluate(() => window.saccadeGui.screenPointOf('neck'));
+    const p = await page.evaluate(() => window.saccadeGui.screenPointOf('neck_link'));
     assert.ok(p.visible, `the neck is hidden in the view (${JSON.stringify(p)})`);
     const gain = await page.evaluate(() => window.saccadeGui.dragGainDegPerPx);
     await page.mouse.move(p.x, p.y);

@@ -40,7 +40,10 @@ struct Schema {
   std::optional<std::size_t> length;  ///< arrays: exactly this many items
   std::vector<Field> fields;          ///< objects: the fields, in order
   bool open = false;                  ///< objects: fields besides `fields` are allowed
-  bool some = false;                  ///< objects: at least one field
+  /// Open objects: what the other fields are ("a joint (scene.head.joints)"), for messages and
+  /// docs; `items[0]`, when given, is what each of their values must be.
+  std::string others;
+  bool some = false;  ///< objects: at least one field
 };
 
 /// A field of an object: its name, what its value must be, whether it must be there, and one

@@ -87,8 +87,11 @@ class HeadModel {
   /// The actuated joints' names, shared by every JointState of this head.
   const std::shared_ptr<const JointNames>& joint_names() const { return joint_names_; }
   /// A JointState of this head's joints with these values (size num_joints()).
-  JointState State(Eigen::VectorXd values) const { return JointState(joint_names_, std::move(values)); }
-  /// POPEYE's four joints as this head's (a legacy head's, whose joints are pan, tilt, left, right).
+  JointState State(Eigen::VectorXd values) const {
+    return JointState(joint_names_, std::move(values));
+  }
+  /// POPEYE's four joints as this head's (a legacy head's, whose joints are pan, tilt, left,
+  /// right).
   JointState State(const PopeyeJoints& q) const {
     return State(Eigen::Vector4d(q.pan, q.tilt, q.left, q.right));
   }

@@ -23,7 +23,8 @@ struct JsonCodec<head::JointState> {
     auto names = std::make_shared<head::JointNames>();
     Eigen::VectorXd values(static_cast<Eigen::Index>(j.size()));
     for (const auto& [name, value] : j.items()) {
-      if (!value.is_number() || !std::isfinite(value.get<double>())) {
+      if (!value.is_number()) JsonWhere{at.Path(), name}.Fail(value, "a number");
+      if (!std::isfinite(value.get<double>())) {
         JsonWhere{at.Path(), name}.Fail(value, "a finite number");
       }
       values[static_cast<Eigen::Index>(names->size())] = value.get<double>();

@@ -52,7 +52,7 @@ const char* ToString(Reachability reachability);
 
 struct IkOptions {
   VergenceMode mode = VergenceMode::kSymmetric;
-  PopeyeJoints seed;           ///< start of the iteration; pan comes from here in kIndependent
+  PopeyeJoints seed;         ///< start of the iteration; pan comes from here in kIndependent
   double tolerance = 1e-12;  ///< on the joint update (rad); the result is within 1e-9 rad
   int max_iterations = 100;
 };

@@ -113,8 +113,8 @@ class Motors {
 
  private:
   // Validates a command; throws naming the joint. Returns the clamped values.
-  std::pair<double, double> Clamp(const char* function, int joint, double position,
-                                  double velocity, bool* clamped) const;
+  std::pair<double, double> Clamp(const char* function, int joint, double position, double velocity,
+                                  bool* clamped) const;
   void Command(int joint, double position, double velocity);
   JointState Arranged(const JointState& joints) const;
   template <typename F>

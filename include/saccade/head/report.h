@@ -6,8 +6,8 @@
 #include <string>
 
 #include "saccade/geometry/pose.h"
-#include "saccade/head/head_description.h"
 #include "saccade/head/fixation.h"
+#include "saccade/head/head_description.h"
 #include "saccade/head/head_model.h"
 #include "saccade/head/kinematics.h"
 

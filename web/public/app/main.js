@@ -275,7 +275,7 @@ async function start() {
       : box.getCenter(new THREE.Vector3());
     const c = pageOf(centre);
     const targets = [...world.pickables, ...head.draggables,
-      ...head.links.get('base').children.flatMap((part) => part.children)];
+      ...[...head.links.values()].flatMap((link) => link.children.flatMap((part) => part.children))];
     const sees = (ndcX, ndcY) => {
       if (Math.abs(ndcX) > 1 || Math.abs(ndcY) > 1) return false;
       raycaster.setFromCamera(new THREE.Vector2(ndcX, ndcY), camera);

@@ -31,12 +31,10 @@ export const table = {
     "point": {"kind":"array","items":[{"kind":"number"}],"length":3},
     "joints": {
       "kind": "object",
-      "fields": [
-        {"name":"pan","required":true,"schema":{"kind":"number"}},
-        {"name":"tilt","required":true,"schema":{"kind":"number"}},
-        {"name":"left","required":true,"schema":{"kind":"number"}},
-        {"name":"right","required":true,"schema":{"kind":"number"}}
-      ]
+      "items": [{"kind":"number"}],
+      "fields": [],
+      "open": true,
+      "others": "a joint (scene.head.joints)"
     },
     "rgb": {"kind":"array","items":[{"kind":"number"}],"length":3},
     "rgba": {"kind":"array","items":[{"kind":"number"}],"length":4},
@@ -63,13 +61,10 @@ export const table = {
             "required": true,
             "schema": {
               "kind": "object",
-              "fields": [
-                {"name":"pan","required":false,"schema":{"kind":"number"}},
-                {"name":"tilt","required":false,"schema":{"kind":"number"}},
-                {"name":"left","required":false,"schema":{"kind":"number"}},
-                {"name":"right","required":false,"schema":{"kind":"number"}},
-                {"name":"vergence","required":false,"schema":{"kind":"number"}}
-              ],
+              "items": [{"kind":"number"}],
+              "fields": [{"name":"vergence","required":false,"schema":{"kind":"number"}}],
+              "open": true,
+              "others": "a joint (scene.head.joints)",
               "some": true
             }
           }
@@ -307,10 +302,8 @@ export const table = {
               "nullable": true,
               "fields": [
                 {"name":"X_WB","required":true,"schema":{"ref":"pose"}},
-                {"name":"X_WN","required":true,"schema":{"ref":"pose"}},
                 {"name":"X_WC","required":true,"schema":{"ref":"pose"}},
-                {"name":"left_eye","required":true,"schema":{"ref":"pose"}},
-                {"name":"right_eye","required":true,"schema":{"ref":"pose"}},
+                {"name":"links","required":true,"schema":{"kind":"object","fields":[],"open":true}},
                 {"name":"left","required":true,"schema":{"ref":"pose"}},
                 {"name":"right","required":true,"schema":{"ref":"pose"}}
               ]
@@ -593,6 +586,31 @@ export const table = {
               "fields": [
                 {"name":"visible","required":true,"schema":{"kind":"boolean"}},
                 {
+                  "name": "links",
+                  "required": true,
+                  "schema": {
+                    "kind": "array",
+                    "items": [
+                      {
+                        "kind": "object",
+                        "fields": [
+                          {"name":"name","required":true,"schema":{"kind":"string"}},
+                          {
+                            "name": "parent",
+                            "required": true,
+                            "schema": {"kind":"string","nullable":true}
+                          },
+                          {
+                            "name": "joint",
+                            "required": true,
+                            "schema": {"kind":"string","nullable":true}
+                          }
+                        ]
+                      }
+                    ]
+                  }
+                },
+                {
                   "name": "parts",
                   "required": true,
                   "schema": {
@@ -601,14 +619,7 @@ export const table = {
                       {
                         "kind": "object",
                         "fields": [
-                          {
-                            "name": "link",
-                            "required": true,
-                            "schema": {
-                              "kind": "string",
-                              "values": ["base","neck","cyclopean","left_eye","right_eye"]
-                            }
-                          },
+                          {"name":"link","required":true,"schema":{"kind":"string"}},
                           {"name":"model","required":true,"schema":{"kind":"integer","min":-1.0}},
                           {"name":"X_LinkPart","required":true,"schema":{"ref":"pose"}},
                           {"name":"scale","required":true,"schema":{"ref":"point"}}
@@ -626,6 +637,7 @@ export const table = {
             "schema": {
               "kind": "object",
               "fields": [
+                {"name":"name","required":true,"schema":{"kind":"string"}},
                 {
                   "name": "joints",
                   "required": true,
@@ -635,19 +647,37 @@ export const table = {
                       {
                         "kind": "object",
                         "fields": [
+                          {"name":"name","required":true,"schema":{"kind":"string"}},
                           {
-                            "name": "name",
+                            "name": "type",
                             "required": true,
-                            "schema": {"kind":"string","values":["pan","tilt","left","right"]}
+                            "schema": {"kind":"string","values":["revolute","continuous","prismatic"]}
                           },
-                          {"name":"min","required":true,"schema":{"kind":"number"}},
-                          {"name":"max","required":true,"schema":{"kind":"number"}},
+                          {"name":"link","required":true,"schema":{"kind":"string"}},
+                          {"name":"axis","required":true,"schema":{"ref":"point"}},
+                          {"name":"min","required":true,"schema":{"kind":"number","nullable":true}},
+                          {"name":"max","required":true,"schema":{"kind":"number","nullable":true}},
                           {
                             "name": "max_velocity",
                             "required": true,
                             "schema": {"kind":"number","min":0.0}
-                          }
+                          },
+                          {"name":"driven","required":true,"schema":{"kind":"boolean"}}
                         ]
+                      }
+                    ]
+                  }
+                },
+                {
+                  "name": "symmetric",
+                  "required": true,
+                  "schema": {
+                    "kind": "array",
+                    "items": [
+                      {
+                        "kind": "array",
+                        "items": [{"kind":"string"},{"kind":"string"},{"kind":"number"}],
+                        "length": 3
                       }
                     ]
                   }

@@ -75,7 +75,9 @@ function makeCheckValue(types) {
   const checkObject = (s, value, path) => {
     const fields = s.fields ?? [];
     if (s.some && Object.keys(value).length === 0) {
-      return `${where(path)} must name at least one of ${fields.map((f) => f.name).join(', ')}`;
+      let what = fields.map((f) => f.name).join(', ');
+      if (s.others) what += (what ? ' or ' : '') + s.others;
+      return `${where(path)} must name at least one of ${what}`;
     }
     for (const f of fields) {
       if (!Object.hasOwn(value, f.name)) {
@@ -85,8 +87,16 @@ function makeCheckValue(types) {
       const problem = check(f.schema, value[f.name], child(path, f.name));
       if (problem) return problem;
     }
-    if (s.open) return '';
     const known = new Set(fields.map((f) => f.name));
+    if (s.open) {
+      if (!(s.items ?? []).length) return '';
+      for (const key of Object.keys(value).sort(byName)) {
+        if (known.has(key)) continue;
+        const problem = check(s.items[0], value[key], child(path, key));
+        if (problem) return problem;
+      }
+      return '';
+    }
     for (const key of Object.keys(value).sort(byName)) {
       if (known.has(key)) continue;
       const names = fields.map((f) => f.name)
