@@ -156,8 +156,7 @@ void BM_RenderBatch(benchmark::State& bench) {
   const auto pose = [&](int k) {
     JointState joints = head.Home();
     const auto& pan = head.joint(0).limits;
-    joints[0] =
-        std::clamp(0.002 * (k % 64) * static_cast<double>(step % 100), pan.min, pan.max);
+    joints[0] = std::clamp(0.002 * (k % 64) * static_cast<double>(step % 100), pan.min, pan.max);
     return joints;
   };
   for (int k = 0; k < count; ++k) heads[k].state.joints = pose(k);

@@ -1,7 +1,5 @@
 #include "saccade/components/attention_component.h"
 
-#include "saccade/head/fixation.h"
-
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -11,6 +9,7 @@
 #include "components/internal_frames.h"
 #include "components/internal_scene.h"
 #include "saccade/core/error.h"
+#include "saccade/head/fixation.h"
 #include "saccade/head/kinematics.h"
 #include "saccade/vision/image_camera.h"
 

@@ -51,12 +51,12 @@ JointStateMessage RemoteHead::Move(const JointCommand& command) {
   }
   for (int j = 0; j < head.num_joints(); ++j) {
     if (!std::isfinite(clamped.positions[j]) || !std::isfinite(clamped.velocities[j])) {
-      throw Error(fmt::format("{}: the command's {} is not a finite number", name(),
-                              head.joint_name(j)));
+      throw Error(
+          fmt::format("{}: the command's {} is not a finite number", name(), head.joint_name(j)));
     }
     const head::JointSettings& s = head.joint(j);
-    clamped.positions[j] = s.driven ? std::clamp(clamped.positions[j], s.limits.min, s.limits.max)
-                                    : s.hold;
+    clamped.positions[j] =
+        s.driven ? std::clamp(clamped.positions[j], s.limits.min, s.limits.max) : s.hold;
   }
   clamped.time = time_;
   pending_ = clamped;

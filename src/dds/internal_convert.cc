@@ -423,7 +423,7 @@ void FillJointState(double time, const head::JointState& positions,
 
 bool ArrivedOn(const head::JointState& positions, const head::JointState& velocities,
                const head::JointState& targets, const head::JointState& target_velocities) {
-  constexpr double kTolerance = 1e-4;  // sim.head's (SimHead::State)
+  constexpr double kTolerance = 1e-4;            // sim.head's (SimHead::State)
   const bool still = target_velocities.empty();  // empty: the targets stand still
   if (targets.size() != positions.size() || velocities.size() != positions.size() ||
       (!still && target_velocities.size() != positions.size())) {

@@ -141,12 +141,14 @@ const char* JointName(Joint joint) {
 double& PopeyeJoints::operator[](Joint joint) {
   SACCADE_ASSERT(static_cast<int>(joint) >= 0 && static_cast<int>(joint) < 4,
                  "PopeyeJoints: invalid joint");
-  double PopeyeJoints::*const kMembers[] = {&PopeyeJoints::pan, &PopeyeJoints::tilt, &PopeyeJoints::left,
-                                          &PopeyeJoints::right};
+  double PopeyeJoints::*const kMembers[] = {&PopeyeJoints::pan, &PopeyeJoints::tilt,
+                                            &PopeyeJoints::left, &PopeyeJoints::right};
   return this->*kMembers[static_cast<int>(joint)];
 }
 
-double PopeyeJoints::operator[](Joint joint) const { return const_cast<PopeyeJoints&>(*this)[joint]; }
+double PopeyeJoints::operator[](Joint joint) const {
+  return const_cast<PopeyeJoints&>(*this)[joint];
+}
 
 HeadDescription::HeadDescription(std::string name, const HeadGeometry& geometry,
                                  const std::array<JointLimits, 4>& limits,

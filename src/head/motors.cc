@@ -47,9 +47,9 @@ void Motors::Reset(const JointState& position_state, const JointState& velocity_
     const double v = velocities[j];
     const std::string& name = (*names_)[j];
     if (!std::isfinite(x) || !l.Contains(x)) {
-      throw InvalidArgument(fmt::format(
-          "Motors::Reset: {} position = {} rad, expected a finite value in [{}, {}]{}", name, x,
-          l.min, l.max, driven_[j] ? "" : " (the head holds this joint)"));
+      throw InvalidArgument(
+          fmt::format("Motors::Reset: {} position = {} rad, expected a finite value in [{}, {}]{}",
+                      name, x, l.min, l.max, driven_[j] ? "" : " (the head holds this joint)"));
     }
     if (!std::isfinite(v) || std::abs(v) > l.max_velocity || (!driven_[j] && v != 0.0)) {
       throw InvalidArgument(
@@ -78,14 +78,14 @@ std::pair<double, double> Motors::Clamp(const char* function, int joint, double 
                                         double velocity, bool* clamped) const {
   const std::string& name = (*names_)[joint];
   if (!std::isfinite(position)) {
-    throw InvalidArgument(fmt::format(
-        "Motors::{}: {} target position = {} rad, expected a finite value", function, name,
-        position));
+    throw InvalidArgument(
+        fmt::format("Motors::{}: {} target position = {} rad, expected a finite value", function,
+                    name, position));
   }
   if (!std::isfinite(velocity)) {
-    throw InvalidArgument(fmt::format(
-        "Motors::{}: {} target velocity = {} rad/s, expected a finite value", function, name,
-        velocity));
+    throw InvalidArgument(
+        fmt::format("Motors::{}: {} target velocity = {} rad/s, expected a finite value", function,
+                    name, velocity));
   }
   const JointLimits& l = limits_[joint];
   const double x = std::clamp(position, l.min, l.max);
@@ -109,8 +109,7 @@ ClampReport Motors::SetTarget(const JointState& position) {
   return SetTarget(position, JointState{});
 }
 
-ClampReport Motors::SetTarget(const JointState& position_state,
-                              const JointState& velocity_state) {
+ClampReport Motors::SetTarget(const JointState& position_state, const JointState& velocity_state) {
   const JointState position = Arranged(position_state);
   const JointState velocity = Arranged(velocity_state);
   ClampReport report;
@@ -131,8 +130,8 @@ ClampReport Motors::SetTarget(const JointState& position_state,
 
 bool Motors::SetJointTarget(int joint, double position, double velocity) {
   if (!driven_[joint]) {
-    throw InvalidArgument(fmt::format("Motors::SetJointTarget: the head does not drive joint {}",
-                                      (*names_)[joint]));
+    throw InvalidArgument(
+        fmt::format("Motors::SetJointTarget: the head does not drive joint {}", (*names_)[joint]));
   }
   bool was_clamped = false;
   const auto [x, v] = Clamp("SetJointTarget", joint, position, velocity, &was_clamped);

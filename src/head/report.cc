@@ -112,7 +112,8 @@ json FkReportJson(const HeadModel& head, const JointState& q) {
   return {{"head", head.name()},
           {"joints", ToJson(q)},
           {"within_limits", head.WithinLimits(head.Arrange(q).values())},
-          {"cameras", {{"left", PoseReadableJson(cameras[0])}, {"right", PoseReadableJson(cameras[1])}}},
+          {"cameras",
+           {{"left", PoseReadableJson(cameras[0])}, {"right", PoseReadableJson(cameras[1])}}},
           {"fixation", fixation ? ToJson<Eigen::Vector3d>(*fixation) : json(nullptr)}};
 }
 
@@ -153,10 +154,10 @@ std::string IkReportText(const HeadModel& head, const Eigen::Vector3d& p_W,
   std::string out = fmt::format("target {} m in the world\n", FormatVector(p_W));
   out += fmt::format("joints: {}\n", FormatJoints(head, head.State(result.joints)));
   if (result.reachable()) {
-    out += fmt::format("reachable: {} through the target (axis error {:.2e} rad, {} iterations)\n",
-                       result.mid_axis ? "the axis midway between the cameras passes"
-                                       : "both optical axes pass",
-                       result.axis_error, result.iterations);
+    out += fmt::format(
+        "reachable: {} through the target (axis error {:.2e} rad, {} iterations)\n",
+        result.mid_axis ? "the axis midway between the cameras passes" : "both optical axes pass",
+        result.axis_error, result.iterations);
   } else {
     out += fmt::format(
         "NOT reachable ({}): {}\n  the joints above are the best found within the limits (axis "

@@ -138,11 +138,10 @@ class DynamixelHead final : public HeadDriver {
         const std::vector<uint8_t> state =
             bus_.Read(Id(joint), table::kPresentVelocity.address, 8).data;  // velocity, position
         const double v = dxl::VelocityUnitsToRadiansPerSecond(FromLe32(state, 0));  // servo rad/s
-        const double a = profile_acceleration_[joint];            // rad/s^2
+        const double a = profile_acceleration_[joint];                              // rad/s^2
         const double braking_rad = v * std::abs(v) / (2.0 * a);
         int32_t ticks = FromLe32(state, 4) + dxl::RadiansToTicks(braking_rad);
-        ticks = std::clamp(ticks, tick_limits_[joint].first,
-                           tick_limits_[joint].second);
+        ticks = std::clamp(ticks, tick_limits_[joint].first, tick_limits_[joint].second);
         hold[joint] = TicksToJoint(servos_[joint], ticks);
         if (torque_) bus_.WriteItem(Id(joint), table::kGoalPosition, ticks);
       } catch (const Error&) {
@@ -193,10 +192,12 @@ class DynamixelHead final : public HeadDriver {
       const head::JointSettings& settings = description().joint(joint);
       // A held joint's servo stays at its hold value: its range is that one position.
       const head::JointLimits limits =
-          settings.driven ? settings.limits
-                          : head::JointLimits{settings.hold, settings.hold,
-                                              settings.limits.max_velocity > 0 ? settings.limits.max_velocity : 1.0,
-                                              settings.limits.max_acceleration > 0 ? settings.limits.max_acceleration : 1.0};
+          settings.driven
+              ? settings.limits
+              : head::JointLimits{
+                    settings.hold, settings.hold,
+                    settings.limits.max_velocity > 0 ? settings.limits.max_velocity : 1.0,
+                    settings.limits.max_acceleration > 0 ? settings.limits.max_acceleration : 1.0};
       int32_t a = JointToTicks(servo, limits.min);
       int32_t b = JointToTicks(servo, limits.max);
       if (a > b) std::swap(a, b);
@@ -228,8 +229,7 @@ class DynamixelHead final : public HeadDriver {
   void WriteGoals(const head::JointState& positions) {
     std::vector<std::pair<uint8_t, std::vector<uint8_t>>> data;
     for (const int joint : joints_) {
-      data.push_back(
-          {Id(joint), Le32(JointToTicks(servos_[joint], positions[joint]))});
+      data.push_back({Id(joint), Le32(JointToTicks(servos_[joint], positions[joint]))});
     }
     bus_.SyncWrite(table::kGoalPosition.address, 4, data);
   }
@@ -237,7 +237,7 @@ class DynamixelHead final : public HeadDriver {
   std::string port_;
   DynamixelBus bus_;
   std::vector<head::ServoMapping> servos_;  // by joint; valid for the joints in joints_
-  std::vector<int> joints_;                // the joints with a servo, in the head's order
+  std::vector<int> joints_;                 // the joints with a servo, in the head's order
   std::vector<uint8_t> ids_;
   bool torque_ = false;
   std::vector<std::pair<int32_t, int32_t>> tick_limits_;  // the servos' position limits

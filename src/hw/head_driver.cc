@@ -60,12 +60,10 @@ CommandReport HeadDriver::Command(const head::JointState& position_state,
   for (int joint = 0; joint < n; ++joint) {
     const std::string& name = description_.joint_name(joint);
     if (!std::isfinite(positions[joint])) {
-      reject(fmt::format("joint {} position is {} (not a finite number)", name,
-                         positions[joint]));
+      reject(fmt::format("joint {} position is {} (not a finite number)", name, positions[joint]));
     }
     if (!std::isfinite(velocities[joint])) {
-      reject(fmt::format("joint {} velocity is {} (not a finite number)", name,
-                         velocities[joint]));
+      reject(fmt::format("joint {} velocity is {} (not a finite number)", name, velocities[joint]));
     }
   }
   if (status_.emergency_stopped) reject("emergency stop (clear it first)");
@@ -91,18 +89,17 @@ CommandReport HeadDriver::Command(const head::JointState& position_state,
     if (p < limits.min || p > limits.max) {
       report.position_clamped[i] = true;
       report.sent_positions[joint] = std::clamp(p, limits.min, limits.max);
-      report.description += fmt::format(
-          "{}{} target {:.2f} deg clamped to {:.2f} deg", report.description.empty() ? "" : "; ",
-          name, p * kRadToDeg, report.sent_positions[joint] * kRadToDeg);
+      report.description += fmt::format("{}{} target {:.2f} deg clamped to {:.2f} deg",
+                                        report.description.empty() ? "" : "; ", name, p * kRadToDeg,
+                                        report.sent_positions[joint] * kRadToDeg);
     }
     const double v = velocities[joint];
     if (std::abs(v) > limits.max_velocity) {
       report.velocity_limited[i] = true;
       report.sent_velocities[joint] = std::copysign(limits.max_velocity, v);
-      report.description +=
-          fmt::format("{}{} velocity {:.1f} deg/s limited to {:.1f} deg/s",
-                      report.description.empty() ? "" : "; ", name, v * kRadToDeg,
-                      report.sent_velocities[joint] * kRadToDeg);
+      report.description += fmt::format("{}{} velocity {:.1f} deg/s limited to {:.1f} deg/s",
+                                        report.description.empty() ? "" : "; ", name, v * kRadToDeg,
+                                        report.sent_velocities[joint] * kRadToDeg);
     }
   }
   try {

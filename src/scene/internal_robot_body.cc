@@ -46,8 +46,7 @@ std::vector<RobotPart> BuildRobotBody(const head::HeadModel& head) {
   std::vector<RobotPart> parts;
   const auto add = [&](Link link, const geometry::Pose& X,
                        const std::shared_ptr<const Model>& model, const Eigen::Vector3d& size) {
-    parts.push_back(
-        RobotPart{links[link], link == kBase ? X : paper_to_link * X, model, size});
+    parts.push_back(RobotPart{links[link], link == kBase ? X : paper_to_link * X, model, size});
   };
 
   // Eyes: in {l} and {r} the optical centre is at z = delta (eqs. 7-8); everything is behind.

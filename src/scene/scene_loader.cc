@@ -502,8 +502,8 @@ class SceneReader {
     try {
       model.emplace(head::HeadModel::FromFile(head_path));
     } catch (const Error& error) {
-      head_entry.Fail(
-          fmt::format("cannot load head description '{}': {}", head_entry.AsString(), error.what()));
+      head_entry.Fail(fmt::format("cannot load head description '{}': {}", head_entry.AsString(),
+                                  error.what()));
     }
     if (const auto pose = e.Find("pose")) model.emplace(model->WithPose(ReadPose(*pose)));
 

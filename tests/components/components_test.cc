@@ -107,8 +107,8 @@ PictureFace Astronaut() {
 TEST(PerceptionComponents, FromRenderedImagesToACommandThatFixatesTheFace) {
   const scene::Scene& scene = Scene();
   const Eigen::Vector3d face = FaceCentreAt(scene, Astronaut(), 0.0);
-  const head::IkResult look =
-      head::SolveFixation(*scene.robot()->head.AppendixAHead(), face + Eigen::Vector3d(0, 0.1, -0.05));
+  const head::IkResult look = head::SolveFixation(*scene.robot()->head.AppendixAHead(),
+                                                  face + Eigen::Vector3d(0, 0.1, -0.05));
   ASSERT_TRUE(look.reachable());
 
   auto cameras = Make("sim.cameras", {{"scene", kScene}});
@@ -134,7 +134,8 @@ TEST(PerceptionComponents, FromRenderedImagesToACommandThatFixatesTheFace) {
   cameras->Start();
   for (int64_t step = 0; step < 3; ++step) {
     JointStateMessage joints;
-    joints.positions = joints.velocities = joints.targets = joints.target_velocities = head::JointState::Popeye(0, 0, 0, 0);
+    joints.positions = joints.velocities = joints.targets = joints.target_velocities =
+        head::JointState::Popeye(0, 0, 0, 0);
     joints.time = At(step).time;
     joints.positions = look.joints;
     In<JointStateMessage>(*cameras, "joints").Deliver(joints);
@@ -183,8 +184,8 @@ TEST(PerceptionComponents, FromRenderedImagesToACommandThatFixatesTheFace) {
   ASSERT_TRUE((*target)->valid);
   EXPECT_LT(((*target)->p_W - face).norm(), kTriangulationToleranceM);
   // The command fixates the target exactly: both optical axes meet on it.
-  const head::HeadFrames frames =
-      head::ForwardKinematics(*scene.robot()->head.AppendixAHead(), head::PopeyeJoints::From((*command)->positions));
+  const head::HeadFrames frames = head::ForwardKinematics(
+      *scene.robot()->head.AppendixAHead(), head::PopeyeJoints::From((*command)->positions));
   ASSERT_TRUE(frames.p_WFixation);
   EXPECT_LT((*frames.p_WFixation - (*target)->p_W).norm(), kIkToleranceM);
   EXPECT_FALSE((*command)->pursuit());  // a still face: a saccade
@@ -199,7 +200,8 @@ std::shared_ptr<const Image> RenderOne(const std::string& scene_file, const std:
   auto image = Capture<runtime::ImageMessage>(*cameras, camera);
   cameras->Start();
   JointStateMessage state;
-  state.positions = state.velocities = state.targets = state.target_velocities = head::JointState::Popeye(0, 0, 0, 0);
+  state.positions = state.velocities = state.targets = state.target_velocities =
+      head::JointState::Popeye(0, 0, 0, 0);
   state.positions = joints;
   state.velocities = velocities;
   In<JointStateMessage>(*cameras, "joints").Deliver(state);
@@ -234,7 +236,8 @@ TEST(SimCameras, PipelinedCaptureEmitsThePreviousStepsFrameUnchanged) {
   std::shared_ptr<const Image> previous;
   for (int64_t step = 0; step < 4; ++step) {
     JointStateMessage joints;
-    joints.positions = joints.velocities = joints.targets = joints.target_velocities = head::JointState::Popeye(0, 0, 0, 0);
+    joints.positions = joints.velocities = joints.targets = joints.target_velocities =
+        head::JointState::Popeye(0, 0, 0, 0);
     joints.time = At(step).time;
     joints.positions = head::JointState::Popeye(0.05 * step, -0.02 * step, 0.0, 0.0);
     In<JointStateMessage>(*pipelined, "joints").Deliver(joints);
@@ -293,8 +296,8 @@ TEST(SimCameras, WhileWaitingRunsOnTheStepsThreadWhileTheRendererDraws) {
 // The left eye's image with the head fixating the astronaut's face; null when it cannot.
 std::shared_ptr<const Image> LeftEyeOnTheAstronaut() {
   const scene::Scene& scene = Scene();
-  const head::IkResult look =
-      head::SolveFixation(*scene.robot()->head.AppendixAHead(), FaceCentreAt(scene, Astronaut(), 0.0));
+  const head::IkResult look = head::SolveFixation(*scene.robot()->head.AppendixAHead(),
+                                                  FaceCentreAt(scene, Astronaut(), 0.0));
   EXPECT_TRUE(look.reachable());
   if (!look.reachable()) return nullptr;
   return RenderOne(kScene, "left", look.joints, {});
@@ -417,10 +420,11 @@ TEST(FaceDetectorComponent, WithThePartnersFacesSearchesTheirEpipolarBandsNotThe
   const scene::Scene& scene = Scene();
   const Eigen::Vector3d her_W = FaceCentreAt(scene, Astronaut(), 0.0);
   const Eigen::Vector3d base_W =
-      head::ForwardKinematics(*scene.robot()->head.AppendixAHead(), head::PopeyeJoints::From(scene.robot()->initial_joints))
+      head::ForwardKinematics(*scene.robot()->head.AppendixAHead(),
+                              head::PopeyeJoints::From(scene.robot()->initial_joints))
           .X_WC.translation();
-  const head::IkResult look =
-      head::SolveFixation(*scene.robot()->head.AppendixAHead(), her_W + 5.0 * (her_W - base_W).normalized());
+  const head::IkResult look = head::SolveFixation(*scene.robot()->head.AppendixAHead(),
+                                                  her_W + 5.0 * (her_W - base_W).normalized());
   ASSERT_TRUE(look.reachable());
   const std::shared_ptr<const Image> left = RenderOne(kScene, "left", look.joints, {});
   const std::shared_ptr<const Image> right = RenderOne(kScene, "right", look.joints, {});
@@ -848,7 +852,8 @@ TEST(SimCameras, TheHeadsMotionBlursTheEyeImages) {
   const std::string portraits = std::string(SACCADE_SOURCE_DIR) + "/scenes/portraits.yaml";
   const head::JointState still = head::JointState::Popeye(0.0, 0.0, 0.0, 0.0);
   const auto sharp = RenderOne(portraits, "left", still, still);
-  const auto blurred = RenderOne(portraits, "left", still, head::JointState::Popeye(3.0, 0.0, 0.0, 0.0));  // 170 deg/s
+  const auto blurred = RenderOne(portraits, "left", still,
+                                 head::JointState::Popeye(3.0, 0.0, 0.0, 0.0));  // 170 deg/s
   EXPECT_EQ(blurred->metadata().joints[0], 0.0);
   // 3 rad/s over 8 ms sweeps 0.024 rad, ~31 px: the edges' energy falls several-fold.
   EXPECT_LT(Sharpness(*blurred), 0.5 * Sharpness(*sharp));
@@ -912,8 +917,10 @@ TEST(AttentionComponent, VisitsTheClosestFirstThenTheNextThenGoesHome) {
     // The head is on whatever was selected last (as if the motors were instant).
     if (*selection && (*selection)->valid) {
       JointStateMessage joints;
-      joints.positions = joints.velocities = joints.targets = joints.target_velocities = head::JointState::Popeye(0, 0, 0, 0);
-      joints.positions = head::SolveFixation(*scene.robot()->head.AppendixAHead(), (*selection)->p_W).joints;
+      joints.positions = joints.velocities = joints.targets = joints.target_velocities =
+          head::JointState::Popeye(0, 0, 0, 0);
+      joints.positions =
+          head::SolveFixation(*scene.robot()->head.AppendixAHead(), (*selection)->p_W).joints;
       joints.arrived = true;
       In<JointStateMessage>(*attention, "joints").Deliver(joints);
     }
@@ -943,7 +950,8 @@ TEST(AttentionComponent, AFixationBeginsWhereThisStepsSightingAgreesWithTheEyes)
   // A point `deg` degrees beside the face, seen from the head (a turn about the vertical).
   const auto beside = [&](double deg) {
     const Eigen::Vector3d viewer =
-        head::ForwardKinematics(*scene.robot()->head.AppendixAHead(), head::PopeyeJoints::From(scene.robot()->initial_joints))
+        head::ForwardKinematics(*scene.robot()->head.AppendixAHead(),
+                                head::PopeyeJoints::From(scene.robot()->initial_joints))
             .X_WC.translation();
     return Eigen::Vector3d(
         viewer + Eigen::AngleAxisd(deg * M_PI / 180.0, Eigen::Vector3d::UnitZ()) * (face - viewer));
@@ -957,8 +965,10 @@ TEST(AttentionComponent, AFixationBeginsWhereThisStepsSightingAgreesWithTheEyes)
     std::vector<bool> fixating;
     for (std::size_t step = 0; step < steps.size(); ++step) {
       JointStateMessage joints;
-      joints.positions = joints.velocities = joints.targets = joints.target_velocities = head::JointState::Popeye(0, 0, 0, 0);
-      joints.positions = head::SolveFixation(*scene.robot()->head.AppendixAHead(), steps[step].first).joints;
+      joints.positions = joints.velocities = joints.targets = joints.target_velocities =
+          head::JointState::Popeye(0, 0, 0, 0);
+      joints.positions =
+          head::SolveFixation(*scene.robot()->head.AppendixAHead(), steps[step].first).joints;
       joints.arrived = true;
       In<JointStateMessage>(*attention, "joints").Deliver(joints);
       In<CandidatesMessage>(*attention, "candidates")
@@ -989,7 +999,8 @@ TEST(SimHead, CommandsBeyondTheLimitsAreClampedAndCountedNeverExceeded) {
   head_component->Start();
   JointCommand command;
   command.positions = command.velocities = head::JointState::Popeye(0, 0, 0, 0);
-  command.positions = head::JointState::Popeye(3.0, -2.0, 0.0, 0.0);  // pan 172 deg, tilt -115 deg: beyond the limits
+  command.positions = head::JointState::Popeye(
+      3.0, -2.0, 0.0, 0.0);  // pan 172 deg, tilt -115 deg: beyond the limits
   In<JointCommand>(*head_component, "command").Deliver(command);
   const auto& limits = scene.robot()->head;
   for (int64_t step = 0; step < 100; ++step) {
@@ -997,8 +1008,7 @@ TEST(SimHead, CommandsBeyondTheLimitsAreClampedAndCountedNeverExceeded) {
     head_component->inputs()[0]->MarkSeen();
     EXPECT_LE((*joints)->positions[0], limits.joint(0).limits.max + 1e-12);
     EXPECT_GE((*joints)->positions[1], limits.joint(1).limits.min - 1e-12);
-    EXPECT_LE(std::abs((*joints)->velocities[0]),
-              limits.joint(0).limits.max_velocity + 1e-9);
+    EXPECT_LE(std::abs((*joints)->velocities[0]), limits.joint(0).limits.max_velocity + 1e-9);
   }
   EXPECT_TRUE((*joints)->arrived);
   EXPECT_DOUBLE_EQ((*joints)->positions[0], limits.joint(0).limits.max);
@@ -1068,7 +1078,8 @@ TEST(FixationComponent, AMovingTargetGetsPursuitVelocitiesThatFollowIt) {
   const double expected = 0.2 * 2.0 / (4.0 + std::pow(0.2 * t, 2));
   EXPECT_NEAR((*command)->velocities[0], expected, 0.01 * expected);
   const auto& head = scene.robot()->head;
-  const head::HeadFrames frames = head::ForwardKinematics(*head.AppendixAHead(), head::PopeyeJoints::From((*command)->positions));
+  const head::HeadFrames frames = head::ForwardKinematics(
+      *head.AppendixAHead(), head::PopeyeJoints::From((*command)->positions));
   ASSERT_TRUE(frames.p_WFixation);
   EXPECT_LT((*frames.p_WFixation - (Eigen::Vector3d(2.0, 0.0, 1.2) + v * t)).norm(), kIkToleranceM);
 }

@@ -127,7 +127,8 @@ TEST_F(PipelineTopics, ClockSourceStepsOnTheReceivedStamps) {
   std::vector<double> times;
   std::vector<double> targets;  // the head's pan target after each step
   components::demo::Tap<components::JointStateMessage>(
-      pipeline, [&](const components::JointStateMessage& m) { targets.push_back(m.targets.at("pan")); });
+      pipeline,
+      [&](const components::JointStateMessage& m) { targets.push_back(m.targets.at("pan")); });
   runtime::RunOptions options;
   options.after_step = [&](const runtime::StepContext& context) {
     times.push_back(context.time);

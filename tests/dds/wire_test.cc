@@ -233,7 +233,8 @@ TEST_F(WireTest, BytesEqualAnIndependentRos2Serializer) {
       MakeImage(7, 2, PixelFormat::kGray8, 2, geometry::Distortion::RadialTangential(plumb));
   gray->metadata().time = 0.04 * 3;
   JointStateMessage state;
-  state.positions = state.velocities = state.targets = state.target_velocities = head::JointState::Popeye(0, 0, 0, 0);
+  state.positions = state.velocities = state.targets = state.target_velocities =
+      head::JointState::Popeye(0, 0, 0, 0);
   state.time = 7.04;
   state.positions = head::JointState::Popeye(0.1, -0.2, 0.3125, -0.0625);
   state.velocities = head::JointState::Popeye(1.5, 0, -2.25, 1e-9);
@@ -289,7 +290,8 @@ TEST_F(WireTest, LateJoiningSubscriberGetsTheNewestJointState) {
   auto writer =
       Writer::Create(participant, "head.joints", Topic("/saccade/joint_states", Qos::Latched()));
   JointStateMessage state;
-  state.positions = state.velocities = state.targets = state.target_velocities = head::JointState::Popeye(0, 0, 0, 0);
+  state.positions = state.velocities = state.targets = state.target_velocities =
+      head::JointState::Popeye(0, 0, 0, 0);
   for (int i = 1; i <= 3; ++i) {
     state.time = 0.04 * i;
     state.positions[0] = 0.1 * i;
@@ -427,7 +429,8 @@ TEST_F(WireTest, ReaderHandsOverTheMessageOfTheAskedTimeAndKeepsLaterOnes) {
   ASSERT_TRUE(writer->WaitForReaders(1, 10));
   // The sender runs ahead: four states before the receiver's first step.
   JointStateMessage state;
-  state.positions = state.velocities = state.targets = state.target_velocities = head::JointState::Popeye(0, 0, 0, 0);
+  state.positions = state.velocities = state.targets = state.target_velocities =
+      head::JointState::Popeye(0, 0, 0, 0);
   for (const double t : {0.04, 0.08, 0.12, 0.16}) {
     state.time = t;
     state.positions[0] = t;
@@ -597,7 +600,8 @@ TEST_F(WireTest, JointStatesBringTheirTargetsAndArrivalAsTheSenderSaysIt) {
 
   // Pursuit, on its target: sim.head says arrived while every joint moves at 0.02 rad/s.
   JointStateMessage pursuit;
-  pursuit.positions = pursuit.velocities = pursuit.targets = pursuit.target_velocities = head::JointState::Popeye(0, 0, 0, 0);
+  pursuit.positions = pursuit.velocities = pursuit.targets = pursuit.target_velocities =
+      head::JointState::Popeye(0, 0, 0, 0);
   pursuit.time = 0.04;
   pursuit.positions = head::JointState::Popeye(0.2, -0.1, 0.05, -0.05);
   pursuit.velocities = head::JointState::Popeye(0.02, 0.0, 0.01, -0.01);

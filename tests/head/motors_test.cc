@@ -61,7 +61,8 @@ TEST(MotorsTest, SaccadeOfEachJointTakesTheTimeOptimalDuration) {
     const double half_range = std::min(l.max, -l.min);
     const double short_move = 0.3 * v * v / a;
     const double long_move = 0.9 * half_range;
-    ASSERT_GT(2 * long_move, v * v / a) << head::JointState::PopeyeNames()->at(joint) << ": the long move must cruise";
+    ASSERT_GT(2 * long_move, v * v / a)
+        << head::JointState::PopeyeNames()->at(joint) << ": the long move must cruise";
     const std::vector<std::pair<double, double>> moves = {
         {0.0, short_move}, {0.0, -short_move}, {-long_move, long_move}, {long_move, -long_move}};
     for (const auto& [x0, x1] : moves) {
@@ -145,7 +146,8 @@ TEST(MotorsTest, RandomSaccadesFromRandomVelocitiesStayWithinEveryLimit) {
     double v0 = l.max_velocity * (2 * unit(rng) - 1);
     const double stop = x0 + v0 * std::abs(v0) / (2 * l.max_acceleration);
     if (!l.Contains(stop)) v0 = 0.0;
-    JointState positions = head::JointState::Popeye(0, 0, 0, 0), velocities = head::JointState::Popeye(0, 0, 0, 0);
+    JointState positions = head::JointState::Popeye(0, 0, 0, 0),
+               velocities = head::JointState::Popeye(0, 0, 0, 0);
     positions[joint] = x0;
     velocities[joint] = v0;
     Motors motors(head);
@@ -240,7 +242,8 @@ TEST(MotorsTest, StateDoesNotDependOnTheStepSize) {
       once.Step(t_end);
       for (int joint = 0; joint < 4; ++joint) {
         EXPECT_NEAR(fine.positions()[joint], once.positions()[joint], kDtIndependenceTolerance)
-            << head::JointState::PopeyeNames()->at(joint) << " t=" << t_end << " pursuit=" << pursuit;
+            << head::JointState::PopeyeNames()->at(joint) << " t=" << t_end
+            << " pursuit=" << pursuit;
         EXPECT_NEAR(coarse.positions()[joint], once.positions()[joint], kDtIndependenceTolerance);
         EXPECT_NEAR(fine.velocities()[joint], once.velocities()[joint], kDtIndependenceTolerance);
         EXPECT_NEAR(coarse.velocities()[joint], once.velocities()[joint], kDtIndependenceTolerance);
@@ -288,7 +291,8 @@ TEST(MotorsTest, PursuitConvergesThenTracksWithZeroLag) {
       // other way: it must turn, catch up and lock on.
       const double vt = sign * 0.25 * l.max_velocity;
       const double p0 = -sign * 0.4 * std::min(l.max, -l.min);
-      JointState start = head::JointState::Popeye(0, 0, 0, 0), start_v = head::JointState::Popeye(0, 0, 0, 0);
+      JointState start = head::JointState::Popeye(0, 0, 0, 0),
+                 start_v = head::JointState::Popeye(0, 0, 0, 0);
       start[joint] = -sign * 0.5 * std::min(l.max, -l.min);
       start_v[joint] = -0.5 * vt;
       Motors motors(head);
@@ -300,7 +304,8 @@ TEST(MotorsTest, PursuitConvergesThenTracksWithZeroLag) {
       const double limit = sign > 0 ? l.max : l.min;
       const double t_brake = (limit - sign * vt * vt / (2 * l.max_acceleration) - p0) / vt;
       ASSERT_LT(meet, t_brake) << head::JointState::PopeyeNames()->at(joint);
-      RecordAndCheck(motors, joint, 1e-3, static_cast<int>(meet / 1e-3) + 1, head::JointState::PopeyeNames()->at(joint));
+      RecordAndCheck(motors, joint, 1e-3, static_cast<int>(meet / 1e-3) + 1,
+                     head::JointState::PopeyeNames()->at(joint));
       // From the meeting time until the braking point: exact tracking.
       double t = motors.command_time(joint);
       while (t < t_brake - 1e-3) {
@@ -354,10 +359,12 @@ TEST(MotorsTest, TargetsBeyondTheLimitsAreClampedAndNeverExceeded) {
   const JointState far = head::JointState::Popeye(200 * kDeg, -100 * kDeg, 60 * kDeg, -1e6);
   const ClampReport report = motors.SetTarget(far);
   EXPECT_TRUE(report.any());
-  for (int joint = 0; joint < 4; ++joint) EXPECT_TRUE(report[joint]) << head::JointState::PopeyeNames()->at(joint);
+  for (int joint = 0; joint < 4; ++joint)
+    EXPECT_TRUE(report[joint]) << head::JointState::PopeyeNames()->at(joint);
   EXPECT_EQ(motors.clamped_commands(), 4);
-  const JointState expected = head::JointState::Popeye(head.joint(0).limits.max, head.joint(1).limits.min,
-                            head.joint(2).limits.max, head.joint(3).limits.min);
+  const JointState expected =
+      head::JointState::Popeye(head.joint(0).limits.max, head.joint(1).limits.min,
+                               head.joint(2).limits.max, head.joint(3).limits.min);
   EXPECT_EQ(motors.targets(), expected);
   for (int joint = 0; joint < 4; ++joint) {
     Motors copy = motors;
@@ -394,25 +401,28 @@ TEST(MotorsTest, NonFiniteTargetsThrowNamingTheJointAndChangeNothing) {
     EXPECT_EQ(motors.targets(), t);
     EXPECT_EQ(motors.TimeToTarget(), remaining);
   };
+  expect_throw([&] { motors.SetTarget(head::JointState::Popeye(0.0, 0.0, nan, 0.0)); },
+               "left target position = nan");
   expect_throw(
       [&] {
-        motors.SetTarget(head::JointState::Popeye(0.0, 0.0, nan, 0.0));
-      },
-      "left target position = nan");
-  expect_throw(
-      [&] {
-        motors.SetTarget(head::JointState::Popeye(0.0, 0.0, 0.0, 0.0), head::JointState::Popeye(0, inf, 0, 0));
+        motors.SetTarget(head::JointState::Popeye(0.0, 0.0, 0.0, 0.0),
+                         head::JointState::Popeye(0, inf, 0, 0));
       },
       "tilt target velocity = inf");
   expect_throw([&] { motors.SetJointTarget(3, -inf); }, "right target position = -inf");
   expect_throw([&] { motors.Step(nan); }, "Motors::Step: dt = nan");
   expect_throw([&] { motors.Step(-1.0); }, "dt = -1");
   expect_throw([&] { motors.Reset(head::JointState::Popeye(0, 0, 0, 2.0)); }, "right position = 2");
-  expect_throw([&] { motors.Reset(head::JointState::Popeye(0, 0, 0, 0), head::JointState::Popeye(100, 0, 0, 0)); }, "pan velocity = 100");
+  expect_throw(
+      [&] {
+        motors.Reset(head::JointState::Popeye(0, 0, 0, 0), head::JointState::Popeye(100, 0, 0, 0));
+      },
+      "pan velocity = 100");
   // pan at 89 deg moving at 300 deg/s towards 90: needs 15 deg to stop.
   expect_throw(
       [&] {
-        motors.Reset(head::JointState::Popeye(89 * kDeg, 0, 0, 0), head::JointState::Popeye(300 * kDeg, 0, 0, 0));
+        motors.Reset(head::JointState::Popeye(89 * kDeg, 0, 0, 0),
+                     head::JointState::Popeye(300 * kDeg, 0, 0, 0));
       },
       "cannot stop before its limit");
   EXPECT_EQ(motors.clamped_commands(), 0);
@@ -422,11 +432,11 @@ TEST(MotorsTest, ResetWithVelocityBrakesToRest) {
   const HeadModel head = Popeye();
   Motors motors(head);
   const JointLimits& l = head.joint(1).limits;
-  motors.Reset(head::JointState::Popeye(0, 0.1, 0, 0), head::JointState::Popeye(0, -l.max_velocity, 0, 0));
+  motors.Reset(head::JointState::Popeye(0, 0.1, 0, 0),
+               head::JointState::Popeye(0, -l.max_velocity, 0, 0));
   const double stop = 0.1 - l.max_velocity * l.max_velocity / (2 * l.max_acceleration);
   EXPECT_NEAR(motors.targets()[1], stop, kRoundingSlack);
-  EXPECT_NEAR(motors.TimeToTarget(1), l.max_velocity / l.max_acceleration,
-              kRoundingSlack);
+  EXPECT_NEAR(motors.TimeToTarget(1), l.max_velocity / l.max_acceleration, kRoundingSlack);
   motors.Step(1.0);
   EXPECT_NEAR(motors.positions()[1], stop, kRoundingSlack);
   EXPECT_TRUE(motors.Arrived());

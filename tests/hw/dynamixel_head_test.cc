@@ -27,7 +27,7 @@ constexpr double kTick = 360.0 / 4096.0;  // deg
 
 head::JointState Joints(double pan_deg, double tilt_deg, double left_deg, double right_deg) {
   return head::JointState::Popeye(pan_deg * kDeg, tilt_deg * kDeg, left_deg * kDeg,
-                                 right_deg * kDeg);
+                                  right_deg * kDeg);
 }
 
 class DynamixelHeadTest : public ::testing::Test {

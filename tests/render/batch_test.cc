@@ -148,7 +148,8 @@ objects:
   std::vector<BatchHead> heads(3);
   for (std::size_t i = 0; i < heads.size(); ++i) {
     heads[i].state = scene.InitialState();
-    heads[i].state.joints = head::JointState::Popeye(0.01 * static_cast<double>(i), -0.1, 0.02, -0.02);
+    heads[i].state.joints =
+        head::JointState::Popeye(0.01 * static_cast<double>(i), -0.1, 0.02, -0.02);
   }
   const std::size_t tile_bytes = 48 * 4096 * 3;
   std::vector<uint8_t> images[2], again[2];

@@ -299,8 +299,7 @@ TEST(RendererTest, ObjectsPartlyInViewAreDrawn) {
 // A scene with the head (robots/popeye.yaml), its two eye cameras, a world camera with lens
 // distortion, a checker ground, textures, a shiny sphere and every kind of light.
 scene::Scene RichScene() {
-  const head::HeadModel head =
-      head::HeadModel::FromFile(SACCADE_SOURCE_DIR "/robots/popeye.yaml");
+  const head::HeadModel head = head::HeadModel::FromFile(SACCADE_SOURCE_DIR "/robots/popeye.yaml");
   scene::Robot robot{head, head::JointState::Popeye(0, 0, 0, 0), true, {}, 100};
   robot.parts.push_back(scene::RobotPart{head.tree().root(), At(Vector3d(0, 0, -0.3)),
                                          scene::MakeBox(Vector4f(0.2f, 0.2f, 0.2f, 1)),
@@ -401,9 +400,8 @@ TEST(RendererTest, SubmitAndRetrieveReturnFramesInOrderWithTheirMetadata) {
       const bool eye = camera.mount != scene::CameraMount::kWorld;
       EXPECT_EQ(meta.has_joints, eye);
       if (eye) {
-        EXPECT_EQ(meta.joints,
-                  (std::vector<double>{states[i].joints[0], states[i].joints[1],
-                                       states[i].joints[2], states[i].joints[3]}));
+        EXPECT_EQ(meta.joints, (std::vector<double>{states[i].joints[0], states[i].joints[1],
+                                                    states[i].joints[2], states[i].joints[3]}));
         ASSERT_TRUE(meta.joint_names);
         EXPECT_EQ(*meta.joint_names, *head::JointState::PopeyeNames());
       }

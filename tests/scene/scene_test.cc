@@ -263,9 +263,8 @@ TEST(RobotBody, EyesCannotSeeTheirOwnEyeNorTheHeadAnywhereWithinTheLimits) {
         const Eigen::Vector3d p_W = X_WPart * Eigen::Vector3d(p.cwiseProduct(part.scale));
         for (const char* name : {"left", "right"}) {
           const CameraSpec& camera = *scene.FindCamera(name);
-          const bool own_eye =
-              (part.link == left_eye && camera.mount == CameraMount::kLeftEye) ||
-              (part.link == right_eye && camera.mount == CameraMount::kRightEye);
+          const bool own_eye = (part.link == left_eye && camera.mount == CameraMount::kLeftEye) ||
+                               (part.link == right_eye && camera.mount == CameraMount::kRightEye);
           const Eigen::Vector3d p_C = scene.CameraPose(camera, state).inverse() * p_W;
           // Its own eye lies behind its optical centre: never in the view, whatever the near
           // plane.

@@ -46,7 +46,8 @@ FaceDetection DetectAstronaut(const Image& image) {
 // The scene's initial state, the head fixating the astronaut's face.
 scene::SceneState FixatingTheAstronaut() {
   const head::HeadModel& head = Portraits().robot()->head;
-  const head::IkResult ik = head::SolveFixation(*head.AppendixAHead(), FaceCentreWorld("astronaut"));
+  const head::IkResult ik =
+      head::SolveFixation(*head.AppendixAHead(), FaceCentreWorld("astronaut"));
   EXPECT_TRUE(ik.reachable());
   scene::SceneState state = Portraits().InitialState();
   state.joints = head.State(ik.joints);

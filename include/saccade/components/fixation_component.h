@@ -40,7 +40,7 @@ class FixationComponent : public runtime::Component {
   std::optional<TargetMessage> previous_;
   Eigen::Vector3d velocity_W_ = Eigen::Vector3d::Zero();
   head::JointState last_joints_;
-  std::optional<head::HeadDescription> appendix_a_;      // POPEYE's legacy head: appendix A
+  std::optional<head::HeadDescription> appendix_a_;       // POPEYE's legacy head: appendix A
   mutable std::unique_ptr<head::FixationSolver> solver_;  // any other head
 };
 

@@ -61,12 +61,12 @@ class TypedValues {
 /// distortion of the image as it is) and the camera's pose X_WC (its optical frame in the
 /// world) are geometry's types, in `typed` (geometry/image_camera.h).
 struct ImageMetadata {
-  std::string camera;              ///< camera name ("left", "right", ...)
-  double time = 0.0;               ///< simulation (or capture) time, seconds
-  int64_t frame_index = 0;         ///< 0, 1, 2, ... per camera
-  TypedValues typed;               ///< the camera model and pose
-  int exposure_samples = 1;        ///< sub-frames the exposure was drawn in (motion blur)
-  bool has_joints = false;  ///< whether the camera rides on a head
+  std::string camera;        ///< camera name ("left", "right", ...)
+  double time = 0.0;         ///< simulation (or capture) time, seconds
+  int64_t frame_index = 0;   ///< 0, 1, 2, ... per camera
+  TypedValues typed;         ///< the camera model and pose
+  int exposure_samples = 1;  ///< sub-frames the exposure was drawn in (motion blur)
+  bool has_joints = false;   ///< whether the camera rides on a head
   /// The head's joint values at capture (rad, or m for a prismatic joint), named by
   /// `joint_names` in the same order (shared by every image of the head).
   std::vector<double> joints;

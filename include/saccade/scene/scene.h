@@ -185,7 +185,7 @@ struct Robot {
 
 /// What changes while the description stays: time and joint angles.
 struct SceneState {
-  double time = 0.0;  ///< seconds
+  double time = 0.0;        ///< seconds
   head::JointState joints;  ///< the robot's joints (empty without a robot)
   /// Joint velocities (rad/s) at `time`: during a camera's exposure the joints move at this
   /// constant rate, which blurs the eye cameras' images (SensorSpec::exposure). Empty or
