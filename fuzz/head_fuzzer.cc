@@ -69,7 +69,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, std::size_t size) {
   // Forward kinematics at zero and at the corners of the limits (clamped to a turn).
   const auto clamp = [](double v) { return std::max(-M_PI, std::min(M_PI, v)); };
   for (int corner = 0; corner < 17; ++corner) {
-    head::JointState q;
+    head::PopeyeJoints q;
     if (corner < 16) {
       for (const head::Joint joint : head::kAllJoints) {
         const int bit = 1 << static_cast<int>(joint);
