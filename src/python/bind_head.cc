@@ -201,6 +201,13 @@ Eigen::VectorXd PostureOf(const head::HeadModel& head, const py::handle& joints,
   return Eigen::Map<const Eigen::VectorXd>(q.data(), q.shape(0));
 }
 
+// One limit of every joint, in the head's order.
+Eigen::VectorXd PerJoint(const head::HeadModel& h, double head::JointLimits::*field) {
+  Eigen::VectorXd v(h.num_joints());
+  for (int j = 0; j < h.num_joints(); ++j) v[j] = h.joint(j).limits.*field;
+  return v;
+}
+
 py::dict JointInfo(const head::HeadModel& h, int j) {
   const head::JointSettings& s = h.joint(j);
   py::dict info;
@@ -275,27 +282,12 @@ void BindHeadModel(py::module_& m) {
           },
           "name"_a, "min, max (rad or m), max_velocity, max_acceleration, driven, hold.")
       .def_property_readonly("limits_min",
-                             [](const HeadModel& h) {
-                               Eigen::VectorXd v(h.num_joints());
-                               for (int j = 0; j < h.num_joints(); ++j)
-                                 v[j] = h.joint(j).limits.min;
-                               return v;
-                             })
+                             [](const HeadModel& h) { return PerJoint(h, &JointLimits::min); })
       .def_property_readonly("limits_max",
-                             [](const HeadModel& h) {
-                               Eigen::VectorXd v(h.num_joints());
-                               for (int j = 0; j < h.num_joints(); ++j)
-                                 v[j] = h.joint(j).limits.max;
-                               return v;
-                             })
-      .def_property_readonly("max_velocity",
-                             [](const HeadModel& h) {
-                               Eigen::VectorXd v(h.num_joints());
-                               for (int j = 0; j < h.num_joints(); ++j) {
-                                 v[j] = h.joint(j).limits.max_velocity;
-                               }
-                               return v;
-                             })
+                             [](const HeadModel& h) { return PerJoint(h, &JointLimits::max); })
+      .def_property_readonly(
+          "max_velocity",
+          [](const HeadModel& h) { return PerJoint(h, &JointLimits::max_velocity); })
       .def("home", &HeadModel::HomePosture, "The home posture (head order).")
       .def_property_readonly("X_WB", [](const HeadModel& h) { return PoseToMatrix(h.X_WB()); })
       .def_property_readonly("left_camera", [](const HeadModel& h) { return h.camera(0).model; })
