@@ -175,6 +175,10 @@ Runner AddGuiCommand(CLI::App& app) {
   gui->add_option("--scene", o->demo.scene,
                   "Scene YAML (default: the demo's, scenes/portraits.yaml)")
       ->check(CLI::ExistingFile);
+  gui->add_option("--head", o->demo.head,
+                  "Head file (robots/*.yaml) in place of the scene's robot head, at its home "
+                  "joints: any head, e.g. robots/humanoid.yaml")
+      ->check(CLI::ExistingFile);
   gui->add_option("--pipeline", o->demo.pipeline, "Pipeline YAML (default: the demo's)")
       ->check(CLI::ExistingFile)
       ->capture_default_str();
@@ -214,7 +218,8 @@ Runner AddDemoCommand(CLI::App& app) {
   auto o = std::make_shared<Options>();
   auto* demo = app.add_subcommand(
       "demo",
-      "The main job, the active-vision loop of the seed paper, headless: the POPEYE head finds "
+      "The main job, the active-vision loop of the seed paper, headless: the head (POPEYE, or "
+      "any head with --head) finds "
       "the faces on the scene's portraits (rejecting the cat), tracks each with CamShift, "
       "triangulates it and fixates it, closest first, moving on once inhibition of return "
       "suppresses it. Prints each fixation's object, 3D error against the true face centre, "
@@ -228,6 +233,11 @@ Runner AddDemoCommand(CLI::App& app) {
                    "Scene YAML; replaces every component's `scene` parameter (default: the "
                    "pipeline's, scenes/portraits.yaml; scenes/portraits_moving.yaml shows "
                    "smooth pursuit)")
+      ->check(CLI::ExistingFile);
+  demo->add_option("--head", o->demo.head,
+                   "Head file (robots/*.yaml) in place of the scene's robot head, at its home "
+                   "joints (robots/humanoid.yaml, robots/pan_tilt_vergence.yaml, ...; default: "
+                   "the scene's, POPEYE)")
       ->check(CLI::ExistingFile);
   demo->add_option("--hardware", o->demo.hardware,
                    "Hardware file: which robot runs the loop, replacing the pipeline's "

@@ -37,6 +37,7 @@ extern "C" void OnInterrupt(int) { g_interrupted = true; }
 
 struct RenderOptions {
   std::string scene;
+  std::string head;  ///< --head: replaces the scene's robot head
   std::string out;
   int frames = 1;
   double fps = 30.0;
@@ -64,7 +65,7 @@ int RunRender(const RenderOptions& o) {
   const bool truth_given = o.truth_option != nullptr && o.truth_option->count() > 0;
   const render::TruthRequest truth =
       truth_given ? render::TruthRequest::Parse(o.truth) : render::TruthRequest{};
-  const scene::Scene scene = scene::Scene::Load(o.scene);
+  const scene::Scene scene = scene::Scene::Load(o.scene, {o.head});
   const scene::SceneState initial = StateFor(scene, o.joints, o.degrees);
   render::RendererOptions options = o.renderer;
   options.cameras = o.cameras;
@@ -100,6 +101,7 @@ int RunRender(const RenderOptions& o) {
 
 struct BenchOptions {
   std::string scene = ShippedFile("scenes/bench.yaml");
+  std::string head;  ///< --head: replaces the scene's robot head
   // 60 frames time a run to a few per cent; the effect table's seven runs then take about a
   // minute on llvmpipe (motion blur draws the scene blur_samples times per frame).
   int frames = 60;
@@ -110,7 +112,7 @@ struct BenchOptions {
 };
 
 int RunBench(const BenchOptions& o) {
-  const scene::Scene scene = scene::Scene::Load(o.scene);
+  const scene::Scene scene = scene::Scene::Load(o.scene, {o.head});
   if (scene.cameras().empty()) throw InvalidArgument("bench: the scene has no cameras");
   std::optional<ProgressBar> bar;
   const auto progress = [&bar, &o](int done, double fps) {
@@ -176,6 +178,10 @@ Runner AddRenderCommand(CLI::App& app) {
   render->add_option("--scene", o->scene, "Scene YAML (scenes/portraits.yaml, ...)")
       ->check(CLI::ExistingFile)
       ->required();
+  render->add_option("--head", o->head,
+                     "Head file (robots/*.yaml) in place of the scene's robot head, at its home "
+                     "joints (--joints then are that head's)")
+      ->check(CLI::ExistingFile);
   render->add_option("--out", o->out, "Output folder")->required();
   render->add_option("--frames", o->frames, "Number of frames")
       ->check(CLI::Range(1, 100000000))
@@ -218,6 +224,8 @@ Runner AddBenchCommand(CLI::App& app) {
   bench->add_option("--scene", o->scene, "Scene YAML")
       ->check(CLI::ExistingFile)
       ->capture_default_str();
+  bench->add_option("--head", o->head, "Head file (robots/*.yaml) in place of the scene's robot head")
+      ->check(CLI::ExistingFile);
   bench
       ->add_option("--frames", o->frames,
                    "Frames to time, in each run (the first figure and each row of the effect "

@@ -37,6 +37,7 @@ struct RunCommandOptions {
   std::string pipeline;
   std::string hardware;
   std::string scene;
+  std::string head;
   int64_t steps = -1;
   bool realtime = false;
   bool json = false;
@@ -153,7 +154,9 @@ int Run(const RunCommandOptions& o) {
     spec.clock.source.clear();  // the wall clock times the steps, not the sender's stamps
   }
   ApplyDdsOverrides(o.dds, spec);
-  runtime::Pipeline pipeline = runtime::Pipeline::Build(spec);
+  runtime::Pipeline pipeline =
+      o.head.empty() ? runtime::Pipeline::Build(spec)
+                     : runtime::Pipeline::Build(spec, components::RegistryWithHead(o.head, "--head"));
 
   std::unique_ptr<std::ofstream> csv;
   if (!o.joints_csv.empty()) {
@@ -213,6 +216,10 @@ Runner AddRunCommand(CLI::App& app) {
   run->add_option("pipeline", o->pipeline, "The pipeline file")->required();
   run->add_option("--hardware", o->hardware, "Hardware file replacing the pipeline's own");
   run->add_option("--scene", o->scene, "Scene replacing the pipeline's (and its hardware's)");
+  run->add_option("--head", o->head,
+                  "Head file (robots/*.yaml) in place of the scene's robot head, at its home "
+                  "joints")
+      ->check(CLI::ExistingFile);
   run->add_option("--steps", o->steps,
                   "Steps to run (default: the file's clock.steps; 0 until "
                   "Ctrl-C)");

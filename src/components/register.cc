@@ -1,6 +1,10 @@
 #include "saccade/components/register.h"
 
+#include <filesystem>
+#include <memory>
+
 #include "components/internal_scene.h"
+#include "saccade/core/error.h"
 #include "saccade/components/fixation_component.h"
 #include "saccade/components/hw_components.h"
 #include "saccade/components/messages.h"
@@ -38,6 +42,26 @@ void RegisterComponents(runtime::ComponentRegistry& registry) {
   registry.Register<RemoteCameras>("remote.cameras",
                                    "the eye cameras of a robot process, through topics");
   registry.Register<DebugFault>("debug.fault", "throws at a given step (fault injection)");
+}
+
+runtime::ComponentRegistry RegistryWithHead(const std::string& head, const std::string& origin,
+                                            const runtime::ComponentRegistry& registry) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  if (!fs::is_regular_file(head, ec)) {
+    throw InvalidArgument(origin + " " + head + ": no such head file (robots/*.yaml)");
+  }
+  runtime::ComponentRegistry copy = registry;
+  RegisterComponents(copy);
+  const scene::LoadOptions options{fs::absolute(head).lexically_normal()};
+  copy.ReplaceResource("scene", runtime::ResourceLoader{
+                                    typeid(scene::Scene), "scene::Scene",
+                                    [options](const std::string& path) {
+                                      return std::shared_ptr<const void>(
+                                          std::make_shared<const scene::Scene>(
+                                              scene::Scene::Load(path, options)));
+                                    }});
+  return copy;
 }
 
 }  // namespace saccade::components

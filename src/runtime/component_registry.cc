@@ -34,6 +34,15 @@ void ComponentRegistry::RegisterResource(const std::string& kind, ResourceLoader
   }
 }
 
+void ComponentRegistry::ReplaceResource(const std::string& kind, ResourceLoader loader) {
+  const auto it = resources_.find(kind);
+  if (it == resources_.end() || !loader.load) {
+    throw InvalidArgument("ComponentRegistry::ReplaceResource: resource '" + kind +
+                          "' is not registered, or the loader is empty");
+  }
+  it->second = std::move(loader);
+}
+
 bool ComponentRegistry::Has(const std::string& type) const {
   return std::any_of(entries_.begin(), entries_.end(),
                      [&](const auto& entry) { return entry.first == type; });

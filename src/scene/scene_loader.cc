@@ -33,8 +33,8 @@ using namespace internal_reader;  // NOLINT: this file's own helpers
 
 class SceneReader {
  public:
-  SceneReader(std::string source, fs::path base_dir)
-      : source_(std::move(source)), base_dir_(std::move(base_dir)) {}
+  SceneReader(std::string source, fs::path base_dir, LoadOptions options)
+      : source_(std::move(source)), base_dir_(std::move(base_dir)), options_(std::move(options)) {}
 
   Scene Read(const YAML::Node& root) {
     const Entry top(root, "", &source_, 1);
@@ -79,6 +79,11 @@ class SceneReader {
     std::map<std::string, std::string> camera_names;  // name -> key path
     std::optional<Robot> robot;
     std::optional<Entry> robot_id_entry;
+    if (!options_.head.empty() && !top.Find("robot")) {
+      top.Fail(fmt::format("the head '{}' replaces the scene's robot head, but this scene has no "
+                           "robot: add one (robot: {{head: FILE}})",
+                           options_.head.string()));
+    }
     if (const auto e = top.Find("robot")) {
       robot = ReadRobot(*e, &cameras, &robot_id_entry);
       for (const CameraSpec& camera : cameras) {
@@ -497,15 +502,21 @@ class SceneReader {
     e.ExpectMap({"head", "id", "pose", "joints", "joints_deg", "visible", "cameras"},
                 "a robot {head, joints_deg, pose, visible, cameras}");
     const Entry head_entry = e.Get("head");
-    const fs::path head_path = ResolveFile(head_entry, "head description");
+    const bool replaced = !options_.head.empty();  // LoadOptions::head: the scene's is not used
+    const fs::path head_path =
+        replaced ? options_.head : ResolveFile(head_entry, "head description");
     std::optional<head::HeadModel> model;
     try {
       model.emplace(head::HeadModel::FromFile(head_path));
     } catch (const Error& error) {
+      if (replaced) throw;  // names the head file, which is not this scene's
       head_entry.Fail(fmt::format("cannot load head description '{}': {}", head_entry.AsString(),
                                   error.what()));
     }
-    if (const auto pose = e.Find("pose")) model.emplace(model->WithPose(ReadPose(*pose)));
+    if (const auto pose = e.Find("pose")) {
+      const geometry::Pose X_WB = ReadPose(*pose);
+      if (!replaced) model.emplace(model->WithPose(X_WB));
+    }
 
     geometry::ClipPlanes clips[2];
     SensorSpec sensors[2];
@@ -522,14 +533,15 @@ class SceneReader {
         camera->ExpectMap({"calibration", "clip", "sensor"},
                           "an eye camera {calibration, clip, sensor}");
         if (const auto calibration = camera->Find("calibration")) {
-          model.emplace(model->WithCamera(i, ReadCalibration(*calibration)));
+          const geometry::CameraModel eye = ReadCalibration(*calibration);
+          if (!replaced) model.emplace(model->WithCamera(i, eye));
         }
         if (const auto clip = camera->Find("clip")) clips[i] = ReadClip(*clip);
         if (const auto sensor = camera->Find("sensor")) sensors[i] = ReadSensor(*sensor);
       }
     }
     Robot robot{*model, model->Home(), true, {}, 0};
-    ReadInitialJoints(e, &robot);
+    if (!replaced) ReadInitialJoints(e, &robot);
     if (const auto v = e.Find("visible")) robot.visible = v->AsBool();
     if (const auto id = e.Find("id")) {
       robot.id = static_cast<uint32_t>(id->AsInteger(1, kMaxId));
@@ -587,6 +599,7 @@ class SceneReader {
 
   std::string source_;
   fs::path base_dir_;
+  LoadOptions options_;
   internal::AssetCache cache_;
   std::map<std::string, std::shared_ptr<const Model>> primitives_;
   std::map<std::string, std::shared_ptr<const Model>> pictures_;
@@ -594,7 +607,7 @@ class SceneReader {
 
 }  // namespace
 
-Scene Scene::Load(const std::filesystem::path& path) {
+Scene Scene::Load(const std::filesystem::path& path, const LoadOptions& options) {
   const std::string name = path.string();
   std::error_code ec;
   if (!fs::exists(path, ec)) throw FileError(name, 0, "", "scene file not found");
@@ -607,14 +620,14 @@ Scene Scene::Load(const std::filesystem::path& path) {
   if (stream.bad()) throw FileError(name, 0, "", "cannot read the scene file");
   fs::path base_dir = path.parent_path();
   if (base_dir.empty()) base_dir = ".";
-  return FromYamlString(text.str(), name, base_dir);
+  return FromYamlString(text.str(), name, base_dir, options);
 }
 
 Scene Scene::FromYamlString(const std::string& text, const std::string& source,
-                            const std::filesystem::path& base_dir) {
+                            const std::filesystem::path& base_dir, const LoadOptions& options) {
   const YAML::Node root = saccade::internal::ParseYaml(text, source);
   try {
-    return SceneReader(source, base_dir).Read(root);
+    return SceneReader(source, base_dir, options).Read(root);
   } catch (const FileError&) {
     throw;
   } catch (const YAML::Exception& error) {

@@ -76,6 +76,9 @@ class ComponentRegistry {
                                           }});
   }
   void RegisterResource(const std::string& kind, ResourceLoader loader);
+  /// Replaces how `kind` loads (a copy of a registry that loads scenes with another head).
+  /// Throws InvalidArgument when `kind` is not registered or the loader is empty.
+  void ReplaceResource(const std::string& kind, ResourceLoader loader);
   bool HasResource(const std::string& kind) const { return resources_.contains(kind); }
   const std::map<std::string, ResourceLoader>& resource_loaders() const { return resources_; }
 

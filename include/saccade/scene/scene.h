@@ -193,6 +193,16 @@ struct SceneState {
   head::JointState joint_velocities;
 };
 
+/// How Scene::Load reads a file, beyond what the file says.
+struct LoadOptions {
+  /// A head file (robots/*.yaml) that replaces the scene's robot head (`saccade demo --head`):
+  /// the robot stands where that file's `pose` puts it, at its home joints; the scene's
+  /// robot `head`, `pose`, `joints` / `joints_deg` and eye `calibration` (written for its own
+  /// head) are not used; `visible`, `id` and each eye's `clip` and `sensor` apply. Empty: the
+  /// scene's own head. With a head, a scene without a robot is an error.
+  std::filesystem::path head;
+};
+
 /// A loaded, validated world. Immutable; cheap to share by reference.
 class Scene {
  public:
@@ -201,10 +211,11 @@ class Scene {
   /// saccade::FileError "file:line: key: what was expected, what was got", including those of
   /// the files it refers to (models, images, head descriptions, calibrations). A model file is
   /// loaded once however many objects show it.
-  static Scene Load(const std::filesystem::path& path);
+  static Scene Load(const std::filesystem::path& path, const LoadOptions& options = {});
   /// Same from text; `source` names it in errors, `base_dir` resolves relative paths.
   static Scene FromYamlString(const std::string& text, const std::string& source,
-                              const std::filesystem::path& base_dir);
+                              const std::filesystem::path& base_dir,
+                              const LoadOptions& options = {});
 
   Eigen::Vector3f background() const { return background_; }  ///< sky colour, linear RGB
   const std::vector<Light>& lights() const { return lights_; }

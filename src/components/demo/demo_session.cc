@@ -9,6 +9,7 @@
 #include "saccade/components/demo/fixation_scoring.h"
 #include "saccade/components/demo/recording.h"
 #include "saccade/components/messages.h"
+#include "saccade/components/register.h"
 #include "saccade/components/roles.h"
 #include "saccade/core/error.h"
 
@@ -74,7 +75,9 @@ DemoSession::Impl::Impl(const DemoOptions& o, Progress p)
     : options(Checked(o)),
       progress(std::move(p)),
       spec(LoadSpec(options)),
-      pipeline(runtime::Pipeline::Build(spec)),
+      pipeline(options.head.empty()
+                   ? runtime::Pipeline::Build(spec)
+                   : runtime::Pipeline::Build(spec, RegistryWithHead(options.head, "--head"))),
       figures(pipeline) {
   cameras = pipeline.FindRole<EyeCamerasRole>(&cameras_name);
   if (cameras == nullptr) {

@@ -35,6 +35,7 @@ struct DemoOptions {
   std::string pipeline;     ///< the pipeline file (components and connections)
   std::string scene;        ///< a scene replacing the pipeline's; empty: the pipeline's
   std::string hardware;     ///< a hardware file replacing the pipeline's; empty: its own
+  std::string head;         ///< a head file replacing the scene's head; empty: the scene's
   double duration = 40.0;   ///< s, > 0: the longest run on the loop's clock (wall s with realtime)
   std::string record;       ///< a folder for the recording (recording.h); empty: none
   bool force = false;       ///< replace an earlier recording in `record`
