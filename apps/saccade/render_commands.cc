@@ -178,9 +178,10 @@ Runner AddRenderCommand(CLI::App& app) {
   render->add_option("--scene", o->scene, "Scene YAML (scenes/portraits.yaml, ...)")
       ->check(CLI::ExistingFile)
       ->required();
-  render->add_option("--head", o->head,
-                     "Head file (robots/*.yaml) in place of the scene's robot head, at its home "
-                     "joints (--joints then are that head's)")
+  render
+      ->add_option("--head", o->head,
+                   "Head file (robots/*.yaml) in place of the scene's robot head, at its home "
+                   "joints (--joints then are that head's)")
       ->check(CLI::ExistingFile);
   render->add_option("--out", o->out, "Output folder")->required();
   render->add_option("--frames", o->frames, "Number of frames")
@@ -224,7 +225,9 @@ Runner AddBenchCommand(CLI::App& app) {
   bench->add_option("--scene", o->scene, "Scene YAML")
       ->check(CLI::ExistingFile)
       ->capture_default_str();
-  bench->add_option("--head", o->head, "Head file (robots/*.yaml) in place of the scene's robot head")
+  bench
+      ->add_option("--head", o->head,
+                   "Head file (robots/*.yaml) in place of the scene's robot head")
       ->check(CLI::ExistingFile);
   bench
       ->add_option("--frames", o->frames,

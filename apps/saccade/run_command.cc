@@ -155,8 +155,9 @@ int Run(const RunCommandOptions& o) {
   }
   ApplyDdsOverrides(o.dds, spec);
   runtime::Pipeline pipeline =
-      o.head.empty() ? runtime::Pipeline::Build(spec)
-                     : runtime::Pipeline::Build(spec, components::RegistryWithHead(o.head, "--head"));
+      o.head.empty()
+          ? runtime::Pipeline::Build(spec)
+          : runtime::Pipeline::Build(spec, components::RegistryWithHead(o.head, "--head"));
 
   std::unique_ptr<std::ofstream> csv;
   if (!o.joints_csv.empty()) {

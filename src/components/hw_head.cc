@@ -224,6 +224,9 @@ void HwHead::Report(const hw::HeadStatus& status) {
 JointStateMessage HwHead::Joints(const hw::HeadStatus& status, double time) const {
   JointStateMessage out;
   out.time = time;
+  if (scene_ && scene_->robot()) {
+    out.head = std::shared_ptr<const head::HeadModel>(scene_, &scene_->robot()->head);
+  }
   if (virtual_) {
     out.positions = virtual_->positions();
     out.velocities = virtual_->velocities();

@@ -4,13 +4,13 @@
 #include <memory>
 
 #include "components/internal_scene.h"
-#include "saccade/core/error.h"
 #include "saccade/components/fixation_component.h"
 #include "saccade/components/hw_components.h"
 #include "saccade/components/messages.h"
 #include "saccade/components/remote_components.h"
 #include "saccade/components/sim_components.h"
 #include "saccade/components/vision_components.h"
+#include "saccade/core/error.h"
 
 namespace saccade::components {
 
@@ -54,13 +54,12 @@ runtime::ComponentRegistry RegistryWithHead(const std::string& head, const std::
   runtime::ComponentRegistry copy = registry;
   RegisterComponents(copy);
   const scene::LoadOptions options{fs::absolute(head).lexically_normal()};
-  copy.ReplaceResource("scene", runtime::ResourceLoader{
-                                    typeid(scene::Scene), "scene::Scene",
-                                    [options](const std::string& path) {
-                                      return std::shared_ptr<const void>(
-                                          std::make_shared<const scene::Scene>(
-                                              scene::Scene::Load(path, options)));
-                                    }});
+  copy.ReplaceResource(
+      "scene", runtime::ResourceLoader{
+                   typeid(scene::Scene), "scene::Scene", [options](const std::string& path) {
+                     return std::shared_ptr<const void>(
+                         std::make_shared<const scene::Scene>(scene::Scene::Load(path, options)));
+                   }});
   return copy;
 }
 

@@ -59,6 +59,7 @@ JointStateMessage SimHead::State(double time) const {
   out.target_velocities = motors_->target_velocities();
   out.arrived = motors_->Arrived(1e-4);
   out.clamped_commands = motors_->clamped_commands();
+  out.head = std::shared_ptr<const head::HeadModel>(scene_, &scene_->robot()->head);
   return out;
 }
 

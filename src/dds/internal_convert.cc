@@ -10,6 +10,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "saccade/geometry/image_camera.h"
+#include "saccade/head/urdf_export.h"
 
 namespace saccade::dds::internal {
 
@@ -214,6 +215,42 @@ bool FillCameraTransform(const Image& image, Holder& holder,
   out->transform.translation = {t.x(), t.y(), t.z()};
   out->transform.rotation = {q.x(), q.y(), q.z(), q.w()};
   return true;
+}
+
+void FillLinkTransforms(double time, const head::HeadModel& head, const head::JointState& positions,
+                        Holder& holder,
+                        std::vector<geometry_msgs_msg_dds__TransformStamped_>* out) {
+  const head::KinematicTree& tree = head.tree();
+  std::vector<geometry::Pose> X_WL;
+  head.ForwardKinematics(head.Posture(positions), &X_WL);
+  out->clear();
+  out->reserve(tree.num_links());
+  // Every frame name once, before any pointer into them is taken (no reallocation after).
+  holder.strings.clear();
+  holder.strings.reserve(tree.num_links() + 1);
+  holder.strings.emplace_back(kWorldFrame);
+  for (int link = 0; link < tree.num_links(); ++link)
+    holder.strings.push_back(tree.link_name(link));
+  const auto frame = [&holder](int link) { return holder.strings[link + 1].data(); };
+  const auto Add = [&](char* parent, char* child, const geometry::Pose& X_PC) {
+    geometry_msgs_msg_dds__TransformStamped_ t{};
+    t.header = Header(time, parent);
+    t.child_frame_id = child;
+    const Eigen::Vector3d p = X_PC.translation();
+    const Eigen::Quaterniond q(X_PC.rotation());
+    t.transform.translation = {p.x(), p.y(), p.z()};
+    t.transform.rotation = {q.x(), q.y(), q.z(), q.w()};
+    out->push_back(t);
+  };
+  Add(holder.strings[0].data(), frame(tree.root()), X_WL[tree.root()]);
+  for (const int j : tree.joint_order()) {
+    const head::KinematicTree::Joint& joint = tree.joint(j);
+    Add(frame(joint.parent), frame(joint.child), X_WL[joint.parent].inverse() * X_WL[joint.child]);
+  }
+}
+
+std::string RobotDescription(const head::HeadModel& head) {
+  return head.urdf_xml().empty() ? head::ExportUrdf(head).xml : head.urdf_xml();
 }
 
 std::optional<geometry::CameraModel> CameraModelOf(const sensor_msgs_msg_dds__CameraInfo_& info,

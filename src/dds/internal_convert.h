@@ -105,6 +105,16 @@ class ImagePool {
 std::shared_ptr<Image> ImageOf(const sensor_msgs_msg_dds__Image_& msg, std::string* error,
                                ImagePool* pool = nullptr);
 
+/// Every link of `head` at `positions` (by name) as TF, as robot_state_publisher sends them:
+/// world -> the root link (the head's pose X_WB), then for each joint its parent link -> child
+/// link; frame ids are the URDF's link names. `out`'s strings point into `holder`. Throws
+/// InvalidArgument (HeadModel::Posture) when `positions` are not the head's joints.
+void FillLinkTransforms(double time, const head::HeadModel& head, const head::JointState& positions,
+                        Holder& holder, std::vector<geometry_msgs_msg_dds__TransformStamped_>* out);
+/// The head's URDF for robot_description: its own file's text, or for a head without one
+/// (legacy POPEYE) the URDF `saccade urdf` writes (head::ExportUrdf).
+std::string RobotDescription(const head::HeadModel& head);
+
 /// A head's joints as a sensor_msgs/JointState, with their names (POPEYE: pan, tilt, left,
 /// right); `velocities` may be null. The names point into the states' shared name lists.
 void FillJointState(double time, const head::JointState& positions,

@@ -335,11 +335,29 @@ class SimpleWriter final : public Writer {
                             false, offset_);
       targets_topic_name_ = options.targets_topic;
     }
+    if constexpr (std::is_same_v<M, JointStateMessage>) {
+      if (!options.robot_description_topic.empty()) {
+        description_topic_name_ = options.robot_description_topic;
+        description_topic_ =
+            MakeTopic(*participant_, &std_msgs_msg_dds__String__desc, description_topic_name_);
+        description_ = MakeWriter(*participant_, description_topic_, Qos::Latched(),
+                                  description_topic_name_, false, offset_);
+      }
+      if (!options.tf_topic.empty()) {
+        // ROS 2's tf QoS (reliable, keep last 100), transient local as the images' poses.
+        tf_topic_name_ = options.tf_topic;
+        tf_topic_ = MakeTopic(*participant_, &tf2_msgs_msg_dds__TFMessage__desc, tf_topic_name_);
+        tf_ = MakeWriter(*participant_, tf_topic_,
+                         {Reliability::kReliable, Durability::kTransientLocal, 100}, tf_topic_name_,
+                         false, offset_);
+      }
+    }
   }
   void WriteErased(const void* message) override {
     const M& m = *static_cast<const M*>(message);
     if (!Publishable(m)) return;
     if constexpr (std::is_same_v<M, JointStateMessage>) {
+      if (m.head) WriteRobot(m);
       // The targets first, so that a reader has them when the state arrives.
       if (targets_.get() > 0) {
         head::JointState targets, velocities;
@@ -379,6 +397,36 @@ class SimpleWriter final : public Writer {
   const LinkStats& stats() const override { return stats_; }
 
  private:
+  // The head's URDF once (again if the head changes) and the pose of every link, before the
+  // joint state, as robot_state_publisher does: rviz2 draws the robot from them.
+  void WriteRobot(const JointStateMessage& m) {
+    if (description_.get() > 0 && m.head != described_) {
+      const std::string urdf = internal::RobotDescription(*m.head);
+      std_msgs_msg_dds__String_ text{};
+      text.data = const_cast<char*>(urdf.c_str());
+      WriteSample(description_, &text, description_topic_name_, stats_);
+      described_ = m.head;
+    }
+    if (tf_.get() <= 0) return;
+    internal::Holder holder;
+    std::vector<geometry_msgs_msg_dds__TransformStamped_> transforms;
+    try {
+      internal::FillLinkTransforms(m.time, *m.head, m.positions, holder, &transforms);
+    } catch (const InvalidArgument& error) {
+      if (!said_no_tf_) {
+        log::Log(log::Level::kWarn, "dds: {}: no TF for the head's links: {}", topic(),
+                 error.what());
+      }
+      said_no_tf_ = true;
+      return;
+    }
+    for (auto& t : transforms) t.header.stamp = internal::ShiftStamp(t.header.stamp, offset_);
+    tf2_msgs_msg_dds__TFMessage_ tf{};
+    tf.transforms = {static_cast<uint32_t>(transforms.size()),
+                     static_cast<uint32_t>(transforms.size()), transforms.data(), false};
+    WriteSample(tf_, &tf, tf_topic_name_, stats_);
+  }
+
   // A target that is not valid (nothing to look at) is not a point: it is not published.
   static bool Publishable(const TargetMessage& m) { return m.valid && m.p_W.allFinite(); }
   static bool Publishable(const JointStateMessage&) { return true; }
@@ -404,6 +452,12 @@ class SimpleWriter final : public Writer {
   Entity topic_, writer_;
   Entity targets_topic_, targets_;  // joint states: their targets (TopicOptions::targets_topic)
   std::string targets_topic_name_;
+  // Joint states with a head: its URDF (TopicOptions::robot_description_topic) and its links'
+  // poses (tf_topic).
+  Entity description_topic_, description_, tf_topic_, tf_;
+  std::string description_topic_name_, tf_topic_name_;
+  std::shared_ptr<const head::HeadModel> described_;  // the head whose URDF was sent
+  bool said_no_tf_ = false;
   bool lockstep_;
   int64_t offset_;
   // The latest stamp written since the last step mark (MarkStep).

@@ -92,6 +92,9 @@ constexpr int kOnStampsImageDepth = 16;
 constexpr double kLockstepWaitS = 10.0;
 // Where joint states' targets go by default: /saccade/joint_states -> /saccade/joint_targets.
 constexpr char kTargetsSibling[] = "joint_targets";
+// Where a joint-state writer puts its head's URDF: robot_description in the namespace (a
+// robot_state_publisher in that namespace publishes it there too).
+constexpr char kRobotDescription[] = "robot_description";
 
 struct Endpoint {
   std::shared_ptr<Participant> participant;
@@ -122,6 +125,17 @@ Endpoint Resolve(const runtime::TopicEndpoint& endpoint, const std::set<std::str
   // Joint states carry their targets on a sibling topic (TopicOptions::targets_topic).
   const bool joints = endpoint.message_type == MessageName<JointStateMessage>();
   if (joints) out.options.targets_topic = SiblingTopic(out.options.topic, kTargetsSibling);
+  // And the head's URDF on robot_description (TopicOptions::robot_description_topic).
+  if (joints) out.options.robot_description_topic = ResolveTopic(kRobotDescription, ns);
+  if (const auto it = endpoint.options.find(kRobotDescription); it != endpoint.options.end()) {
+    if (!joints || !it->is_string()) {
+      throw InvalidArgument(
+          fmt::format("{}.robot_description: expected a topic or \"\" (joint states only), got {}",
+                      where, it->dump()));
+    }
+    const std::string topic = it->get<std::string>();
+    out.options.robot_description_topic = topic.empty() ? "" : ResolveTopic(topic, ns);
+  }
   if (const auto it = endpoint.options.find("targets"); it != endpoint.options.end()) {
     if (!joints) {
       throw InvalidArgument(
@@ -443,7 +457,7 @@ void RegisterDdsTransport(runtime::ComponentRegistry& registry) {
       [](const runtime::TopicEndpoint& endpoint,
          runtime::OutputBase& output) -> std::function<void(const runtime::StepContext&)> {
     Endpoint e = Resolve(endpoint, {"qos", "start_wait_s", "tf", "targets", "lockstep",
-                                    "compressed", "jpeg_quality"});
+                                    "compressed", "jpeg_quality", kRobotDescription});
     const double start_wait_s = Seconds(endpoint.options, "start_wait_s", endpoint.where);
     std::shared_ptr<Writer> writer =
         Writer::Create(e.participant, endpoint.message_type, e.options);

@@ -80,9 +80,10 @@ class SceneReader {
     std::optional<Robot> robot;
     std::optional<Entry> robot_id_entry;
     if (!options_.head.empty() && !top.Find("robot")) {
-      top.Fail(fmt::format("the head '{}' replaces the scene's robot head, but this scene has no "
-                           "robot: add one (robot: {{head: FILE}})",
-                           options_.head.string()));
+      top.Fail(
+          fmt::format("the head '{}' replaces the scene's robot head, but this scene has no "
+                      "robot: add one (robot: {{head: FILE}})",
+                      options_.head.string()));
     }
     if (const auto e = top.Find("robot")) {
       robot = ReadRobot(*e, &cameras, &robot_id_entry);

@@ -246,8 +246,8 @@ TEST(DemoCli, ABadHeadIsNamed) {
     std::ofstream(dir / "not_a_head.yaml") << "name: x\nwheels: 4\n";
     std::ofstream(dir / "no_robot.yaml") << "objects: []\n";
   }
-  const CommandRun bad = Saccade("demo --head " + (dir / "not_a_head.yaml").string() +
-                                 " --scene " + kTwoPictures + " --duration 0.08");
+  const CommandRun bad = Saccade("demo --head " + (dir / "not_a_head.yaml").string() + " --scene " +
+                                 kTwoPictures + " --duration 0.08");
   EXPECT_EQ(bad.status, 1) << bad.output;
   EXPECT_THAT(bad.output, HasSubstr("not_a_head.yaml"));
   EXPECT_THAT(bad.output, HasSubstr("wheels"));

@@ -756,3 +756,262 @@ describe('saccade gui restarted', () => {
     await page.close();
   });
 });
+
+// A head other than POPEYE: robots/humanoid.yaml put in place of the scene's by --head.
+const kHumanoidHead = path.join(kRepo, 'robots', 'humanoid.yaml');
+const kHumanoidUrdf = path.join(kRepo, 'robots', 'humanoid', 'humanoid.urdf');
+const kHumanoidJoints = ['neck_pitch', 'neck_roll', 'neck_yaw', 'eye_tilt', 'left_eye_pan', 'right_eye_pan'];
+// POPEYE's links and joints, none of which the humanoid has.
+const kPopeyeLinks = ['neck_link', 'tilt_link', 'cyclopean_link', 'left_camera_optical', 'right_camera_optical'];
+const kPopeyeJoints = ['pan', 'tilt', 'left', 'right', 'L', 'R'];
+const kHumanoidDragPx = 20;           // 10 deg of neck yaw at the page's drag gain (0.5 deg/px)
+const kHumanoidDragToleranceDeg = 1;  // two pixels of the drag: the mouse lands on whole pixels
+const kSettledDeg = 0.05;             // a joint at its target: the servo settles far closer
+const kPoseTolerance = 1e-9;          // a link the drag does not move: its frame, in doubles
+const kYawAngleToleranceDeg = 0.1;    // the eyes turn with the neck's yaw: FK in doubles, settling
+const kHumanoidFixationToleranceDeg = 0.5;  // each optical axis to the clicked point, settled
+const kRobotCentreToleranceM = 0.3;   // the drawn body's box centre to the eyes: the head is ~0.3 m tall
+
+/**
+ * The URDF's links with their number of <visual>s, and its non-fixed joints, from the file
+ * itself: what the page must draw and list.
+ */
+function readUrdf(file) {
+  const text = fs.readFileSync(file, 'utf8').replace(/<!--[\s\S]*?-->/g, '');
+  const visuals = {};
+  for (const m of text.matchAll(/<link\s+name="([^"]+)"\s*(?:\/>|>([\s\S]*?)<\/link>)/g)) {
+    visuals[m[1]] = (m[2] ?? '').match(/<visual[\s>]/g)?.length ?? 0;
+  }
+  const joints = [...text.matchAll(/<joint\s+name="([^"]+)"\s+type="([^"]+)"/g)]
+    .filter((m) => m[2] !== 'fixed').map((m) => m[1]);
+  return { visuals, joints };
+}
+
+/** The largest absolute difference between two 4x4 matrices (row by row). */
+const maxAbsDiff = (A, B) => A.flat().reduce((m, v, i) => Math.max(m, Math.abs(v - B.flat()[i])), 0);
+
+/** The rotation angle (deg) from rotation A to rotation B (4x4 poses, row by row): of B A^T. */
+function rotationBetweenDeg(A, B) {
+  let trace = 0;
+  for (let i = 0; i < 3; i++) for (let k = 0; k < 3; k++) trace += B[i][k] * A[i][k];
+  return Math.acos(Math.max(-1, Math.min(1, (trace - 1) / 2))) * 180 / Math.PI;
+}
+
+describe('saccade gui with the humanoid head (--head robots/humanoid.yaml)', () => {
+  let browser, server, page;
+  const urdf = readUrdf(kHumanoidUrdf);
+
+  before(async () => {
+    browser = await chromium.launch({ executablePath: '/usr/bin/chromium', args: kChromiumArgs });
+    server = await startSaccade(['gui', '--scene', kScene, '--head', kHumanoidHead, '--port', '0']);
+    page = await browser.newPage({ viewport: kViewport });
+    page.on('pageerror', (e) => console.log(`page error: ${e.message}`));
+    // The joints plot is the page's list of the joints: its legend (one "NAME VALUE" per joint,
+    // drawn after the title on its canvas) is recorded as the page draws it.
+    await page.addInitScript(() => {
+      const fillText = CanvasRenderingContext2D.prototype.fillText;
+      let drawing = null;
+      CanvasRenderingContext2D.prototype.fillText = function (text, ...rest) {
+        if (this.canvas.id === 'plot-joints') {
+          if (/^joints\b/.test(text)) drawing = window.jointsPlotLegend = [];
+          else drawing?.push(String(text));
+        }
+        return fillText.call(this, text, ...rest);
+      };
+    });
+    await page.goto(server.url.href);
+  });
+
+  after(async () => {
+    await page?.close().catch(() => {});
+    await browser?.close().catch(() => {});
+    await stopSaccade(server);
+  });
+
+  test('humanoid: drawn from its URDF, its joints listed, a drag turns the neck, a click fixates', async () => {
+    assert.deepEqual([...urdf.joints].sort(), [...kHumanoidJoints].sort(), `${kHumanoidUrdf}: its joints`);
+    await waitReady(page);
+    await send(page, 'resume');
+
+    // 1. The robot is drawn: every URDF link is a group of the page's 3D scene, with one part
+    // (meshes with vertices) per <visual>; nothing of POPEYE. The scene is taken from the page's
+    // own three.js module (the same URL: the same module) as the renderer updates it.
+    const drawn = await page.evaluate(async (popeyeLinks) => {
+      const THREE = await import('/vendor/three/build/three.module.js');
+      const update = THREE.Object3D.prototype.updateMatrixWorld;
+      let scene = null;
+      THREE.Object3D.prototype.updateMatrixWorld = function (force) {
+        if (this.isScene) scene = this;
+        return update.call(this, force);
+      };
+      try {
+        window.saccadeGui.render();
+      } finally {
+        THREE.Object3D.prototype.updateMatrixWorld = update;
+      }
+      if (!scene) throw new Error('the page rendered no scene');
+      const g = window.saccadeGui;
+      const names = new Set(g.scene.robot.links.map((l) => l.name));
+      const links = {};
+      const robot = new THREE.Box3();
+      for (const group of scene.children.filter((o) => names.has(o.name))) {
+        const parts = group.children.map((part) => {
+          const meshes = [];
+          part.traverse((m) => { if (m.isMesh) meshes.push(m); });
+          return meshes.map((m) => ({ vertices: m.geometry.attributes.position?.count ?? 0,
+            link: m.userData.link, visible: m.visible }));
+        });
+        group.updateMatrixWorld(true);
+        if (group.children.length) robot.expandByObject(group);
+        links[group.name] = { visible: group.visible, parts };
+      }
+      const popeye = popeyeLinks.filter((n) => scene.getObjectByName(n));
+      const strayMeshes = [];
+      scene.traverse((m) => {
+        const link = m.userData.link;
+        if (m.isMesh && link !== undefined && !names.has(link)) strayMeshes.push(link);
+      });
+      return {
+        sceneLinks: [...names], links, popeye, strayMeshes,
+        robotCentre: robot.isEmpty() ? null : robot.getCenter(new THREE.Vector3()).toArray(),
+        X_WC: g.state.frames.X_WC,
+        headJoints: g.scene.head.joints.map((j) => j.name),
+        stateJoints: Object.keys(g.state.joints.positions),
+        legend: window.jointsPlotLegend ?? null,
+      };
+    }, kPopeyeLinks);
+    assert.deepEqual([...drawn.sceneLinks].sort(), Object.keys(urdf.visuals).sort(), '/api/scene robot.links');
+    assert.deepEqual(Object.keys(drawn.links).sort(), Object.keys(urdf.visuals).sort(),
+      'the link groups in the page');
+    for (const [name, count] of Object.entries(urdf.visuals)) {
+      const link = drawn.links[name];
+      assert.equal(link.visible, true, `link ${name} is hidden`);
+      assert.equal(link.parts.length, count,
+        `link ${name}: ${link.parts.length} parts drawn, the URDF has ${count} visuals`);
+      for (const meshes of link.parts) {
+        assert.ok(meshes.length > 0, `link ${name}: a part without a mesh`);
+        for (const m of meshes) {
+          assert.ok(m.vertices > 0 && m.visible && m.link === name, `link ${name}: mesh ${JSON.stringify(m)}`);
+        }
+      }
+    }
+    assert.deepEqual(drawn.popeye, [], 'POPEYE\'s links in the page');
+    assert.deepEqual(drawn.strayMeshes, [], 'robot meshes of links the head does not have');
+    // The drawn body is where the head is: its box's centre near the point between the eyes.
+    const cyclopean = [0, 1, 2].map((r) => drawn.X_WC[r][3]);
+    const offset = Math.hypot(...drawn.robotCentre.map((v, i) => v - cyclopean[i]));
+    assert.ok(offset < kRobotCentreToleranceM,
+      `the robot's centre [${drawn.robotCentre}] is ${offset.toFixed(3)} m from the eyes' [${cyclopean}]`);
+    // The six joints, in the head's order, in the scene, the state and the joints plot's legend.
+    assert.deepEqual(drawn.headJoints, kHumanoidJoints, '/api/scene head.joints');
+    assert.deepEqual([...drawn.stateJoints].sort(), [...kHumanoidJoints].sort(), 'state joints.positions');
+    assert.ok(drawn.legend, 'the joints plot drew no legend');
+    const labels = drawn.legend.map((t) => t.slice(0, t.lastIndexOf(' ')));
+    assert.deepEqual(labels, kHumanoidJoints, `the joints plot's legend ${JSON.stringify(drawn.legend)}`);
+    for (const p of kPopeyeJoints) assert.ok(!labels.includes(p), `POPEYE's joint ${p} in the legend`);
+
+    // 2. Dragging the skull turns the neck's yaw (its joint, head_link's), nothing else: a drag
+    // of kHumanoidDragPx to the right, seen from behind the head, turns it right by 10 deg.
+    const home = Object.fromEntries(kHumanoidJoints.map((j) => [j, 0]));
+    await moveHead(page, home);
+    await page.evaluate(() => window.saccadeGui.setView([-0.75, -0.35, 1.55], [0.0, 0.0, 1.2]));
+    const watched = ['base_link', 'neck_roll_link', 'head_link', 'left_eye_link', 'left_camera_link',
+      'right_camera_link'];
+    const placed = (names) => page.evaluate((ns) => Object.fromEntries(
+      ns.map((n) => [n, window.saccadeGui.placementOf(n)])), names);
+    const before = await placed(watched);
+    const p = await page.evaluate(() => window.saccadeGui.screenPointOf('head_link'));
+    assert.ok(p.visible, `the skull is hidden in the view (${JSON.stringify(p)})`);
+    const x0 = Math.round(p.x), y0 = Math.round(p.y);
+    const gain = await page.evaluate(() => window.saccadeGui.dragGainDegPerPx);
+    await page.mouse.move(x0, y0);
+    await page.mouse.down();
+    for (let i = 1; i <= kHumanoidDragPx; i++) {
+      await page.mouse.move(x0 + i, y0);
+      await page.waitForTimeout(30);
+    }
+    await page.mouse.up();
+    const expected = -gain * kHumanoidDragPx * kDeg;
+    let s;
+    try {
+      s = await waitState(page, (st, { e, tol, settled, names }) => {
+        const { positions: q, targets: t } = st.joints;
+        return Math.abs(t.neck_yaw - e) < tol && names.every((n) => Math.abs(q[n] - t[n]) < settled);
+      }, { e: expected, tol: kHumanoidDragToleranceDeg * kDeg, settled: kSettledDeg * kDeg,
+        names: kHumanoidJoints });
+    } catch {
+      s = await page.evaluate(() => window.saccadeGui.state);
+      assert.fail(`neck_yaw not at ${(expected / kDeg).toFixed(1)} deg after the drag: ` +
+        `joints ${JSON.stringify(s.joints)}`);
+    }
+    const yaw = s.joints.positions.neck_yaw;
+    for (const j of kHumanoidJoints.filter((n) => n !== 'neck_yaw')) {
+      assert.equal(s.joints.targets[j], 0, `the drag moved ${j}'s target`);
+      assert.ok(Math.abs(s.joints.positions[j]) < kSettledDeg * kDeg, `${j} at ${s.joints.positions[j]} rad`);
+    }
+    // The page follows: the base and the neck below the yaw joint stay, the skull, the eyes and
+    // the cameras turn by the yaw about the vertical; each placed at the state's frame.
+    await page.waitForFunction((step) => window.saccadeGui.state.step > step, s.step, { timeout: kMoveTimeoutMs });
+    const moved = await page.evaluate((ns) => ({ frames: window.saccadeGui.state.frames.links,
+      placed: Object.fromEntries(ns.map((n) => [n, window.saccadeGui.placementOf(n)])) }), watched);
+    for (const n of watched) {
+      assert.ok(maxAbsDiff(moved.placed[n], moved.frames[n]) <= kPoseTolerance,
+        `${n} placed ${JSON.stringify(moved.placed[n])}, its frame ${JSON.stringify(moved.frames[n])}`);
+    }
+    for (const n of ['base_link', 'neck_roll_link']) {
+      const d = maxAbsDiff(moved.placed[n], before[n]);
+      assert.ok(d <= kPoseTolerance, `${n} moved by ${d} with the neck's yaw`);
+    }
+    for (const n of ['head_link', 'left_eye_link', 'left_camera_link', 'right_camera_link']) {
+      const turned = rotationBetweenDeg(before[n], moved.placed[n]);
+      assert.ok(Math.abs(turned - Math.abs(yaw) / kDeg) < kYawAngleToleranceDeg,
+        `${n} turned by ${turned.toFixed(3)} deg, the neck's yaw is ${(yaw / kDeg).toFixed(3)} deg`);
+      // About the vertical: the link's z axis stays where it was.
+      assert.ok(Math.abs(moved.placed[n][2][2] - before[n][2][2]) < 1e-6, `${n}: its z axis tilted`);
+    }
+    const shift = Math.hypot(...[0, 1, 2].map(
+      (r) => moved.placed.left_camera_link[r][3] - before.left_camera_link[r][3]));
+    assert.ok(shift > 0.01, `the left camera moved by ${shift.toFixed(4)} m with a 10 deg yaw`);
+
+    // 3. Clicking a portrait fixates it: both optical axes (the z columns of the state's camera
+    // frames) through the clicked point, every joint within the head's limits.
+    await moveHead(page, home);
+    await page.evaluate(() => window.saccadeGui.setView([-1.5, -0.7, 2.1], [1.0, 0.0, 1.0]));
+    const q = await page.evaluate(() => window.saccadeGui.screenPointOf('astronaut_near'));
+    assert.ok(q.visible, `astronaut_near is hidden in the view (${JSON.stringify(q)})`);
+    const errorsBefore = await page.evaluate(() => window.saccadeGui.errors.length);
+    await page.evaluate(() => { window.saccadeGui.lastClick = null; });
+    await page.mouse.click(q.x, q.y);
+    await page.waitForFunction(() => window.saccadeGui.lastClick, null, { timeout: 10_000 });
+    const click = await page.evaluate(() => window.saccadeGui.lastClick);
+    const axisErrors = (st, x) => ['left', 'right'].map((name) => {
+      const m = st.frames[name];
+      const d = [x[0] - m[0][3], x[1] - m[1][3], x[2] - m[2][3]];
+      const cos = (m[0][2] * d[0] + m[1][2] * d[1] + m[2][2] * d[2]) / Math.hypot(...d);
+      return Math.acos(Math.min(1, cos)) * 180 / Math.PI;
+    });
+    try {
+      s = await waitState(page, (st, { names, settled }) => {
+        const { positions: x, targets: t } = st.joints;
+        return names.some((n) => Math.abs(t[n]) > 1e-3) && names.every((n) => Math.abs(x[n] - t[n]) < settled);
+      }, { names: kHumanoidJoints, settled: 0.02 * kDeg }, 60_000);
+    } catch {
+      s = await page.evaluate(() => window.saccadeGui.state);
+      const errors = await page.evaluate((n) => window.saccadeGui.errors.slice(n), errorsBefore);
+      assert.fail(`not fixated in 60 s: axis errors ${axisErrors(s, click).map((x) => x.toFixed(2))} deg, ` +
+        `joints ${JSON.stringify(s.joints)}; errors ${JSON.stringify(errors)}`);
+    }
+    assert.deepEqual(await page.evaluate((n) => window.saccadeGui.errors.slice(n), errorsBefore), []);
+    const errors = axisErrors(s, click);
+    console.log(`humanoid fixated [${click.map((v) => v.toFixed(3))}]: axis errors ` +
+      `${errors.map((x) => x.toFixed(3))} deg, joints ${JSON.stringify(Object.fromEntries(
+        Object.entries(s.joints.positions).map(([k, v]) => [k, +(v / kDeg).toFixed(2)])))} deg`);
+    for (const e of errors) assert.ok(e < kHumanoidFixationToleranceDeg, `axis errors ${errors} deg`);
+    const limits = await page.evaluate(() => window.saccadeGui.scene.head.joints);
+    for (const j of limits) {
+      const v = s.joints.positions[j.name];
+      assert.ok(v >= j.min && v <= j.max, `${j.name} at ${v} rad, outside [${j.min}, ${j.max}]`);
+    }
+    assert.equal(s.joints.targets.neck_roll, 0, 'the fixation moved the held neck roll');
+  });
+});

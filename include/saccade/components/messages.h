@@ -19,6 +19,7 @@
 #include "saccade/core/image.h"
 #include "saccade/geometry/json.h"
 #include "saccade/head/head_description.h"
+#include "saccade/head/head_model.h"
 #include "saccade/head/json.h"
 #include "saccade/runtime/message.h"
 #include "saccade/vision/json.h"
@@ -35,6 +36,9 @@ struct JointStateMessage {
   head::JointState target_velocities;  ///< rad/s: how fast the targets move (pursuit), or 0
   bool arrived = true;                 ///< every joint on its target, in position and velocity
   int64_t clamped_commands = 0;        ///< commands clamped to the joint limits so far
+  /// The head these are the joints of (its tree and URDF: DDS publishes robot_description and
+  /// every link's TF from it), or null (joints received from another process). Not in JSON.
+  std::shared_ptr<const head::HeadModel> head;
 };
 
 /// A joint command: a saccade (velocities zero) or smooth pursuit (the target moves at

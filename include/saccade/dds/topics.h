@@ -48,8 +48,15 @@ namespace saccade::dds {
 /// Where a message type goes.
 struct TopicOptions {
   std::string topic;  ///< fully qualified ROS topic (ResolveTopic), e.g. "/saccade/joint_states"
-  Qos qos = Qos::Default();      ///< of the main topic (camera_info and tf: reliable, keep last)
-  std::string tf_topic = "/tf";  ///< images: where the camera poses go ("" : none)
+  Qos qos = Qos::Default();  ///< of the main topic (camera_info and tf: reliable, keep last)
+  /// Images: where the camera poses go; joint states with a head
+  /// (components::JointStateMessage::head): every link's pose, world -> root link and parent
+  /// -> child link per joint ("" : none).
+  std::string tf_topic = "/tf";
+  /// Joint states with a head: where its URDF goes, once, as std_msgs/String (reliable,
+  /// transient local, keep last 1, as robot_state_publisher's robot_description), so that a
+  /// reader that comes later gets it ("" : none).
+  std::string robot_description_topic;
   /// Joint states: where the head's targets go, as a JointState of the same stamp written
   /// just before it (positions: where each joint is heading, velocities: how fast that target
   /// moves), so that a reader knows whether the head has arrived exactly as the sender does
