@@ -46,8 +46,10 @@
 #include <numbers>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core.hpp>
+#include <optional>
 #include <random>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "image_camera_helpers.h"
@@ -56,6 +58,7 @@
 #include "saccade/geometry/camera_model.h"
 #include "saccade/geometry/distortion.h"
 #include "saccade/geometry/pose.h"
+#include "saccade/head/head_model.h"
 #include "saccade/render/renderer.h"
 #include "saccade/scene/scene.h"
 
@@ -112,6 +115,9 @@ struct Case {
   geometry::CameraModel model;
   int msaa;
   double max_angle_deg = 90.0;  // markers only where the ray is at most this far off the axis
+  // A head file: the camera is instead its right eye (the model from the head, the pose from its
+  // forward kinematics at home), rendered as the robot's eye camera with the body hidden.
+  std::string head = {};
 };
 
 std::ostream& operator<<(std::ostream& os, const Case& c) { return os << c.name; }
@@ -234,12 +240,15 @@ class MarkerAccuracyTest : public ::testing::TestWithParam<Case> {};
 
 TEST_P(MarkerAccuracyTest, CentroidsMatchOpenCvProjection) {
   const Case& param = GetParam();
-  const geometry::CameraModel& model = param.model;
+  std::optional<head::HeadModel> head;
+  if (!param.head.empty()) head.emplace(head::HeadModel::FromFile(param.head));
+  const geometry::CameraModel& model = head ? head->camera(1).model : param.model;
   const geometry::Intrinsics& K = model.intrinsics();
   const bool lens = model.distortion().model() != geometry::DistortionModel::kNone;
-  // A camera metres from the origin, in a general orientation.
-  const geometry::Pose X_WC =
-      geometry::MakePose(geometry::RotationFromRpy(-1.9, 0.15, 2.4), Vector3d(3.2, -1.7, 1.4));
+  // A camera metres from the origin, in a general orientation; or the head's right eye.
+  const geometry::Pose X_WC = head ? head->CameraPoses(head->Home())[1]
+                                   : geometry::MakePose(geometry::RotationFromRpy(-1.9, 0.15, 2.4),
+                                                        Vector3d(3.2, -1.7, 1.4));
 
   // Markers on a jittered grid that covers the whole image up to kBorderPx from its edges,
   // corners included (where there is a ray at most max_angle_deg off the axis), at depths (along
@@ -313,11 +322,23 @@ TEST_P(MarkerAccuracyTest, CentroidsMatchOpenCvProjection) {
   ambient.intensity = 1.0f;
   scene::Ground no_ground;
   no_ground.enabled = false;
-  const scene::Scene world(Eigen::Vector3f::Zero(), {ambient}, no_ground, objects, {camera},
-                           std::nullopt);
+  std::vector<scene::CameraSpec> cameras = {camera};
+  std::optional<scene::Robot> robot;
+  if (head) {  // the eyes as a head file's scene has them (scene_loader.cc), the body hidden
+    cameras = {};
+    for (const auto& [name, eye, mount] : {std::tuple{"left", 0, scene::CameraMount::kLeftEye},
+                                           std::tuple{"right", 1, scene::CameraMount::kRightEye}}) {
+      cameras.push_back(scene::CameraSpec{name, head->camera(eye).model, mount,
+                                          geometry::Pose::Identity(),
+                                          geometry::ClipPlanes{0.1, 20.0}, scene::SensorSpec{}});
+    }
+    robot = scene::Robot{*head, head->Home(), false, {}, static_cast<uint32_t>(markers.size() + 1)};
+  }
+  const scene::Scene world(Eigen::Vector3f::Zero(), {ambient}, no_ground, objects, cameras, robot);
 
   RendererOptions options;
   options.msaa_samples = param.msaa;
+  if (head) options.cameras = {"right"};
   const std::unique_ptr<Renderer> renderer = MakeRenderer(world, options);
   const std::vector<Frame> frames = renderer->Render(world.InitialState(), 0);
   ASSERT_EQ(frames.size(), 1u);
@@ -407,6 +428,24 @@ const geometry::CameraModel kFisheye190(
     geometry::Intrinsics(1024, 1024, 305.0, 305.6, 512.8, 510.9),
     geometry::Distortion::Fisheye(std::vector<double>{0.01, -0.003, 0.0005, -0.0001}));
 
+// The humanoid head's right eye: a Gazebo <sensor type="camera"> block (1024 x 768,
+// horizontal_fov 0.8 rad, Gazebo's radial-tangential <distortion>) on a URDF link, placed by the
+// head's forward kinematics. Its intrinsics are Gazebo's: fx = fy = width / 2 / tan(fov / 2).
+const std::string kHumanoid = std::string(SACCADE_SOURCE_DIR) + "/robots/humanoid.yaml";
+
+TEST(GazeboCamera, IntrinsicsAreGazebosFormula) {
+  const head::HeadModel head = head::HeadModel::FromFile(kHumanoid);
+  for (int eye = 0; eye < 2; ++eye) {
+    const geometry::Intrinsics& K = head.camera(eye).model.intrinsics();
+    EXPECT_EQ(K.width(), 1024);
+    EXPECT_EQ(K.height(), 768);
+    EXPECT_NEAR(K.fx(), 1024 / 2.0 / std::tan(0.8 / 2.0), 1e-9);
+    EXPECT_NEAR(K.fy(), K.fx(), 1e-9);
+  }
+  EXPECT_EQ(head.camera(1).model.distortion().model(),
+            geometry::DistortionModel::kRadialTangential);
+}
+
 INSTANTIATE_TEST_SUITE_P(Cameras, MarkerAccuracyTest,
                          ::testing::Values(Case{"1024x768", geometry::CameraModel(kEven), 0},
                                            Case{"641x479", geometry::CameraModel(kOdd), 0},
@@ -414,7 +453,9 @@ INSTANTIATE_TEST_SUITE_P(Cameras, MarkerAccuracyTest,
                                            Case{"641x479_msaa4", geometry::CameraModel(kOdd), 4},
                                            Case{"radtan_strong", kRadTan, 0},
                                            Case{"radtan_strong_msaa4", kRadTan, 4},
-                                           Case{"fisheye_190deg_msaa4", kFisheye190, 4, 87.5}),
+                                           Case{"fisheye_190deg_msaa4", kFisheye190, 4, 87.5},
+                                           Case{"gazebo_humanoid_right_eye_msaa4",
+                                                geometry::CameraModel(kEven), 4, 90.0, kHumanoid}),
                          [](const ::testing::TestParamInfo<Case>& info) {
                            return info.param.name;
                          });
