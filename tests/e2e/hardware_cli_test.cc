@@ -110,6 +110,51 @@ TEST(HardwareCli, TheDemoFixatesTheFaceWithTheHeadOnTheEmulatedServoBus) {
   EXPECT_THAT(run.output, HasSubstr("head: dynamixel on"));
 }
 
+// Any head on the bus (issue 42): the humanoid head's six joints on six servos, mapped by joint
+// name from its head file (robots/humanoid.yaml: ids 1-6); the loop fixates through them. A bus
+// that lacks one of its servos is refused at start, naming the servo and its joint.
+TEST(HardwareCli, TheHumanoidHeadFixatesOnSixEmulatedServos) {
+  const fs::path dir = TempDir("six_servos");
+  const std::string humanoid = kSource + "/robots/humanoid.yaml";
+  {
+    Emulator emulator(dir / "bus", {"--ids", "1,2,3,4,5,6"});
+    ASSERT_THAT(emulator.first_line(), HasSubstr("serving servos 1,2,3,4,5,6"));
+    const CommandRun run = Saccade("demo --head " + humanoid + " --hardware " +
+                                   ServoHardware(dir, dir / "bus", false).string() +
+                                   " --duration 3 --record " + (dir / "rec").string());
+    ASSERT_EQ(run.status, 0) << run.output;
+    const json s = Summary(dir / "rec");
+    EXPECT_EQ(s["faces_fixated"], 1);
+    const json& f = s["fixations"][0];
+    EXPECT_LT(f["error_3d_m"].get<double>(), 0.015);
+    EXPECT_LT(f["eye_error_deg"]["left"].get<double>(), 0.5);
+    EXPECT_LT(f["eye_error_deg"]["right"].get<double>(), 0.5);
+    const json& head = s["head"];
+    EXPECT_EQ(head["fault"], "");
+    EXPECT_EQ(head["rejected_commands"], 0);
+    EXPECT_GT(head["commands"].get<int>(), 10);
+    // The servos' own positions, by the humanoid's joint names; the eyes turned to the face
+    // (the picture is off to the left), each servo at its target within a few ticks.
+    ASSERT_EQ(head["positions"].size(), 6u) << head.dump();
+    for (const char* joint :
+         {"neck_pitch", "neck_roll", "neck_yaw", "eye_tilt", "left_eye_pan", "right_eye_pan"}) {
+      ASSERT_TRUE(head["positions"].contains(joint)) << joint << " " << head.dump();
+      EXPECT_NEAR(head["positions"][joint].get<double>(), head["targets"][joint].get<double>(),
+                  0.01)
+          << joint;
+    }
+    EXPECT_GT(head["positions"]["left_eye_pan"].get<double>(), 0.02);
+    EXPECT_GT(head["positions"]["right_eye_pan"].get<double>(), 0.02);
+    EXPECT_EQ(head["positions"]["neck_roll"].get<double>(), 0.0);  // held by the fixation rule
+  }
+  Emulator four(dir / "bus4", {});  // servos 1-4 only
+  const CommandRun missing =
+      Saccade("demo --head " + humanoid + " --hardware " +
+              ServoHardware(dir, dir / "bus4", false).string() + " --duration 1");
+  EXPECT_EQ(missing.status, 1) << missing.output;
+  EXPECT_THAT(missing.output, HasSubstr("servo 5 (left_eye_pan) does not answer"));
+}
+
 TEST(HardwareCli, InMirrorModeTheServosFollowTheVirtualHead) {
   const fs::path dir = TempDir("mirror");
   Emulator emulator(dir / "bus", {});
