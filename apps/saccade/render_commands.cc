@@ -101,7 +101,8 @@ int RunRender(const RenderOptions& o) {
 
 struct BenchOptions {
   std::string scene = ShippedFile("scenes/bench.yaml");
-  std::string head;  ///< --head: replaces the scene's robot head
+  std::string head;         ///< --head: replaces the scene's robot head
+  bool hide_robot = false;  ///< --hide-robot: the robot's body not drawn
   // 60 frames time a run to a few per cent; the effect table's seven runs then take about a
   // minute on llvmpipe (motion blur draws the scene blur_samples times per frame).
   int frames = 60;
@@ -111,9 +112,19 @@ struct BenchOptions {
   bool effect_table = true;
 };
 
+/// The scene with its robot's body hidden (--hide-robot): what the robot's own meshes cost.
+scene::Scene WithoutRobotBody(const scene::Scene& scene) {
+  std::optional<scene::Robot> robot = scene.robot();
+  if (!robot) throw InvalidArgument("bench: --hide-robot: the scene has no robot");
+  robot->visible = false;
+  return scene::Scene(scene.background(), scene.lights(), scene.ground(), scene.objects(),
+                      scene.cameras(), robot);
+}
+
 int RunBench(const BenchOptions& o) {
-  const scene::Scene scene = scene::Scene::Load(o.scene, {o.head});
+  scene::Scene scene = scene::Scene::Load(o.scene, {o.head});
   if (scene.cameras().empty()) throw InvalidArgument("bench: the scene has no cameras");
+  if (o.hide_robot) scene = WithoutRobotBody(scene);
   std::optional<ProgressBar> bar;
   const auto progress = [&bar, &o](int done, double fps) {
     if (!bar) bar.emplace(o.frames);
@@ -229,6 +240,9 @@ Runner AddBenchCommand(CLI::App& app) {
       ->add_option("--head", o->head,
                    "Head file (robots/*.yaml) in place of the scene's robot head")
       ->check(CLI::ExistingFile);
+  bench->add_flag("--hide-robot", o->hide_robot,
+                  "Do not draw the robot's body (its URDF visuals): against a run without it, "
+                  "what the robot's own meshes cost");
   bench
       ->add_option("--frames", o->frames,
                    "Frames to time, in each run (the first figure and each row of the effect "
