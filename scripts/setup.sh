@@ -51,6 +51,8 @@ packages=(
   # any robot head from its URDF (issue 42): urdfdom parses URDF (it brings TinyXML, which also
   # reads the URDF's <gazebo> camera blocks, and console_bridge, which carries its messages)
   liburdfdom-dev
+  # recordings in MCAP (issue 43): zstd chunk compression
+  libzstd-dev
 )
 # What the tests, benchmarks and the Python package add (the full setup only).
 test_packages=(
@@ -186,6 +188,15 @@ fi
 ref=tests/dds/ros2_reference
 if ! $program_only && ! cmp -s $ref/package-lock.json $ref/node_modules/.saccade-installed-lock 2>/dev/null; then
   echo "setup: installing the DDS tests' npm packages ($ref/package-lock.json)"
+  (cd $ref && npm ci --no-audit --no-fund --loglevel=error)
+  cp $ref/package-lock.json $ref/node_modules/.saccade-installed-lock
+fi
+
+# The recording tests' reference MCAP implementation (Foxglove's @mcap/core and @mcap/support,
+# tests/record/mcap_reference/), exactly as its package-lock.json pins it.
+ref=tests/record/mcap_reference
+if ! $program_only && ! cmp -s $ref/package-lock.json $ref/node_modules/.saccade-installed-lock 2>/dev/null; then
+  echo "setup: installing the recording tests' npm packages ($ref/package-lock.json)"
   (cd $ref && npm ci --no-audit --no-fund --loglevel=error)
   cp $ref/package-lock.json $ref/node_modules/.saccade-installed-lock
 fi
