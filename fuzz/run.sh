@@ -12,6 +12,7 @@
 #   calibration_fuzzer  OpenCV YAML/XML and ROS CameraInfo files, read and re-read   6/60
 #   command_fuzzer      the GUI protocol's command envelope (server/internal_command.h) 5/60
 #   dynamixel_fuzzer    bytes from a servo bus in any split (hw/dynamixel_protocol.h)  4/60
+#   mcap_fuzzer         MCAP recordings, cut short or damaged (record/mcap.h)         5/60
 # Each fuzz/<target>.cc says what it checks beyond "no crash". Exits non-zero when a fuzzer
 # finds a crash, a failed check, a sanitizer report, a leak or a hang; the reproducer is left
 # in build-fuzz/ (crash-*, leak-*, timeout-*). Reproduce one with
@@ -22,7 +23,8 @@
 #                                            SECONDS shared among them by the same weights;
 #   SACCADE_FUZZ_BUILD_ONLY=1                builds the fuzzers and stops.
 # Needs (Debian 12): clang, libclang-rt-14-dev, libyaml-cpp-dev, libassimp-dev, libeigen3-dev,
-# libfmt-dev, libpng-dev, libstb-dev, nlohmann-json3-dev, liburdfdom-dev, libtinyxml-dev; the
+# libfmt-dev, libpng-dev, libstb-dev, nlohmann-json3-dev, liburdfdom-dev, libtinyxml-dev,
+# libzstd-dev; the
 # scenes' assets (see scenes/portraits.yaml) are not needed: the seeds use robots/popeye.yaml and
 # assimp-testmodels' small files when present.
 set -euo pipefail
@@ -45,7 +47,7 @@ flags=(-std=c++20 -O1 -g -fno-omit-frame-pointer
 # urdfdom (and the TinyXML 1 and console_bridge it reads and reports with): every target that
 # compiles src/head/ (the URDF loader, issue 42).
 libs=($(pkg-config --libs yaml-cpp assimp libpng fmt) -lstb -lurdfdom_model -ltinyxml
-      -lconsole_bridge -lpthread)
+      -lconsole_bridge -lzstd -lpthread)
 
 # Each target: its sources, its weight in the time budget, its longest input.
 declare -A target_sources target_weight target_max_len
@@ -62,12 +64,14 @@ target_sources[urdf]="${head[*]} fuzz/urdf_fuzzer.cc"
 target_sources[calibration]="${geometry[*]} fuzz/calibration_fuzzer.cc"
 target_sources[command]="src/server/internal_command.cc fuzz/command_fuzzer.cc"
 target_sources[dynamixel]="${core[*]} src/hw/dynamixel_protocol.cc fuzz/dynamixel_fuzzer.cc"
+target_sources[mcap]="${core[*]} src/record/*.cc fuzz/mcap_fuzzer.cc"
 target_weight=([scene]=12 [pipeline]=7 [hardware]=7 [urdf]=7 [head]=6 [head_model]=6
-               [calibration]=6 [command]=5 [dynamixel]=4)
+               [calibration]=6 [command]=5 [dynamixel]=4 [mcap]=5)
 # The URDF and head-file seeds are the shipped heads (humanoid.urdf is 9 KB).
 target_max_len=([scene]=4096 [pipeline]=4096 [hardware]=4096 [urdf]=16384 [head]=4096
-                [head_model]=8192 [calibration]=4096 [command]=1024 [dynamixel]=1024)
-all_targets=(scene pipeline hardware urdf head head_model calibration command dynamixel)
+                [head_model]=8192 [calibration]=4096 [command]=1024 [dynamixel]=1024
+                [mcap]=16384)
+all_targets=(scene pipeline hardware urdf head head_model calibration command dynamixel mcap)
 read -r -a targets <<< "${SACCADE_FUZZ_TARGETS:-${all_targets[*]}}"
 for target in "${targets[@]}"; do
   if [[ -z "${target_weight[$target]:-}" ]]; then

@@ -70,7 +70,7 @@ if $ci; then
 fi
 
 if $ci || [ "${SACCADE_FUZZ:-}" = "1" ]; then
-  begin "fuzzing: nine targets (libFuzzer, ${SACCADE_FUZZ_SECONDS:-60} s)"
+  begin "fuzzing: ten targets (libFuzzer, ${SACCADE_FUZZ_SECONDS:-60} s)"
   bash fuzz/run.sh "${SACCADE_FUZZ_SECONDS:-60}"
   end
 fi

@@ -16,6 +16,8 @@ using internal::Reader;
 
 namespace {
 
+constexpr uint64_t kMaxChunkBytes = uint64_t{512} << 20;
+
 // The reader keeps no file open: each pass opens it again (a reader may outlive many passes).
 class File {
  public:
@@ -115,7 +117,15 @@ void McapReader::Impl::Decompress(Reader chunk, uint64_t at, std::vector<uint8_t
     if (records.size() != size) Fail(at, "a chunk's size is not its records'");
     out->assign(records.begin(), records.end());
   } else if (compression == "zstd") {
-    if (size > (uint64_t{1} << 34)) Fail(at, fmt::format("a chunk of {} bytes", size));
+    // Chunks hold a few MiB (writers close them at 1-4 MiB; one message may add an image);
+    // a larger size is damage, not a chunk, and is not allocated.
+    if (size > kMaxChunkBytes) {
+      Fail(at, fmt::format("a chunk of {} bytes (more than {} MiB)", size, kMaxChunkBytes >> 20));
+    }
+    const unsigned long long declared = ZSTD_getFrameContentSize(records.data(), records.size());
+    if (declared != ZSTD_CONTENTSIZE_UNKNOWN && declared != size) {
+      Fail(at, fmt::format("a zstd chunk whose frame holds {} bytes, not its {}", declared, size));
+    }
     out->resize(size);
     const std::size_t n = ZSTD_decompress(out->data(), size, records.data(), records.size());
     if (ZSTD_isError(n) || n != size) {

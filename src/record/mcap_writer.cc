@@ -102,6 +102,7 @@ McapWriter::~McapWriter() {
 
 uint16_t McapWriter::AddSchema(const std::string& name, const std::string& encoding,
                                const std::string& data) {
+  if (impl_->schemas.size() >= 65535) throw InvalidArgument("mcap: more than 65,535 schemas");
   const auto id = static_cast<uint16_t>(impl_->schemas.size() + 1);
   impl_->schemas[id] = McapSchema{id, name, encoding, data};
   Bytes content;
@@ -119,6 +120,7 @@ uint16_t McapWriter::AddChannel(uint16_t schema_id, const std::string& topic,
   if (schema_id != 0 && !impl_->schemas.contains(schema_id)) {
     throw InvalidArgument(fmt::format("mcap: channel {}: unknown schema id {}", topic, schema_id));
   }
+  if (impl_->channels.size() >= 65535) throw InvalidArgument("mcap: more than 65,535 channels");
   const auto id = static_cast<uint16_t>(impl_->channels.size() + 1);
   impl_->channels[id] = McapChannel{id, schema_id, topic, message_encoding, metadata};
   Bytes content;
