@@ -27,6 +27,26 @@ struct ChunkIndex {
   uint64_t compressed_size = 0, uncompressed_size = 0;
 };
 
+// The contents of Schema and Channel records: the same in a chunk and in the summary.
+Bytes SchemaContent(const McapSchema& s) {
+  Bytes c;
+  c.U16(s.id);
+  c.String(s.name);
+  c.String(s.encoding);
+  c.String(s.data);  // uint32-prefixed bytes: as a string
+  return c;
+}
+
+Bytes ChannelContent(const McapChannel& ch) {
+  Bytes c;
+  c.U16(ch.id);
+  c.U16(ch.schema_id);
+  c.String(ch.topic);
+  c.String(ch.message_encoding);
+  c.StringMap(ch.metadata);
+  return c;
+}
+
 }  // namespace
 
 struct McapWriter::Impl {
@@ -105,12 +125,7 @@ uint16_t McapWriter::AddSchema(const std::string& name, const std::string& encod
   if (impl_->schemas.size() >= 65535) throw InvalidArgument("mcap: more than 65,535 schemas");
   const auto id = static_cast<uint16_t>(impl_->schemas.size() + 1);
   impl_->schemas[id] = McapSchema{id, name, encoding, data};
-  Bytes content;
-  content.U16(id);
-  content.String(name);
-  content.String(encoding);
-  content.String(data);  // uint32-prefixed bytes: as a string
-  impl_->chunk.Record(internal::kSchema, content);
+  impl_->chunk.Record(internal::kSchema, SchemaContent(impl_->schemas[id]));
   return id;
 }
 
@@ -123,13 +138,7 @@ uint16_t McapWriter::AddChannel(uint16_t schema_id, const std::string& topic,
   if (impl_->channels.size() >= 65535) throw InvalidArgument("mcap: more than 65,535 channels");
   const auto id = static_cast<uint16_t>(impl_->channels.size() + 1);
   impl_->channels[id] = McapChannel{id, schema_id, topic, message_encoding, metadata};
-  Bytes content;
-  content.U16(id);
-  content.U16(schema_id);
-  content.String(topic);
-  content.String(message_encoding);
-  content.StringMap(metadata);
-  impl_->chunk.Record(internal::kChannel, content);
+  impl_->chunk.Record(internal::kChannel, ChannelContent(impl_->channels[id]));
   return id;
 }
 
@@ -236,24 +245,12 @@ void McapWriter::Impl::WriteSummary() {
       groups.emplace_back(opcode, summary_start + before, summary.size() - before);
   };
   group(internal::kSchema, [&] {
-    for (const auto& [id, s] : schemas) {
-      Bytes c;
-      c.U16(id);
-      c.String(s.name);
-      c.String(s.encoding);
-      c.String(s.data);
-      summary.Record(internal::kSchema, c);
-    }
+    for (const auto& [id, schema] : schemas)
+      summary.Record(internal::kSchema, SchemaContent(schema));
   });
   group(internal::kChannel, [&] {
-    for (const auto& [id, ch] : channels) {
-      Bytes c;
-      c.U16(id);
-      c.U16(ch.schema_id);
-      c.String(ch.topic);
-      c.String(ch.message_encoding);
-      c.StringMap(ch.metadata);
-      summary.Record(internal::kChannel, c);
+    for (const auto& [id, channel] : channels) {
+      summary.Record(internal::kChannel, ChannelContent(channel));
     }
   });
   group(internal::kChunkIndex, [&] {
