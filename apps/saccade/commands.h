@@ -12,6 +12,7 @@
 
 #include "saccade/head/head_model.h"
 #include "saccade/head/joint_state.h"
+#include "saccade/record/recorder.h"
 #include "saccade/runtime/pipeline.h"
 
 namespace saccade::app {
@@ -27,6 +28,7 @@ Runner AddBenchCommand(CLI::App& app);
 Runner AddGuiCommand(CLI::App& app);
 Runner AddRunCommand(CLI::App& app);
 Runner AddUrdfCommand(CLI::App& app);
+Runner AddMcapCommand(CLI::App& app);
 
 // Shared helpers.
 inline constexpr double kDegToRad = M_PI / 180.0;
@@ -55,5 +57,44 @@ void AddDdsOptions(CLI::App* command, DdsOverrides& o);
 /// The entries of the pipeline's `transport:` map that the options replace.
 nlohmann::json DdsTransport(const DdsOverrides& o);
 void ApplyDdsOverrides(const DdsOverrides& o, runtime::PipelineSpec& spec);
+
+/// `--record FILE.mcap` and its tuning (record_commands.cc).
+struct McapOptions {
+  std::string path;  ///< "": no recording
+  double chunk_s = 1.0;
+  std::string compression = "zstd";
+  bool force = false;  ///< replace an existing file
+};
+bool IsMcapPath(const std::string& path);
+/// --record-chunk-s and --record-compression.
+void AddRecordTuning(CLI::App* command, McapOptions& o);
+
+/// The "saccade" metadata of a recording: the command and the files it ran (empty ones left out).
+std::map<std::string, std::string> RunMetadata(const std::string& command,
+                                               const std::string& pipeline,
+                                               const std::string& scene, const std::string& head,
+                                               const std::string& hardware);
+
+/// A run's MCAP recording (record/recorder.h) with, for rendered cameras, the scene's ground
+/// truth on /saccade/ground_truth each step (JSON: every object's pose, every face's centre).
+/// Its Metadata record "saccade" holds `metadata` plus the head and whether the cameras are
+/// rendered or real.
+class Recording {
+ public:
+  /// Throws InvalidArgument (before anything is written) for a name without .mcap, an existing
+  /// file without `force`, a chunk length <= 0; FileError when it cannot be created.
+  Recording(const McapOptions& o, runtime::Pipeline& pipeline,
+            std::map<std::string, std::string> metadata);
+  ~Recording();
+  /// runtime::RunOptions::after_step.
+  void AfterStep(const runtime::StepContext& context);
+  /// Closes the file; returns a line for people ("record: N steps, ... MB in FILE").
+  std::string Close();
+
+ private:
+  struct Truth;
+  std::unique_ptr<Truth> truth_;
+  std::unique_ptr<record::PipelineRecorder> recorder_;
+};
 
 }  // namespace saccade::app

@@ -47,6 +47,7 @@ struct Options {
   bool dds = false;  // gui --dds: pipelines/remote.yaml unless --pipeline names another
   DdsOverrides dds_overrides;
   gui::GuiOptions gui_options;
+  McapOptions record;  // --record FILE.mcap (a folder name: DemoOptions::record)
 };
 
 /// --list-components: the component types, as text, JSON or docs/components.md.
@@ -71,16 +72,19 @@ std::unique_ptr<GuiSession> ServeGui(Options& o, DemoSession& session) {
 }
 
 /// The demo's loop until it ends or Ctrl-C (or SIGTERM).
-DemoSummary RunUntilDone(DemoSession& session, GuiSession* gui) {
+DemoSummary RunUntilDone(DemoSession& session, GuiSession* gui, Recording* recording) {
   components::demo::RunHooks hooks;
   hooks.on_error = [](const runtime::StepError& error) {
     fmt::print(stderr, "saccade: error: {}\n", error.ToString());
   };
-  if (gui != nullptr) {
-    hooks.while_waiting = [gui] { gui->WhileWaiting(); };
-    hooks.after_step =
-        [gui](const runtime::StepContext& context, const components::demo::Latest& latest,
-              const std::atomic<bool>& stop) { gui->AfterStep(context, latest, stop); };
+  if (gui != nullptr) hooks.while_waiting = [gui] { gui->WhileWaiting(); };
+  if (gui != nullptr || recording != nullptr) {
+    hooks.after_step = [gui, recording](const runtime::StepContext& context,
+                                        const components::demo::Latest& latest,
+                                        const std::atomic<bool>& stop) {
+      if (recording != nullptr) recording->AfterStep(context);
+      if (gui != nullptr) gui->AfterStep(context, latest, stop);
+    };
   }
   g_stop = false;
   auto previous_int = std::signal(SIGINT, OnDemoInterrupt);
@@ -100,6 +104,11 @@ int RunDemo(Options o) {
   dds::RegisterDdsTransport(runtime::ComponentRegistry::Global());
   o.demo.transport = DdsTransport(o.dds_overrides);
   o.demo.live = o.gui;
+  if (IsMcapPath(o.demo.record)) {
+    o.record.path = o.demo.record;
+    o.record.force = o.demo.force;
+    o.demo.record.clear();
+  }
   DemoSession::Progress progress;
   if (!o.json) {
     progress = [](const std::string& line) {
@@ -108,9 +117,20 @@ int RunDemo(Options o) {
     };
   }
   DemoSession session(o.demo, progress);
+  std::unique_ptr<Recording> recording;
+  if (!o.record.path.empty()) {
+    recording =
+        std::make_unique<Recording>(o.record, session.pipeline(),
+                                    RunMetadata(o.gui ? "gui" : "demo", o.demo.pipeline,
+                                                o.demo.scene, o.demo.head, o.demo.hardware));
+  }
   std::unique_ptr<GuiSession> gui;
   if (o.gui) gui = ServeGui(o, session);
-  const DemoSummary summary = RunUntilDone(session, gui.get());
+  const DemoSummary summary = RunUntilDone(session, gui.get(), recording.get());
+  if (recording) {
+    const std::string line = recording->Close();
+    if (!o.json) fmt::print("{}", line);
+  }
 
   if (o.json) {
     fmt::print("{}\n", summary.Json().dump(2));
@@ -194,6 +214,11 @@ Runner AddGuiCommand(CLI::App& app) {
       ->excludes("--hardware");
   AddDdsOptions(gui, o->dds_overrides);
   AddGuiOptions(gui, *o);
+  gui->add_option("--record", o->record.path,
+                  "Record every topic of the session to this MCAP file (ROS 2 messages and "
+                  "JSON, with the ground truth), until Ctrl-C");
+  gui->add_flag("--force", o->record.force, "Replace an existing --record file");
+  AddRecordTuning(gui, o->record);
   // The protocol's table (gui/protocol.h) as its generated files; nothing is served.
   auto protocol_markdown = std::make_shared<bool>(false);
   auto protocol_js = std::make_shared<bool>(false);
@@ -249,9 +274,12 @@ Runner AddDemoCommand(CLI::App& app) {
                    "--realtime); it ends sooner once every face was fixated")
       ->capture_default_str();
   demo->add_option("--record", o->demo.record,
-                   "Folder for the annotated frames (frames/*.jpg), a video (demo.avi, MJPEG), "
-                   "a PNG per fixation and summary.json");
-  demo->add_flag("--force", o->demo.force, "Replace an earlier recording in the --record folder");
+                   "FILE.mcap: every topic of the run in MCAP (ROS 2 messages and JSON, with "
+                   "the ground truth; Foxglove, rosbag2, `saccade mcap info`). Any other name: "
+                   "a folder for the annotated frames (frames/*.jpg), a video (demo.avi, "
+                   "MJPEG), a PNG per fixation and summary.json");
+  demo->add_flag("--force", o->demo.force, "Replace an earlier recording (--record)");
+  AddRecordTuning(demo, o->record);
   demo->add_flag("--json", o->json, "Print the report as JSON (the same as summary.json)");
   demo->add_flag("--realtime", o->demo.realtime,
                  "Run on the wall clock at the pipeline's rate instead of simulated time");

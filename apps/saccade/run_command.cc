@@ -43,6 +43,7 @@ struct RunCommandOptions {
   bool json = false;
   bool score = false;
   std::string joints_csv;
+  McapOptions record;
   DdsOverrides dds;  // the pipeline's `transport:` map, overridden
 };
 
@@ -171,10 +172,16 @@ int Run(const RunCommandOptions& o) {
   std::unique_ptr<components::demo::FixationScorer> scorer;
   if (o.score) scorer = MakeScorer(pipeline, o, &latest);
 
+  std::unique_ptr<Recording> recording;
+  if (!o.record.path.empty()) {
+    recording = std::make_unique<Recording>(
+        o.record, pipeline, RunMetadata("run", o.pipeline, o.scene, o.head, o.hardware));
+  }
   runtime::RunOptions run;
   run.steps = o.steps;
   const double dt = spec.clock.step;
   run.after_step = [&](const runtime::StepContext& context) {
+    if (recording) recording->AfterStep(context);
     if (!scorer) return;
     // The frame index of the step's images (the sender's, with clock.source).
     const auto frame = static_cast<int64_t>(std::llround(context.time / dt));
@@ -195,6 +202,10 @@ int Run(const RunCommandOptions& o) {
   std::signal(SIGINT, previous_int);
   std::signal(SIGTERM, previous_term);
   if (csv) csv->flush();
+  if (recording) {
+    const std::string line = recording->Close();
+    if (!o.json) fmt::print("{}", line);
+  }
   PrintResult(o, summary, fixations, scorer.get());
   // Stops the components (the DDS readers report what crossed) before exiting.
   return !summary.errors.empty() && summary.stopped_on_error ? 1 : 0;
@@ -238,6 +249,12 @@ Runner AddRunCommand(CLI::App& app) {
   run->add_option("--joints-csv", o->joints_csv,
                   "Write every head state the pipeline emits (time, pan, tilt, left, right in "
                   "rad, arrived) to this CSV file");
+  run->add_option("--record", o->record.path,
+                  "Record every output of the run to this MCAP file (ROS 2 messages: images, "
+                  "camera info, joint states and targets, TF; JSON: detections, tracks, "
+                  "selections, ground truth), for Foxglove, rosbag2 and `saccade mcap`");
+  run->add_flag("--force", o->record.force, "Replace an existing --record file");
+  AddRecordTuning(run, o->record);
   AddDdsOptions(run, o->dds);
   return [o] { return Run(*o); };
 }

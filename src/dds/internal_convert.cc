@@ -1,5 +1,7 @@
 #include "dds/internal_convert.h"
 
+#include <dds/ddsi/ddsi_cdrstream.h>
+#include <dds/ddsi/q_protocol.h>
 #include <fmt/format.h>
 
 #include <Eigen/Geometry>
@@ -368,6 +370,33 @@ bool ImageViewOfCdr(const uint8_t* cdr, std::size_t size, sensor_msgs_msg_dds__I
   out->is_bigendian = is_bigendian;
   out->data = {data_length, data_length, const_cast<uint8_t*>(data), false};
   return true;
+}
+
+void SerializeCdr(const dds_topic_descriptor_t& descriptor, const void* sample,
+                  std::vector<uint8_t>* out) {
+  static_assert(std::endian::native == std::endian::little, "CDR_LE header below");
+  dds_ostream_t os;
+  dds_ostream_init(&os, 0, CDR_ENC_VERSION_1);
+  // Alignment counts from the first byte after the encapsulation header.
+  dds_stream_write(&os, static_cast<const char*>(sample), descriptor.m_ops);
+  out->resize(4 + os.m_index);
+  (*out)[0] = 0x00;  // CDR_LE: 0x0001, big-endian on the wire, then two option bytes
+  (*out)[1] = 0x01;
+  (*out)[2] = (*out)[3] = 0x00;
+  if (os.m_index > 0) std::memcpy(out->data() + 4, os.m_buffer, os.m_index);
+  dds_ostream_fini(&os);
+}
+
+std::string RosTypeName(const std::string& dds_type_name) {
+  // pkg::msg::dds_::Type_ -> pkg/msg/Type
+  std::string name = dds_type_name;
+  const std::string dds_part = "::dds_::";
+  if (const auto at = name.find(dds_part); at != std::string::npos) {
+    name.replace(at, dds_part.size(), "::");
+  }
+  if (!name.empty() && name.back() == '_') name.pop_back();
+  for (std::size_t at; (at = name.find("::")) != std::string::npos;) name.replace(at, 2, "/");
+  return name;
 }
 
 std::shared_ptr<Image> ImagePool::Get(int width, int height, PixelFormat format) {

@@ -82,6 +82,14 @@ geometry::Pose PoseOf(const geometry_msgs_msg_dds__Transform_& transform);
 bool ImageViewOfCdr(const uint8_t* cdr, std::size_t size, sensor_msgs_msg_dds__Image_* out,
                     std::string* error);
 
+/// `sample` (of `descriptor`'s type) serialized as Cyclone writes it for rmw_cyclonedds: the
+/// 4-byte encapsulation header (CDR, this machine's byte order: little-endian), then XCDR1.
+void SerializeCdr(const dds_topic_descriptor_t& descriptor, const void* sample,
+                  std::vector<uint8_t>* out);
+/// The ROS 2 name of an idlc type name: "sensor_msgs::msg::dds_::Image_" ->
+/// "sensor_msgs/msg/Image".
+std::string RosTypeName(const std::string& dds_type_name);
+
 /// Images a reader handed out before, reused once nobody else holds them. A received frame is
 /// megabytes: a fresh one costs a page fault per 4 KiB page, and between frames the heap gave
 /// the pages back to the kernel (on the dev VM 15 ms of CPU for a 1024x768 RGB frame, against

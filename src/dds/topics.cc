@@ -133,6 +133,77 @@ void WriteSample(const Entity& writer, const void* sample, const std::string& to
   }
 }
 
+// ---- outlets: where a writer's samples go --------------------------------------------------
+
+// One topic of a writer: a DDS writer on it, or its samples serialized for a recording
+// (Writer::CreateSerializing). The writers below fill samples the same way for both.
+class Outlet {
+ public:
+  virtual ~Outlet() = default;
+  // Writes `sample` (of the outlet's type), captured at `stamp_ns` (its header's stamp).
+  virtual void Write(const void* sample, int64_t stamp_ns, LinkStats& stats) = 0;
+  // Readers matched now; a serializing outlet's sink counts as one.
+  virtual int matched() const = 0;
+};
+
+class DdsOutlet final : public Outlet {
+ public:
+  DdsOutlet(const Participant& participant, const dds_topic_descriptor_t* descriptor,
+            const std::string& ros_topic, const Qos& qos, bool lockstep, int64_t offset)
+      : topic_name_(ros_topic),
+        topic_(MakeTopic(participant, descriptor, ros_topic)),
+        writer_(MakeWriter(participant, topic_, qos, ros_topic, lockstep, offset)) {}
+  void Write(const void* sample, int64_t, LinkStats& stats) override {
+    WriteSample(writer_, sample, topic_name_, stats);
+  }
+  int matched() const override { return PublicationMatches(writer_); }
+
+ private:
+  std::string topic_name_;
+  Entity topic_, writer_;
+};
+
+class SerializingOutlet final : public Outlet {
+ public:
+  SerializingOutlet(const dds_topic_descriptor_t* descriptor, std::string ros_topic,
+                    SerializedSink sink)
+      : descriptor_(descriptor),
+        topic_(std::move(ros_topic)),
+        ros_type_(internal::RosTypeName(descriptor->m_typename)),
+        sink_(std::move(sink)) {}
+  void Write(const void* sample, int64_t stamp_ns, LinkStats&) override {
+    internal::SerializeCdr(*descriptor_, sample, &buffer_);
+    sink_({topic_, ros_type_, stamp_ns, buffer_.data(), buffer_.size()});
+  }
+  int matched() const override { return 1; }
+
+ private:
+  const dds_topic_descriptor_t* descriptor_;
+  std::string topic_;
+  std::string ros_type_;
+  SerializedSink sink_;
+  std::vector<uint8_t> buffer_;  // reused: the serialized sample
+};
+
+// Makes a writer's outlets: (descriptor, ROS topic, QoS, lockstep) -> the outlet.
+using OutletFactory = std::function<std::unique_ptr<Outlet>(const dds_topic_descriptor_t*,
+                                                            const std::string&, const Qos&, bool)>;
+
+OutletFactory DdsOutlets(std::shared_ptr<Participant> participant, int64_t offset) {
+  return [participant = std::move(participant), offset](const dds_topic_descriptor_t* descriptor,
+                                                        const std::string& topic, const Qos& qos,
+                                                        bool lockstep) {
+    return std::make_unique<DdsOutlet>(*participant, descriptor, topic, qos, lockstep, offset);
+  };
+}
+
+OutletFactory SerializingOutlets(SerializedSink sink) {
+  return [sink = std::move(sink)](const dds_topic_descriptor_t* descriptor,
+                                  const std::string& topic, const Qos&, bool) {
+    return std::make_unique<SerializingOutlet>(descriptor, topic, sink);
+  };
+}
+
 // Takes every sample there is from `reader` (loaned), calls `each(sample, info)` on the
 // valid ones in arrival order, returns the count of valid samples.
 template <typename Sample, typename Each>
@@ -225,36 +296,30 @@ class Announcements {
 
 class ImageWriter final : public Writer {
  public:
-  ImageWriter(std::shared_ptr<Participant> participant, const TopicOptions& options)
+  ImageWriter(OutletFactory make, const TopicOptions& options)
       : Writer(MessageName<ImageMessage>(), options.topic),
-        participant_(std::move(participant)),
+        make_(std::move(make)),
         offset_(options.stamp_offset_ns),
         compressed_format_(options.compressed_format),
         jpeg_quality_(options.jpeg_quality) {
-    const std::string info_topic = SiblingTopic(options.topic, "camera_info");
     // Transient local whatever the QoS: the writer keeps its last images for readers that come
     // later and ask for them (a perception started after the robot's first step gets that
     // step's images); every reader, volatile or not, matches it.
     Qos qos = options.qos;
     qos.durability = Durability::kTransientLocal;
-    image_topic_ = MakeTopic(*participant_, &sensor_msgs_msg_dds__Image__desc, options.topic);
-    image_ = MakeWriter(*participant_, image_topic_, qos, options.topic, false, offset_);
-    info_topic_ = MakeTopic(*participant_, &sensor_msgs_msg_dds__CameraInfo__desc, info_topic);
-    info_ = MakeWriter(*participant_, info_topic_, Qos::Latched(), info_topic, false, offset_);
+    image_ = make_(&sensor_msgs_msg_dds__Image__desc, options.topic, qos, false);
+    info_ = make_(&sensor_msgs_msg_dds__CameraInfo__desc,
+                  SiblingTopic(options.topic, "camera_info"), Qos::Latched(), false);
     if (!options.tf_topic.empty()) {
-      tf_topic_ = MakeTopic(*participant_, &tf2_msgs_msg_dds__TFMessage__desc, options.tf_topic);
       // ROS 2's tf QoS (reliable, keep last 100), transient local as the images: a reader of
       // the images' history gets their poses too (ROS's volatile readers match).
-      tf_ = MakeWriter(*participant_, tf_topic_,
-                       {Reliability::kReliable, Durability::kTransientLocal, 100}, options.tf_topic,
-                       false, offset_);
+      tf_ = make_(&tf2_msgs_msg_dds__TFMessage__desc, options.tf_topic,
+                  {Reliability::kReliable, Durability::kTransientLocal, 100}, false);
     }
     if (!compressed_format_.empty()) {
       compressed_topic_name_ = options.topic + "/compressed";
-      compressed_topic_ = MakeTopic(*participant_, &sensor_msgs_msg_dds__CompressedImage__desc,
-                                    compressed_topic_name_);
       compressed_ =
-          MakeWriter(*participant_, compressed_topic_, qos, compressed_topic_name_, false, offset_);
+          make_(&sensor_msgs_msg_dds__CompressedImage__desc, compressed_topic_name_, qos, false);
     }
   }
 
@@ -264,19 +329,19 @@ class ImageWriter final : public Writer {
     const Image& image = *m.image;
     internal::Holder holder;
     // Pose and camera info first, so that a reader has them when the image arrives.
-    if (tf_.get() > 0) {
+    if (tf_) {
       geometry_msgs_msg_dds__TransformStamped_ transform{};
       if (internal::FillCameraTransform(image, holder, &transform)) {
         tf2_msgs_msg_dds__TFMessage_ tf{};
         transform.header.stamp = internal::ShiftStamp(transform.header.stamp, offset_);
         tf.transforms = {1, 1, &transform, false};
-        WriteSample(tf_, &tf, "/tf", stats_);
+        tf_->Write(&tf, internal::StampNs(transform.header.stamp), stats_);
       }
     }
     sensor_msgs_msg_dds__CameraInfo_ info{};
     if (internal::FillCameraInfo(image, holder, &info)) {
       info.header.stamp = internal::ShiftStamp(info.header.stamp, offset_);
-      WriteSample(info_, &info, topic(), stats_);
+      info_->Write(&info, internal::StampNs(info.header.stamp), stats_);
     }
     sensor_msgs_msg_dds__Image_ msg{};
     if (!internal::FillImage(image, holder, &msg)) {
@@ -284,16 +349,16 @@ class ImageWriter final : public Writer {
                                         ToString(image.format()), topic()));
     }
     msg.header.stamp = internal::ShiftStamp(msg.header.stamp, offset_);
-    WriteSample(image_, &msg, topic(), stats_);
+    image_->Write(&msg, internal::StampNs(msg.header.stamp), stats_);
     ++stats_.messages;
     // Compressed only for a reader of it: encoding costs milliseconds an image.
-    if (compressed_.get() > 0 && PublicationMatches(compressed_) > 0) {
+    if (compressed_ && compressed_->matched() > 0) {
       internal::Holder compressed_holder;
       sensor_msgs_msg_dds__CompressedImage_ compressed{};
       if (internal::FillCompressedImage(image, compressed_format_, jpeg_quality_, compressed_holder,
                                         &compressed_bytes_, &compressed)) {
         compressed.header.stamp = internal::ShiftStamp(compressed.header.stamp, offset_);
-        WriteSample(compressed_, &compressed, compressed_topic_name_, stats_);
+        compressed_->Write(&compressed, internal::StampNs(compressed.header.stamp), stats_);
       } else if (!said_uncompressible_) {
         said_uncompressible_ = true;
         log::Log(log::Level::kWarn, "dds: {}: {} images have no {} form; none sent",
@@ -301,17 +366,16 @@ class ImageWriter final : public Writer {
       }
     }
   }
-  int matched() const override { return PublicationMatches(image_); }
+  int matched() const override { return image_->matched(); }
   const LinkStats& stats() const override { return stats_; }
 
  private:
-  std::shared_ptr<Participant> participant_;
+  OutletFactory make_;  // holds the participant: destroyed after the outlets
   int64_t offset_;
   std::string compressed_format_;
   int jpeg_quality_;
   std::string compressed_topic_name_;
-  Entity image_topic_, info_topic_, tf_topic_, compressed_topic_;
-  Entity image_, info_, tf_, compressed_;
+  std::unique_ptr<Outlet> image_, info_, tf_, compressed_;
   std::vector<uint8_t> compressed_bytes_;  // reused: the encoded image
   bool said_uncompressible_ = false;
   LinkStats stats_;
@@ -321,35 +385,25 @@ class ImageWriter final : public Writer {
 template <typename M, typename Sample>
 class SimpleWriter final : public Writer {
  public:
-  SimpleWriter(std::shared_ptr<Participant> participant, const TopicOptions& options,
+  SimpleWriter(OutletFactory make, const TopicOptions& options,
                const dds_topic_descriptor_t* descriptor)
       : Writer(MessageName<M>(), options.topic),
-        participant_(std::move(participant)),
+        make_(std::move(make)),
         lockstep_(options.lockstep),
         offset_(options.stamp_offset_ns) {
-    topic_ = MakeTopic(*participant_, descriptor, options.topic);
-    writer_ = MakeWriter(*participant_, topic_, options.qos, options.topic, lockstep_, offset_);
-    if (std::is_same_v<M, JointStateMessage> && !options.targets_topic.empty()) {
-      targets_topic_ = MakeTopic(*participant_, descriptor, options.targets_topic);
-      targets_ = MakeWriter(*participant_, targets_topic_, options.qos, options.targets_topic,
-                            false, offset_);
-      targets_topic_name_ = options.targets_topic;
-    }
+    writer_ = make_(descriptor, options.topic, options.qos, lockstep_);
     if constexpr (std::is_same_v<M, JointStateMessage>) {
+      if (!options.targets_topic.empty()) {
+        targets_ = make_(descriptor, options.targets_topic, options.qos, false);
+      }
       if (!options.robot_description_topic.empty()) {
-        description_topic_name_ = options.robot_description_topic;
-        description_topic_ =
-            MakeTopic(*participant_, &std_msgs_msg_dds__String__desc, description_topic_name_);
-        description_ = MakeWriter(*participant_, description_topic_, Qos::Latched(),
-                                  description_topic_name_, false, offset_);
+        description_ = make_(&std_msgs_msg_dds__String__desc, options.robot_description_topic,
+                             Qos::Latched(), false);
       }
       if (!options.tf_topic.empty()) {
         // ROS 2's tf QoS (reliable, keep last 100), transient local as the images' poses.
-        tf_topic_name_ = options.tf_topic;
-        tf_topic_ = MakeTopic(*participant_, &tf2_msgs_msg_dds__TFMessage__desc, tf_topic_name_);
-        tf_ = MakeWriter(*participant_, tf_topic_,
-                         {Reliability::kReliable, Durability::kTransientLocal, 100}, tf_topic_name_,
-                         false, offset_);
+        tf_ = make_(&tf2_msgs_msg_dds__TFMessage__desc, options.tf_topic,
+                    {Reliability::kReliable, Durability::kTransientLocal, 100}, false);
       }
     }
   }
@@ -359,21 +413,21 @@ class SimpleWriter final : public Writer {
     if constexpr (std::is_same_v<M, JointStateMessage>) {
       if (m.head) WriteRobot(m);
       // The targets first, so that a reader has them when the state arrives.
-      if (targets_.get() > 0) {
+      if (targets_) {
         head::JointState targets, velocities;
         internal::TargetsToSend(m, &targets, &velocities);
         internal::Holder holder;
         Sample sample{};
         internal::FillJointState(m.time, targets, &velocities, holder, &sample);
         sample.header.stamp = internal::ShiftStamp(sample.header.stamp, offset_);
-        WriteSample(targets_, &sample, targets_topic_name_, stats_);
+        targets_->Write(&sample, internal::StampNs(sample.header.stamp), stats_);
       }
     }
     internal::Holder holder;
     Sample sample{};
     Fill(m, holder, &sample);
     sample.header.stamp = internal::ShiftStamp(sample.header.stamp, offset_);
-    WriteSample(writer_, &sample, topic(), stats_);
+    writer_->Write(&sample, internal::StampNs(sample.header.stamp), stats_);
     ++stats_.messages;
     written_up_to_ = std::max(written_up_to_, m.time);
   }
@@ -388,26 +442,28 @@ class SimpleWriter final : public Writer {
         mark.name = {0, 0, nullptr, false};
         mark.position = mark.velocity = {0, 0, nullptr, false};
         mark.header.stamp = internal::ShiftStamp(mark.header.stamp, offset_);
-        WriteSample(writer_, &mark, topic(), stats_);
+        writer_->Write(&mark, internal::StampNs(mark.header.stamp), stats_);
       }
     }
     written_up_to_ = -std::numeric_limits<double>::infinity();
   }
-  int matched() const override { return PublicationMatches(writer_); }
+  int matched() const override { return writer_->matched(); }
   const LinkStats& stats() const override { return stats_; }
 
  private:
   // The head's URDF once (again if the head changes) and the pose of every link, before the
   // joint state, as robot_state_publisher does: rviz2 draws the robot from them.
   void WriteRobot(const JointStateMessage& m) {
-    if (description_.get() > 0 && m.head != described_) {
+    const int64_t stamp_ns =
+        internal::StampNs(internal::ShiftStamp(internal::ToStamp(m.time), offset_));
+    if (description_ && m.head != described_) {
       const std::string urdf = internal::RobotDescription(*m.head);
       std_msgs_msg_dds__String_ text{};
       text.data = const_cast<char*>(urdf.c_str());
-      WriteSample(description_, &text, description_topic_name_, stats_);
+      description_->Write(&text, stamp_ns, stats_);
       described_ = m.head;
     }
-    if (tf_.get() <= 0) return;
+    if (!tf_) return;
     internal::Holder holder;
     std::vector<geometry_msgs_msg_dds__TransformStamped_> transforms;
     try {
@@ -424,7 +480,7 @@ class SimpleWriter final : public Writer {
     tf2_msgs_msg_dds__TFMessage_ tf{};
     tf.transforms = {static_cast<uint32_t>(transforms.size()),
                      static_cast<uint32_t>(transforms.size()), transforms.data(), false};
-    WriteSample(tf_, &tf, tf_topic_name_, stats_);
+    tf_->Write(&tf, stamp_ns, stats_);
   }
 
   // A target that is not valid (nothing to look at) is not a point: it is not published.
@@ -448,14 +504,12 @@ class SimpleWriter final : public Writer {
     out->point = {m.p_W.x(), m.p_W.y(), m.p_W.z()};
   }
 
-  std::shared_ptr<Participant> participant_;
-  Entity topic_, writer_;
-  Entity targets_topic_, targets_;  // joint states: their targets (TopicOptions::targets_topic)
-  std::string targets_topic_name_;
+  OutletFactory make_;  // holds the participant: destroyed after the outlets
+  std::unique_ptr<Outlet> writer_;
+  std::unique_ptr<Outlet> targets_;  // joint states: their targets (TopicOptions::targets_topic)
   // Joint states with a head: its URDF (TopicOptions::robot_description_topic) and its links'
   // poses (tf_topic).
-  Entity description_topic_, description_, tf_topic_, tf_;
-  std::string description_topic_name_, tf_topic_name_;
+  std::unique_ptr<Outlet> description_, tf_;
   std::shared_ptr<const head::HeadModel> described_;  // the head whose URDF was sent
   bool said_no_tf_ = false;
   bool lockstep_;
@@ -933,8 +987,7 @@ class CycloneClockWriter final : public ClockWriter {
   LinkStats stats_;
 };
 
-void CheckCreate(const std::shared_ptr<Participant>& participant, const TopicOptions& options) {
-  if (!participant) throw InvalidArgument("dds: no participant");
+void CheckOptions(const TopicOptions& options) {
   DdsTopicName(options.topic);  // throws for a name that is not fully qualified and valid
   std::string error;
   if (!options.qos.IsValid(&error)) {
@@ -950,6 +1003,11 @@ void CheckCreate(const std::shared_ptr<Participant>& participant, const TopicOpt
     throw InvalidArgument(fmt::format("dds: JPEG quality of {}: expected 1..100, got {}",
                                       options.topic, options.jpeg_quality));
   }
+}
+
+void CheckCreate(const std::shared_ptr<Participant>& participant, const TopicOptions& options) {
+  if (!participant) throw InvalidArgument("dds: no participant");
+  CheckOptions(options);
 }
 
 std::string SupportedList() {
@@ -1008,24 +1066,45 @@ bool Reader::WaitForWriters(int count, double timeout_s) const {
   return WaitUntil(timeout_s, [&] { return matched() >= count; });
 }
 
+namespace {
+
+std::unique_ptr<Writer> MakeTypedWriter(OutletFactory make, const std::string& message_type,
+                                        const TopicOptions& options) {
+  if (message_type == MessageName<ImageMessage>()) {
+    return std::make_unique<ImageWriter>(std::move(make), options);
+  }
+  if (message_type == MessageName<JointStateMessage>()) {
+    return std::make_unique<SimpleWriter<JointStateMessage, sensor_msgs_msg_dds__JointState_>>(
+        std::move(make), options, &sensor_msgs_msg_dds__JointState__desc);
+  }
+  if (message_type == MessageName<JointCommand>()) {
+    return std::make_unique<SimpleWriter<JointCommand, sensor_msgs_msg_dds__JointState_>>(
+        std::move(make), options, &sensor_msgs_msg_dds__JointState__desc);
+  }
+  return std::make_unique<SimpleWriter<TargetMessage, geometry_msgs_msg_dds__PointStamped_>>(
+      std::move(make), options, &geometry_msgs_msg_dds__PointStamped__desc);
+}
+
+}  // namespace
+
 std::unique_ptr<Writer> Writer::Create(std::shared_ptr<Participant> participant,
                                        const std::string& message_type,
                                        const TopicOptions& options) {
   RosTypeOf(message_type);  // throws for an unsupported type
   CheckCreate(participant, options);
-  if (message_type == MessageName<ImageMessage>()) {
-    return std::make_unique<ImageWriter>(std::move(participant), options);
-  }
-  if (message_type == MessageName<JointStateMessage>()) {
-    return std::make_unique<SimpleWriter<JointStateMessage, sensor_msgs_msg_dds__JointState_>>(
-        std::move(participant), options, &sensor_msgs_msg_dds__JointState__desc);
-  }
-  if (message_type == MessageName<JointCommand>()) {
-    return std::make_unique<SimpleWriter<JointCommand, sensor_msgs_msg_dds__JointState_>>(
-        std::move(participant), options, &sensor_msgs_msg_dds__JointState__desc);
-  }
-  return std::make_unique<SimpleWriter<TargetMessage, geometry_msgs_msg_dds__PointStamped_>>(
-      std::move(participant), options, &geometry_msgs_msg_dds__PointStamped__desc);
+  return MakeTypedWriter(DdsOutlets(std::move(participant), options.stamp_offset_ns), message_type,
+                         options);
+}
+
+std::unique_ptr<Writer> Writer::CreateSerializing(const std::string& message_type,
+                                                  const TopicOptions& options,
+                                                  SerializedSink sink) {
+  RosTypeOf(message_type);  // throws for an unsupported type
+  if (!sink) throw InvalidArgument("dds: no sink for the serialized messages of " + options.topic);
+  TopicOptions serializing = options;
+  serializing.lockstep = false;
+  CheckOptions(serializing);
+  return MakeTypedWriter(SerializingOutlets(std::move(sink)), message_type, serializing);
 }
 
 std::unique_ptr<ClockWriter> ClockWriter::Create(std::shared_ptr<Participant> participant,

@@ -23,6 +23,8 @@ enum Opcode : uint8_t {
   kChunk = 0x06,
   kMessageIndex = 0x07,
   kChunkIndex = 0x08,
+  kMetadata = 0x0C,
+  kMetadataIndex = 0x0D,
   kStatistics = 0x0B,
   kSummaryOffset = 0x0E,
   kDataEnd = 0x0F,

@@ -51,6 +51,7 @@ struct McapReader::Impl {
   std::map<uint16_t, McapSchema> schemas;
   std::map<uint16_t, McapChannel> channels;
   McapStatistics stats;
+  std::vector<McapMetadata> metadata;
   bool recovered = false;
   uint64_t lost_bytes = 0;
   uint64_t data_start = 0;  // the first record after the header
@@ -76,6 +77,13 @@ struct McapReader::Impl {
     c.metadata = r.StringMap();
     if (!r.ok()) Fail(at, "a Channel record shorter than its fields");
     channels[c.id] = std::move(c);
+  }
+  void ReadMetadata(Reader r, uint64_t at) {
+    McapMetadata m;
+    m.name = r.String();
+    m.values = r.StringMap();
+    if (!r.ok()) Fail(at, "a Metadata record shorter than its fields");
+    metadata.push_back(std::move(m));
   }
   void ReadStatistics(Reader r, uint64_t at) {
     stats.message_count = r.U64();
@@ -170,6 +178,7 @@ uint64_t McapReader::Impl::Walk(
 
 void McapReader::Impl::Scan(File& file) {
   stats = {};
+  metadata.clear();
   const uint64_t cut = Walk(
       file,
       [&](uint8_t opcode, std::span<const uint8_t> content, uint64_t at) {
@@ -188,6 +197,7 @@ void McapReader::Impl::Scan(File& file) {
           ++stats.channel_message_counts[channel];
         }
         if (opcode == internal::kChunk) ++stats.chunk_count;
+        if (opcode == internal::kMetadata) ReadMetadata(Reader(content), at);
         return true;
       },
       true);
@@ -220,6 +230,7 @@ bool McapReader::Impl::ReadSummary(File& file) {
       summary_offset_start != 0 ? summary_offset_start - summary_start : summary.size();
   Reader r(std::span<const uint8_t>(summary).first(std::min<uint64_t>(end, summary.size())));
   bool statistics = false;
+  std::vector<std::pair<uint64_t, uint64_t>> metadata_records;  // offset, length
   while (r.left() > 0) {
     const uint64_t at = summary_start + r.pos();
     const uint8_t opcode = r.U8();
@@ -231,6 +242,21 @@ bool McapReader::Impl::ReadSummary(File& file) {
       ReadStatistics(Reader(content), at);
       statistics = true;
     }
+    if (opcode == internal::kMetadataIndex) {
+      Reader index(content);
+      const uint64_t offset = index.U64();
+      const uint64_t length = index.U64();
+      if (!index.ok()) Fail(at, "a Metadata Index record shorter than its fields");
+      metadata_records.emplace_back(offset, length);
+    }
+  }
+  std::vector<uint8_t> record;
+  for (const auto& [offset, length] : metadata_records) {
+    if (length < internal::kRecordPrefix || !file.Read(offset, length, &record) ||
+        record[0] != internal::kMetadata) {
+      Fail(offset, "a Metadata Index that points at no Metadata record");
+    }
+    ReadMetadata(Reader(std::span<const uint8_t>(record).subspan(internal::kRecordPrefix)), offset);
   }
   return statistics;
 }
@@ -278,6 +304,7 @@ const std::string& McapReader::profile() const { return impl_->profile; }
 const std::string& McapReader::library() const { return impl_->library; }
 const std::map<uint16_t, McapSchema>& McapReader::schemas() const { return impl_->schemas; }
 const std::map<uint16_t, McapChannel>& McapReader::channels() const { return impl_->channels; }
+const std::vector<McapMetadata>& McapReader::metadata() const { return impl_->metadata; }
 const McapStatistics& McapReader::statistics() const { return impl_->stats; }
 bool McapReader::recovered() const { return impl_->recovered; }
 uint64_t McapReader::lost_bytes() const { return impl_->lost_bytes; }

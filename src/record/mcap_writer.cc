@@ -60,6 +60,11 @@ struct McapWriter::Impl {
   std::map<uint16_t, uint32_t> sequences;
   McapStatistics stats;
   std::vector<ChunkIndex> chunk_indexes;
+  struct MetadataIndex {
+    uint64_t offset = 0, length = 0;
+    std::string name;
+  };
+  std::vector<MetadataIndex> metadata_indexes;
   // The open chunk: its records, their messages' offsets by channel, its time span.
   Bytes chunk;
   std::map<uint16_t, std::vector<std::pair<uint64_t, uint64_t>>> chunk_messages;
@@ -140,6 +145,20 @@ uint16_t McapWriter::AddChannel(uint16_t schema_id, const std::string& topic,
   impl_->channels[id] = McapChannel{id, schema_id, topic, message_encoding, metadata};
   impl_->chunk.Record(internal::kChannel, ChannelContent(impl_->channels[id]));
   return id;
+}
+
+void McapWriter::AddMetadata(const std::string& name,
+                             const std::map<std::string, std::string>& values) {
+  Impl& w = *impl_;
+  if (w.closed) throw InvalidArgument("mcap: metadata after Close");
+  w.FlushChunk();  // records outside chunks go between them
+  Bytes content, record;
+  content.String(name);
+  content.StringMap(values);
+  record.Record(internal::kMetadata, content);
+  w.metadata_indexes.push_back({w.offset, record.size(), name});
+  w.Put(record.data());
+  std::fflush(w.file);
 }
 
 void McapWriter::Write(uint16_t channel_id, uint64_t log_time, uint64_t publish_time,
@@ -273,13 +292,22 @@ void McapWriter::Impl::WriteSummary() {
       summary.Record(internal::kChunkIndex, c);
     }
   });
+  group(internal::kMetadataIndex, [&] {
+    for (const MetadataIndex& i : metadata_indexes) {
+      Bytes c;
+      c.U64(i.offset);
+      c.U64(i.length);
+      c.String(i.name);
+      summary.Record(internal::kMetadataIndex, c);
+    }
+  });
   group(internal::kStatistics, [&] {
     Bytes c, counts;
     c.U64(stats.message_count);
     c.U16(static_cast<uint16_t>(schemas.size()));
     c.U32(static_cast<uint32_t>(channels.size()));
     c.U32(0);  // attachments
-    c.U32(0);  // metadata
+    c.U32(static_cast<uint32_t>(metadata_indexes.size()));
     c.U32(stats.chunk_count);
     c.U64(stats.message_start_time);
     c.U64(stats.message_end_time);

@@ -282,6 +282,53 @@ TEST_F(WireTest, BytesEqualAnIndependentRos2Serializer) {
   const std::vector<std::string> reference = ReferenceSerialize(inputs);
   ASSERT_EQ(reference.size(), ours.size());
   for (std::size_t i = 0; i < ours.size(); ++i) ExpectSameCdr(ours[i], reference[i], what[i]);
+
+  // The same messages serialized for a recording (Writer::CreateSerializing) are the same
+  // bytes, in the same order, with their topics, ROS 2 types and stamps.
+  std::vector<std::vector<uint8_t>> serialized;
+  std::vector<std::string> topics, types;
+  std::vector<int64_t> stamps;
+  const SerializedSink sink = [&](const SerializedMessage& m) {
+    serialized.emplace_back(m.data, m.data + m.size);
+    topics.push_back(m.topic);
+    types.push_back(m.ros_type);
+    stamps.push_back(m.stamp_ns);
+  };
+  TopicOptions image_topic = Topic("/cam/left/image");
+  image_topic.compressed_format = "";
+  for (const auto& image : {rgb, std::shared_ptr<Image>(gray)}) {
+    Writer::CreateSerializing("runtime.image", image_topic, sink)->Write(ImageMessage{image});
+  }
+  Writer::CreateSerializing("head.joints", Topic("/saccade/joint_states"), sink)->Write(state);
+  Writer::CreateSerializing("head.command", Topic("/saccade/head/command"), sink)->Write(command);
+  Writer::CreateSerializing("vision.target", Topic("/saccade/target"), sink)->Write(target);
+  ASSERT_EQ(serialized.size(), ours.size());
+  for (std::size_t i = 0; i < ours.size(); ++i) {
+    ExpectSameCdr(serialized[i], reference[i], what[i] + " (serialized)");
+  }
+  EXPECT_EQ(topics, (std::vector<std::string>{"/tf", "/cam/left/camera_info", "/cam/left/image",
+                                              "/tf", "/cam/left/camera_info", "/cam/left/image",
+                                              "/saccade/joint_states", "/saccade/head/command",
+                                              "/saccade/target"}));
+  EXPECT_EQ(types[0], "tf2_msgs/msg/TFMessage");
+  EXPECT_EQ(types[2], "sensor_msgs/msg/Image");
+  EXPECT_EQ(types[8], "geometry_msgs/msg/PointStamped");
+  EXPECT_EQ(stamps[5], 120'000'000);
+  EXPECT_EQ(stamps[6], 7'040'000'000);
+}
+
+TEST(RosMessageDefinition, IsTheMsgFileWithItsDependenciesAsRosbag2StoresIt) {
+  const std::string image = RosMessageDefinition("sensor_msgs/msg/Image");
+  EXPECT_EQ(image.substr(0, image.find('=')),
+            "std_msgs/Header header\nuint32 height\nuint32 width\nstring encoding\n"
+            "uint8 is_bigendian\nuint32 step\nuint8[] data\n");
+  EXPECT_NE(image.find(std::string(80, '=') + "\nMSG: std_msgs/Header\n"), std::string::npos);
+  EXPECT_NE(image.find("MSG: builtin_interfaces/Time\nint32 sec\nuint32 nanosec\n"),
+            std::string::npos);
+  // Each type once, even when used twice (Vector3 and Quaternion through Transform).
+  const std::string tf = RosMessageDefinition("tf2_msgs/msg/TFMessage");
+  EXPECT_EQ(tf.find("MSG: std_msgs/Header"), tf.rfind("MSG: std_msgs/Header"));
+  EXPECT_THROW(RosMessageDefinition("nav_msgs/msg/Odometry"), InvalidArgument);
 }
 
 TEST_F(WireTest, LateJoiningSubscriberGetsTheNewestJointState) {

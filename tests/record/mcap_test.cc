@@ -7,8 +7,10 @@
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
+#include <csignal>
 #include <filesystem>
 #include <fstream>
 #include <random>
@@ -182,6 +184,60 @@ TEST(Mcap, ARecordingCutShortLosesAtMostItsOpenChunk) {
   EXPECT_TRUE(reader.recovered());
   EXPECT_EQ(reader.lost_bytes(), 0u);
   EXPECT_EQ(ReadAll(reader).size(), 100u);
+}
+
+// A recorder killed with SIGKILL (no destructor, no flush) at three random moments: the file
+// keeps every chunk closed before the kill. A forked child writes the messages, telling the
+// parent on a pipe each one it has written; the parent kills it after a random count.
+TEST(Mcap, ARecorderKilledAtRandomMomentsLosesAtMostItsOpenChunk) {
+  const std::vector<Sent> sent = Messages(23);
+  std::mt19937 rng(std::random_device{}());
+  const uint32_t seed = rng();
+  SCOPED_TRACE("seed " + std::to_string(seed));
+  rng.seed(seed);
+  for (int kill_index = 0; kill_index < 3; ++kill_index) {
+    const fs::path file = TempFile("killed.mcap");
+    fs::remove(file);
+    const std::size_t kill_after = 20 + rng() % (sent.size() - 40);
+    SCOPED_TRACE("killed after message " + std::to_string(kill_after));
+    int pipe_fds[2];
+    ASSERT_EQ(::pipe(pipe_fds), 0);
+    const pid_t child = ::fork();
+    ASSERT_GE(child, 0);
+    if (child == 0) {
+      ::close(pipe_fds[0]);
+      McapWriterOptions options;
+      options.chunk_seconds = 0.1;
+      McapWriter writer(file, options);
+      const uint16_t schema = writer.AddSchema("std_msgs/msg/String", "ros2msg", "string data\n");
+      for (uint16_t c = 1; c <= 3; ++c) writer.AddChannel(schema, "/c" + std::to_string(c), "cdr");
+      for (uint32_t i = 0; i < sent.size(); ++i) {
+        writer.Write(sent[i].channel, sent[i].log_time, sent[i].publish_time, sent[i].data);
+        if (::write(pipe_fds[1], &i, sizeof i) != sizeof i) ::_exit(2);
+        ::usleep(500);
+      }
+      ::pause();  // until killed: the file is never closed
+      ::_exit(0);
+    }
+    ::close(pipe_fds[1]);
+    uint32_t written = 0;
+    while (written < kill_after &&
+           ::read(pipe_fds[0], &written, sizeof written) == sizeof written) {
+    }
+    ::kill(child, SIGKILL);
+    ::waitpid(child, nullptr, 0);
+    ::close(pipe_fds[0]);
+    ASSERT_GE(written, kill_after);
+    const McapReader reader(file);
+    EXPECT_TRUE(reader.recovered());
+    const std::vector<Sent> got = ReadAll(reader);
+    ASSERT_LE(got.size(), sent.size());
+    for (std::size_t i = 0; i < got.size(); ++i) ASSERT_EQ(got[i].data, sent[i].data) << i;
+    // Every message more than a chunk's 0.1 s older than the last one written is in the file.
+    std::size_t must_have = 0;
+    while (sent[must_have].log_time + 100'000'000 <= sent[written].log_time) ++must_have;
+    EXPECT_GE(got.size(), must_have) << "written " << written;
+  }
 }
 
 TEST(Mcap, FilesThatAreNotMcapOrAreDamagedAreNamed) {

@@ -32,7 +32,9 @@
 // counts it.
 //
 // Thread-safety: one Writer or Reader is used by one thread at a time.
+#include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <limits>
 #include <memory>
 #include <string>
@@ -103,6 +105,25 @@ std::vector<std::string> SupportedMessageTypes();
 /// InvalidArgument naming the type and the supported ones.
 std::string RosTypeOf(const std::string& message_type);
 
+/// The ROS 2 message definition of a type the writers produce ("sensor_msgs/msg/Image", ...), in
+/// the form rosbag2 stores as an MCAP schema of encoding `ros2msg`: the type's fields as its
+/// .msg file declares them, then each type it uses, after a line of 80 '=' and "MSG: pkg/Type".
+/// Throws InvalidArgument for another type.
+std::string RosMessageDefinition(const std::string& ros_type);
+
+/// A message serialized as a Writer puts it on the wire (Writer::CreateSerializing): its ROS
+/// topic, ROS 2 type ("sensor_msgs/msg/Image"), capture stamp (its header's, in ns; a
+/// robot_description's: its joint state's) and bytes: the 4-byte encapsulation header (CDR,
+/// little-endian), then XCDR1. Valid during the call.
+struct SerializedMessage {
+  const std::string& topic;
+  const std::string& ros_type;
+  int64_t stamp_ns;
+  const uint8_t* data;
+  std::size_t size;
+};
+using SerializedSink = std::function<void(const SerializedMessage&)>;
+
 /// Publishes one saccade message type on one ROS topic.
 class Writer {
  public:
@@ -111,6 +132,13 @@ class Writer {
   static std::unique_ptr<Writer> Create(std::shared_ptr<Participant> participant,
                                         const std::string& message_type,
                                         const TopicOptions& options);
+  /// A writer that hands each ROS 2 message to `sink`, serialized with the same conversion and
+  /// the same serializer (Cyclone's) as the DDS writer, instead of publishing it (a recording:
+  /// record/). Every topic counts as matched (CompressedImage included, unless
+  /// compressed_format is ""); `lockstep` is ignored. Throws as Create.
+  static std::unique_ptr<Writer> CreateSerializing(const std::string& message_type,
+                                                   const TopicOptions& options,
+                                                   SerializedSink sink);
   virtual ~Writer() = default;
 
   /// Publishes `message` (M must be the writer's type, else InvalidArgument). Does not block

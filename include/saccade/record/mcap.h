@@ -36,6 +36,12 @@ struct McapChannel {
   std::map<std::string, std::string> metadata;
 };
 
+/// A Metadata record: a name and string pairs (saccade: the run's head, scene and pipeline).
+struct McapMetadata {
+  std::string name;
+  std::map<std::string, std::string> values;
+};
+
 /// One message as read: `data` points into the reader's buffer (valid during the callback).
 struct McapMessage {
   uint16_t channel_id = 0;
@@ -87,6 +93,8 @@ class McapWriter {
   /// Throws InvalidArgument for an unknown channel, FileError when the file cannot be written.
   void Write(uint16_t channel_id, uint64_t log_time, uint64_t publish_time,
              std::span<const uint8_t> data);
+  /// Writes a Metadata record (after the open chunk, which it closes), indexed in the summary.
+  void AddMetadata(const std::string& name, const std::map<std::string, std::string>& values);
   /// Writes the open chunk, the summary and the footer, and closes the file. Idempotent.
   void Close();
 
@@ -114,6 +122,8 @@ class McapReader {
   const std::string& library() const;
   const std::map<uint16_t, McapSchema>& schemas() const;
   const std::map<uint16_t, McapChannel>& channels() const;
+  /// The Metadata records, in file order.
+  const std::vector<McapMetadata>& metadata() const;
   /// The file's Statistics record, or (cut short) what reading the data section found.
   const McapStatistics& statistics() const;
   /// True when the file had no footer (a recording cut short): what it holds was recovered

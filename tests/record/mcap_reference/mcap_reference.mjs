@@ -3,6 +3,7 @@
 //
 //   node mcap_reference.mjs read FILE    # prints what the file holds, as JSON
 //   node mcap_reference.mjs write FILE   # writes the test's messages with @mcap/core's writer
+//   node mcap_reference.mjs decode FILE  # every message decoded, as JSON
 //
 // `read` reads the file twice: with McapStreamReader from the first byte to the last, every CRC
 // checked (data section, chunks, summary), and with McapIndexedReader through the footer, summary
@@ -13,6 +14,11 @@
 import { readFileSync, writeFileSync } from 'node:fs';
 import { McapIndexedReader, McapStreamReader, McapWriter, TempBuffer } from '@mcap/core';
 import { loadDecompressHandlers } from '@mcap/support';
+import { parse as parseMessageDefinition } from '@foxglove/rosmsg';
+import { MessageReader } from '@foxglove/rosmsg2-serialization';
+import rosmsgMsgsCommon from '@foxglove/rosmsg-msgs-common';
+
+const { ros2humble } = rosmsgMsgsCommon;
 
 const [command, file] = process.argv.slice(2);
 // FNV-1a, 32 bits.
@@ -83,10 +89,76 @@ async function write() {
   writeFileSync(file, buffer.get());
 }
 
+// A decoded value as JSON: byte arrays as their length and FNV-1a hash, other typed arrays as
+// arrays (doubles print exactly: JSON's shortest round-trip form), 64-bit integers as strings.
+function plain(value) {
+  if (value instanceof Uint8Array) return { length: value.length, fnv1a: fnv1a(value) };
+  if (ArrayBuffer.isView(value)) return Array.from(value, plain);
+  if (Array.isArray(value)) return value.map(plain);
+  if (typeof value === 'bigint') return String(value);
+  if (value && typeof value === 'object') {
+    return Object.fromEntries(Object.entries(value).map(([k, v]) => [k, plain(v)]));
+  }
+  return value;
+}
+
+// How a schema's parsed definitions differ from the ROS 2 (Humble) definitions of
+// common_interfaces as @foxglove/rosmsg-msgs-common has them: [] when they agree.
+function schemaDifferences(name, definitions) {
+  const differences = [];
+  const fields = (d) => JSON.stringify(d.definitions.filter((f) => !f.isConstant).map((f) => [
+    f.name, f.type.replace('/msg/', '/'), f.isArray ?? false, f.arrayLength ?? null]));
+  definitions.forEach((d, i) => {
+    const typeName = i === 0 ? name.replace('/msg/', '/') : d.name.replace('/msg/', '/');
+    const reference = ros2humble[typeName];
+    if (!reference) differences.push(`${typeName}: not in common_interfaces`);
+    else if (fields(d) !== fields(reference)) differences.push(`${typeName}: ${fields(d)} != ${fields(reference)}`);
+  });
+  return differences;
+}
+
+async function decode() {
+  const bytes = new Uint8Array(readFileSync(file));
+  const decompressHandlers = await loadDecompressHandlers();
+  const readable = {
+    size: async () => BigInt(bytes.length),
+    read: async (offset, size) => bytes.subarray(Number(offset), Number(offset + size)),
+  };
+  const reader = await McapIndexedReader.Initialize({ readable, decompressHandlers });
+  const readers = new Map();
+  const schemas = {};
+  for (const [id, schema] of reader.schemasById) {
+    if (schema.encoding !== 'ros2msg') continue;
+    const definitions = parseMessageDefinition(decoder.decode(schema.data), { ros2: true });
+    readers.set(id, new MessageReader(definitions));
+    schemas[schema.name] = schemaDifferences(schema.name, definitions);
+  }
+  const messages = [];
+  for await (const m of reader.readMessages({ validateCrcs: true })) {
+    const channel = reader.channelsById.get(m.channelId);
+    let value;
+    if (channel.messageEncoding === 'cdr') value = readers.get(channel.schemaId).readMessage(m.data);
+    else if (channel.messageEncoding === 'json') value = JSON.parse(decoder.decode(m.data));
+    messages.push({ topic: channel.topic, log_time: String(m.logTime),
+      publish_time: String(m.publishTime), value: plain(value) });
+  }
+  const s = reader.statistics;
+  console.log(JSON.stringify({
+    schemas, messages,
+    message_count: String(s.messageCount),
+    metadata: Object.fromEntries(await (async () => {
+      const out = [];
+      for await (const m of reader.readMetadata()) out.push([m.name, Object.fromEntries(m.metadata)]);
+      return out;
+    })()),
+  }));
+}
+
 try {
   if (command === 'read') await read();
+  else if (command === 'decode') await decode();
   else if (command === 'write') await write();
-  else throw new Error('usage: mcap_reference.mjs read|write FILE');
+  else throw new Error('usage: mcap_reference.mjs read|write|decode FILE');
 } catch (error) {
   console.error(`mcap_reference: ${error.message}`);
   process.exit(1);

@@ -1,0 +1,310 @@
+#include "saccade/record/recorder.h"
+
+#include <fmt/format.h>
+
+#include <cmath>
+#include <condition_variable>
+#include <deque>
+#include <exception>
+#include <mutex>
+#include <thread>
+#include <vector>
+
+#include "saccade/components/messages.h"
+#include "saccade/components/roles.h"
+#include "saccade/core/error.h"
+#include "saccade/core/log.h"
+#include "saccade/dds/topic_names.h"
+#include "saccade/dds/topics.h"
+#include "saccade/record/mcap.h"
+
+namespace saccade::record {
+
+namespace {
+
+// Steps handed over and not yet written, at most: the loop waits beyond (bounded memory).
+constexpr std::size_t kMaxQueuedSteps = 2;
+
+uint64_t Nanoseconds(double seconds) {
+  return seconds <= 0.0 || !std::isfinite(seconds)
+             ? 0
+             : static_cast<uint64_t>(std::llround(seconds * 1e9));
+}
+
+}  // namespace
+
+struct PipelineRecorder::Impl {
+  // One tapped output: serialized to ROS 2 messages by `ros`, or written as JSON on `json`.
+  struct Source {
+    std::unique_ptr<dds::Writer> ros;
+    std::string json_topic;
+  };
+  // A message sent during the step, kept until the writing thread takes it.
+  struct Pending {
+    Source* source = nullptr;
+    std::shared_ptr<const void> message;  // ROS: the message
+    std::string json;                     // JSON: its text
+    uint64_t publish_time = 0;            // JSON: its time
+  };
+  struct Step {
+    uint64_t log_time = 0;
+    std::vector<Pending> messages;
+  };
+
+  std::filesystem::path path;
+  RecorderOptions options;
+  McapWriter writer;
+  std::vector<std::unique_ptr<Source>> sources;
+  std::map<std::string, std::unique_ptr<Source>> extra;  // AddJson's, by topic
+
+  std::mutex step_mutex;  // guards `step` (outputs emit from any thread)
+  std::vector<Pending> step;
+
+  // The writing thread's side.
+  std::mutex queue_mutex;
+  std::condition_variable queue_changed;
+  std::deque<Step> queue;
+  bool closing = false;
+  bool closed = false;
+  std::exception_ptr failure;
+  int64_t steps = 0;
+  uint64_t messages = 0;
+  uint64_t bytes = 0;
+  std::thread thread;
+
+  // Written by the writing thread only.
+  uint64_t log_time = 0;
+  std::map<std::string, uint16_t> schema_ids;   // by ROS type
+  std::map<std::string, uint16_t> channel_ids;  // by topic
+
+  Impl(const std::filesystem::path& p, RecorderOptions o)
+      : path(p), options(std::move(o)), writer(p, WriterOptions(options)) {}
+
+  static McapWriterOptions WriterOptions(const RecorderOptions& o) {
+    if (o.compression != "zstd" && o.compression != "none") {
+      throw InvalidArgument("record: compression must be zstd or none, got '" + o.compression +
+                            "'");
+    }
+    if (!(o.chunk_seconds > 0.0) || !std::isfinite(o.chunk_seconds)) {
+      throw InvalidArgument(
+          fmt::format("record: chunk seconds must be > 0, got {}", o.chunk_seconds));
+    }
+    McapWriterOptions w;
+    w.compression = o.compression == "none" ? "" : o.compression;
+    w.chunk_seconds = o.chunk_seconds;
+    w.chunk_bytes = 8 << 20;
+    return w;
+  }
+
+  uint16_t ChannelOf(const std::string& topic, const std::string& ros_type) {
+    if (const auto found = channel_ids.find(topic); found != channel_ids.end()) {
+      return found->second;
+    }
+    uint16_t schema = 0;
+    if (!ros_type.empty()) {
+      auto [at, added] = schema_ids.try_emplace(ros_type, 0);
+      if (added) {
+        at->second = writer.AddSchema(ros_type, "ros2msg", dds::RosMessageDefinition(ros_type));
+      }
+      schema = at->second;
+    }
+    const uint16_t id = writer.AddChannel(schema, topic, ros_type.empty() ? "json" : "cdr");
+    channel_ids[topic] = id;
+    return id;
+  }
+
+  void Tap(runtime::Pipeline& pipeline);
+  void Add(Source* source, std::shared_ptr<const void> message) {
+    std::lock_guard lock(step_mutex);
+    step.push_back({source, std::move(message), {}, 0});
+  }
+  void AddJsonText(Source* source, const nlohmann::json& json, uint64_t publish_time) {
+    Pending p{source, nullptr, json.dump(), publish_time};
+    std::lock_guard lock(step_mutex);
+    step.push_back(std::move(p));
+  }
+  void WriteLoop();
+  void WriteStep(Step& s);
+  void RethrowFailure() {
+    std::lock_guard lock(queue_mutex);
+    if (failure) std::rethrow_exception(failure);
+  }
+};
+
+void PipelineRecorder::Impl::Tap(runtime::Pipeline& pipeline) {
+  const std::string image_type = runtime::MessageName<runtime::ImageMessage>();
+  const std::string joints_type = runtime::MessageName<components::JointStateMessage>();
+  const auto ros_types = dds::SupportedMessageTypes();
+  for (const auto& component : pipeline.components()) {
+    const bool cameras = dynamic_cast<components::EyeCamerasRole*>(component.get()) != nullptr;
+    const bool head = dynamic_cast<components::HeadRole*>(component.get()) != nullptr;
+    for (const auto& output : component->outputs()) {
+      const std::string& type = output->message_type();
+      auto source = std::make_unique<Source>();
+      Source* raw = source.get();
+      std::string topic;
+      try {
+        topic = dds::ResolveTopic(component->name() + "/" + output->name(), options.ns);
+      } catch (const InvalidArgument& error) {
+        log::Log(log::Level::kWarn, "record: {}.{} is not recorded: {}", component->name(),
+                 output->name(), error.what());
+        continue;
+      }
+      if (std::find(ros_types.begin(), ros_types.end(), type) != ros_types.end()) {
+        dds::TopicOptions t;
+        t.topic = topic;
+        t.tf_topic = "";
+        t.compressed_format = "";
+        if (cameras && type == image_type) {
+          t.topic = dds::ResolveTopic(output->name() + "/image_raw", options.ns);
+          t.tf_topic = "/tf";
+        } else if (head && type == joints_type && output->name() == "joints") {
+          t.topic = dds::ResolveTopic("joint_states", options.ns);
+          t.targets_topic = dds::ResolveTopic("joint_targets", options.ns);
+          t.robot_description_topic = dds::ResolveTopic("robot_description", options.ns);
+          t.tf_topic = "/tf";
+        }
+        raw->ros = dds::Writer::CreateSerializing(type, t, [this](const dds::SerializedMessage& m) {
+          writer.Write(ChannelOf(m.topic, m.ros_type), log_time,
+                       static_cast<uint64_t>(std::max<int64_t>(m.stamp_ns, 0)), {m.data, m.size});
+        });
+        // Typed: images are kept by their shared pixels, not converted during the step.
+        if (type == image_type) {
+          auto* typed = dynamic_cast<runtime::Output<runtime::ImageMessage>*>(output.get());
+          typed->signal().Connect([this, raw](const runtime::ImageMessage& m) {
+            Add(raw, std::make_shared<runtime::ImageMessage>(m));
+          });
+        } else if (type == joints_type) {
+          auto* typed = dynamic_cast<runtime::Output<components::JointStateMessage>*>(output.get());
+          typed->signal().Connect([this, raw](const components::JointStateMessage& m) {
+            Add(raw, std::make_shared<components::JointStateMessage>(m));
+          });
+        } else if (type == runtime::MessageName<components::JointCommand>()) {
+          auto* typed = dynamic_cast<runtime::Output<components::JointCommand>*>(output.get());
+          typed->signal().Connect([this, raw](const components::JointCommand& m) {
+            Add(raw, std::make_shared<components::JointCommand>(m));
+          });
+        } else {
+          auto* typed = dynamic_cast<runtime::Output<components::TargetMessage>*>(output.get());
+          typed->signal().Connect([this, raw](const components::TargetMessage& m) {
+            Add(raw, std::make_shared<components::TargetMessage>(m));
+          });
+        }
+      } else {
+        raw->json_topic = topic;
+        output->ConnectJson([this, raw](const nlohmann::json& json) {
+          const auto time = json.is_object() ? json.find("time") : json.end();
+          const double t = time != json.end() && time->is_number() ? time->get<double>() : -1.0;
+          AddJsonText(raw, json, Nanoseconds(t));
+        });
+      }
+      sources.push_back(std::move(source));
+    }
+  }
+}
+
+void PipelineRecorder::Impl::WriteStep(Step& s) {
+  log_time = s.log_time;
+  for (Pending& p : s.messages) {
+    if (p.source->ros) {
+      p.source->ros->WriteErased(p.message.get());
+    } else {
+      const auto* data = reinterpret_cast<const uint8_t*>(p.json.data());
+      writer.Write(ChannelOf(p.source->json_topic, ""), log_time,
+                   p.publish_time == 0 ? log_time : p.publish_time, {data, p.json.size()});
+    }
+  }
+}
+
+void PipelineRecorder::Impl::WriteLoop() {
+  for (;;) {
+    Step s;
+    {
+      std::unique_lock lock(queue_mutex);
+      queue_changed.wait(lock, [&] { return closing || !queue.empty(); });
+      if (queue.empty()) return;
+      s = std::move(queue.front());
+    }
+    try {
+      WriteStep(s);
+    } catch (...) {
+      std::lock_guard lock(queue_mutex);
+      if (!failure) failure = std::current_exception();
+    }
+    std::lock_guard lock(queue_mutex);
+    queue.pop_front();
+    ++steps;
+    messages = writer.statistics().message_count;
+    bytes = writer.bytes_written();
+    queue_changed.notify_all();
+  }
+}
+
+PipelineRecorder::PipelineRecorder(runtime::Pipeline& pipeline, const std::filesystem::path& path,
+                                   RecorderOptions options)
+    : impl_(std::make_unique<Impl>(path, std::move(options))) {
+  impl_->writer.AddMetadata("saccade", impl_->options.metadata);
+  impl_->Tap(pipeline);
+  impl_->thread = std::thread([this] { impl_->WriteLoop(); });
+}
+
+PipelineRecorder::~PipelineRecorder() {
+  {
+    std::lock_guard lock(impl_->queue_mutex);
+    impl_->closing = true;
+  }
+  impl_->queue_changed.notify_all();
+  if (impl_->thread.joinable()) impl_->thread.join();
+  // The McapWriter, destroyed without Close, leaves the file as a recording cut short.
+}
+
+void PipelineRecorder::AfterStep(const runtime::StepContext& context) {
+  impl_->RethrowFailure();
+  Impl::Step s;
+  s.log_time = Nanoseconds(context.time);
+  {
+    std::lock_guard lock(impl_->step_mutex);
+    s.messages.swap(impl_->step);
+  }
+  std::unique_lock lock(impl_->queue_mutex);
+  impl_->queue_changed.wait(lock, [&] { return impl_->queue.size() < kMaxQueuedSteps; });
+  impl_->queue.push_back(std::move(s));
+  impl_->queue_changed.notify_all();
+}
+
+void PipelineRecorder::AddJson(const std::string& topic, double time,
+                               const nlohmann::json& message) {
+  auto& source = impl_->extra[topic];
+  if (!source) {
+    source = std::make_unique<Impl::Source>();
+    source->json_topic = topic;
+  }
+  impl_->AddJsonText(source.get(), message, Nanoseconds(time));
+}
+
+RecordingStats PipelineRecorder::Close() {
+  Impl& r = *impl_;
+  if (!r.closed) {
+    {
+      std::lock_guard lock(r.queue_mutex);
+      r.closing = true;
+    }
+    r.queue_changed.notify_all();
+    if (r.thread.joinable()) r.thread.join();
+    r.RethrowFailure();
+    r.closed = true;
+    r.writer.Close();
+    r.messages = r.writer.statistics().message_count;
+    r.bytes = r.writer.bytes_written();
+  }
+  return stats();
+}
+
+RecordingStats PipelineRecorder::stats() const {
+  std::lock_guard lock(impl_->queue_mutex);
+  return {impl_->steps, impl_->messages, impl_->bytes};
+}
+
+const std::filesystem::path& PipelineRecorder::path() const { return impl_->path; }
+
+}  // namespace saccade::record

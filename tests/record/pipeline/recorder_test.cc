@@ -1,0 +1,239 @@
+// A pipeline's run recorded to MCAP (record/recorder.h), checked by parts nobody here wrote:
+// Foxglove's @mcap/core reads the file under Node (every CRC checked, through the summary and
+// the indexes), its ROS 2 parser reads the schemas (compared with common_interfaces' definitions
+// of @foxglove/rosmsg-msgs-common) and @foxglove/rosmsg2-serialization decodes every message,
+// which must be what the pipeline sent: images byte for byte (hashed), joints to the bit.
+#include "saccade/record/recorder.h"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "saccade/components/messages.h"
+#include "saccade/components/register.h"
+#include "saccade/core/error.h"
+#include "saccade/record/mcap.h"
+#include "saccade/runtime/pipeline.h"
+#include "saccade/runtime/scheduler.h"
+
+namespace saccade::record {
+namespace {
+
+namespace fs = std::filesystem;
+using components::JointStateMessage;
+using components::TargetMessage;
+using nlohmann::json;
+using ::testing::HasSubstr;
+
+const std::string kSource = SACCADE_SOURCE_DIR;
+
+fs::path TempFile(const std::string& name) {
+  const fs::path dir =
+      fs::temp_directory_path() / ("saccade_recorder_test_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  return dir / name;
+}
+
+// The reference script's output for `command` on `file`; its exit status in `*status`.
+std::string Node(const std::string& command, const fs::path& file, int* status) {
+  const std::string line = "node " + kSource + "/tests/record/mcap_reference/mcap_reference.mjs " +
+                           command + " '" + file.string() + "' 2>&1";
+  std::FILE* pipe = ::popen(line.c_str(), "r");
+  if (pipe == nullptr) return "(popen failed)";
+  std::string out;
+  std::array<char, 65536> buffer;
+  for (std::size_t n; (n = std::fread(buffer.data(), 1, buffer.size(), pipe)) > 0;) {
+    out.append(buffer.data(), n);
+  }
+  *status = ::pclose(pipe);
+  return out;
+}
+
+uint32_t Fnv1a(const uint8_t* bytes, std::size_t size) {
+  uint32_t h = 0x811c9dc5u;
+  for (std::size_t i = 0; i < size; ++i) h = (h ^ bytes[i]) * 0x01000193u;
+  return h;
+}
+
+int64_t StampNs(const json& stamp) {
+  return stamp["sec"].get<int64_t>() * 1'000'000'000 + stamp["nanosec"].get<int64_t>();
+}
+
+// What the pipeline sent, as the decoded messages must give it back.
+struct Sent {
+  std::map<std::string, std::vector<json>> images;  // by camera: stamp, size, pixels' hash
+  std::vector<json> joints;                         // names, positions, velocities
+  std::vector<json> targets;                        // valid targets' points
+};
+
+void TapSent(runtime::Pipeline& pipeline, Sent* sent) {
+  for (const auto& c : pipeline.components()) {
+    for (const auto& o : c->outputs()) {
+      if (c->name() == "cameras") {
+        if (auto* i = dynamic_cast<runtime::Output<runtime::ImageMessage>*>(o.get())) {
+          i->signal().Connect([sent](const runtime::ImageMessage& m) {
+            const Image& image = *m.image;
+            sent->images[image.metadata().camera].push_back(
+                {{"stamp", std::llround(image.metadata().time * 1e9)},
+                 {"width", image.width()},
+                 {"height", image.height()},
+                 {"fnv1a", Fnv1a(image.data(), image.size_bytes())}});
+          });
+        }
+      }
+      if (auto* j = dynamic_cast<runtime::Output<JointStateMessage>*>(o.get())) {
+        j->signal().Connect([sent](const JointStateMessage& m) {
+          sent->joints.push_back({{"name", m.positions.names()},
+                                  {"position", m.positions.values()},
+                                  {"velocity", m.velocities.values()}});
+        });
+      }
+      if (auto* t = dynamic_cast<runtime::Output<TargetMessage>*>(o.get())) {
+        t->signal().Connect([sent](const TargetMessage& m) {
+          if (m.valid) sent->targets.push_back({m.p_W.x(), m.p_W.y(), m.p_W.z()});
+        });
+      }
+    }
+  }
+}
+
+TEST(PipelineRecorder, TheDemosRecordingDecodesInFoxglovesReadersToWhatItSent) {
+  components::RegisterComponents();
+  runtime::PipelineSpec spec = runtime::LoadPipelineFile(kSource + "/pipelines/demo.yaml");
+  runtime::Pipeline pipeline = runtime::Pipeline::Build(spec);
+  const fs::path file = TempFile("demo.mcap");
+  Sent sent;
+  TapSent(pipeline, &sent);
+  RecorderOptions options;
+  options.chunk_seconds = 0.1;
+  options.metadata = {{"pipeline", "pipelines/demo.yaml"}};
+  PipelineRecorder recorder(pipeline, file, options);
+  runtime::RunOptions run;
+  run.steps = 12;
+  run.after_step = [&](const runtime::StepContext& context) {
+    recorder.AddJson("/saccade/ground_truth", context.time, {{"step", context.step}});
+    recorder.AfterStep(context);
+  };
+  const runtime::RunSummary summary = runtime::RunPipeline(pipeline, run);
+  ASSERT_TRUE(summary.errors.empty());
+  const RecordingStats stats = recorder.Close();
+  EXPECT_EQ(stats.steps, 12);
+  EXPECT_EQ(stats.bytes, fs::file_size(file));
+
+  int status = 0;
+  const std::string out = Node("decode", file, &status);
+  ASSERT_EQ(status, 0) << out.substr(0, 2000);
+  const json decoded = json::parse(out);
+
+  // The schemas are ROS 2's: each parses, and agrees with common_interfaces' definitions.
+  for (const char* type :
+       {"sensor_msgs/msg/Image", "sensor_msgs/msg/CameraInfo", "sensor_msgs/msg/JointState",
+        "geometry_msgs/msg/PointStamped", "tf2_msgs/msg/TFMessage", "std_msgs/msg/String"}) {
+    ASSERT_TRUE(decoded["schemas"].contains(type)) << type;
+    EXPECT_EQ(decoded["schemas"][type], json::array()) << type;
+  }
+  EXPECT_EQ(decoded["metadata"]["saccade"]["pipeline"], "pipelines/demo.yaml");
+
+  // Every message, in the order recorded; the counts are the summary's.
+  const McapReader reader(file);
+  EXPECT_FALSE(reader.recovered());
+  EXPECT_EQ(decoded["message_count"], std::to_string(reader.statistics().message_count));
+  EXPECT_EQ(decoded["messages"].size(), reader.statistics().message_count);
+  std::map<std::string, std::vector<json>> by_topic;
+  for (const json& m : decoded["messages"]) {
+    by_topic[m["topic"].get<std::string>()].push_back(m);
+  }
+  for (const auto& [camera, images] : sent.images) {
+    SCOPED_TRACE(camera);
+    const auto& got = by_topic["/saccade/" + camera + "/image_raw"];
+    const auto& infos = by_topic["/saccade/" + camera + "/camera_info"];
+    ASSERT_EQ(got.size(), images.size());
+    ASSERT_EQ(infos.size(), images.size());
+    for (std::size_t i = 0; i < got.size(); ++i) {
+      const json& v = got[i]["value"];
+      EXPECT_EQ(StampNs(v["header"]["stamp"]), images[i]["stamp"]) << i;
+      EXPECT_EQ(got[i]["publish_time"], std::to_string(images[i]["stamp"].get<int64_t>()));
+      EXPECT_EQ(v["header"]["frame_id"], camera + "_optical");
+      EXPECT_EQ(v["width"], images[i]["width"]);
+      EXPECT_EQ(v["height"], images[i]["height"]);
+      EXPECT_EQ(v["encoding"], "rgb8");
+      EXPECT_EQ(v["data"]["fnv1a"], images[i]["fnv1a"]) << i;
+      EXPECT_EQ(infos[i]["value"]["width"], images[i]["width"]);
+    }
+  }
+  const auto& joints = by_topic["/saccade/joint_states"];
+  ASSERT_EQ(joints.size(), sent.joints.size());
+  ASSERT_GE(joints.size(), 12u);
+  for (std::size_t i = 0; i < joints.size(); ++i) {
+    const json& v = joints[i]["value"];
+    EXPECT_EQ(v["name"], sent.joints[i]["name"]);
+    // Doubles to the bit: JSON carries each in its shortest exact form.
+    const auto positions = v["position"].get<std::vector<double>>();
+    const auto expected = sent.joints[i]["position"].get<std::vector<double>>();
+    ASSERT_EQ(positions.size(), expected.size());
+    for (std::size_t k = 0; k < positions.size(); ++k) {
+      EXPECT_EQ(std::bit_cast<uint64_t>(positions[k]), std::bit_cast<uint64_t>(expected[k]));
+    }
+    EXPECT_EQ(v["velocity"].get<std::vector<double>>(),
+              sent.joints[i]["velocity"].get<std::vector<double>>());
+  }
+  EXPECT_EQ(by_topic["/saccade/joint_targets"].size(), joints.size());
+  ASSERT_EQ(by_topic["/saccade/robot_description"].size(), 1u);
+  EXPECT_THAT(by_topic["/saccade/robot_description"][0]["value"]["data"].get<std::string>(),
+              HasSubstr("<robot name=\"popeye\""));
+  const auto& targets = by_topic["/saccade/triangulate/target"];
+  ASSERT_EQ(targets.size(), sent.targets.size());
+  ASSERT_FALSE(targets.empty());
+  for (std::size_t i = 0; i < targets.size(); ++i) {
+    const json& p = targets[i]["value"]["point"];
+    EXPECT_EQ(json::array({p["x"], p["y"], p["z"]}), sent.targets[i]);
+  }
+  // The TF of both optical frames and of every link; detections and the extra channel in JSON.
+  EXPECT_GE(by_topic["/tf"].size(), 3 * 12u);
+  EXPECT_EQ(by_topic["/saccade/faces_left/faces"].size(), 12u);
+  ASSERT_EQ(by_topic["/saccade/ground_truth"].size(), 12u);
+  EXPECT_EQ(by_topic["/saccade/ground_truth"][5]["value"]["step"], 5);
+  // Each message is logged at its step's time.
+  EXPECT_EQ(by_topic["/saccade/ground_truth"][5]["log_time"], "200000000");
+  EXPECT_EQ(by_topic["/saccade/left/image_raw"][5]["log_time"], "200000000");
+}
+
+TEST(PipelineRecorder, OptionsOutOfRangeAndUnwritableFilesAreRefused) {
+  components::RegisterComponents();
+  runtime::PipelineSpec spec = runtime::LoadPipelineFile(kSource + "/pipelines/demo.yaml");
+  runtime::Pipeline pipeline = runtime::Pipeline::Build(spec);
+  RecorderOptions lz5;
+  lz5.compression = "lz5";
+  EXPECT_THROW(
+      {
+        try {
+          PipelineRecorder(pipeline, TempFile("a.mcap"), lz5);
+        } catch (const InvalidArgument& e) {
+          EXPECT_THAT(e.what(), HasSubstr("'lz5'"));
+          throw;
+        }
+      },
+      InvalidArgument);
+  RecorderOptions zero;
+  zero.chunk_seconds = 0.0;
+  EXPECT_THROW(PipelineRecorder(pipeline, TempFile("b.mcap"), zero), InvalidArgument);
+  EXPECT_FALSE(fs::exists(TempFile("a.mcap")));
+  try {
+    PipelineRecorder(pipeline, "/nonexistent-dir/run.mcap");
+    FAIL() << "no error";
+  } catch (const FileError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("/nonexistent-dir/run.mcap"));
+  }
+}
+
+}  // namespace
+}  // namespace saccade::record
