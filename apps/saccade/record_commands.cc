@@ -136,12 +136,14 @@ json InfoJson(const std::string& file) {
     const auto schema = reader.schemas().find(channel.schema_id);
     const auto count = s.channel_message_counts.find(id);
     const uint64_t n = count == s.channel_message_counts.end() ? 0 : count->second;
-    channels.push_back({{"topic", channel.topic},
-                        {"type", schema == reader.schemas().end() ? channel.message_encoding
-                                                                  : schema->second.name},
-                        {"encoding", channel.message_encoding},
-                        {"messages", n},
-                        {"hz", duration > 0.0 ? static_cast<double>(n) / duration : 0.0}});
+    channels.push_back(
+        {{"topic", channel.topic},
+         {"type",
+          schema == reader.schemas().end() ? channel.message_encoding : schema->second.name},
+         {"encoding", channel.message_encoding},
+         {"messages", n},
+         // n messages span n - 1 periods
+         {"hz", duration > 0.0 && n > 1 ? static_cast<double>(n - 1) / duration : 0.0}});
   }
   json metadata = json::object();
   for (const record::McapMetadata& m : reader.metadata()) metadata[m.name] = m.values;

@@ -20,7 +20,9 @@
 #include "saccade/components/messages.h"
 #include "saccade/components/register.h"
 #include "saccade/core/error.h"
+#include "saccade/core/log.h"
 #include "saccade/dds/transport.h"
+#include "saccade/record/player.h"
 #include "saccade/runtime/pipeline.h"
 #include "saccade/runtime/scheduler.h"
 #include "saccade/scene/scene.h"
@@ -44,6 +46,8 @@ struct RunCommandOptions {
   bool score = false;
   std::string joints_csv;
   McapOptions record;
+  std::string play;  // --play FILE.mcap
+  record::PlayOptions play_options;
   DdsOverrides dds;  // the pipeline's `transport:` map, overridden
 };
 
@@ -177,11 +181,20 @@ int Run(const RunCommandOptions& o) {
     recording = std::make_unique<Recording>(
         o.record, pipeline, RunMetadata("run", o.pipeline, o.scene, o.head, o.hardware));
   }
+  std::unique_ptr<record::McapPlayer> player;
+  if (!o.play.empty()) {
+    player = std::make_unique<record::McapPlayer>(o.play, spec.transport, o.play_options);
+    for (const std::string& skipped : player->skipped()) {
+      log::Info("play: not played: {}", skipped);
+    }
+  }
   runtime::RunOptions run;
   run.steps = o.steps;
   const double dt = spec.clock.step;
   run.after_step = [&](const runtime::StepContext& context) {
     if (recording) recording->AfterStep(context);
+    // The recording played to its end: the pipeline stepped on its last step's stamps.
+    if (player && context.time >= player->last_time() - 1e-6) g_run_stop = true;
     if (!scorer) return;
     // The frame index of the step's images (the sender's, with clock.source).
     const auto frame = static_cast<int64_t>(std::llround(context.time / dt));
@@ -198,7 +211,15 @@ int Run(const RunCommandOptions& o) {
   if (o.steps < 0 && spec.clock.steps == 0) run.steps = 0;  // until Ctrl-C
   auto previous_int = std::signal(SIGINT, OnRunInterrupt);
   auto previous_term = std::signal(SIGTERM, OnRunInterrupt);
+  if (player) player->Start();
   const runtime::RunSummary summary = runtime::RunPipeline(pipeline, run);
+  if (player) {
+    const record::PlayStats played = player->Stop();
+    if (!o.json) {
+      fmt::print("play: {} steps, {} messages of {}{}\n", played.steps, played.messages, o.play,
+                 played.late > 0 ? fmt::format(", {} answered late", played.late) : "");
+    }
+  }
   std::signal(SIGINT, previous_int);
   std::signal(SIGTERM, previous_term);
   if (csv) csv->flush();
@@ -255,6 +276,23 @@ Runner AddRunCommand(CLI::App& app) {
                   "selections, ground truth), for Foxglove, rosbag2 and `saccade mcap`");
   run->add_flag("--force", o->record.force, "Replace an existing --record file");
   AddRecordTuning(run, o->record);
+  run->add_option("--play", o->play,
+                  "Play this MCAP recording (of `--record`, or rosbag2's of saccade's topics) "
+                  "as the robot: its ROS 2 messages are published again on the pipeline's DDS "
+                  "domain, so that a pipeline reading topics (pipelines/perception.yaml) runs on "
+                  "it as on the live robot; the run ends with the recording")
+      ->check(CLI::ExistingFile);
+  run->add_option("--play-pace", o->play_options.pace,
+                  "lockstep: each recorded step waits for the pipeline's answer (its lockstep "
+                  "head/command output), so it computes what it did live, bit for bit; "
+                  "recorded: the recorded rate (times --play-speed); fast: no waiting (frames "
+                  "the pipeline is too slow for are skipped)")
+      ->check(CLI::IsMember({"lockstep", "recorded", "fast"}))
+      ->capture_default_str();
+  run->add_option("--play-speed", o->play_options.speed,
+                  "With --play-pace recorded: recorded seconds per wall second")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
   AddDdsOptions(run, o->dds);
   return [o] { return Run(*o); };
 }

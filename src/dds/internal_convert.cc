@@ -387,6 +387,39 @@ void SerializeCdr(const dds_topic_descriptor_t& descriptor, const void* sample,
   dds_ostream_fini(&os);
 }
 
+bool DeserializeCdr(const dds_topic_descriptor_t& descriptor, const uint8_t* data, std::size_t size,
+                    void* sample, std::string* error) {
+  if (size < 4) {
+    *error = fmt::format("{} bytes: shorter than the encapsulation header", size);
+    return false;
+  }
+  if (size > std::numeric_limits<uint32_t>::max()) {
+    *error = fmt::format("{} bytes: more than CDR's 4 GiB", size);
+    return false;
+  }
+  const unsigned id = (unsigned{data[0]} << 8) | data[1];
+  if (id != 0x0000 && id != 0x0001) {
+    *error = fmt::format("encapsulation 0x{:04x} is not plain CDR (0x0000 or 0x0001)", id);
+    return false;
+  }
+  const bool little = id == 0x0001;
+  // Checked (and put in this machine's byte order) in a copy: normalizing writes in place.
+  std::vector<char> body(data + 4, data + size);
+  uint32_t end = 0;
+  if (dds_stream_normalize_data(body.data(), &end, static_cast<uint32_t>(body.size()),
+                                little != (std::endian::native == std::endian::little),
+                                CDR_ENC_VERSION_1, descriptor.m_ops) == nullptr) {
+    *error =
+        fmt::format("{} bytes that are not one whole {}", size, RosTypeName(descriptor.m_typename));
+    return false;
+  }
+  dds_istream_t is;
+  dds_istream_init(&is, static_cast<uint32_t>(body.size()), body.data(), CDR_ENC_VERSION_1);
+  dds_stream_read(&is, static_cast<char*>(sample), descriptor.m_ops);
+  dds_istream_fini(&is);
+  return true;
+}
+
 std::string RosTypeName(const std::string& dds_type_name) {
   // pkg::msg::dds_::Type_ -> pkg/msg/Type
   std::string name = dds_type_name;

@@ -86,6 +86,13 @@ bool ImageViewOfCdr(const uint8_t* cdr, std::size_t size, sensor_msgs_msg_dds__I
 /// 4-byte encapsulation header (CDR, this machine's byte order: little-endian), then XCDR1.
 void SerializeCdr(const dds_topic_descriptor_t& descriptor, const void* sample,
                   std::vector<uint8_t>* out);
+/// Reads serialized bytes (`size`: the 4-byte encapsulation header, then XCDR1 of either byte
+/// order) into `sample`, zero-filled and of `descriptor`'s type; its strings and sequences are
+/// allocated by Cyclone (free them with dds_stream_free_sample). False (and `*error` says
+/// why) when the bytes are not one whole message of the type.
+bool DeserializeCdr(const dds_topic_descriptor_t& descriptor, const uint8_t* data, std::size_t size,
+                    void* sample, std::string* error);
+
 /// The ROS 2 name of an idlc type name: "sensor_msgs::msg::dds_::Image_" ->
 /// "sensor_msgs/msg/Image".
 std::string RosTypeName(const std::string& dds_type_name);

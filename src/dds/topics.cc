@@ -1,5 +1,6 @@
 #include "saccade/dds/topics.h"
 
+#include <dds/ddsi/ddsi_cdrstream.h>
 #include <dds/ddsi/ddsi_serdata.h>
 #include <fmt/format.h>
 
@@ -1105,6 +1106,84 @@ std::unique_ptr<Writer> Writer::CreateSerializing(const std::string& message_typ
   serializing.lockstep = false;
   CheckOptions(serializing);
   return MakeTypedWriter(SerializingOutlets(std::move(sink)), message_type, serializing);
+}
+
+namespace {
+
+// The ROS 2 types saccade's IDL declares, by their ROS 2 names.
+const std::vector<const dds_topic_descriptor_t*>& Descriptors() {
+  static const std::vector<const dds_topic_descriptor_t*> descriptors = {
+      &sensor_msgs_msg_dds__Image__desc,
+      &sensor_msgs_msg_dds__CameraInfo__desc,
+      &sensor_msgs_msg_dds__CompressedImage__desc,
+      &sensor_msgs_msg_dds__JointState__desc,
+      &geometry_msgs_msg_dds__PointStamped__desc,
+      &tf2_msgs_msg_dds__TFMessage__desc,
+      &std_msgs_msg_dds__String__desc,
+      &rosgraph_msgs_msg_dds__Clock__desc};
+  return descriptors;
+}
+
+class CycloneCdrWriter final : public CdrWriter {
+ public:
+  CycloneCdrWriter(std::shared_ptr<Participant> participant,
+                   const dds_topic_descriptor_t* descriptor, const std::string& topic,
+                   const Qos& qos)
+      : participant_(std::move(participant)),
+        descriptor_(descriptor),
+        topic_name_(topic),
+        ros_type_(internal::RosTypeName(descriptor->m_typename)),
+        topic_(MakeTopic(*participant_, descriptor, topic)),
+        writer_(MakeWriter(*participant_, topic_, qos, topic)),
+        sample_(descriptor->m_size) {}
+
+  void Write(const uint8_t* data, std::size_t size) override {
+    std::fill(sample_.begin(), sample_.end(), 0);
+    std::string error;
+    if (!internal::DeserializeCdr(*descriptor_, data, size, sample_.data(), &error)) {
+      throw InvalidArgument(fmt::format("dds: {} ({}): {}", topic_name_, ros_type_, error));
+    }
+    WriteSample(writer_, sample_.data(), topic_name_, stats_);
+    dds_stream_free_sample(sample_.data(), descriptor_->m_ops);
+  }
+  int matched() const override { return PublicationMatches(writer_); }
+
+ private:
+  std::shared_ptr<Participant> participant_;
+  const dds_topic_descriptor_t* descriptor_;
+  std::string topic_name_;
+  std::string ros_type_;
+  Entity topic_, writer_;
+  std::vector<char> sample_;  // the message read (operator new's alignment suits every type)
+  LinkStats stats_;
+};
+
+}  // namespace
+
+std::vector<std::string> RosMessageTypes() {
+  std::vector<std::string> types;
+  for (const dds_topic_descriptor_t* d : Descriptors()) {
+    types.push_back(internal::RosTypeName(d->m_typename));
+  }
+  return types;
+}
+
+std::unique_ptr<CdrWriter> CdrWriter::Create(std::shared_ptr<Participant> participant,
+                                             const std::string& ros_type, const std::string& topic,
+                                             const Qos& qos) {
+  if (!participant) throw InvalidArgument("dds: no participant");
+  DdsTopicName(topic);  // throws for a name that is not fully qualified and valid
+  std::string error;
+  if (!qos.IsValid(&error)) throw InvalidArgument("dds: QoS of " + topic + ": " + error);
+  for (const dds_topic_descriptor_t* d : Descriptors()) {
+    if (internal::RosTypeName(d->m_typename) == ros_type) {
+      return std::make_unique<CycloneCdrWriter>(std::move(participant), d, topic, qos);
+    }
+  }
+  std::string known;
+  for (const std::string& type : RosMessageTypes()) known += (known.empty() ? "" : ", ") + type;
+  throw InvalidArgument("dds: " + topic + ": no ROS 2 type '" + ros_type + "' (saccade has " +
+                        known + ")");
 }
 
 std::unique_ptr<ClockWriter> ClockWriter::Create(std::shared_ptr<Participant> participant,

@@ -126,6 +126,8 @@ class BackgroundProcess {
       if (line->find(text) != std::string::npos) return true;
     }
   }
+  /// The process id (-1 when it could not start or was stopped).
+  pid_t pid() const { return pid_; }
   /// SIGTERM, then everything it prints until it exits; its exit status (-1 when it did not
   /// exit normally or was already stopped).
   int Stop(std::string* rest = nullptr) {

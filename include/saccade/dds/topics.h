@@ -244,4 +244,27 @@ class Reader {
   std::string topic_;
 };
 
+/// The ROS 2 types of the messages the writers produce ("sensor_msgs/msg/Image", ...): those a
+/// CdrWriter publishes and RosMessageDefinition knows.
+std::vector<std::string> RosMessageTypes();
+
+/// Publishes ROS 2 messages given serialized, as SerializedMessage holds them (a recording
+/// played back as the robot: record/player.h): each is read into its type, checked whole,
+/// and written as a Writer writes.
+class CdrWriter {
+ public:
+  /// `ros_type` one of RosMessageTypes(), `topic` fully qualified. Throws InvalidArgument for
+  /// another type, a bad topic or QoS; saccade::Error when Cyclone refuses.
+  static std::unique_ptr<CdrWriter> Create(std::shared_ptr<Participant> participant,
+                                           const std::string& ros_type, const std::string& topic,
+                                           const Qos& qos);
+  virtual ~CdrWriter() = default;
+  /// Publishes the message of `size` bytes (encapsulation header, then CDR of either byte
+  /// order). Throws InvalidArgument naming the topic and type when they are not one whole
+  /// message of the type.
+  virtual void Write(const uint8_t* data, std::size_t size) = 0;
+  /// Readers matched now.
+  virtual int matched() const = 0;
+};
+
 }  // namespace saccade::dds
