@@ -3,9 +3,14 @@
 // recording.
 #include <fmt/format.h>
 
+#include <Eigen/Geometry>
 #include <filesystem>
+#include <fstream>
 #include <map>
 #include <memory>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <set>
 #include <string>
 
 #include "commands.h"
@@ -14,6 +19,7 @@
 #include "saccade/core/error.h"
 #include "saccade/record/mcap.h"
 #include "saccade/record/recorder.h"
+#include "saccade/record/ros_message.h"
 
 namespace saccade::app {
 
@@ -123,6 +129,168 @@ namespace {
 struct McapCommandOptions {
   std::string file;
   bool json = false;
+  std::string out;  // export
+  bool force = false;
+};
+
+// A 4x4 pose from a geometry_msgs/Transform as decoded.
+json PoseMatrix(const json& transform) {
+  const json& t = transform["translation"];
+  const json& r = transform["rotation"];
+  const Eigen::Quaterniond q(r["w"].get<double>(), r["x"].get<double>(), r["y"].get<double>(),
+                             r["z"].get<double>());
+  const Eigen::Matrix3d R = q.normalized().toRotationMatrix();
+  json m = json::array();
+  for (int i = 0; i < 3; ++i) {
+    m.push_back({R(i, 0), R(i, 1), R(i, 2), t[std::string(1, "xyz"[i])].get<double>()});
+  }
+  m.push_back({0.0, 0.0, 0.0, 1.0});
+  return m;
+}
+
+int64_t StampNs(const json& header) {
+  return header["stamp"]["sec"].get<int64_t>() * 1'000'000'000 +
+         header["stamp"]["nanosec"].get<int64_t>();
+}
+
+// `saccade mcap export`: the recording's images as a data set folder, as `saccade render`
+// writes one (render/dataset.h): DIR/<camera>/NNNNNN.png and DIR/frames.jsonl.
+class Exporter {
+ public:
+  Exporter(const std::string& file, const fs::path& out, bool force) : reader_(file), out_(out) {
+    if (fs::exists(out / "frames.jsonl") && !force) {
+      throw InvalidArgument("mcap export: " + (out / "frames.jsonl").string() +
+                            " exists; --force replaces the data set (nothing was written)");
+    }
+    fs::create_directories(out);
+    index_.open(out / "frames.jsonl.tmp");
+    if (!index_) throw FileError((out / "frames.jsonl").string(), 0, "", "cannot be written");
+    for (const auto& [id, channel] : reader_.channels()) {
+      const auto schema = reader_.schemas().find(channel.schema_id);
+      if (channel.message_encoding != "cdr" || schema == reader_.schemas().end() ||
+          schema->second.encoding != "ros2msg") {
+        continue;
+      }
+      decoders_.emplace(
+          id, std::make_pair(schema->second.name,
+                             record::RosMessageDecoder(schema->second.name, schema->second.data)));
+    }
+  }
+
+  int Run() {
+    reader_.ForEachMessage([&](const record::McapMessage& m) {
+      const auto decoder = decoders_.find(m.channel_id);
+      if (decoder == decoders_.end()) return true;
+      const std::string& type = decoder->second.first;
+      if (type != "sensor_msgs/msg/Image" && type != "sensor_msgs/msg/CameraInfo" &&
+          type != "tf2_msgs/msg/TFMessage" && type != "sensor_msgs/msg/JointState") {
+        return true;
+      }
+      std::vector<std::span<const uint8_t>> blobs;
+      const json v = decoder->second.second.Decode(m.data, &blobs);
+      const std::string& topic = reader_.channels().at(m.channel_id).topic;
+      if (type == "sensor_msgs/msg/CameraInfo") {
+        infos_[v["header"]["frame_id"]] = v;
+      } else if (type == "tf2_msgs/msg/TFMessage") {
+        for (const json& t : v["transforms"]) poses_[t["child_frame_id"]] = t["transform"];
+      } else if (type == "sensor_msgs/msg/JointState") {
+        if (topic.size() >= 12 && topic.compare(topic.size() - 12, 12, "joint_states") == 0) {
+          joints_ = json::object();
+          for (std::size_t i = 0; i < v["name"].size() && i < v["position"].size(); ++i) {
+            joints_[v["name"][i].get<std::string>()] = v["position"][i];
+          }
+        }
+      } else {
+        AddImage(v, blobs);
+      }
+      return true;
+    });
+    Flush();
+    index_.close();
+    fs::rename(out_ / "frames.jsonl.tmp", out_ / "frames.jsonl");
+    return frames_;
+  }
+
+ private:
+  void AddImage(const json& image, const std::vector<std::span<const uint8_t>>& blobs) {
+    const int64_t stamp = StampNs(image["header"]);
+    if (!frame_.empty() && stamp != frame_stamp_) Flush();
+    frame_stamp_ = stamp;
+    std::string frame_id = image["header"]["frame_id"];
+    std::string camera = frame_id;
+    if (camera.size() > 8 && camera.compare(camera.size() - 8, 8, "_optical") == 0) {
+      camera.resize(camera.size() - 8);
+    }
+    const std::string encoding = image["encoding"];
+    const int width = image["width"], height = image["height"];
+    const std::size_t step = image["step"];
+    int cv_type = 0;
+    if (encoding == "rgb8" || encoding == "bgr8")
+      cv_type = CV_8UC3;
+    else if (encoding == "rgba8" || encoding == "bgra8")
+      cv_type = CV_8UC4;
+    else if (encoding == "mono8" || encoding == "8UC1")
+      cv_type = CV_8UC1;
+    else if (encoding == "mono16" || encoding == "16UC1")
+      cv_type = CV_16UC1;
+    else {
+      if (said_.insert(encoding).second) {
+        fmt::print(stderr, "mcap export: {} images not exported (encoding {})\n", camera, encoding);
+      }
+      return;
+    }
+    const std::span<const uint8_t> pixels = blobs.at(image["data"]["blob"].get<std::size_t>());
+    if (pixels.size() < step * static_cast<std::size_t>(height)) {
+      throw InvalidArgument(fmt::format("mcap export: an image of {} holds {} bytes, not {}",
+                                        camera, pixels.size(), step * height));
+    }
+    cv::Mat mat(height, width, cv_type, const_cast<uint8_t*>(pixels.data()), step);
+    cv::Mat bgr;
+    if (encoding == "rgb8")
+      cv::cvtColor(mat, bgr, cv::COLOR_RGB2BGR);
+    else if (encoding == "rgba8")
+      cv::cvtColor(mat, bgr, cv::COLOR_RGBA2BGRA);
+    else
+      bgr = mat;
+    const std::string file = fmt::format("{}/{:06d}.png", camera, frames_);
+    fs::create_directories(out_ / camera);
+    if (!cv::imwrite((out_ / file).string(), bgr)) {
+      throw FileError((out_ / file).string(), 0, "", "cannot be written");
+    }
+    json entry = {{"file", file}, {"width", width}, {"height", height}, {"encoding", encoding}};
+    if (const auto info = infos_.find(frame_id); info != infos_.end()) {
+      const json& k = info->second["k"];
+      entry["K"] = {{k[0], k[1], k[2]}, {k[3], k[4], k[5]}, {k[6], k[7], k[8]}};
+      entry["distortion"] = {{"model", info->second["distortion_model"]},
+                             {"coefficients", info->second["d"]}};
+    }
+    if (const auto pose = poses_.find(frame_id); pose != poses_.end()) {
+      entry["X_WC"] = PoseMatrix(pose->second);
+    }
+    if (!joints_.empty()) entry["joints"] = joints_;
+    frame_[camera] = entry;
+  }
+  void Flush() {
+    if (frame_.empty()) return;
+    index_ << json{{"frame", frames_},
+                   {"time", static_cast<double>(frame_stamp_) * 1e-9},
+                   {"cameras", frame_}}
+                  .dump()
+           << "\n";
+    ++frames_;
+    frame_ = json::object();
+  }
+
+  record::McapReader reader_;
+  fs::path out_;
+  std::ofstream index_;
+  std::map<uint16_t, std::pair<std::string, record::RosMessageDecoder>> decoders_;
+  std::map<std::string, json> infos_, poses_;  // by frame id
+  json joints_ = json::object();
+  json frame_ = json::object();
+  int64_t frame_stamp_ = 0;
+  int frames_ = 0;
+  std::set<std::string> said_;
 };
 
 json InfoJson(const std::string& file) {
@@ -207,9 +375,24 @@ Runner AddMcapCommand(CLI::App& app) {
       "complete chunks, and says how many bytes were lost");
   info->add_option("file", o->file, "The recording (.mcap)")->required();
   info->add_flag("--json", o->json, "Print it as JSON");
-  return [o] {
-    const json report = InfoJson(o->file);
-    fmt::print("{}", o->json ? report.dump(2) + "\n" : InfoText(report));
+  auto* export_command = mcap->add_subcommand(
+      "export",
+      "The recording's images as a data set folder, the format `saccade render` writes: "
+      "DIR/<camera>/NNNNNN.png and DIR/frames.jsonl, a line per frame (the images of one "
+      "stamp) with each camera's file, size, K, distortion (ROS's model name and "
+      "coefficients), X_WC (from /tf) and the joints");
+  export_command->add_option("file", o->file, "The recording (.mcap)")->required();
+  export_command->add_option("--out", o->out, "The data set folder")->required();
+  export_command->add_flag("--force", o->force, "Replace a data set already in --out");
+  return [o, info] {
+    if (info->parsed()) {
+      const json report = InfoJson(o->file);
+      fmt::print("{}", o->json ? report.dump(2) + "\n" : InfoText(report));
+      return 0;
+    }
+    Exporter exporter(o->file, o->out, o->force);
+    const int frames = exporter.Run();
+    fmt::print("{} frames -> {}\n", frames, o->out);
     return 0;
   };
 }

@@ -8,6 +8,7 @@ The C++ library's layers as submodules (docs/python.md):
 - ``saccade.render``: the headless OpenGL renderer, frames as numpy arrays, batch rendering
 - ``saccade.runtime``: pipelines from YAML, signals, methods, components written in Python
 - ``saccade.hw``: hardware files and servo mappings of the real robot
+- ``saccade.mcap``: recordings (``--record FILE.mcap``): topics, messages decoded, images as numpy
 - ``saccade.envs``: Gymnasium-style environments (FixationEnv, VectorFixationEnv)
 
 Errors are ``saccade.Error`` (a RuntimeError) and its subclasses ``InvalidArgument`` (also a
@@ -22,7 +23,7 @@ import os as _os
 
 from . import _saccade
 from ._saccade import Error, FileError, InvalidArgument
-from ._saccade import core, geometry, head, hw, render, runtime, scene
+from ._saccade import core, geometry, head, hw, mcap, render, runtime, scene
 from ._saccade.core import Image
 from .components import Component
 
@@ -36,6 +37,7 @@ __all__ = [
     "geometry",
     "head",
     "hw",
+    "mcap",
     "render",
     "runtime",
     "scene",

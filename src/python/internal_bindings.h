@@ -24,6 +24,7 @@ void BindScene(py::module_& m);
 void BindRender(py::module_& m);
 void BindRuntime(py::module_& m);
 void BindHw(py::module_& m);
+void BindRecord(py::module_& m);
 
 /// The C++ owner of an image's pixels, as Python sees it (saccade.Image): numpy arrays made
 /// from it borrow its memory and keep it alive through their `base`.

@@ -79,4 +79,6 @@ PYBIND11_MODULE(_saccade, m) {
   BindRuntime(runtime);
   py::module_ hw = m.def_submodule("hw", "the real robot's files: hardware files, servo mappings");
   BindHw(hw);
+  py::module_ mcap = m.def_submodule("mcap", "recordings in MCAP: their topics, messages decoded");
+  BindRecord(mcap);
 }

@@ -261,7 +261,7 @@ bool McapReader::Impl::ReadSummary(File& file) {
   return statistics;
 }
 
-McapReader::McapReader(const std::filesystem::path& path) : impl_(std::make_unique<Impl>()) {
+McapReader::McapReader(const std::filesystem::path& path) : impl_(std::make_shared<Impl>()) {
   Impl& m = *impl_;
   m.path = path;
   std::error_code ec;
@@ -309,23 +309,83 @@ const McapStatistics& McapReader::statistics() const { return impl_->stats; }
 bool McapReader::recovered() const { return impl_->recovered; }
 uint64_t McapReader::lost_bytes() const { return impl_->lost_bytes; }
 
+// Reads top-level records from the first after the header; a chunk's records in turn.
+class McapReader::MessageCursor final : public McapReader::Cursor {
+ public:
+  explicit MessageCursor(std::shared_ptr<const McapReader::Impl> impl)
+      : impl_(std::move(impl)), file_(impl_->path), at_(impl_->data_start) {}
+
+  bool Next(McapMessage* m) override;
+
+ private:
+  std::shared_ptr<const McapReader::Impl> impl_;
+  File file_;
+  uint64_t at_;            // the next top-level record
+  uint64_t chunk_at_ = 0;  // the chunk being read (for errors)
+  std::vector<uint8_t> prefix_, content_, records_;
+  std::size_t inner_ = 0;  // the next record in records_
+  bool in_chunk_ = false, done_ = false;
+};
+
+bool McapReader::MessageCursor::Next(McapMessage* m) {
+  const auto message = [&](std::span<const uint8_t> content, uint64_t at) {
+    Reader r(content);
+    m->channel_id = r.U16();
+    m->sequence = r.U32();
+    m->log_time = r.U64();
+    m->publish_time = r.U64();
+    m->data = r.Take(r.left());
+    if (!r.ok()) impl_->Fail(at, "a Message record shorter than its fields");
+  };
+  while (!done_) {
+    if (in_chunk_) {
+      Reader inner(std::span<const uint8_t>(records_).subspan(inner_));
+      if (inner.left() == 0) {
+        in_chunk_ = false;
+        continue;
+      }
+      const uint8_t opcode = inner.U8();
+      const std::span<const uint8_t> content = inner.Take(inner.U64());
+      if (!inner.ok()) {
+        impl_->Fail(chunk_at_, fmt::format("a chunk whose record at {} runs past it", inner_));
+      }
+      inner_ += inner.pos();
+      if (opcode != internal::kMessage) continue;
+      message(content, chunk_at_);
+      return true;
+    }
+    if (at_ >= file_.size() || !file_.Read(at_, internal::kRecordPrefix, &prefix_)) break;
+    Reader p(prefix_);
+    const uint8_t opcode = p.U8();
+    const uint64_t length = p.U64();
+    if (opcode == internal::kDataEnd || opcode == internal::kFooter) break;
+    if (!file_.Read(at_ + internal::kRecordPrefix, length, &content_)) break;  // cut short
+    const uint64_t at = at_;
+    at_ += internal::kRecordPrefix + length;
+    if (opcode == internal::kChunk) {
+      impl_->Decompress(Reader(content_), at, &records_);
+      chunk_at_ = at;
+      inner_ = 0;
+      in_chunk_ = true;
+    } else if (opcode == internal::kMessage) {
+      message(content_, at);
+      return true;
+    }
+  }
+  done_ = true;
+  return false;
+}
+
+std::unique_ptr<McapReader::Cursor> McapReader::Messages() const {
+  return std::make_unique<MessageCursor>(impl_);
+}
+
 void McapReader::ForEachMessage(const std::function<bool(const McapMessage&)>& visit) const {
-  File file(impl_->path);
-  impl_->Walk(
-      file,
-      [&](uint8_t opcode, std::span<const uint8_t> content, uint64_t at) {
-        if (opcode != internal::kMessage) return true;
-        Reader r(content);
-        McapMessage m;
-        m.channel_id = r.U16();
-        m.sequence = r.U32();
-        m.log_time = r.U64();
-        m.publish_time = r.U64();
-        m.data = r.Take(r.left());
-        if (!r.ok()) impl_->Fail(at, "a Message record shorter than its fields");
-        return visit(m);
-      },
-      true);
+  const auto cursor = Messages();
+  McapMessage m;
+  while (cursor->Next(&m)) {
+    if (!visit(m)) return;
+  }
 }
 
 }  // namespace saccade::record

@@ -5,10 +5,13 @@
 #include <gtest/gtest.h>
 
 #include <chrono>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 #include <random>
 #include <string>
 #include <thread>
@@ -17,6 +20,7 @@
 #include "e2e/run_saccade.h"
 #include "saccade/core/error.h"
 #include "saccade/record/mcap.h"
+#include "saccade/record/ros_message.h"
 
 namespace saccade::e2e {
 namespace {
@@ -127,6 +131,44 @@ TEST_F(RecordCli, TheDemoRecordsEveryTopicOfAnyHeadAndMcapInfoDescribesIt) {
   EXPECT_THAT(text.output, HasSubstr("saccade.head: humanoid"));
   EXPECT_THAT(text.output, ::testing::ContainsRegex(
                                "/saccade/left/image_raw +sensor_msgs/msg/Image +10 +25.00"));
+
+  // Exported to a data set folder: a line per frame, each camera's PNG the recorded pixels.
+  const CommandRun exported = Saccade("mcap export " + file + " --out " + Path("set"));
+  ASSERT_EQ(exported.status, 0) << exported.output;
+  EXPECT_THAT(exported.output, HasSubstr("10 frames"));
+  std::ifstream index(Path("set/frames.jsonl"));
+  std::vector<json> frames;
+  for (std::string line; std::getline(index, line);) frames.push_back(json::parse(line));
+  ASSERT_EQ(frames.size(), 10u);
+  EXPECT_EQ(frames[3]["frame"], 3);
+  EXPECT_NEAR(frames[3]["time"].get<double>(), 0.12, 1e-12);
+  EXPECT_EQ(frames[3]["cameras"]["left"]["file"], "left/000003.png");
+  EXPECT_NEAR(frames[3]["cameras"]["right"]["K"][0][0].get<double>(), 1210.99, 0.01);
+  EXPECT_EQ(frames[3]["cameras"]["left"]["X_WC"].size(), 4u);
+  EXPECT_TRUE(frames[3]["cameras"]["left"]["joints"].contains("neck_yaw"))
+      << frames[3]["cameras"]["left"].dump();
+  {
+    const record::McapReader reader(file);
+    int left = 0;
+    bool compared = false;
+    reader.ForEachMessage([&](const record::McapMessage& m) {
+      const auto& channel = reader.channels().at(m.channel_id);
+      if (channel.topic != "/saccade/left/image_raw" || left++ != 3) return true;
+      const auto& schema = reader.schemas().at(channel.schema_id);
+      const record::RosMessageDecoder decoder(schema.name, schema.data);
+      std::vector<std::span<const uint8_t>> blobs;
+      const json image = decoder.Decode(m.data, &blobs);
+      cv::Mat bgr = cv::imread(Path("set/left/000003.png"), cv::IMREAD_UNCHANGED);
+      EXPECT_EQ(bgr.cols, image["width"].get<int>());
+      if (bgr.empty()) return false;
+      cv::Mat rgb;
+      cv::cvtColor(bgr, rgb, cv::COLOR_BGR2RGB);
+      EXPECT_EQ(0, std::memcmp(rgb.data, blobs[0].data(), blobs[0].size()));
+      compared = true;
+      return false;
+    });
+    EXPECT_TRUE(compared);
+  }
 
   // Not replaced without --force; nothing else is refused silently.
   const auto size = fs::file_size(file);

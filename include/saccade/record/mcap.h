@@ -135,9 +135,21 @@ class McapReader {
   /// Throws FileError as the constructor.
   void ForEachMessage(const std::function<bool(const McapMessage&)>& visit) const;
 
+  /// The messages one at a time, in file order (a generator's state, as Python's Reader).
+  class Cursor {
+   public:
+    virtual ~Cursor() = default;
+    /// The next message, its data valid until the next call; false after the last (and for a
+    /// file cut short, after the last complete chunk). Throws FileError as the constructor.
+    virtual bool Next(McapMessage* message) = 0;
+  };
+  /// A cursor before the first message; it reads the file anew and may outlive the reader.
+  std::unique_ptr<Cursor> Messages() const;
+
  private:
   struct Impl;
-  std::unique_ptr<Impl> impl_;
+  class MessageCursor;
+  std::shared_ptr<Impl> impl_;
 };
 
 }  // namespace saccade::record
