@@ -90,6 +90,8 @@ class Recording {
   void AfterStep(const runtime::StepContext& context);
   /// Closes the file; returns a line for people ("record: N steps, ... MB in FILE").
   std::string Close();
+  std::string file() const;
+  uint64_t bytes() const;  ///< written so far
 
  private:
   struct Truth;

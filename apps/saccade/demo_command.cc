@@ -8,6 +8,7 @@
 #include <atomic>
 #include <csignal>
 #include <cstdio>
+#include <ctime>
 #include <filesystem>
 #include <memory>
 #include <string>
@@ -47,8 +48,36 @@ struct Options {
   bool dds = false;  // gui --dds: pipelines/remote.yaml unless --pipeline names another
   DdsOverrides dds_overrides;
   gui::GuiOptions gui_options;
-  McapOptions record;  // --record FILE.mcap (a folder name: DemoOptions::record)
+  McapOptions record;            // --record FILE.mcap (a folder name: DemoOptions::record)
+  std::string record_dir = ".";  // the page's Record button writes here
 };
+
+/// A recording the GUI holds (gui::GuiRecording): the page starts and stops it.
+class GuiMcapRecording final : public gui::GuiRecording {
+ public:
+  GuiMcapRecording(const McapOptions& o, runtime::Pipeline& pipeline,
+                   std::map<std::string, std::string> metadata)
+      : recording_(o, pipeline, std::move(metadata)) {}
+  void AfterStep(const runtime::StepContext& context) override { recording_.AfterStep(context); }
+  std::string Close() override { return recording_.Close(); }
+  std::string file() const override { return recording_.file(); }
+  uint64_t bytes() const override { return recording_.bytes(); }
+
+ private:
+  Recording recording_;
+};
+
+/// A new file in `dir` for the page's Record button: saccade-YYYYMMDD-HHMMSS[-N].mcap.
+std::string NewRecordingFile(const std::string& dir) {
+  const std::time_t now = std::time(nullptr);
+  char stamp[32];
+  std::strftime(stamp, sizeof stamp, "%Y%m%d-%H%M%S", std::localtime(&now));
+  fs::path file = fs::path(dir) / fmt::format("saccade-{}.mcap", stamp);
+  for (int n = 2; fs::exists(file); ++n) {
+    file = fs::path(dir) / fmt::format("saccade-{}-{}.mcap", stamp, n);
+  }
+  return file.string();
+}
 
 /// --list-components: the component types, as text, JSON or docs/components.md.
 int ListComponents(const Options& o) {
@@ -117,12 +146,22 @@ int RunDemo(Options o) {
     };
   }
   DemoSession session(o.demo, progress);
+  const auto metadata = RunMetadata(o.gui ? "gui" : "demo", o.demo.pipeline, o.demo.scene,
+                                    o.demo.head, o.demo.hardware);
   std::unique_ptr<Recording> recording;
-  if (!o.record.path.empty()) {
-    recording =
-        std::make_unique<Recording>(o.record, session.pipeline(),
-                                    RunMetadata(o.gui ? "gui" : "demo", o.demo.pipeline,
-                                                o.demo.scene, o.demo.head, o.demo.hardware));
+  if (o.gui) {
+    // The GUI holds the recordings, so that the page can stop and start them.
+    if (!o.record.path.empty()) {
+      o.gui_options.recording =
+          std::make_shared<GuiMcapRecording>(o.record, session.pipeline(), metadata);
+    }
+    o.gui_options.start_recording = [&o, &session, metadata] {
+      McapOptions file = o.record;
+      file.path = NewRecordingFile(o.record_dir);
+      return std::make_shared<GuiMcapRecording>(file, session.pipeline(), metadata);
+    };
+  } else if (!o.record.path.empty()) {
+    recording = std::make_unique<Recording>(o.record, session.pipeline(), metadata);
   }
   std::unique_ptr<GuiSession> gui;
   if (o.gui) gui = ServeGui(o, session);
@@ -175,6 +214,12 @@ void AddGuiOptions(CLI::App* command, Options& o) {
       ->capture_default_str();
   command->add_flag("--paused", o.gui_options.paused,
                     "Start paused (the page's Resume and Step buttons run it)");
+  command
+      ->add_option("--record-dir", o.record_dir,
+                   "Folder of the recordings the page's Record button starts "
+                   "(saccade-YYYYMMDD-HHMMSS.mcap, every topic in MCAP)")
+      ->check(CLI::ExistingDirectory)
+      ->capture_default_str();
 }
 
 }  // namespace

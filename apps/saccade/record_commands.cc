@@ -115,6 +115,9 @@ void Recording::AfterStep(const runtime::StepContext& context) {
   recorder_->AfterStep(context);
 }
 
+std::string Recording::file() const { return recorder_->path().string(); }
+uint64_t Recording::bytes() const { return recorder_->stats().bytes; }
+
 std::string Recording::Close() {
   const record::RecordingStats s = recorder_->Close();
   return fmt::format("record: {} steps, {} messages, {:.1f} MB in {}\n", s.steps, s.messages,

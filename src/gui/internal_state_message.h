@@ -32,6 +32,7 @@ struct StateParts {
   double realtime_factor = 0.0;  ///< simulated s per wall s, recently
   double frames_per_s = 0.0;     ///< images encoded per second, recently
   nlohmann::json head_status;    ///< hw.head's newest status, null without one
+  nlohmann::json recording;      ///< {file, megabytes} of the recording, null without one
 };
 
 /// The state message: the joints with the head's frames (forward kinematics), the target with

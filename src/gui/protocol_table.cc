@@ -144,6 +144,13 @@ void AddSimulationCommands(std::vector<Message>& out) {
   out.push_back(Command("step", "while paused: runs that many steps",
                         {Optional("count", Integer(1, 1000), "steps (missing: 1)")},
                         {Required("steps", Integer(1, 1000), "the steps it runs")}));
+  out.push_back(Command(
+      "record",
+      "starts (true) or stops (false) recording every topic to an MCAP file in the server's "
+      "recording folder (`saccade gui --record-dir`), named by the server; an error when it has "
+      "none",
+      {Required("enabled", Boolean(), "record or stop")},
+      {Required("recording", Boolean(), "as asked: the state's `recording` says when it is")}));
   out.push_back(Command("speed",
                         "the pace: simulated seconds per wall second, at most (best effort)",
                         {Required("factor", Number(0.05, 10), "simulated s per wall s")},
@@ -216,7 +223,11 @@ Message State() {
                 "the moving objects only"),
        Required("timing", timing, "how fast the loop runs"),
        Required("head_status", head_status,
-                "hw.head's head.status message (components/messages.h); null without one")});
+                "hw.head's head.status message (components/messages.h); null without one"),
+       Required("recording",
+                OrNull(Object({Required("file", String(), "the MCAP file being written"),
+                               Required("megabytes", Number(0), "written so far")})),
+                "the recording the page or --record started; null when none")});
 }
 
 void AddServerMessages(std::vector<Message>& out) {

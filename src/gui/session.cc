@@ -64,6 +64,8 @@ GuiSession::GuiSession(runtime::Pipeline& pipeline, const scene::Scene& scene,
     throw InvalidArgument(fmt::format("--speed must be in [0.05, 10], got {}", options.speed));
   }
   control_.SetSpeed(options.speed);
+  recording_ = options.recording;
+  if (recording_) recording_json_ = {{"file", recording_->file()}, {"megabytes", 0.0}};
   if (options.port < 0 || options.port > 65535) {
     throw InvalidArgument(fmt::format("--port must be in [0, 65535], got {}", options.port));
   }
@@ -150,6 +152,13 @@ GuiSession::~GuiSession() {
   encode_cv_.notify_all();
   if (encoder_.joinable()) encoder_.join();
   server_->Stop();
+  if (recording_) {
+    try {
+      fmt::print("{}", recording_->Close());
+    } catch (const std::exception& e) {
+      log::Log(log::Level::kWarn, "gui: the recording did not close: {}", e.what());
+    }
+  }
 }
 
 std::string GuiSession::Describe() const {
@@ -207,6 +216,7 @@ const std::map<std::string, GuiSession::CommandFn>& GuiSession::CommandTable() {
                                                          {"resume", &GuiSession::OnResume},
                                                          {"step", &GuiSession::OnStep},
                                                          {"speed", &GuiSession::OnSpeed},
+                                                         {"record", &GuiSession::OnRecord},
                                                          {"stop", &GuiSession::OnHeadStop},
                                                          {"estop", &GuiSession::OnHeadStop},
                                                          {"clear", &GuiSession::OnHeadStop},
@@ -407,6 +417,31 @@ json GuiSession::OnHeadStop(const json& command) {
   return {{"perception", false}};
 }
 
+json GuiSession::OnRecord(const json& command) {
+  const bool enabled = command["enabled"].get<bool>();
+  if (enabled && !options_.start_recording) {
+    throw CommandError("record: this server records nowhere (start it with --record-dir)");
+  }
+  Enqueue([this, enabled] {
+    if (recording_ && !enabled) {
+      const std::string line = recording_->Close();
+      fmt::print("{}", line);
+      recording_.reset();
+    } else if (!recording_ && enabled) {
+      try {
+        recording_ = options_.start_recording();
+        fmt::print("gui: recording to {}\n", recording_->file());
+      } catch (const std::exception& e) {
+        log::Log(log::Level::kWarn, "gui: cannot record: {}", e.what());
+      }
+    }
+    std::fflush(stdout);
+    std::lock_guard lock(recording_mutex_);
+    recording_json_ = recording_ ? json{{"file", recording_->file()}, {"megabytes", 0.0}} : json();
+  });
+  return {{"recording", enabled}};
+}
+
 json GuiSession::OnPing(const json&) { return {{"time", sim_time_.load()}}; }
 
 json GuiSession::StateJson(const runtime::StepContext& context, const Latest& latest) {
@@ -440,6 +475,10 @@ json GuiSession::StateJson(const runtime::StepContext& context, const Latest& la
   parts.step_ms = last_step_ms_;
   parts.realtime_factor = parts.steps_per_s * context.dt;
   parts.head_status = head_status_;
+  {
+    std::lock_guard lock(recording_mutex_);
+    parts.recording = recording_json_;
+  }
   json state = internal::StateJson(parts, scene_);
   Conform(protocol::CheckServerMessage(state));
   return state;
@@ -454,6 +493,12 @@ void GuiSession::AfterStep(const runtime::StepContext& context, const Latest& la
   sim_time_ = context.time + context.dt;
 
   commanded_.reset();  // this step's joints are the newest
+  if (recording_) {
+    recording_->AfterStep(context);
+    std::lock_guard lock(recording_mutex_);
+    recording_json_ = {{"file", recording_->file()},
+                       {"megabytes", static_cast<double>(recording_->bytes()) / 1e6}};
+  }
   last_context_ = context;
   last_context_->while_waiting = nullptr;
   last_latest_ = &latest;

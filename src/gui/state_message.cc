@@ -66,6 +66,7 @@ json StateJson(const StateParts& parts, const scene::Scene& scene) {
                      {"realtime_factor", parts.realtime_factor},
                      {"frames_per_s", parts.frames_per_s}};
   state["head_status"] = parts.head_status;
+  state["recording"] = parts.recording;
   return state;
 }
 

@@ -10,7 +10,7 @@
 // camera, ping and joints-to-state latencies).
 import { after, before, describe, test } from 'node:test';
 import assert from 'node:assert/strict';
-import { spawn } from 'node:child_process';
+import { spawn, spawnSync } from 'node:child_process';
 import fs from 'node:fs';
 import http from 'node:http';
 import os from 'node:os';
@@ -199,7 +199,9 @@ describe('saccade gui (portraits.yaml)', () => {
 
   before(async () => {
     browser = await chromium.launch({ executablePath: '/usr/bin/chromium', args: kChromiumArgs });
-    server = await startSaccade(['gui', '--scene', kScene, '--port', '0']);
+    fs.mkdirSync(path.join(kOutput, 'recordings'), { recursive: true });
+    server = await startSaccade(['gui', '--scene', kScene, '--port', '0',
+      '--record-dir', path.join(kOutput, 'recordings')]);
     page = await openPage(browser, server.url.href);
   });
 
@@ -398,6 +400,31 @@ describe('saccade gui (portraits.yaml)', () => {
       return { shown, done, failed: view.failed, width: canvas.width, height: canvas.height };
     }, 10_000);
     assert.deepEqual(result, { shown: 1, done: 3, failed: 1, width: 8, height: 6 });
+  });
+
+  test('the Record button records every topic to an MCAP file that saccade mcap info reads', async () => {
+    await waitReady(page);
+    await send(page, 'resume');
+    await page.click('#record');
+    const s = await waitState(page, (st) => st.recording && st.recording.megabytes > 0);
+    assert.match(await page.locator('#record').innerText(), /Stop recording \([0-9.]+ MB\)/);
+    const step = s.step;
+    await waitState(page, (st, n) => st.step >= n + 3, step);
+    await page.click('#record');
+    await waitState(page, (st) => st.recording === null);
+    assert.match(await page.locator('#record').innerText(), /Record/);
+    const file = s.recording.file;
+    assert.equal(path.dirname(file), path.join(kOutput, 'recordings'));
+    assert.match(path.basename(file), /^saccade-\d{8}-\d{6}(-\d+)?\.mcap$/);
+    const info = spawnSync(kBinary, ['mcap', 'info', '--json', file], { encoding: 'utf8' });
+    assert.equal(info.status, 0, info.stderr);
+    const report = JSON.parse(info.stdout);
+    assert.equal(report.complete, true, 'closed with its summary');
+    const channels = Object.fromEntries(report.channels.map((c) => [c.topic, c]));
+    assert.equal(channels['/saccade/left/image_raw'].type, 'sensor_msgs/msg/Image');
+    assert.ok(channels['/saccade/left/image_raw'].messages >= 3, JSON.stringify(channels));
+    assert.ok(channels['/saccade/joint_states'].messages >= 3);
+    assert.equal(report.metadata.saccade.command, 'gui');
   });
 
   test('a joints command outside the limits is refused and moves nothing', async () => {

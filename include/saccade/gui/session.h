@@ -40,6 +40,19 @@ using components::demo::Annotate;
 using components::demo::Latest;
 using components::demo::Tap;
 
+/// A recording the session writes (the page's Record button, the `record` command): the program
+/// makes it (app: an MCAP file, record/recorder.h), the session calls it after each step and
+/// closes it when asked, all on the simulation thread between steps.
+class GuiRecording {
+ public:
+  virtual ~GuiRecording() = default;
+  virtual void AfterStep(const runtime::StepContext& context) = 0;
+  /// Closes the file; a line for the terminal.
+  virtual std::string Close() = 0;
+  virtual std::string file() const = 0;
+  virtual uint64_t bytes() const = 0;
+};
+
 struct GuiOptions {
   std::string listen = "127.0.0.1";
   int port = 8080;
@@ -53,6 +66,11 @@ struct GuiOptions {
   int jpeg_quality = 80;
   /// The page's folder: public/ (index.html, app/) and node_modules/three.
   std::string web_dir = "web";
+  /// Starts a recording of the pipeline (a new file each time): the `record` command. Empty:
+  /// the command is refused. Throws saccade::Error when it cannot (the page is told).
+  std::function<std::shared_ptr<GuiRecording>()> start_recording;
+  /// A recording running from the start (`--record FILE.mcap`), which the page can stop.
+  std::shared_ptr<GuiRecording> recording;
 };
 
 class GuiSession {
@@ -93,6 +111,7 @@ class GuiSession {
   nlohmann::json OnResume(const nlohmann::json& command);
   nlohmann::json OnStep(const nlohmann::json& command);
   nlohmann::json OnSpeed(const nlohmann::json& command);
+  nlohmann::json OnRecord(const nlohmann::json& command);
   nlohmann::json OnHeadStop(const nlohmann::json& command);  // stop, estop, clear
   nlohmann::json OnPing(const nlohmann::json& command);
   const head::HeadModel& RequireHead(const std::string& type) const;
@@ -132,6 +151,11 @@ class GuiSession {
   std::optional<JointStateMessage> commanded_;
   mutable std::mutex joints_mutex_;
   head::JointState targets_;  // the latest targets, for partial joint commands (joints_mutex_)
+
+  // The recording (simulation thread) and what the state says of it.
+  std::shared_ptr<GuiRecording> recording_;
+  std::mutex recording_mutex_;
+  nlohmann::json recording_json_;  // {file, megabytes} or null (recording_mutex_)
 
   // The last step AfterStep saw (simulation thread), for the states WhileWaiting publishes.
   std::optional<runtime::StepContext> last_context_;

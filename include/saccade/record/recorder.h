@@ -26,8 +26,9 @@
 // the open chunk, at most RecorderOptions::chunk_seconds of the run, and the at most two steps
 // handed over and not yet written.
 //
-// Threads: components' outputs may emit from any thread during a step; AfterStep, AddJson and
-// Close are called from the thread that runs the pipeline.
+// Threads: components' outputs may emit from any thread during a step; the recorder is made,
+// called (AfterStep, AddJson, Close) and destroyed on the thread that runs the pipeline, between
+// steps (the GUI starts and stops recordings while the pipeline runs on).
 #include <cstdint>
 #include <filesystem>
 #include <map>
@@ -63,8 +64,9 @@ class PipelineRecorder {
   /// options out of range.
   PipelineRecorder(runtime::Pipeline& pipeline, const std::filesystem::path& path,
                    RecorderOptions options = {});
-  /// Without Close: the steps handed over are written and the file is left without its
-  /// summary, as a killed recording (readers recover its chunks).
+  /// Leaves the pipeline's outputs as they were. Without Close: the steps handed over are
+  /// written and the file is left without its summary, as a killed recording (readers recover
+  /// its chunks).
   ~PipelineRecorder();
   PipelineRecorder(const PipelineRecorder&) = delete;
   PipelineRecorder& operator=(const PipelineRecorder&) = delete;

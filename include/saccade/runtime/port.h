@@ -67,6 +67,9 @@ class OutputBase : public PortBase {
   /// Subscribes `slot` to every message, converted to JSON (for text links only: it costs a
   /// conversion per message).
   virtual ConnectionId ConnectJson(std::function<void(const nlohmann::json&)> slot) = 0;
+  /// Removes a subscription (ConnectJson's, or the typed signal's); false when not connected.
+  /// Not while the output may emit (between steps, on the pipeline's thread).
+  virtual bool Disconnect(ConnectionId id) = 0;
   virtual std::size_t subscriber_count() const = 0;
 };
 
@@ -122,6 +125,7 @@ class Output final : public OutputBase {
     return signal_.Connect(
         [slot = std::move(slot)](const T& message) { slot(MessageTraits<T>::ToJson(message)); });
   }
+  bool Disconnect(ConnectionId id) override { return signal_.Disconnect(id); }
   std::size_t subscriber_count() const override { return signal_.subscriber_count(); }
 
  private:

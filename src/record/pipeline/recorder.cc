@@ -55,6 +55,7 @@ struct PipelineRecorder::Impl {
   RecorderOptions options;
   McapWriter writer;
   std::vector<std::unique_ptr<Source>> sources;
+  std::vector<std::pair<runtime::OutputBase*, runtime::ConnectionId>> connections;
   std::map<std::string, std::unique_ptr<Source>> extra;  // AddJson's, by topic
 
   std::mutex step_mutex;  // guards `step` (outputs emit from any thread)
@@ -142,6 +143,7 @@ void PipelineRecorder::Impl::Tap(runtime::Pipeline& pipeline) {
       const std::string& type = output->message_type();
       auto source = std::make_unique<Source>();
       Source* raw = source.get();
+      runtime::ConnectionId id = 0;
       std::string topic;
       try {
         topic = dds::ResolveTopic(component->name() + "/" + output->name(), options.ns);
@@ -171,33 +173,34 @@ void PipelineRecorder::Impl::Tap(runtime::Pipeline& pipeline) {
         // Typed: images are kept by their shared pixels, not converted during the step.
         if (type == image_type) {
           auto* typed = dynamic_cast<runtime::Output<runtime::ImageMessage>*>(output.get());
-          typed->signal().Connect([this, raw](const runtime::ImageMessage& m) {
+          id = typed->signal().Connect([this, raw](const runtime::ImageMessage& m) {
             Add(raw, std::make_shared<runtime::ImageMessage>(m));
           });
         } else if (type == joints_type) {
           auto* typed = dynamic_cast<runtime::Output<components::JointStateMessage>*>(output.get());
-          typed->signal().Connect([this, raw](const components::JointStateMessage& m) {
+          id = typed->signal().Connect([this, raw](const components::JointStateMessage& m) {
             Add(raw, std::make_shared<components::JointStateMessage>(m));
           });
         } else if (type == runtime::MessageName<components::JointCommand>()) {
           auto* typed = dynamic_cast<runtime::Output<components::JointCommand>*>(output.get());
-          typed->signal().Connect([this, raw](const components::JointCommand& m) {
+          id = typed->signal().Connect([this, raw](const components::JointCommand& m) {
             Add(raw, std::make_shared<components::JointCommand>(m));
           });
         } else {
           auto* typed = dynamic_cast<runtime::Output<components::TargetMessage>*>(output.get());
-          typed->signal().Connect([this, raw](const components::TargetMessage& m) {
+          id = typed->signal().Connect([this, raw](const components::TargetMessage& m) {
             Add(raw, std::make_shared<components::TargetMessage>(m));
           });
         }
       } else {
         raw->json_topic = topic;
-        output->ConnectJson([this, raw](const nlohmann::json& json) {
+        id = output->ConnectJson([this, raw](const nlohmann::json& json) {
           const auto time = json.is_object() ? json.find("time") : json.end();
           const double t = time != json.end() && time->is_number() ? time->get<double>() : -1.0;
           AddJsonText(raw, json, Nanoseconds(t));
         });
       }
+      connections.emplace_back(output.get(), id);
       sources.push_back(std::move(source));
     }
   }
@@ -249,6 +252,7 @@ PipelineRecorder::PipelineRecorder(runtime::Pipeline& pipeline, const std::files
 }
 
 PipelineRecorder::~PipelineRecorder() {
+  for (const auto& [output, id] : impl_->connections) output->Disconnect(id);
   {
     std::lock_guard lock(impl_->queue_mutex);
     impl_->closing = true;

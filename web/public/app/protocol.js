@@ -158,6 +158,19 @@ export const table = {
       "reply": [{"name":"steps","required":true,"schema":{"kind":"integer","min":1.0,"max":1000.0}}]
     },
     {
+      "type": "record",
+      "channel": "command",
+      "body": {
+        "kind": "object",
+        "fields": [
+          {"name":"type","required":true,"schema":{"kind":"string","const":"record"}},
+          {"name":"id","required":true,"schema":{"kind":"integer"}},
+          {"name":"enabled","required":true,"schema":{"kind":"boolean"}}
+        ]
+      },
+      "reply": [{"name":"recording","required":true,"schema":{"kind":"boolean"}}]
+    },
+    {
       "type": "speed",
       "channel": "command",
       "body": {
@@ -368,6 +381,18 @@ export const table = {
             "name": "head_status",
             "required": true,
             "schema": {"kind":"object","nullable":true,"fields":[],"open":true}
+          },
+          {
+            "name": "recording",
+            "required": true,
+            "schema": {
+              "kind": "object",
+              "nullable": true,
+              "fields": [
+                {"name":"file","required":true,"schema":{"kind":"string"}},
+                {"name":"megabytes","required":true,"schema":{"kind":"number","min":0.0}}
+              ]
+            }
           }
         ]
       }

@@ -81,7 +81,7 @@ export function log(element, text, level = 'info') {
 }
 
 /**
- * The controls: effects, perception, pause/resume, step, speed, stop, and the image plane's
+ * The controls: effects, perception, pause/resume, step, speed, stop, record, and the image plane's
  * distance. `send(type, fields)` sends a command; `onDistance(d)` moves the image planes.
  */
 export class Controls {
@@ -99,6 +99,9 @@ export class Controls {
     this.step = $('step');
     this.step.addEventListener('click', () => send('step', { count: 1 }));
     $('stop').addEventListener('click', () => send('stop'));
+    this.record = $('record');
+    this.recording = false;
+    this.record.addEventListener('click', () => send('record', { enabled: !this.recording }));
     this.speed = $('speed');
     this.speed.addEventListener('change', () => send('speed', { factor: Number(this.speed.value) }));
     this.distance = $('plane-distance');
@@ -121,6 +124,12 @@ export class Controls {
     this.pause.textContent = this.paused ? 'Resume' : 'Pause';
     this.pause.classList.toggle('active', this.paused);
     this.step.disabled = !this.paused;
+    this.recording = !!state.recording;
+    this.record.classList.toggle('active', this.recording);
+    this.record.textContent = this.recording
+      ? `■ Stop recording (${state.recording.megabytes.toFixed(1)} MB)` : '● Record';
+    this.record.title = this.recording ? `recording to ${state.recording.file}`
+      : 'record every topic to an MCAP file on the server';
     if (Number.isFinite(state.speed) && document.activeElement !== this.speed) {
       const options = [...this.speed.options].map((o) => Number(o.value));
       if (!options.includes(state.speed)) {
