@@ -62,7 +62,7 @@ TEST(GuiProtocol, DeclaresEveryMessageEachWay) {
   }
   EXPECT_EQ(types[protocol::Channel::kCommand],
             (std::set<std::string>{"joints", "fixate", "perception", "effects", "pause", "resume",
-                                   "step", "speed", "stop", "estop", "clear", "ping",
+                                   "step", "record", "speed", "stop", "estop", "clear", "ping",
                                    "frame_window", "frame_ack"}));
   EXPECT_EQ(types[protocol::Channel::kText],
             (std::set<std::string>{"hello", "state", "reply", "error", "event"}));
@@ -127,7 +127,7 @@ TEST_F(GuiProtocolMessages, TheStateConformsInEachOfItsForms) {
   EXPECT_EQ(protocol::CheckServerMessage(state),
             "state: unknown field 'stowaway' (expected step, time, paused, speed, perception, "
             "manual, effects, joints, frames, fixation_W, target, fixation_error_deg, objects, "
-            "timing, head_status)");
+            "timing, head_status, recording)");
 }
 
 TEST_F(GuiProtocolMessages, TheSceneDocumentConforms) {

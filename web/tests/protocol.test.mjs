@@ -36,7 +36,7 @@ describe('the page checks the GUI protocol as the server does', () => {
     assert.equal(kProtocol, 'saccade-gui');
     assert.equal(kVersion, 2);
     const count = (channel) => table.messages.filter((m) => m.channel === channel).length;
-    assert.equal(count('command'), 14);
+    assert.equal(count('command'), 15);
     assert.equal(count('text'), 5);
     assert.equal(count('frame'), 1);
     assert.equal(count('document'), 1);
