@@ -1,8 +1,11 @@
-// libFuzzer target: any bytes as an MCAP file -> record::McapReader, then every message. A
-// recording may be cut short or damaged anywhere; the reader must never crash, never allocate
-// what the file only claims, and fail only with saccade::FileError (naming the file and byte).
-// What it reads of a file cut short it must read the same way twice. Built and run by
-// fuzz/run.sh; the seeds are small recordings saccade wrote (zstd and uncompressed).
+// libFuzzer target: any bytes as an MCAP file -> record::McapReader, then every message, each
+// decoded with its channel's ros2msg schema (record::RosMessageDecoder). A recording may be cut
+// short or damaged anywhere; the reader must never crash, never allocate what the file only
+// claims, and fail only with saccade::FileError (naming the file and byte); a schema or a
+// message that is not what it claims only with InvalidArgument. What it reads of a file cut
+// short it must read the same way twice. Built and run by fuzz/run.sh; the seeds are small
+// recordings saccade wrote (zstd and uncompressed) and one @mcap/core wrote with ROS 2
+// messages (tests/record/mcap_reference/ros2_sample.mjs).
 
 #include <unistd.h>
 
@@ -11,10 +14,15 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <map>
+#include <optional>
+#include <span>
 #include <string>
+#include <vector>
 
 #include "saccade/core/error.h"
 #include "saccade/record/mcap.h"
+#include "saccade/record/ros_message.h"
 
 namespace {
 
@@ -32,6 +40,35 @@ uint64_t CountMessages(const saccade::record::McapReader& reader) {
   return n;
 }
 
+// Every message of a channel with a ros2msg schema, decoded by it.
+void DecodeMessages(const saccade::record::McapReader& reader) {
+  std::map<uint16_t, std::optional<saccade::record::RosMessageDecoder>> decoders;
+  for (const auto& [id, channel] : reader.channels()) {
+    const auto schema = reader.schemas().find(channel.schema_id);
+    if (schema == reader.schemas().end() || schema->second.encoding != "ros2msg") continue;
+    try {
+      decoders.emplace(
+          id, saccade::record::RosMessageDecoder(schema->second.name, schema->second.data));
+    } catch (const saccade::InvalidArgument&) {
+      // A definition that is not one: named, as it must be.
+    }
+  }
+  reader.ForEachMessage([&](const saccade::record::McapMessage& m) {
+    const auto decoder = decoders.find(m.channel_id);
+    if (decoder == decoders.end() || !decoder->second) return true;
+    std::vector<std::span<const uint8_t>> blobs;
+    try {
+      decoder->second->Decode(m.data, &blobs);
+      for (const auto& blob : blobs) {
+        Check(blob.data() >= m.data.data() &&
+              blob.data() + blob.size() <= m.data.data() + m.data.size());
+      }
+    } catch (const saccade::InvalidArgument&) {
+    }
+    return true;
+  });
+}
+
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, std::size_t size) {
@@ -45,6 +82,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, std::size_t size) {
     Check(CountMessages(reader) == first);
     // A recovered file's statistics are what its scan counted: the same messages.
     if (reader.recovered()) Check(reader.statistics().message_count == first);
+    DecodeMessages(reader);
   } catch (const saccade::FileError&) {
     // A clear error for a damaged file: what the reader must do.
   }
