@@ -47,7 +47,7 @@ flags=(-std=c++20 -O1 -g -fno-omit-frame-pointer
 # urdfdom (and the TinyXML 1 and console_bridge it reads and reports with): every target that
 # compiles src/head/ (the URDF loader, issue 42).
 libs=($(pkg-config --libs yaml-cpp assimp libpng fmt) -lstb -lurdfdom_model -ltinyxml
-      -lconsole_bridge -lzstd -lpthread)
+      -lconsole_bridge -lzstd -lz -lpthread)
 
 # Each target: its sources, its weight in the time budget, its longest input.
 declare -A target_sources target_weight target_max_len

@@ -51,8 +51,8 @@ packages=(
   # any robot head from its URDF (issue 42): urdfdom parses URDF (it brings TinyXML, which also
   # reads the URDF's <gazebo> camera blocks, and console_bridge, which carries its messages)
   liburdfdom-dev
-  # recordings in MCAP (issue 43): zstd chunk compression
-  libzstd-dev
+  # recordings in MCAP (issue 43): zstd chunk compression, zlib's CRC-32
+  libzstd-dev zlib1g-dev
 )
 # What the tests, benchmarks and the Python package add (the full setup only).
 test_packages=(

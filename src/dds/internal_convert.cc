@@ -372,19 +372,23 @@ bool ImageViewOfCdr(const uint8_t* cdr, std::size_t size, sensor_msgs_msg_dds__I
   return true;
 }
 
-void SerializeCdr(const dds_topic_descriptor_t& descriptor, const void* sample,
-                  std::vector<uint8_t>* out) {
+CdrSerializer::CdrSerializer() { dds_ostream_init(&os_, 4096, CDR_ENC_VERSION_1); }
+
+CdrSerializer::~CdrSerializer() { dds_ostream_fini(&os_); }
+
+std::span<const uint8_t> CdrSerializer::Serialize(const dds_topic_descriptor_t& descriptor,
+                                                  const void* sample) {
   static_assert(std::endian::native == std::endian::little, "CDR_LE header below");
-  dds_ostream_t os;
-  dds_ostream_init(&os, 0, CDR_ENC_VERSION_1);
-  // Alignment counts from the first byte after the encapsulation header.
-  dds_stream_write(&os, static_cast<const char*>(sample), descriptor.m_ops);
-  out->resize(4 + os.m_index);
-  (*out)[0] = 0x00;  // CDR_LE: 0x0001, big-endian on the wire, then two option bytes
-  (*out)[1] = 0x01;
-  (*out)[2] = (*out)[3] = 0x00;
-  if (os.m_index > 0) std::memcpy(out->data() + 4, os.m_buffer, os.m_index);
-  dds_ostream_fini(&os);
+  // The body starts at byte 8 of the buffer: XCDR1 aligns to at most 8 bytes from the first
+  // byte after the header, which is then aligned as the buffer is. The header goes in 4..7.
+  constexpr uint32_t kBody = 8;
+  os_.m_index = kBody;  // the buffer holds 4096 bytes from the start, and grows as needed
+  dds_stream_write(&os_, static_cast<const char*>(sample), descriptor.m_ops);
+  uint8_t* buffer = os_.m_buffer;
+  buffer[4] = 0x00;  // CDR_LE: 0x0001, big-endian on the wire, then two option bytes
+  buffer[5] = 0x01;
+  buffer[6] = buffer[7] = 0x00;
+  return {buffer + 4, os_.m_index - 4};
 }
 
 bool DeserializeCdr(const dds_topic_descriptor_t& descriptor, const uint8_t* data, std::size_t size,

@@ -3,10 +3,13 @@
 // structs). The writers' side fills structs that borrow the message's memory (pixels and
 // strings are not copied: the struct is only valid while the message and `Holder` live); the
 // readers' side copies out of Cyclone's loaned samples.
+#include <dds/ddsi/ddsi_cdrstream.h>
+
 #include <cmath>
 #include <cstdint>
 #include <memory>
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -82,10 +85,22 @@ geometry::Pose PoseOf(const geometry_msgs_msg_dds__Transform_& transform);
 bool ImageViewOfCdr(const uint8_t* cdr, std::size_t size, sensor_msgs_msg_dds__Image_* out,
                     std::string* error);
 
-/// `sample` (of `descriptor`'s type) serialized as Cyclone writes it for rmw_cyclonedds: the
-/// 4-byte encapsulation header (CDR, this machine's byte order: little-endian), then XCDR1.
-void SerializeCdr(const dds_topic_descriptor_t& descriptor, const void* sample,
-                  std::vector<uint8_t>* out);
+/// Serializes samples as Cyclone writes them for rmw_cyclonedds: the 4-byte encapsulation header
+/// (CDR, this machine's byte order: little-endian), then XCDR1. Keeps its buffer from message to
+/// message (an image's megabytes are neither allocated nor copied again). One thread at a time.
+class CdrSerializer {
+ public:
+  CdrSerializer();
+  ~CdrSerializer();
+  CdrSerializer(const CdrSerializer&) = delete;
+  CdrSerializer& operator=(const CdrSerializer&) = delete;
+  /// `sample` (of `descriptor`'s type) serialized; valid until the next call.
+  std::span<const uint8_t> Serialize(const dds_topic_descriptor_t& descriptor, const void* sample);
+
+ private:
+  dds_ostream_t os_;
+};
+
 /// Reads serialized bytes (`size`: the 4-byte encapsulation header, then XCDR1 of either byte
 /// order) into `sample`, zero-filled and of `descriptor`'s type; its strings and sequences are
 /// allocated by Cyclone (free them with dds_stream_free_sample). False (and `*error` says

@@ -173,8 +173,8 @@ class SerializingOutlet final : public Outlet {
         ros_type_(internal::RosTypeName(descriptor->m_typename)),
         sink_(std::move(sink)) {}
   void Write(const void* sample, int64_t stamp_ns, LinkStats&) override {
-    internal::SerializeCdr(*descriptor_, sample, &buffer_);
-    sink_({topic_, ros_type_, stamp_ns, buffer_.data(), buffer_.size()});
+    const std::span<const uint8_t> bytes = serializer_.Serialize(*descriptor_, sample);
+    sink_({topic_, ros_type_, stamp_ns, bytes.data(), bytes.size()});
   }
   int matched() const override { return 1; }
 
@@ -183,7 +183,7 @@ class SerializingOutlet final : public Outlet {
   std::string topic_;
   std::string ros_type_;
   SerializedSink sink_;
-  std::vector<uint8_t> buffer_;  // reused: the serialized sample
+  internal::CdrSerializer serializer_;  // its buffer reused from message to message
 };
 
 // Makes a writer's outlets: (descriptor, ROS topic, QoS, lockstep) -> the outlet.

@@ -91,9 +91,9 @@ McapWriter::McapWriter(const std::filesystem::path& path, McapWriterOptions opti
     throw InvalidArgument(fmt::format("mcap: compression must be zstd or \"\" (none), got '{}'",
                                       options.compression));
   }
-  if (options.zstd_level < 1 || options.zstd_level > 19) {
+  if (options.zstd_level < -7 || options.zstd_level > 19 || options.zstd_level == 0) {
     throw InvalidArgument(
-        fmt::format("mcap: zstd level must be 1..19, got {}", options.zstd_level));
+        fmt::format("mcap: zstd level must be -7..-1 (fast) or 1..19, got {}", options.zstd_level));
   }
   if (options.chunk_bytes < 1 || !(options.chunk_seconds > 0.0)) {
     throw InvalidArgument("mcap: chunk_bytes and chunk_seconds must be > 0");

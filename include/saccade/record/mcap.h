@@ -61,7 +61,8 @@ struct McapStatistics {
 
 struct McapWriterOptions {
   std::string compression = "zstd";  ///< "zstd" or "" (none)
-  int zstd_level = 1;                ///< 1 (fast) .. 19
+  /// -7 .. -1: zstd's fast levels (less compression, several times faster); 1 .. 19.
+  int zstd_level = 1;
   /// A chunk is closed and written once it holds this many bytes (uncompressed) or spans this
   /// much log time, whichever comes first: a recording killed at any moment loses at most the
   /// open chunk, so at most this long of the run.

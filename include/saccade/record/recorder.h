@@ -43,6 +43,9 @@ namespace saccade::record {
 
 struct RecorderOptions {
   std::string compression = "zstd";  ///< "zstd" or "none"
+  /// zstd's level: its fast levels by default, since rendered images with sensor noise hardly
+  /// compress (bench/baselines/record-2core.md has the figures); -7 .. -1 or 1 .. 19.
+  int zstd_level = -3;
   /// Crash safety: a chunk spans at most this much of the run's time (a recording killed at
   /// any moment loses at most the open chunk), s > 0.
   double chunk_seconds = 1.0;

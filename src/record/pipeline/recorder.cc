@@ -1,6 +1,9 @@
 #include "saccade/record/recorder.h"
 
 #include <fmt/format.h>
+#include <pthread.h>
+#include <sys/resource.h>
+#include <unistd.h>
 
 #include <cmath>
 #include <condition_variable>
@@ -93,6 +96,7 @@ struct PipelineRecorder::Impl {
     McapWriterOptions w;
     w.compression = o.compression == "none" ? "" : o.compression;
     w.chunk_seconds = o.chunk_seconds;
+    w.zstd_level = o.zstd_level;
     w.chunk_bytes = 8 << 20;
     return w;
   }
@@ -248,7 +252,13 @@ PipelineRecorder::PipelineRecorder(runtime::Pipeline& pipeline, const std::files
     : impl_(std::make_unique<Impl>(path, std::move(options))) {
   impl_->writer.AddMetadata("saccade", impl_->options.metadata);
   impl_->Tap(pipeline);
-  impl_->thread = std::thread([this] { impl_->WriteLoop(); });
+  impl_->thread = std::thread([this] {
+    pthread_setname_np(pthread_self(), "mcap-writer");  // in top and perf
+    // Below the loop's threads: the writing uses the cores' idle moments (a loop waiting on
+    // the renderer's readback), and the queue bounds how far it may fall behind.
+    setpriority(PRIO_PROCESS, static_cast<id_t>(::gettid()), 10);
+    impl_->WriteLoop();
+  });
 }
 
 PipelineRecorder::~PipelineRecorder() {

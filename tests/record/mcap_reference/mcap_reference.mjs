@@ -4,6 +4,7 @@
 //   node mcap_reference.mjs read FILE    # prints what the file holds, as JSON
 //   node mcap_reference.mjs write FILE   # writes the test's messages with @mcap/core's writer
 //   node mcap_reference.mjs decode FILE  # every message decoded, as JSON
+//   node mcap_reference.mjs summary FILE # what @mcap/core's indexed reader finds, for people
 //
 // `read` reads the file twice: with McapStreamReader from the first byte to the last, every CRC
 // checked (data section, chunks, summary), and with McapIndexedReader through the footer, summary
@@ -154,11 +155,35 @@ async function decode() {
   }));
 }
 
+async function summary() {
+  const bytes = new Uint8Array(readFileSync(file));
+  const readable = {
+    size: async () => BigInt(bytes.length),
+    read: async (offset, size) => bytes.subarray(Number(offset), Number(offset + size)),
+  };
+  const reader = await McapIndexedReader.Initialize({ readable,
+    decompressHandlers: await loadDecompressHandlers() });
+  const s = reader.statistics;
+  const seconds = Number(s.messageEndTime - s.messageStartTime) / 1e9;
+  console.log(`@mcap/core ${file.split('/').pop()}: profile ${reader.header.profile}, library ` +
+    `${reader.header.library}, ${s.messageCount} messages in ${s.chunkCount} chunks, ` +
+    `${seconds.toFixed(2)} s`);
+  for (const m of await (async () => { const a = []; for await (const x of reader.readMetadata()) a.push(x); return a; })()) {
+    console.log(`metadata ${m.name}: ${[...m.metadata].map(([k, v]) => `${k}=${v}`).join(', ')}`);
+  }
+  for (const c of reader.channelsById.values()) {
+    const schema = reader.schemasById.get(c.schemaId);
+    console.log(`  ${c.topic.padEnd(30)} ${(schema ? `${schema.name} (${schema.encoding})` : c.messageEncoding).padEnd(40)} ` +
+      `${String(s.channelMessageCounts.get(c.id) ?? 0n).padStart(5)}`);
+  }
+}
+
 try {
   if (command === 'read') await read();
+  else if (command === 'summary') await summary();
   else if (command === 'decode') await decode();
   else if (command === 'write') await write();
-  else throw new Error('usage: mcap_reference.mjs read|write|decode FILE');
+  else throw new Error('usage: mcap_reference.mjs read|write|decode|summary FILE');
 } catch (error) {
   console.error(`mcap_reference: ${error.message}`);
   process.exit(1);
