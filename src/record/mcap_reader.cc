@@ -14,7 +14,7 @@ namespace saccade::record {
 using internal::Crc32;
 using internal::Reader;
 
-namespace {
+namespace reader_detail {
 
 constexpr uint64_t kMaxChunkBytes = uint64_t{512} << 20;
 
@@ -43,7 +43,9 @@ class File {
   uint64_t size_ = 0;
 };
 
-}  // namespace
+}  // namespace reader_detail
+
+using namespace reader_detail;  // NOLINT: this file's own helpers
 
 struct McapReader::Impl {
   std::filesystem::path path;

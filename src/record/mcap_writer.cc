@@ -15,7 +15,7 @@ namespace saccade::record {
 using internal::Bytes;
 using internal::Crc32;
 
-namespace {
+namespace writer_detail {
 
 // A Chunk Index record's fields, kept until the summary.
 struct ChunkIndex {
@@ -47,7 +47,9 @@ Bytes ChannelContent(const McapChannel& ch) {
   return c;
 }
 
-}  // namespace
+}  // namespace writer_detail
+
+using namespace writer_detail;  // NOLINT: this file's own helpers
 
 struct McapWriter::Impl {
   std::filesystem::path path;

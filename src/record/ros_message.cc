@@ -11,7 +11,7 @@
 
 namespace saccade::record {
 
-namespace {
+namespace ros_message_detail {
 
 enum class Kind { kBool, kInt, kUint, kFloat, kString, kMessage };
 
@@ -184,7 +184,9 @@ class Cursor {
   std::size_t pos_ = 0;
 };
 
-}  // namespace
+}  // namespace ros_message_detail
+
+using namespace ros_message_detail;  // NOLINT: this file's own helpers
 
 struct RosMessageDecoder::Impl {
   std::string type;
