@@ -17,6 +17,8 @@
 #include "saccade/components/demo/face_truth.h"
 #include "saccade/components/roles.h"
 #include "saccade/core/error.h"
+#include "saccade/geometry/json.h"
+#include "saccade/geometry/pose.h"
 #include "saccade/record/mcap.h"
 #include "saccade/record/recorder.h"
 #include "saccade/record/ros_message.h"
@@ -136,19 +138,15 @@ struct McapCommandOptions {
   bool force = false;
 };
 
-// A 4x4 pose from a geometry_msgs/Transform as decoded.
-json PoseMatrix(const json& transform) {
+// The pose of a geometry_msgs/Transform as decoded, in saccade's one JSON form of a pose.
+json PoseJson(const json& transform) {
   const json& t = transform["translation"];
   const json& r = transform["rotation"];
   const Eigen::Quaterniond q(r["w"].get<double>(), r["x"].get<double>(), r["y"].get<double>(),
                              r["z"].get<double>());
-  const Eigen::Matrix3d R = q.normalized().toRotationMatrix();
-  json m = json::array();
-  for (int i = 0; i < 3; ++i) {
-    m.push_back({R(i, 0), R(i, 1), R(i, 2), t[std::string(1, "xyz"[i])].get<double>()});
-  }
-  m.push_back({0.0, 0.0, 0.0, 1.0});
-  return m;
+  return JsonCodec<geometry::Pose>::Encode(
+      geometry::MakePose(q.normalized().toRotationMatrix(),
+                         {t["x"].get<double>(), t["y"].get<double>(), t["z"].get<double>()}));
 }
 
 int64_t StampNs(const json& header) {
@@ -268,7 +266,7 @@ class Exporter {
                              {"coefficients", info->second["d"]}};
     }
     if (const auto pose = poses_.find(frame_id); pose != poses_.end()) {
-      entry["X_WC"] = PoseMatrix(pose->second);
+      entry["X_WC"] = PoseJson(pose->second);
     }
     if (!joints_.empty()) entry["joints"] = joints_;
     frame_[camera] = entry;

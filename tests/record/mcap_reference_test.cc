@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "record/run_node.h"
 #include "saccade/record/mcap.h"
 
 namespace saccade::record {
@@ -21,9 +22,6 @@ namespace {
 namespace fs = std::filesystem;
 using nlohmann::json;
 
-const std::string kScript =
-    std::string(SACCADE_SOURCE_DIR) + "/tests/record/mcap_reference/mcap_reference.mjs";
-
 fs::path TempFile(const std::string& name) {
   const fs::path dir =
       fs::temp_directory_path() / ("saccade_mcap_ref_" + std::to_string(::getpid()));
@@ -31,18 +29,9 @@ fs::path TempFile(const std::string& name) {
   return dir / name;
 }
 
-// Runs the reference script; its standard output, and its exit status in `*status`.
+// The reference script on `file`; its output, and its exit status in `*status`.
 std::string Node(const std::string& command, const fs::path& file, int* status) {
-  const std::string line = "node " + kScript + " " + command + " '" + file.string() + "' 2>&1";
-  std::FILE* pipe = ::popen(line.c_str(), "r");
-  if (pipe == nullptr) return "(popen failed)";
-  std::string out;
-  std::array<char, 65536> buffer;
-  for (std::size_t n; (n = std::fread(buffer.data(), 1, buffer.size(), pipe)) > 0;) {
-    out.append(buffer.data(), n);
-  }
-  *status = ::pclose(pipe);
-  return out;
+  return testing::RunNode("mcap_reference.mjs", command + " '" + file.string() + "'", status);
 }
 
 uint32_t Fnv1a(std::span<const uint8_t> bytes) {

@@ -18,6 +18,7 @@
 #include <string>
 #include <vector>
 
+#include "record/run_node.h"
 #include "saccade/core/error.h"
 
 namespace saccade::record {
@@ -37,16 +38,9 @@ std::vector<Sample> Reference(const json& inputs) {
   const fs::path input =
       fs::temp_directory_path() / ("saccade_ros_message_" + std::to_string(::getpid()) + ".json");
   std::ofstream(input) << inputs.dump();
-  const std::string command = "node " SACCADE_SOURCE_DIR
-                              "/tests/record/mcap_reference/ros2_sample.mjs '" +
-                              input.string() + "' 2>&1";
-  std::FILE* pipe = ::popen(command.c_str(), "r");
-  std::string out;
-  std::array<char, 65536> buffer;
-  for (std::size_t n; (n = std::fread(buffer.data(), 1, buffer.size(), pipe)) > 0;) {
-    out.append(buffer.data(), n);
-  }
-  EXPECT_EQ(::pclose(pipe), 0) << out;
+  int status = 0;
+  const std::string out = testing::RunNode("ros2_sample.mjs", "'" + input.string() + "'", &status);
+  EXPECT_EQ(status, 0) << out;
   fs::remove(input);
   std::vector<Sample> samples;
   std::size_t start = 0;

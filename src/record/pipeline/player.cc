@@ -8,6 +8,7 @@
 #include <exception>
 #include <map>
 #include <mutex>
+#include <set>
 #include <thread>
 
 #include "saccade/components/messages.h"
@@ -46,7 +47,7 @@ struct McapPlayer::Impl {
   McapReader reader;
   std::shared_ptr<dds::Participant> participant;
   std::map<uint16_t, std::unique_ptr<dds::CdrWriter>> writers;  // by channel
-  std::map<uint16_t, bool> images;                              // channels of images
+  std::set<uint16_t> images;                                    // channels of images
   std::unique_ptr<dds::Reader> answers;                         // lockstep
   std::vector<std::string> skipped;
   double last_time = 0.0;
@@ -151,7 +152,7 @@ McapPlayer::McapPlayer(const std::filesystem::path& file, const nlohmann::json& 
       p.skipped.push_back(channel.topic + " (" + type + ": no ROS 2 form in saccade)");
     } else {
       p.writers[id] = dds::CdrWriter::Create(p.participant, type, channel.topic, QosOf(type));
-      if (type == "sensor_msgs/msg/Image") p.images[id] = true;
+      if (type == "sensor_msgs/msg/Image") p.images.insert(id);
     }
   }
   if (p.writers.empty()) {

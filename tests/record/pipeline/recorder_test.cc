@@ -18,6 +18,7 @@
 #include <string>
 #include <vector>
 
+#include "record/run_node.h"
 #include "saccade/components/messages.h"
 #include "saccade/components/register.h"
 #include "saccade/core/error.h"
@@ -45,17 +46,7 @@ fs::path TempFile(const std::string& name) {
 
 // The reference script's output for `command` on `file`; its exit status in `*status`.
 std::string Node(const std::string& command, const fs::path& file, int* status) {
-  const std::string line = "node " + kSource + "/tests/record/mcap_reference/mcap_reference.mjs " +
-                           command + " '" + file.string() + "' 2>&1";
-  std::FILE* pipe = ::popen(line.c_str(), "r");
-  if (pipe == nullptr) return "(popen failed)";
-  std::string out;
-  std::array<char, 65536> buffer;
-  for (std::size_t n; (n = std::fread(buffer.data(), 1, buffer.size(), pipe)) > 0;) {
-    out.append(buffer.data(), n);
-  }
-  *status = ::pclose(pipe);
-  return out;
+  return testing::RunNode("mcap_reference.mjs", command + " '" + file.string() + "'", status);
 }
 
 uint32_t Fnv1a(const uint8_t* bytes, std::size_t size) {
