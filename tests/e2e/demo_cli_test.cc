@@ -13,6 +13,7 @@
 #include <string>
 
 #include "e2e/run_saccade.h"
+#include "scratch_dir.h"
 
 namespace {
 
@@ -25,11 +26,10 @@ using ::testing::HasSubstr;
 const std::string kSource = SACCADE_SOURCE_DIR;
 const std::string kTwoPictures = kSource + "/scenes/astronaut_and_cat.yaml";
 
+// `name` in the test's scratch folder, absent.
 fs::path TempDir(const std::string& name) {
-  const fs::path dir =
-      fs::temp_directory_path() / ("saccade_demo_test_" + std::to_string(::getpid())) / name;
+  const fs::path dir = saccade::testing_helpers::ScratchDir() / name;
   fs::remove_all(dir);
-  fs::create_directories(dir.parent_path());
   return dir;
 }
 
@@ -81,7 +81,6 @@ TEST(DemoCli, FixatesTheFaceRejectsTheCatAndRecordsAVideoThatOpenCvReads) {
   EXPECT_THAT(again.output, HasSubstr("already holds a recording; pass --force"));
   std::ifstream kept(out / "summary.json");
   EXPECT_EQ(json::parse(kept)["steps"], steps);
-  fs::remove_all(out.parent_path());
 }
 
 TEST(DemoCli, ExitsNonZeroWhenNoFaceIsFixated) {
@@ -105,7 +104,6 @@ TEST(DemoCli, ABadPipelineNamesTheFileLineAndWhatIsKnown) {
   EXPECT_THAT(run.output, HasSubstr(file.string() + ":4: components[0].type: unknown component "
                                                     "type 'sim.camera'"));
   EXPECT_THAT(run.output, HasSubstr("sim.cameras"));  // the known types are listed
-  fs::remove_all(dir.parent_path());
 }
 
 // A component that fails mid-run: reported with its name and step, the run stops cleanly, and
@@ -160,7 +158,6 @@ TEST(DemoCli, AFailingComponentIsNamedAndTheRecordingIsKept) {
       << going.output;
   EXPECT_LT(std::stod(dwell[1]), 0.5);
   EXPECT_LT(std::stod(dwell[2]), 0.5);
-  fs::remove_all(dir.parent_path());
 }
 
 // Real time: ticks on the wall clock at the pipeline's 25 Hz (or slower, when a step takes

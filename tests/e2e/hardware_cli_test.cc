@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "e2e/run_saccade.h"
+#include "scratch_dir.h"
 
 namespace {
 
@@ -33,11 +34,7 @@ const std::string kTwoPictures = kSource + "/scenes/astronaut_and_cat.yaml";
 const std::string kPortraits = kSource + "/scenes/portraits.yaml";
 
 fs::path TempDir(const std::string& name) {
-  const fs::path dir =
-      fs::temp_directory_path() / ("saccade_hardware_test_" + std::to_string(::getpid())) / name;
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir;
+  return saccade::testing_helpers::FreshScratchDir(name);
 }
 
 // saccade-servo-emulator in the background, for the length of a test.

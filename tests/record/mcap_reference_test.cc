@@ -15,6 +15,7 @@
 
 #include "record/run_node.h"
 #include "saccade/record/mcap.h"
+#include "scratch_dir.h"
 
 namespace saccade::record {
 namespace {
@@ -22,12 +23,7 @@ namespace {
 namespace fs = std::filesystem;
 using nlohmann::json;
 
-fs::path TempFile(const std::string& name) {
-  const fs::path dir =
-      fs::temp_directory_path() / ("saccade_mcap_ref_" + std::to_string(::getpid()));
-  fs::create_directories(dir);
-  return dir / name;
-}
+fs::path TempFile(const std::string& name) { return testing_helpers::ScratchFile(name); }
 
 // The reference script on `file`; its output, and its exit status in `*status`.
 std::string Node(const std::string& command, const fs::path& file, int* status) {

@@ -19,6 +19,7 @@
 
 #include "record/internal_mcap_bytes.h"
 #include "saccade/core/error.h"
+#include "scratch_dir.h"
 
 namespace saccade::record {
 namespace {
@@ -26,12 +27,7 @@ namespace {
 namespace fs = std::filesystem;
 using ::testing::HasSubstr;
 
-fs::path TempFile(const std::string& name) {
-  const fs::path dir =
-      fs::temp_directory_path() / ("saccade_mcap_test_" + std::to_string(::getpid()));
-  fs::create_directories(dir);
-  return dir / name;
-}
+fs::path TempFile(const std::string& name) { return testing_helpers::ScratchFile(name); }
 
 struct Sent {
   uint16_t channel;

@@ -25,6 +25,7 @@
 #include "saccade/record/mcap.h"
 #include "saccade/runtime/pipeline.h"
 #include "saccade/runtime/scheduler.h"
+#include "scratch_dir.h"
 
 namespace saccade::record {
 namespace {
@@ -37,12 +38,7 @@ using ::testing::HasSubstr;
 
 const std::string kSource = SACCADE_SOURCE_DIR;
 
-fs::path TempFile(const std::string& name) {
-  const fs::path dir =
-      fs::temp_directory_path() / ("saccade_recorder_test_" + std::to_string(::getpid()));
-  fs::create_directories(dir);
-  return dir / name;
-}
+fs::path TempFile(const std::string& name) { return testing_helpers::ScratchFile(name); }
 
 // The reference script's output for `command` on `file`; its exit status in `*status`.
 std::string Node(const std::string& command, const fs::path& file, int* status) {
