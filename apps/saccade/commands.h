@@ -63,10 +63,11 @@ struct McapOptions {
   std::string path;  ///< "": no recording
   double chunk_s = 1.0;
   std::string compression = "zstd";
+  int zstd_level = record::RecorderOptions{}.zstd_level;
   bool force = false;  ///< replace an existing file
 };
 bool IsMcapPath(const std::string& path);
-/// --record-chunk-s and --record-compression.
+/// --record-chunk-s, --record-compression and --record-zstd-level.
 void AddRecordTuning(CLI::App* command, McapOptions& o);
 
 /// The "saccade" metadata of a recording: the command and the files it ran (empty ones left out).

@@ -41,6 +41,11 @@ void AddRecordTuning(CLI::App* command, McapOptions& o) {
                    "MCAP recordings: chunk compression, zstd or none")
       ->check(CLI::IsMember({"zstd", "none"}))
       ->capture_default_str();
+  command
+      ->add_option("--record-zstd-level", o.zstd_level,
+                   "MCAP recordings: zstd's level, -7..-1 (faster, larger) or 1..19 (slower, "
+                   "smaller)")
+      ->capture_default_str();
 }
 
 std::map<std::string, std::string> RunMetadata(const std::string& command,
@@ -72,9 +77,14 @@ Recording::Recording(const McapOptions& o, runtime::Pipeline& pipeline,
   if (!(o.chunk_s > 0.0)) {
     throw InvalidArgument(fmt::format("--record-chunk-s: expected > 0 s, got {}", o.chunk_s));
   }
+  if (o.zstd_level < -7 || o.zstd_level > 19 || o.zstd_level == 0) {
+    throw InvalidArgument(
+        fmt::format("--record-zstd-level: expected -7..-1 or 1..19, got {}", o.zstd_level));
+  }
   record::RecorderOptions r;
   r.compression = o.compression;
   r.chunk_seconds = o.chunk_s;
+  r.zstd_level = o.zstd_level;
   if (auto* cameras = pipeline.FindRole<components::EyeCamerasRole>()) {
     const scene::Scene& scene = cameras->scene();
     if (scene.robot()) metadata["head"] = scene.robot()->head.name();

@@ -1,4 +1,5 @@
 #include <fmt/format.h>
+#include <zlib.h>
 #include <zstd.h>
 
 #include <algorithm>
@@ -73,14 +74,29 @@ struct McapWriter::Impl {
   uint64_t chunk_start = 0, chunk_end = 0;
   bool chunk_has_messages = false;
   std::vector<uint8_t> compressed;
+  Bytes head, indexes;  // a chunk's record fields and its message indexes
+  // zstd's context, kept from chunk to chunk (a fresh one is megabytes of fresh pages).
+  struct FreeZstd {
+    void operator()(ZSTD_CCtx* c) const { ZSTD_freeCCtx(c); }
+  };
+  std::unique_ptr<ZSTD_CCtx, FreeZstd> zstd;
   bool closed = false;
 
   void Put(std::span<const uint8_t> bytes, bool data_section = true) {
+    Write(bytes);
+    if (data_section) data_crc = Crc32(bytes, data_crc);
+  }
+  /// Bytes of the data section whose CRC32 is known: the section's CRC follows without a pass.
+  void Put(std::span<const uint8_t> bytes, uint32_t crc) {
+    Write(bytes);
+    data_crc =
+        static_cast<uint32_t>(crc32_combine(data_crc, crc, static_cast<z_off_t>(bytes.size())));
+  }
+  void Write(std::span<const uint8_t> bytes) {
     if (bytes.empty()) return;
     if (std::fwrite(bytes.data(), 1, bytes.size(), file) != bytes.size()) {
       throw FileError(path.string(), 0, "", fmt::format("cannot write: {}", std::strerror(errno)));
     }
-    if (data_section) data_crc = Crc32(bytes, data_crc);
     offset += bytes.size();
   }
   void FlushChunk();
@@ -203,8 +219,9 @@ void McapWriter::Impl::FlushChunk() {
   std::span<const uint8_t> records = chunk.data();
   if (options.compression == "zstd") {
     compressed.resize(ZSTD_compressBound(chunk.size()));
-    const std::size_t n = ZSTD_compress(compressed.data(), compressed.size(), chunk.data().data(),
-                                        chunk.size(), options.zstd_level);
+    if (zstd == nullptr) zstd.reset(ZSTD_createCCtx());
+    const std::size_t n = ZSTD_compressCCtx(zstd.get(), compressed.data(), compressed.size(),
+                                            chunk.data().data(), chunk.size(), options.zstd_level);
     if (ZSTD_isError(n)) {
       throw FileError(path.string(), 0, "", fmt::format("zstd: {}", ZSTD_getErrorName(n)));
     }
@@ -217,17 +234,21 @@ void McapWriter::Impl::FlushChunk() {
   index.compression = options.compression;
   index.compressed_size = records.size();
   index.uncompressed_size = chunk.size();
-  Bytes content, record;
-  content.U64(index.start_time);
-  content.U64(index.end_time);
-  content.U64(chunk.size());
-  content.U32(Crc32(chunk.data()));
-  content.String(options.compression);
-  content.U64(records.size());
-  content.Raw(records);
-  record.Record(internal::kChunk, content);
-  index.length = record.size();
+  // The Chunk record's fields, then its records as they are: no copy of megabytes (each fresh
+  // buffer of a chunk's size cost a page fault per 4 KiB page).
+  head.Clear();
+  head.U8(internal::kChunk);
+  head.U64(8 + 8 + 8 + 4 + 4 + options.compression.size() + 8 + records.size());
+  head.U64(index.start_time);
+  head.U64(index.end_time);
+  head.U64(chunk.size());
+  const uint32_t chunk_crc = Crc32(chunk.data());
+  head.U32(chunk_crc);
+  head.String(options.compression);
+  head.U64(records.size());
+  index.length = head.size() + records.size();
   // The message indexes right after the chunk, one per channel, in channel order.
+  indexes.Clear();
   for (const auto& [channel, entries] : chunk_messages) {
     Bytes message_index;
     message_index.U16(channel);
@@ -236,12 +257,18 @@ void McapWriter::Impl::FlushChunk() {
       message_index.U64(time);
       message_index.U64(at);
     }
-    index.message_index_offsets[channel] = offset + record.size();
-    const std::size_t before = record.size();
-    record.Record(internal::kMessageIndex, message_index);
-    index.message_index_length += record.size() - before;
+    index.message_index_offsets[channel] = offset + index.length + indexes.size();
+    const std::size_t before = indexes.size();
+    indexes.Record(internal::kMessageIndex, message_index);
+    index.message_index_length += indexes.size() - before;
   }
-  Put(record.data());
+  Put(head.data());
+  if (records.data() == chunk.data().data()) {
+    Put(records, chunk_crc);  // uncompressed: the chunk's CRC is theirs
+  } else {
+    Put(records);
+  }
+  Put(indexes.data());
   std::fflush(file);  // a complete chunk on disk: recoverable whatever comes next
   chunk_indexes.push_back(std::move(index));
   ++stats.chunk_count;
