@@ -67,6 +67,10 @@ struct McapOptions {
   bool force = false;  ///< replace an existing file
 };
 bool IsMcapPath(const std::string& path);
+/// The recorder's options for `--record FILE` and its tuning. Throws InvalidArgument (before
+/// anything is written) for a name without .mcap, an existing file without `force`, a chunk
+/// length <= 0, a zstd level out of range.
+record::RecorderOptions RecorderOptionsFor(const McapOptions& o);
 /// --record-chunk-s, --record-compression and --record-zstd-level.
 void AddRecordTuning(CLI::App* command, McapOptions& o);
 

@@ -22,6 +22,7 @@
 #include "saccade/record/mcap.h"
 #include "saccade/record/recorder.h"
 #include "saccade/record/ros_message.h"
+#include "saccade/render/dataset.h"
 
 namespace saccade::app {
 
@@ -65,8 +66,7 @@ struct Recording::Truth {
   std::vector<components::demo::PictureFace> faces;
 };
 
-Recording::Recording(const McapOptions& o, runtime::Pipeline& pipeline,
-                     std::map<std::string, std::string> metadata) {
+record::RecorderOptions RecorderOptionsFor(const McapOptions& o) {
   if (!IsMcapPath(o.path)) {
     throw InvalidArgument("--record " + o.path + ": an MCAP recording's name ends in .mcap");
   }
@@ -85,6 +85,12 @@ Recording::Recording(const McapOptions& o, runtime::Pipeline& pipeline,
   r.compression = o.compression;
   r.chunk_seconds = o.chunk_s;
   r.zstd_level = o.zstd_level;
+  return r;
+}
+
+Recording::Recording(const McapOptions& o, runtime::Pipeline& pipeline,
+                     std::map<std::string, std::string> metadata) {
+  record::RecorderOptions r = RecorderOptionsFor(o);
   if (auto* cameras = pipeline.FindRole<components::EyeCamerasRole>()) {
     const scene::Scene& scene = cameras->scene();
     if (scene.robot()) metadata["head"] = scene.robot()->head.name();
@@ -212,7 +218,7 @@ class Exporter {
           }
         }
       } else {
-        AddImage(v, blobs);
+        AddImage(topic, v, blobs);
       }
       return true;
     });
@@ -223,10 +229,21 @@ class Exporter {
   }
 
  private:
-  void AddImage(const json& image, const std::vector<std::span<const uint8_t>>& blobs) {
+  // An image: the camera's (<camera>/image_raw) to <camera>/NNNNNN.png, its depth truth
+  // (<camera>/depth/image_raw, 32FC1 metres) to <camera>/depth/ as 16-bit millimetres and its
+  // id truth (<camera>/ids/image_raw, mono16) to <camera>/ids/, as `saccade render` writes them.
+  void AddImage(const std::string& topic, const json& image,
+                const std::vector<std::span<const uint8_t>>& blobs) {
     const int64_t stamp = StampNs(image["header"]);
     if (!frame_.empty() && stamp != frame_stamp_) Flush();
     frame_stamp_ = stamp;
+    const auto ends_with = [&](const std::string& tail) {
+      return topic.size() >= tail.size() &&
+             topic.compare(topic.size() - tail.size(), tail.size(), tail) == 0;
+    };
+    const std::string truth = ends_with("/depth/image_raw") ? "depth"
+                              : ends_with("/ids/image_raw") ? "ids"
+                                                            : "";
     std::string frame_id = image["header"]["frame_id"];
     std::string camera = frame_id;
     if (camera.size() > 8 && camera.compare(camera.size() - 8, 8, "_optical") == 0) {
@@ -244,6 +261,8 @@ class Exporter {
       cv_type = CV_8UC1;
     else if (encoding == "mono16" || encoding == "16UC1")
       cv_type = CV_16UC1;
+    else if (encoding == "32FC1" && truth == "depth")
+      cv_type = CV_32FC1;
     else {
       if (said_.insert(encoding).second) {
         fmt::print(stderr, "mcap export: {} images not exported (encoding {})\n", camera, encoding);
@@ -256,19 +275,33 @@ class Exporter {
                                         camera, pixels.size(), step * height));
     }
     cv::Mat mat(height, width, cv_type, const_cast<uint8_t*>(pixels.data()), step);
-    cv::Mat bgr;
-    if (encoding == "rgb8")
-      cv::cvtColor(mat, bgr, cv::COLOR_RGB2BGR);
-    else if (encoding == "rgba8")
-      cv::cvtColor(mat, bgr, cv::COLOR_RGBA2BGRA);
-    else
-      bgr = mat;
-    const std::string file = fmt::format("{}/{:06d}.png", camera, frames_);
-    fs::create_directories(out_ / camera);
-    if (!cv::imwrite((out_ / file).string(), bgr)) {
+    cv::Mat out;
+    if (encoding == "rgb8") {
+      cv::cvtColor(mat, out, cv::COLOR_RGB2BGR);
+    } else if (encoding == "rgba8") {
+      cv::cvtColor(mat, out, cv::COLOR_RGBA2BGRA);
+    } else if (cv_type == CV_32FC1) {
+      const Image metres(width, height, PixelFormat::kFloat32, pixels.data(), step);
+      const Image mm = render::DepthToMillimetres(metres);
+      cv::Mat(height, width, CV_16UC1, const_cast<uint8_t*>(mm.data())).copyTo(out);
+    } else {
+      out = mat;
+    }
+    const std::string folder = truth.empty() ? camera : camera + "/" + truth;
+    const std::string file = fmt::format("{}/{:06d}.png", folder, frames_);
+    fs::create_directories(out_ / folder);
+    if (!cv::imwrite((out_ / file).string(), out)) {
       throw FileError((out_ / file).string(), 0, "", "cannot be written");
     }
-    json entry = {{"file", file}, {"width", width}, {"height", height}, {"encoding", encoding}};
+    json& entry = frame_[camera];
+    if (!truth.empty()) {
+      entry[truth] = file;
+      return;
+    }
+    entry["file"] = file;
+    entry["width"] = width;
+    entry["height"] = height;
+    entry["encoding"] = encoding;
     if (const auto info = infos_.find(frame_id); info != infos_.end()) {
       const json& k = info->second["k"];
       entry["K"] = {{k[0], k[1], k[2]}, {k[3], k[4], k[5]}, {k[6], k[7], k[8]}};
@@ -279,7 +312,6 @@ class Exporter {
       entry["X_WC"] = PoseJson(pose->second);
     }
     if (!joints_.empty()) entry["joints"] = joints_;
-    frame_[camera] = entry;
   }
   void Flush() {
     if (frame_.empty()) return;

@@ -16,6 +16,7 @@
 #include "commands.h"
 #include "saccade/core/error.h"
 #include "saccade/core/progress.h"
+#include "saccade/record/frame_recorder.h"
 #include "saccade/render/benchmark.h"
 #include "saccade/render/dataset.h"
 #include "saccade/render/renderer.h"
@@ -48,6 +49,20 @@ struct RenderOptions {
   const CLI::Option* truth_option = nullptr;  ///< whether --truth was given (even empty)
   render::RendererOptions renderer;           ///< --msaa, --lod-max-error, --no-distortion, ...
   std::vector<std::string> cameras;
+  McapOptions record;  ///< --record FILE.mcap and its tuning
+};
+
+// Each frame to the data set folder and to the recording, when both are asked for.
+class TeeSink final : public render::FrameSink {
+ public:
+  explicit TeeSink(std::vector<render::FrameSink*> sinks) : sinks_(std::move(sinks)) {}
+  void Write(int64_t index, double time, const scene::SceneState& state,
+             const std::vector<render::Frame>& frames) override {
+    for (render::FrameSink* sink : sinks_) sink->Write(index, time, state, frames);
+  }
+
+ private:
+  std::vector<render::FrameSink*> sinks_;
 };
 
 scene::SceneState StateFor(const scene::Scene& scene, const std::vector<double>& joints,
@@ -62,6 +77,11 @@ scene::SceneState StateFor(const scene::Scene& scene, const std::vector<double>&
 }
 
 int RunRender(const RenderOptions& o) {
+  if (o.out.empty() && o.record.path.empty()) {
+    throw InvalidArgument("render: nowhere to write: give --out DIR, --record FILE.mcap or both");
+  }
+  std::optional<record::RecorderOptions> recording;
+  if (!o.record.path.empty()) recording = RecorderOptionsFor(o.record);
   const bool truth_given = o.truth_option != nullptr && o.truth_option->count() > 0;
   const render::TruthRequest truth =
       truth_given ? render::TruthRequest::Parse(o.truth) : render::TruthRequest{};
@@ -74,26 +94,47 @@ int RunRender(const RenderOptions& o) {
   auto renderer = render::MakeRenderer(scene, options);
   const std::vector<std::string>& cameras = renderer->camera_names();
   const fs::path out(o.out);
-  render::DatasetWriter writer(scene, cameras, truth, out, o.force, options.distortion);
+  std::vector<render::FrameSink*> sinks;
+  std::optional<render::DatasetWriter> writer;
+  if (!o.out.empty()) {
+    writer.emplace(scene, cameras, truth, out, o.force, options.distortion);
+    sinks.push_back(&*writer);
+  }
+  std::optional<record::FrameRecorder> recorder;
+  if (recording) {
+    recording->metadata = RunMetadata("render", "", o.scene, o.head, "");
+    if (scene.robot()) recording->metadata["head"] = scene.robot()->head.name();
+    recording->metadata["cameras"] = "rendered";
+    recording->metadata["fps"] = fmt::format("{}", o.fps);
+    recorder.emplace(scene, truth, o.record.path, *recording);
+    sinks.push_back(&*recorder);
+  }
+  TeeSink sink(sinks);
   auto previous_int = std::signal(SIGINT, OnInterrupt);
   auto previous_term = std::signal(SIGTERM, OnInterrupt);
 
   const ProgressBar progress(o.frames);
   const auto start = std::chrono::steady_clock::now();
   const int written =
-      render::RenderDataset(*renderer, writer, initial, o.frames, o.fps, g_interrupted,
+      render::RenderDataset(*renderer, sink, initial, o.frames, o.fps, g_interrupted,
                             [&](int done, double fps) { progress.Update(done, fps); });
   progress.Finish();
   std::signal(SIGINT, previous_int);
   std::signal(SIGTERM, previous_term);
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  std::string where = o.out;
+  if (recorder) {
+    const record::RecordingStats stats = recorder->Close();
+    where += fmt::format("{}{} ({} messages, {:.1f} MB)", where.empty() ? "" : " and ",
+                         o.record.path, stats.messages, stats.bytes / 1e6);
+  }
   if (g_interrupted) {
-    fmt::print(stderr, "interrupted: {} whole frames written to {}\n", written, out.string());
+    fmt::print(stderr, "interrupted: {} whole frames written to {}\n", written, where);
     return 130;
   }
   fmt::print("{} frames x {} cameras in {:.2f} s ({:.1f} fps) -> {}\n", written, cameras.size(),
-             seconds, written / std::max(seconds, 1e-9), out.string());
+             seconds, written / std::max(seconds, 1e-9), where);
   return 0;
 }
 
@@ -194,7 +235,13 @@ Runner AddRenderCommand(CLI::App& app) {
                    "Head file (robots/*.yaml) in place of the scene's robot head, at its home "
                    "joints (--joints then are that head's)")
       ->check(CLI::ExistingFile);
-  render->add_option("--out", o->out, "Output folder")->required();
+  render->add_option("--out", o->out, "Output folder (the data set); --out, --record or both");
+  render->add_option("--record", o->record.path,
+                     "Also or instead: an MCAP recording (FILE.mcap) of every frame, as ROS 2 "
+                     "messages: <camera>/image_raw, camera_info, /tf, joint_states, with --truth "
+                     "<camera>/depth/image_raw (32FC1, m) and ids/image_raw (mono16), and each "
+                     "frame's record (frames.jsonl's line) on /saccade/frames (docs/recording.md)");
+  AddRecordTuning(render, o->record);
   render->add_option("--frames", o->frames, "Number of frames")
       ->check(CLI::Range(1, 100000000))
       ->capture_default_str();
@@ -219,7 +266,9 @@ Runner AddRenderCommand(CLI::App& app) {
       "visible objects' ids, names, 2D boxes [x_min, y_min, x_max, y_max] (inclusive pixels), "
       "pixel counts and poses X_CO, X_WO (4x4, metres)");
   AddRendererOptions(render, &o->renderer);
-  render->add_flag("--force", o->force, "Replace output already in --out");
+  render->add_flag_callback(
+      "--force", [o] { o->force = o->record.force = true; },
+      "Replace output already in --out, or the --record file");
   return [o] { return RunRender(*o); };
 }
 

@@ -52,8 +52,8 @@ const Image& TruthImage(const std::shared_ptr<const Image>& image, const Frame& 
   return *image;
 }
 
-/// kFloat32 depth (metres) to kGray16 millimetres, rounded to nearest: 0 where there is no
-/// surface, at least 1 where there is one, 65535 for 65.535 m and beyond.
+}  // namespace
+
 Image DepthToMillimetres(const Image& depth) {
   Image out(depth.width(), depth.height(), PixelFormat::kGray16);
   for (int y = 0; y < depth.height(); ++y) {
@@ -97,6 +97,8 @@ Image IdsToPng16(const Image& ids, const std::string& camera) {
   return out;
 }
 
+namespace {
+
 /// The objects seen in a frame (pixels > 0): id, name, 2D box, pixels and pose.
 json ObjectsJson(const Frame& frame, bool scene_has_objects) {
   if (frame.objects.empty() && scene_has_objects) {
@@ -135,14 +137,16 @@ const geometry::CameraModel& RenderedModel(const ImageMetadata& m) {
 }
 
 /// One line of frames.jsonl: a frame index, its time and every camera's image and metadata.
-json FrameJson(int64_t index, double time, const std::vector<Frame>& frames,
-               const TruthRequest& truth, bool scene_has_objects) {
+}  // namespace
+
+json FrameRecord(int64_t index, double time, const std::vector<Frame>& frames,
+                 const TruthRequest& truth, bool scene_has_objects, bool files) {
   json cameras = json::object();
   for (const auto& frame : frames) {
     const ImageMetadata& m = frame.color->metadata();
     // The camera model's codec (geometry/json.h): width, height, K, distortion.
     json entry = ToJson(RenderedModel(m));
-    entry["file"] = fmt::format("{}/{:06d}.png", m.camera, index);
+    if (files) entry["file"] = fmt::format("{}/{:06d}.png", m.camera, index);
     // Poses in geometry/json.h's one form, as everywhere else (4x4 nested, row by row).
     entry["X_WC"] = ToJson(*geometry::FindCameraPose(m));
     entry["exposure_samples"] = m.exposure_samples;
@@ -153,13 +157,15 @@ json FrameJson(int64_t index, double time, const std::vector<Frame>& frames,
       }
       entry["joints"] = joints;
     }
-    if (truth.depth) entry["depth"] = DepthFile(m.camera, index);
-    if (truth.ids) entry["ids"] = IdsFile(m.camera, index);
+    if (truth.depth && files) entry["depth"] = DepthFile(m.camera, index);
+    if (truth.ids && files) entry["ids"] = IdsFile(m.camera, index);
     if (truth.boxes) entry["objects"] = ObjectsJson(frame, scene_has_objects);
     cameras[m.camera] = entry;
   }
   return {{"frame", index}, {"time", time}, {"cameras", cameras}};
 }
+
+namespace {
 
 /// The output folder: created if missing; one that already holds saccade output is refused
 /// unless `force`, in which case the old output of these cameras is removed first. Either way
@@ -362,7 +368,7 @@ void DatasetWriter::Write(int64_t index, double time, const scene::SceneState& s
     if (truth_.depth) TruthImage(frame.depth, frame, "depth", PixelFormat::kFloat32);
     if (truth_.ids) TruthImage(frame.ids, frame, "id", PixelFormat::kUint32);
   }
-  const json line = FrameJson(index, time, frames, truth_, scene_has_objects_);
+  const json line = FrameRecord(index, time, frames, truth_, scene_has_objects_, true);
   std::vector<std::future<void>> writes;
   const int i = static_cast<int>(index);
   for (const auto& frame : frames) {
@@ -375,8 +381,8 @@ void DatasetWriter::Write(int64_t index, double time, const scene::SceneState& s
   ++written_;
 }
 
-int RenderDataset(Renderer& renderer, DatasetWriter& writer, const scene::SceneState& initial,
-                  int frames, double fps, const std::atomic<bool>& stop,
+int RenderDataset(Renderer& renderer, FrameSink& sink, const scene::SceneState& initial, int frames,
+                  double fps, const std::atomic<bool>& stop,
                   const std::function<void(int done, double fps)>& progress) {
   const auto start = std::chrono::steady_clock::now();
   const auto state_at = [&](int i) {
@@ -388,7 +394,7 @@ int RenderDataset(Renderer& renderer, DatasetWriter& writer, const scene::SceneS
   renderer.Submit(state_at(0), 0);
   for (int i = 0; i < frames && !stop; ++i) {
     if (i + 1 < frames) renderer.Submit(state_at(i + 1), i + 1);
-    writer.Write(i, state_at(i).time, initial, renderer.Retrieve());
+    sink.Write(i, state_at(i).time, initial, renderer.Retrieve());
     ++written;
     const double seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

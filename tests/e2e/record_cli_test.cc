@@ -61,25 +61,48 @@ std::map<std::string, std::vector<std::vector<uint8_t>>> MessagesByTopic(const s
 // The split demo (robot and perception over DDS, in lockstep) is the live run; the robot's
 // recording played back into perception in lockstep gives every output perception computed
 // live, byte for byte: detections, stereo candidates, selections, tracks, targets, commands.
-TEST_F(RecordCli, ReplayInLockstepComputesWhatTheLiveRunDidBitForBit) {
+// With POPEYE (the scene's head) and with the six-joint humanoid head (--head on both).
+struct ReplayCase {
+  const char* name;
+  std::string head;  // "" : the scene's
+  const char* live_domain;
+  const char* replay_domain;
+};
+
+class ReplayCli : public RecordCli, public ::testing::WithParamInterface<ReplayCase> {};
+
+TEST_P(ReplayCli, ReplayInLockstepComputesWhatTheLiveRunDidBitForBit) {
   constexpr int kSteps = 30;
   const std::string steps = " --steps " + std::to_string(kSteps);
-  BackgroundProcess perception({kBinary, "run", kPipelines + "perception.yaml", "--dds-domain",
-                                "214", "--steps", std::to_string(kSteps), "--record",
-                                Path("live.mcap")});
-  const CommandRun robot = Saccade("run " + kPipelines + "robot.yaml --dds-domain 214" + steps +
-                                   " --record " + Path("robot.mcap"));
+  const std::string head = GetParam().head.empty() ? "" : " --head " + GetParam().head;
+  const std::string live_domain = GetParam().live_domain;
+  std::vector<std::string> perception_args = {
+      kBinary,          "run",     kPipelines + "perception.yaml", "--dds-domain",
+      live_domain,      "--steps", std::to_string(kSteps),         "--record",
+      Path("live.mcap")};
+  if (!GetParam().head.empty()) {
+    perception_args.insert(perception_args.end(), {"--head", GetParam().head});
+  }
+  BackgroundProcess perception(perception_args);
+  const CommandRun robot = Saccade("run " + kPipelines + "robot.yaml --dds-domain " + live_domain +
+                                   steps + head + " --record " + Path("robot.mcap"));
   ASSERT_EQ(robot.status, 0) << robot.output;
   std::string perception_output;
   while (const auto line = perception.ReadLine(std::chrono::seconds(120))) {
     perception_output += *line;
   }
   const CommandRun replay =
-      Saccade("run " + kPipelines + "perception.yaml --dds-domain 215 --play " +
-              Path("robot.mcap") + " --record " + Path("replay.mcap"));
+      Saccade("run " + kPipelines + "perception.yaml --dds-domain " + GetParam().replay_domain +
+              head + " --play " + Path("robot.mcap") + " --record " + Path("replay.mcap"));
   ASSERT_EQ(replay.status, 0) << replay.output;
   EXPECT_THAT(replay.output, HasSubstr("play: " + std::to_string(kSteps) + " steps"));
   EXPECT_THAT(replay.output, ::testing::Not(HasSubstr("answered late")));
+  if (!GetParam().head.empty()) {
+    // The robot's recording is of that head: its joints on joint_states.
+    const record::McapReader reader(Path("robot.mcap"));
+    ASSERT_FALSE(reader.metadata().empty());
+    EXPECT_EQ(reader.metadata().front().values.at("head"), "humanoid");
+  }
 
   const auto live = MessagesByTopic(Path("live.mcap"));
   const auto replayed = MessagesByTopic(Path("replay.mcap"));
@@ -97,6 +120,12 @@ TEST_F(RecordCli, ReplayInLockstepComputesWhatTheLiveRunDidBitForBit) {
     for (std::size_t i = 0; i < a.size(); ++i) ASSERT_EQ(a[i], b[i]) << "message " << i;
   }
 }
+
+INSTANTIATE_TEST_SUITE_P(Heads, ReplayCli,
+                         ::testing::Values(ReplayCase{"popeye", "", "214", "215"},
+                                           ReplayCase{"humanoid", kSource + "/robots/humanoid.yaml",
+                                                      "218", "219"}),
+                         [](const auto& info) { return std::string(info.param.name); });
 
 // A demo recording holds every topic (images, camera info, joint states and targets, the URDF,
 // TF, detections, targets, ground truth) with the run's head; `mcap info` says so. An existing
@@ -188,10 +217,17 @@ TEST_F(RecordCli, ARecordingKilledAtRandomMomentsKeepsItsCompleteChunks) {
   std::mt19937 rng(std::random_device{}());
   for (int kill_index = 0; kill_index < 3; ++kill_index) {
     const std::string file = Path("killed" + std::to_string(kill_index) + ".mcap");
-    const int after_ms = 1500 + static_cast<int>(rng() % 4000);
-    SCOPED_TRACE("killed after " + std::to_string(after_ms) + " ms");
+    const int after_ms = 500 + static_cast<int>(rng() % 4000);
+    SCOPED_TRACE("killed " + std::to_string(after_ms) + " ms after the file appeared");
     BackgroundProcess run({kBinary, "run", kPipelines + "demo.yaml", "--steps", "0", "--record",
                            file, "--record-chunk-s", "0.2"});
+    // From the moment the recording exists: the start-up (scene, GL) takes seconds on a loaded
+    // machine, and a process killed before it made the file left nothing to read.
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+    while (!fs::exists(file) && std::chrono::steady_clock::now() < deadline) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+    ASSERT_TRUE(fs::exists(file)) << "saccade run made no recording in 60 s";
     std::this_thread::sleep_for(std::chrono::milliseconds(after_ms));
     ::kill(run.pid(), SIGKILL);
     run.Stop();
@@ -208,6 +244,82 @@ TEST_F(RecordCli, ARecordingKilledAtRandomMomentsKeepsItsCompleteChunks) {
     EXPECT_THAT(info.output,
                 HasSubstr("cut short (no summary): the complete chunks were recovered"));
   }
+}
+
+// `saccade render --record` writes what `--out` writes: `mcap export` of the recording gives
+// back the data set's images, depth and id truth pixel for pixel, and each frame's record
+// (/saccade/frames) is frames.jsonl's line without the file names. With the humanoid head.
+TEST_F(RecordCli, RenderRecordsItsFramesAndExportGivesTheDataSetBackPixelForPixel) {
+  const std::string scene = kSource + "/scenes/portraits.yaml";
+  const std::string head = " --head " + kSource + "/robots/humanoid.yaml";
+  EXPECT_THAT(Saccade("render --scene " + scene + " --frames 1").output,
+              HasSubstr("give --out DIR, --record FILE.mcap or both"));
+  const std::string file = Path("render.mcap");
+  const CommandRun render =
+      Saccade("render --scene " + scene + head + " --frames 3 --truth depth,ids,boxes --out " +
+              Path("set") + " --record " + file);
+  ASSERT_EQ(render.status, 0) << render.output;
+  EXPECT_THAT(render.output, HasSubstr(file));
+  const CommandRun exported = Saccade("mcap export " + file + " --out " + Path("exported"));
+  ASSERT_EQ(exported.status, 0) << exported.output;
+
+  std::ifstream set_index(Path("set") + "/frames.jsonl");
+  std::ifstream exported_index(Path("exported") + "/frames.jsonl");
+  std::vector<json> set, out;
+  for (std::string line; std::getline(set_index, line);) set.push_back(json::parse(line));
+  for (std::string line; std::getline(exported_index, line);) out.push_back(json::parse(line));
+  ASSERT_EQ(set.size(), 3u);
+  ASSERT_EQ(out.size(), 3u);
+  int images = 0;
+  for (std::size_t i = 0; i < set.size(); ++i) {
+    ASSERT_EQ(set[i]["cameras"].size(), out[i]["cameras"].size());
+    for (const auto& [camera, entry] : set[i]["cameras"].items()) {
+      SCOPED_TRACE(camera + " frame " + std::to_string(i));
+      const json& other = out[i]["cameras"][camera];
+      EXPECT_EQ(entry["K"], other["K"]);
+      for (const char* key : {"file", "depth", "ids"}) {
+        const cv::Mat a =
+            cv::imread(Path("set") + "/" + entry[key].get<std::string>(), cv::IMREAD_UNCHANGED);
+        const cv::Mat b = cv::imread(Path("exported") + "/" + other[key].get<std::string>(),
+                                     cv::IMREAD_UNCHANGED);
+        ASSERT_FALSE(a.empty()) << key;
+        ASSERT_EQ(a.type(), b.type()) << key;
+        ASSERT_EQ(a.size(), b.size()) << key;
+        EXPECT_EQ(cv::norm(a, b, cv::NORM_INF), 0.0) << key;
+        EXPECT_GT(cv::countNonZero(a.reshape(1)), 0) << key;
+        ++images;
+      }
+    }
+  }
+  EXPECT_EQ(images, 3 * 3 * 3);  // frames x cameras (left, right, overview) x (image, depth, ids)
+
+  const record::McapReader reader(file);
+  EXPECT_EQ(reader.metadata().front().values.at("command"), "render");
+  EXPECT_EQ(reader.metadata().front().values.at("head"), "humanoid");
+  std::vector<json> records;
+  reader.ForEachMessage([&](const record::McapMessage& m) {
+    if (reader.channels().at(m.channel_id).topic == "/saccade/frames") {
+      records.push_back(json::parse(m.data.begin(), m.data.end()));
+    }
+    return true;
+  });
+  ASSERT_EQ(records.size(), 3u);
+  for (std::size_t i = 0; i < set.size(); ++i) {
+    json expected = set[i];
+    for (auto& [camera, entry] : expected["cameras"].items()) {
+      for (const char* key : {"file", "depth", "ids"}) entry.erase(key);
+    }
+    EXPECT_EQ(records[i], expected) << "frame " << i;
+  }
+
+  // An existing recording is kept without --force, and nothing else is written.
+  const auto size = fs::file_size(file);
+  const CommandRun again =
+      Saccade("render --scene " + scene + " --out " + Path("set2") + " --record " + file);
+  EXPECT_EQ(again.status, 1);
+  EXPECT_THAT(again.output, HasSubstr("the file exists; --force replaces it"));
+  EXPECT_EQ(fs::file_size(file), size);
+  EXPECT_FALSE(fs::exists(Path("set2")));
 }
 
 TEST_F(RecordCli, FilesThatAreNotRecordingsGetAClearError) {

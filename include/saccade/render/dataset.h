@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
@@ -29,6 +30,14 @@ struct TruthRequest {
   static TruthRequest Parse(const std::string& list);
 };
 
+/// kFloat32 depth (metres) to kGray16 millimetres, as the data set's depth PNGs: rounded to
+/// nearest, 0 where there is no surface, at least 1 where there is one, 65535 for 65.535 m
+/// and beyond.
+Image DepthToMillimetres(const Image& depth);
+/// kUint32 instance ids to kGray16, as the data set's id PNGs; throws saccade::Error naming
+/// `camera` for an id above 65535 (CheckIdsFitPng16 refuses such scenes before rendering).
+Image IdsToPng16(const Image& ids, const std::string& camera);
+
 /// Sets the renderer's truth outputs that `truth` needs.
 void ApplyTruth(const TruthRequest& truth, RendererOptions* options);
 
@@ -36,8 +45,24 @@ void ApplyTruth(const TruthRequest& truth, RendererOptions* options);
 /// robot) with a larger id that the images could show, before anything is rendered.
 void CheckIdsFitPng16(const scene::Scene& scene, const RendererOptions& options);
 
+/// Where RenderDataset puts its frames: a data set folder (DatasetWriter), an MCAP recording
+/// (record/frame_recorder.h), or both.
+class FrameSink {
+ public:
+  virtual ~FrameSink() = default;
+  /// One frame of every camera at `time`; `state` is the state it was rendered from.
+  virtual void Write(int64_t index, double time, const scene::SceneState& state,
+                     const std::vector<Frame>& frames) = 0;
+};
+
+/// One frame's record, as frames.jsonl holds it: {"frame", "time", "cameras": {name: {width,
+/// height, K, distortion, X_WC, exposure_samples, joints, and with `truth` the objects' boxes
+/// and poses}}}. `files`: each camera's image files too (file, depth, ids).
+nlohmann::json FrameRecord(int64_t index, double time, const std::vector<Frame>& frames,
+                           const TruthRequest& truth, bool scene_has_objects, bool files);
+
 /// Writes frames of `cameras` into the folder `out`.
-class DatasetWriter {
+class DatasetWriter final : public FrameSink {
  public:
   /// Creates `out` if missing. Output already there (frames.jsonl, a camera's folder or file)
   /// is refused with InvalidArgument unless `force`, which removes the old frames first; the
@@ -50,7 +75,7 @@ class DatasetWriter {
   /// Writes one frame of every camera (the calibration files with the first) at `time`;
   /// `state` gives the stereo extrinsics. Throws FileError when a file cannot be written.
   void Write(int64_t index, double time, const scene::SceneState& state,
-             const std::vector<Frame>& frames);
+             const std::vector<Frame>& frames) override;
   int64_t written() const { return written_; }
 
  private:
@@ -64,12 +89,12 @@ class DatasetWriter {
   int64_t written_ = 0;
 };
 
-/// Renders `frames` frames at times i / fps from `initial` into `writer`, two in flight
+/// Renders `frames` frames at times i / fps from `initial` into `sink`, two in flight
 /// (frame i + 1 is drawn while frame i is read back and written); stops after the frame in
 /// hand once `stop` is set. `progress(done, frames per second)` after each frame. Returns
 /// the number of whole frames written.
-int RenderDataset(Renderer& renderer, DatasetWriter& writer, const scene::SceneState& initial,
-                  int frames, double fps, const std::atomic<bool>& stop,
+int RenderDataset(Renderer& renderer, FrameSink& sink, const scene::SceneState& initial, int frames,
+                  double fps, const std::atomic<bool>& stop,
                   const std::function<void(int done, double fps)>& progress = {});
 
 }  // namespace saccade::render

@@ -13,6 +13,7 @@
 #include <thread>
 #include <vector>
 
+#include "record/pipeline/internal_channels.h"
 #include "saccade/components/messages.h"
 #include "saccade/components/roles.h"
 #include "saccade/core/error.h"
@@ -27,12 +28,6 @@ namespace {
 
 // Steps handed over and not yet written, at most: the loop waits beyond (bounded memory).
 constexpr std::size_t kMaxQueuedSteps = 2;
-
-uint64_t Nanoseconds(double seconds) {
-  return seconds <= 0.0 || !std::isfinite(seconds)
-             ? 0
-             : static_cast<uint64_t>(std::llround(seconds * 1e9));
-}
 
 }  // namespace
 
@@ -78,45 +73,10 @@ struct PipelineRecorder::Impl {
 
   // Written by the writing thread only.
   uint64_t log_time = 0;
-  std::map<std::string, uint16_t> schema_ids;   // by ROS type
-  std::map<std::string, uint16_t> channel_ids;  // by topic
+  internal::Channels channels{writer};
 
   Impl(const std::filesystem::path& p, RecorderOptions o)
-      : path(p), options(std::move(o)), writer(p, WriterOptions(options)) {}
-
-  static McapWriterOptions WriterOptions(const RecorderOptions& o) {
-    if (o.compression != "zstd" && o.compression != "none") {
-      throw InvalidArgument("record: compression must be zstd or none, got '" + o.compression +
-                            "'");
-    }
-    if (!(o.chunk_seconds > 0.0) || !std::isfinite(o.chunk_seconds)) {
-      throw InvalidArgument(
-          fmt::format("record: chunk seconds must be > 0, got {}", o.chunk_seconds));
-    }
-    McapWriterOptions w;
-    w.compression = o.compression == "none" ? "" : o.compression;
-    w.chunk_seconds = o.chunk_seconds;
-    w.zstd_level = o.zstd_level;
-    w.chunk_bytes = 8 << 20;
-    return w;
-  }
-
-  uint16_t ChannelOf(const std::string& topic, const std::string& ros_type) {
-    if (const auto found = channel_ids.find(topic); found != channel_ids.end()) {
-      return found->second;
-    }
-    uint16_t schema = 0;
-    if (!ros_type.empty()) {
-      auto [at, added] = schema_ids.try_emplace(ros_type, 0);
-      if (added) {
-        at->second = writer.AddSchema(ros_type, "ros2msg", dds::RosMessageDefinition(ros_type));
-      }
-      schema = at->second;
-    }
-    const uint16_t id = writer.AddChannel(schema, topic, ros_type.empty() ? "json" : "cdr");
-    channel_ids[topic] = id;
-    return id;
-  }
+      : path(p), options(std::move(o)), writer(p, internal::WriterOptions(options)) {}
 
   void Tap(runtime::Pipeline& pipeline);
   void Add(Source* source, std::shared_ptr<const void> message) {
@@ -170,10 +130,8 @@ void PipelineRecorder::Impl::Tap(runtime::Pipeline& pipeline) {
           t.robot_description_topic = dds::ResolveTopic("robot_description", options.ns);
           t.tf_topic = "/tf";
         }
-        raw->ros = dds::Writer::CreateSerializing(type, t, [this](const dds::SerializedMessage& m) {
-          writer.Write(ChannelOf(m.topic, m.ros_type), log_time,
-                       static_cast<uint64_t>(std::max<int64_t>(m.stamp_ns, 0)), {m.data, m.size});
-        });
+        raw->ros = dds::Writer::CreateSerializing(
+            type, t, [this](const dds::SerializedMessage& m) { channels.Write(m, log_time); });
         // Typed: images are kept by their shared pixels, not converted during the step.
         if (type == image_type) {
           auto* typed = dynamic_cast<runtime::Output<runtime::ImageMessage>*>(output.get());
@@ -201,7 +159,7 @@ void PipelineRecorder::Impl::Tap(runtime::Pipeline& pipeline) {
         id = output->ConnectJson([this, raw](const nlohmann::json& json) {
           const auto time = json.is_object() ? json.find("time") : json.end();
           const double t = time != json.end() && time->is_number() ? time->get<double>() : -1.0;
-          AddJsonText(raw, json, Nanoseconds(t));
+          AddJsonText(raw, json, internal::Nanoseconds(t));
         });
       }
       connections.emplace_back(output.get(), id);
@@ -217,7 +175,7 @@ void PipelineRecorder::Impl::WriteStep(Step& s) {
       p.source->ros->WriteErased(p.message.get());
     } else {
       const auto* data = reinterpret_cast<const uint8_t*>(p.json.data());
-      writer.Write(ChannelOf(p.source->json_topic, ""), log_time,
+      writer.Write(channels.Of(p.source->json_topic, ""), log_time,
                    p.publish_time == 0 ? log_time : p.publish_time, {data, p.json.size()});
     }
   }
@@ -275,7 +233,7 @@ PipelineRecorder::~PipelineRecorder() {
 void PipelineRecorder::AfterStep(const runtime::StepContext& context) {
   impl_->RethrowFailure();
   Impl::Step s;
-  s.log_time = Nanoseconds(context.time);
+  s.log_time = internal::Nanoseconds(context.time);
   {
     std::lock_guard lock(impl_->step_mutex);
     s.messages.swap(impl_->step);
@@ -293,7 +251,7 @@ void PipelineRecorder::AddJson(const std::string& topic, double time,
     source = std::make_unique<Impl::Source>();
     source->json_topic = topic;
   }
-  impl_->AddJsonText(source.get(), message, Nanoseconds(time));
+  impl_->AddJsonText(source.get(), message, internal::Nanoseconds(time));
 }
 
 RecordingStats PipelineRecorder::Close() {
