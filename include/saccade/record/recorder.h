@@ -21,7 +21,8 @@
 // record "saccade" holds RecorderOptions::metadata (the head, scene and pipeline of the run).
 //
 // The messages of a step are serialized, written and compressed on a thread of the recorder's
-// own, after the step: the loop waits only when that thread is two steps behind. A recording
+// own (SCHED_IDLE: it runs on a core the loop leaves idle), after the step: the loop waits only
+// when that thread is two steps behind. A recording
 // killed at any moment keeps every complete chunk (McapReader recovers them): what is lost is
 // the open chunk, at most RecorderOptions::chunk_seconds of the run, and the at most two steps
 // handed over and not yet written.

@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 #include <pthread.h>
+#include <sched.h>
 #include <sys/resource.h>
 #include <unistd.h>
 
@@ -213,8 +214,13 @@ PipelineRecorder::PipelineRecorder(runtime::Pipeline& pipeline, const std::files
   impl_->thread = std::thread([this] {
     pthread_setname_np(pthread_self(), "mcap-writer");  // in top and perf
     // Below the loop's threads: the writing uses the cores' idle moments (a loop waiting on
-    // the renderer's readback), and the queue bounds how far it may fall behind.
-    setpriority(PRIO_PROCESS, static_cast<id_t>(::gettid()), 10);
+    // the renderer's readback), and the queue bounds how far it may fall behind. SCHED_IDLE
+    // (any user may ask it for its own threads) runs it only on an idle core; niced where
+    // the kernel refuses.
+    const sched_param idle{};
+    if (pthread_setschedparam(pthread_self(), SCHED_IDLE, &idle) != 0) {
+      setpriority(PRIO_PROCESS, static_cast<id_t>(::gettid()), 10);
+    }
     impl_->WriteLoop();
   });
 }
