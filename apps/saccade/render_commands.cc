@@ -225,8 +225,9 @@ Runner AddRenderCommand(CLI::App& app) {
       "lens distortion, sensor noise and motion blur as the scene describes them, to "
       "DIR/<camera>/<frame>.png, each camera's "
       "calibration as OpenCV YAML with the distortion that was rendered (DIR/<camera>.yaml, "
-      "DIR/stereo.yaml for a head), and DIR/frames.jsonl with every frame's metadata. Ctrl-C "
-      "stops after the frame in hand: only whole frames are left.");
+      "DIR/stereo.yaml for a head), and DIR/frames.jsonl with every frame's metadata; or to an "
+      "MCAP recording of the same (--record FILE.mcap), or both. Ctrl-C stops after the frame "
+      "in hand: only whole frames are left.");
   render->add_option("--scene", o->scene, "Scene YAML (scenes/portraits.yaml, ...)")
       ->check(CLI::ExistingFile)
       ->required();

@@ -209,6 +209,8 @@ describe('saccade gui (portraits.yaml)', () => {
     await page?.close().catch(() => {});
     await browser?.close().catch(() => {});
     await stopSaccade(server);
+    // The Record button's files (tens of MB a run): the pictures beside them stay for people.
+    fs.rmSync(path.join(kOutput, 'recordings'), { recursive: true, force: true });
   });
 
   test('the page loads, draws the world and shows both cameras', async () => {

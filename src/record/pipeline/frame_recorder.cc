@@ -1,8 +1,7 @@
 #include "saccade/record/frame_recorder.h"
 
-#include <cmath>
-#include <cstring>
 #include <map>
+#include <memory>
 
 #include "record/pipeline/internal_channels.h"
 #include "saccade/components/messages.h"
@@ -97,12 +96,12 @@ void FrameRecorder::Write(int64_t index, double time, const scene::SceneState& s
     Impl::Camera& camera = r.CameraOf(frame.color->metadata().camera);
     camera.image->Write(runtime::ImageMessage{frame.color});
     if (camera.depth && frame.depth) camera.depth->Write(runtime::ImageMessage{frame.depth});
-    if (camera.ids && frame.ids)
-      camera.ids->Write(runtime::ImageMessage{std::make_shared<Image>([&] {
-        Image ids = render::IdsToPng16(*frame.ids, frame.color->metadata().camera);
-        ids.metadata() = frame.ids->metadata();
-        return ids;
-      }())});
+    if (camera.ids && frame.ids) {
+      auto ids =
+          std::make_shared<Image>(render::IdsToPng16(*frame.ids, frame.color->metadata().camera));
+      ids->metadata() = frame.ids->metadata();
+      camera.ids->Write(runtime::ImageMessage{std::move(ids)});
+    }
   }
   const std::string record =
       render::FrameRecord(index, time, frames, r.truth, !r.scene.objects().empty(), false).dump();
