@@ -211,7 +211,7 @@ class Exporter {
       } else if (type == "tf2_msgs/msg/TFMessage") {
         for (const json& t : v["transforms"]) poses_[t["child_frame_id"]] = t["transform"];
       } else if (type == "sensor_msgs/msg/JointState") {
-        if (topic.size() >= 12 && topic.compare(topic.size() - 12, 12, "joint_states") == 0) {
+        if (topic.ends_with("joint_states")) {
           joints_ = json::object();
           for (std::size_t i = 0; i < v["name"].size() && i < v["position"].size(); ++i) {
             joints_[v["name"][i].get<std::string>()] = v["position"][i];
@@ -237,16 +237,12 @@ class Exporter {
     const int64_t stamp = StampNs(image["header"]);
     if (!frame_.empty() && stamp != frame_stamp_) Flush();
     frame_stamp_ = stamp;
-    const auto ends_with = [&](const std::string& tail) {
-      return topic.size() >= tail.size() &&
-             topic.compare(topic.size() - tail.size(), tail.size(), tail) == 0;
-    };
-    const std::string truth = ends_with("/depth/image_raw") ? "depth"
-                              : ends_with("/ids/image_raw") ? "ids"
-                                                            : "";
+    const std::string truth = topic.ends_with("/depth/image_raw") ? "depth"
+                              : topic.ends_with("/ids/image_raw") ? "ids"
+                                                                  : "";
     std::string frame_id = image["header"]["frame_id"];
     std::string camera = frame_id;
-    if (camera.size() > 8 && camera.compare(camera.size() - 8, 8, "_optical") == 0) {
+    if (camera.size() > 8 && camera.ends_with("_optical")) {
       camera.resize(camera.size() - 8);
     }
     const std::string encoding = image["encoding"];
