@@ -53,6 +53,9 @@ packages=(
   liburdfdom-dev
   # recordings in MCAP (issue 43): zstd chunk compression, zlib's CRC-32
   libzstd-dev zlib1g-dev
+  # the world map of exploration (issue 44): OctoMap's occupancy octree (occupied, free and
+  # unknown space; two packages, where Open3D brings 79 and PCL 508)
+  liboctomap-dev
 )
 # What the tests, benchmarks and the Python package add (the full setup only).
 test_packages=(
