@@ -1,0 +1,208 @@
+#include "saccade/mapping/world_map.h"
+
+#include <octomap/OcTree.h>
+
+#include <atomic>
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+
+#include "saccade/core/error.h"
+#include "saccade/core/temporary_file.h"
+
+namespace saccade::mapping {
+namespace world_map_internal {
+
+octomap::point3d ToOcto(const Eigen::Vector3d& p) {
+  return octomap::point3d(static_cast<float>(p.x()), static_cast<float>(p.y()),
+                          static_cast<float>(p.z()));
+}
+
+}  // namespace world_map_internal
+
+using world_map_internal::ToOcto;
+
+struct WorldMap::Impl {
+  explicit Impl(double resolution) : tree(resolution) {}
+  octomap::OcTree tree;
+};
+
+bool WorldMap::Options::IsValid(std::string* error) const {
+  std::string what;
+  if (!kResolutions.Contains(resolution_m)) {
+    what = kResolutions.Refusal("resolution_m", resolution_m);
+  } else if (!kRanges.Contains(max_range_m)) {
+    what = kRanges.Refusal("max_range_m", max_range_m);
+  } else if (!kStrides.Contains(stride)) {
+    what = kStrides.Refusal("stride", stride);
+  } else if (!kConfidences.Contains(min_confidence)) {
+    what = kConfidences.Refusal("min_confidence", min_confidence);
+  } else if (!kEdgeRatios.Contains(edge_ratio)) {
+    what = kEdgeRatios.Refusal("edge_ratio", edge_ratio);
+  } else if (!kHits.Contains(hit_probability)) {
+    what = kHits.Refusal("hit_probability", hit_probability);
+  } else if (!kMisses.Contains(miss_probability)) {
+    what = kMisses.Refusal("miss_probability", miss_probability);
+  }
+  if (what.empty()) return true;
+  if (error) *error = "WorldMap::Options: " + what;
+  return false;
+}
+
+WorldMap::WorldMap(const Options& options) : options_(options) {
+  std::string error;
+  if (!options.IsValid(&error)) throw InvalidArgument(error);
+  impl_ = std::make_unique<Impl>(options.resolution_m);
+  impl_->tree.setProbHit(options.hit_probability);
+  impl_->tree.setProbMiss(options.miss_probability);
+}
+
+WorldMap::~WorldMap() = default;
+WorldMap::WorldMap(WorldMap&&) noexcept = default;
+WorldMap& WorldMap::operator=(WorldMap&&) noexcept = default;
+
+FuseStats WorldMap::Fuse(const vision::StereoDepth& stereo) {
+  // The samples of every stride-th row and column, confident enough and not on a depth edge: a
+  // pixel whose neighbours (one pixel away) differ in depth by more than edge_ratio of its own
+  // may have mixed the two surfaces (a "flying pixel" between foreground and background).
+  std::vector<Eigen::Vector3d> points;
+  const Image& depth = stereo.depth;
+  const Eigen::Matrix3d K_inv = stereo.rectified.Matrix().inverse();
+  const auto at = [&](const Image& image, int u, int v) {
+    return reinterpret_cast<const float*>(image.data() + v * image.stride())[u];
+  };
+  for (int v = 1; v + 1 < depth.height(); v += options_.stride) {
+    for (int u = 1; u + 1 < depth.width(); u += options_.stride) {
+      const float z = at(depth, u, v);
+      if (!(z > 0) || at(stereo.confidence, u, v) < options_.min_confidence) continue;
+      bool edge = false;
+      for (const auto& [du, dv] : {std::pair{-1, 0}, {1, 0}, {0, -1}, {0, 1}}) {
+        const float n = at(depth, u + du, v + dv);
+        edge = edge || !(n > 0) || std::abs(n - z) > options_.edge_ratio * z;
+      }
+      if (edge) continue;
+      points.push_back(stereo.X_WR * (z * (K_inv * Eigen::Vector3d(u, v, 1.0))));
+    }
+  }
+  return FusePoints(points, stereo.X_WR.translation());
+}
+
+FuseStats WorldMap::FusePoints(const std::vector<Eigen::Vector3d>& points_W,
+                               const Eigen::Vector3d& origin_W) {
+  octomap::Pointcloud cloud;
+  cloud.reserve(points_W.size());
+  FuseStats stats;
+  for (const Eigen::Vector3d& p : points_W) {
+    if (!p.allFinite() || (p - origin_W).norm() > options_.max_range_m) continue;
+    cloud.push_back(ToOcto(p));
+    ++stats.rays;
+  }
+  // discretize: one ray per end voxel (the same map, far fewer rays at the default stride).
+  impl_->tree.insertPointCloud(cloud, ToOcto(origin_W), options_.max_range_m, false, true);
+  stats.occupied = occupied_voxels();
+  stats.known_voxels = known_voxels();
+  return stats;
+}
+
+Occupancy WorldMap::At(const Eigen::Vector3d& p_W) const {
+  const octomap::OcTreeNode* node = impl_->tree.search(ToOcto(p_W));
+  if (node == nullptr) return Occupancy::kUnknown;
+  return impl_->tree.isNodeOccupied(node) ? Occupancy::kOccupied : Occupancy::kFree;
+}
+
+std::vector<Eigen::Vector3d> WorldMap::OccupiedCentres() const {
+  std::vector<Eigen::Vector3d> out;
+  const octomap::OcTree& tree = impl_->tree;
+  const double resolution = tree.getResolution();
+  for (auto it = tree.begin_leafs(), end = tree.end_leafs(); it != end; ++it) {
+    if (!tree.isNodeOccupied(*it)) continue;
+    const double size = it.getSize();
+    const octomap::point3d c = it.getCoordinate();
+    if (size <= resolution * 1.5) {
+      out.emplace_back(c.x(), c.y(), c.z());
+      continue;
+    }
+    // A pruned leaf stands for a block of finest voxels: give each of them.
+    const int n = static_cast<int>(std::lround(size / resolution));
+    const double first = -size / 2 + resolution / 2;
+    for (int i = 0; i < n; ++i) {
+      for (int j = 0; j < n; ++j) {
+        for (int k = 0; k < n; ++k) {
+          out.emplace_back(c.x() + first + i * resolution, c.y() + first + j * resolution,
+                           c.z() + first + k * resolution);
+        }
+      }
+    }
+  }
+  return out;
+}
+
+bool WorldMap::RayMeetsUnknown(const Eigen::Vector3d& origin_W, const Eigen::Vector3d& direction_W,
+                               double max_range_m, double* distance_m) const {
+  octomap::point3d end;
+  const Eigen::Vector3d d = direction_W.normalized();
+  const bool hit = impl_->tree.castRay(ToOcto(origin_W), ToOcto(d), end, false, max_range_m);
+  const Eigen::Vector3d e(end.x(), end.y(), end.z());
+  const double along = std::min((e - origin_W).dot(d), max_range_m);
+  if (distance_m != nullptr) *distance_m = along;
+  if (hit) return false;  // an occupied voxel first
+  // castRay stops at an unknown voxel (false) or at max_range (false, end beyond it).
+  return along < max_range_m - impl_->tree.getResolution() && impl_->tree.search(end) == nullptr;
+}
+
+int64_t WorldMap::occupied_voxels() const {
+  int64_t n = 0;
+  const octomap::OcTree& tree = impl_->tree;
+  const double resolution = tree.getResolution();
+  for (auto it = tree.begin_leafs(), end = tree.end_leafs(); it != end; ++it) {
+    if (!tree.isNodeOccupied(*it)) continue;
+    const int64_t edge = std::lround(it.getSize() / resolution);
+    n += edge * edge * edge;
+  }
+  return n;
+}
+
+int64_t WorldMap::known_voxels() const {
+  return static_cast<int64_t>(impl_->tree.getNumLeafNodes());
+}
+
+std::size_t WorldMap::memory_bytes() const { return impl_->tree.memoryUsage(); }
+
+void WorldMap::WritePly(const std::filesystem::path& path) const {
+  WritePointsPly(OccupiedCentres(), path);
+}
+
+void WritePointsPly(const std::vector<Eigen::Vector3d>& points, const std::filesystem::path& path) {
+  static std::atomic<unsigned> counter{0};
+  const std::filesystem::path temporary = TemporaryPathFor(path, counter++);
+  std::FILE* file = std::fopen(temporary.c_str(), "wb");
+  if (file == nullptr) {
+    throw FileError(path.string(), 0, "", std::string("cannot write: ") + std::strerror(errno));
+  }
+  const std::string header =
+      "ply\nformat binary_little_endian 1.0\ncomment saccade map, metres, "
+      "world frame (z up)\nelement vertex " +
+      std::to_string(points.size()) +
+      "\nproperty float x\nproperty float y\nproperty float z\nend_header\n";
+  bool ok = std::fwrite(header.data(), 1, header.size(), file) == header.size();
+  for (const Eigen::Vector3d& p : points) {
+    const float xyz[3] = {static_cast<float>(p.x()), static_cast<float>(p.y()),
+                          static_cast<float>(p.z())};
+    ok = ok && std::fwrite(xyz, sizeof(float), 3, file) == 3;
+  }
+  ok = std::fflush(file) == 0 && ok;
+  std::fclose(file);
+  if (!ok) {
+    std::filesystem::remove(temporary);
+    throw FileError(path.string(), 0, "", "cannot write the PLY (disk full or I/O error)");
+  }
+  std::error_code error;
+  std::filesystem::rename(temporary, path, error);
+  if (error) {
+    std::filesystem::remove(temporary);
+    throw FileError(path.string(), 0, "", "cannot rename into place: " + error.message());
+  }
+}
+
+}  // namespace saccade::mapping
