@@ -29,6 +29,7 @@ Runner AddGuiCommand(CLI::App& app);
 Runner AddRunCommand(CLI::App& app);
 Runner AddUrdfCommand(CLI::App& app);
 Runner AddMcapCommand(CLI::App& app);
+Runner AddExploreCommand(CLI::App& app);
 
 // Shared helpers.
 inline constexpr double kDegToRad = M_PI / 180.0;

@@ -82,7 +82,7 @@ int main(int argc, char** argv) {
     std::vector<std::pair<CLI::App*, a::Runner>> list;
     for (auto add : {a::AddFkCommand, a::AddIkCommand, a::AddCameraCommand, a::AddRenderCommand,
                      a::AddBenchCommand, a::AddDemoCommand, a::AddGuiCommand, a::AddRunCommand,
-                     a::AddUrdfCommand, a::AddMcapCommand}) {
+                     a::AddUrdfCommand, a::AddMcapCommand, a::AddExploreCommand}) {
       a::Runner run = add(app);
       list.emplace_back(app.get_subcommands([](CLI::App*) { return true; }).back(), std::move(run));
     }
