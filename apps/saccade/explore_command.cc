@@ -103,7 +103,7 @@ std::string Seconds(double s) { return s < 0 ? "never" : fmt::format("{:.1f} s",
 
 void PrintReport(const std::vector<ExploreReport>& reports, const components::ExploreTruth& truth) {
   fmt::print("\n{} truth samples (the surface the head can see, {} views, rendered in {:.1f} s)\n",
-             truth.samples_W.size(), truth.grid_W.size(), truth.render_ms / 1000);
+             truth.samples_W.size(), truth.views, truth.render_ms / 1000);
   fmt::print("\n{:<10} {:>9} {:>9} {:>9} {:>12} {:>22} {:>22}\n", "strategy", "fixations",
              "to 50 %", "to 80 %", "complete", "map-truth mean/RMS/p95", "at 1-3 m RMS");
   for (const ExploreReport& r : reports) {

@@ -47,7 +47,7 @@ std::string SubcommandSummary(const CLI::App& app) {
 }
 
 // The first word that is neither an option nor an option's value: the subcommand the user
-// meant. CLI11 would let `saccade explore --help` print the main help and exit 0; an unknown
+// meant. CLI11 would let `saccade wander --help` print the main help and exit 0; an unknown
 // name is an error of its own.
 const char* FirstWord(int argc, char** argv) {
   for (int i = 1; i < argc; ++i) {

@@ -49,7 +49,7 @@ void ReadStereo(const Entry& entry, vision::DenseStereo::Options* o) {
 void ReadMap(const Entry& entry, mapping::WorldMap::Options* o) {
   using M = mapping::WorldMap::Options;
   entry.ExpectMap({"resolution_m", "max_range_m", "stride", "min_confidence", "edge_ratio",
-                   "hit_probability", "miss_probability"});
+                   "hit_probability", "miss_probability", "occupancy_threshold"});
   ReadIf(entry, "resolution_m", M::kResolutions, &o->resolution_m);
   ReadIf(entry, "max_range_m", M::kRanges, &o->max_range_m);
   ReadIf(entry, "stride", M::kStrides, &o->stride);
@@ -57,6 +57,7 @@ void ReadMap(const Entry& entry, mapping::WorldMap::Options* o) {
   ReadIf(entry, "edge_ratio", M::kEdgeRatios, &o->edge_ratio);
   ReadIf(entry, "hit_probability", M::kHits, &o->hit_probability);
   ReadIf(entry, "miss_probability", M::kMisses, &o->miss_probability);
+  ReadIf(entry, "occupancy_threshold", M::kThresholds, &o->occupancy_threshold);
 }
 
 constexpr Interval kPositive = Interval::Above(0.0);
@@ -105,9 +106,10 @@ ExploreConfig LoadExploreConfig(const std::filesystem::path& path) {
   if (const std::optional<Entry> e = root.Find("stereo")) ReadStereo(*e, &o.stereo);
   if (const std::optional<Entry> e = root.Find("map")) ReadMap(*e, &o.map);
   if (const std::optional<Entry> e = root.Find("score")) {
-    e->ExpectMap({"sample_every_s", "truth_cell_m"});
+    e->ExpectMap({"sample_every_s", "truth_cell_m", "truth_step"});
     ReadIf(*e, "sample_every_s", kPositive, &o.sample_every_s);
     ReadIf(*e, "truth_cell_m", kPositive, &o.truth_cell_m);
+    ReadIf(*e, "truth_step", Interval::LeftOpen(0.0, 2.0), &o.truth_step);
   }
   return config;
 }

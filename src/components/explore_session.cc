@@ -195,6 +195,9 @@ bool ExploreOptions::IsValid(std::string* error) const {
   if (what.empty() && !(raster_step > 0 && raster_step <= 2)) {
     what = "raster_step: " + std::to_string(raster_step) + ", expected (0, 2] fields of view";
   }
+  if (what.empty() && !(truth_step > 0 && truth_step <= 2)) {
+    what = "truth_step: " + std::to_string(truth_step) + ", expected (0, 2] fields of view";
+  }
   if (what.empty() && !(saliency_weight >= 0 && novelty_weight >= 0)) {
     what = "saliency_weight, novelty_weight: expected numbers >= 0";
   }
@@ -224,10 +227,8 @@ ExploreTruth MakeExploreTruth(const scene::Scene& scene, const ExploreOptions& o
   truth.viewpoint_W = head.X_WB().translation();
   truth.grid_W =
       ReachGrid(head, options.raster_step * FieldOfView(head), options.target_distance_m);
-  // The truth sees from a grid twice as dense as the raster's, so that it holds what any
-  // strategy could see.
   const std::vector<Eigen::Vector3d> views =
-      ReachGrid(head, 0.5 * options.raster_step * FieldOfView(head), options.target_distance_m);
+      ReachGrid(head, options.truth_step * FieldOfView(head), options.target_distance_m);
   std::unique_ptr<render::Renderer> renderer = EyeRenderer(scene, true);
   head::FixationSolver solver(head);
   std::vector<Eigen::Vector3d> samples;
@@ -238,6 +239,7 @@ ExploreTruth MakeExploreTruth(const scene::Scene& scene, const ExploreOptions& o
     AddTruth(frames.at(0), options.map.max_range_m, &samples);
   }
   truth.samples_W = mapping::Thin(samples, options.truth_cell_m);
+  truth.views = static_cast<int>(views.size());
   truth.render_ms = MsSince(start);
   return truth;
 }

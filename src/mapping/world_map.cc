@@ -44,6 +44,8 @@ bool WorldMap::Options::IsValid(std::string* error) const {
     what = kHits.Refusal("hit_probability", hit_probability);
   } else if (!kMisses.Contains(miss_probability)) {
     what = kMisses.Refusal("miss_probability", miss_probability);
+  } else if (!kThresholds.Contains(occupancy_threshold)) {
+    what = kThresholds.Refusal("occupancy_threshold", occupancy_threshold);
   }
   if (what.empty()) return true;
   if (error) *error = "WorldMap::Options: " + what;
@@ -56,6 +58,7 @@ WorldMap::WorldMap(const Options& options) : options_(options) {
   impl_ = std::make_unique<Impl>(options.resolution_m);
   impl_->tree.setProbHit(options.hit_probability);
   impl_->tree.setProbMiss(options.miss_probability);
+  impl_->tree.setOccupancyThres(options.occupancy_threshold);
 }
 
 WorldMap::~WorldMap() = default;

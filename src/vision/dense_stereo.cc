@@ -92,9 +92,19 @@ cv::Mat Match(cv::StereoSGBM& sgbm, int num_disparities, const cv::Mat& left,
   return ToPixels(fixed.colRange(num_disparities, fixed.cols));
 }
 
+// Whether rectified pixel (x, y) samples `image` at least `margin` pixels inside its edges.
+bool Inside(const cv::Mat& map_x, const cv::Mat& map_y, int x, int y, const Image& image,
+            double margin) {
+  if (x < 0 || x >= map_x.cols) return false;
+  const float sx = map_x.at<float>(y, x), sy = map_y.at<float>(y, x);
+  return sx >= margin && sy >= margin && sx <= image.width() - 1 - margin &&
+         sy <= image.height() - 1 - margin;
+}
+
 }  // namespace dense_stereo_internal
 
 using dense_stereo_internal::FloatImage;
+using dense_stereo_internal::Inside;
 using dense_stereo_internal::WrapFloat;
 
 bool DenseStereo::Options::IsValid(std::string* error) const {
@@ -149,10 +159,12 @@ StereoDepth DenseStereo::Compute(const StereoView& left, const StereoView& right
   out.rectified = geometry::Intrinsics(width, height, out.focal_px, out.focal_px, (width - 1) / 2.0,
                                        (height - 1) / 2.0);
   out.R1 = rect.R1;
+  out.R2 = rect.R2;
   out.X_WR = left.X_WC * geometry::MakePose(rect.R1.transpose(), Eigen::Vector3d::Zero());
 
   // The left camera must be on the left (T_rect.x < 0: its centre at -x seen from the right).
   const bool swapped = rect.T_rect.x() > 0;
+  out.mirrored = swapped;
   cv::Mat maps[4];
   RectifyMaps(left.camera, rect.R1, out.rectified, &maps[0], &maps[1]);
   RectifyMaps(right.camera, rect.R2, out.rectified, &maps[2], &maps[3]);
@@ -205,6 +217,24 @@ StereoDepth DenseStereo::Compute(const StereoView& left, const StereoView& right
     cv::flip(disparity, disparity, 1);
     cv::flip(confidence, confidence, 1);
   }
+  // Where a rectified view samples outside its camera's image (a verged or distorted pair turns
+  // parts of each view off the sensor) it is black, and black matches black: only pixels whose
+  // own and matched sources lie inside both images (by half a block) are kept.
+  const double margin = options_.block_size / 2 + 1;
+  const int sign = swapped ? 1 : -1;  // the right view's column of left column x: x + sign d
+  for (int y = 0; y < disparity.rows; ++y) {
+    float* d = disparity.ptr<float>(y);
+    float* c = confidence.ptr<float>(y);
+    for (int x = 0; x < disparity.cols; ++x) {
+      if (d[x] <= 0) continue;
+      const int xr = static_cast<int>(std::lround(x + sign * d[x]));
+      if (!Inside(maps[0], maps[1], x, y, *left.image, margin) ||
+          !Inside(maps[2], maps[3], xr, y, *right.image, margin)) {
+        d[x] = -1.0f;
+        c[x] = 0.0f;
+      }
+    }
+  }
   cv::Mat depth(disparity.size(), CV_32FC1, cv::Scalar(0.0f));
   const double fb = out.focal_px * out.baseline_m;
   for (int y = 0; y < disparity.rows; ++y) {
@@ -224,7 +254,7 @@ StereoDepth DenseStereo::Compute(const StereoView& left, const StereoView& right
 }
 
 Image TruthDisparity(const Image& left_depth, const geometry::CameraModel& left,
-                     const StereoDepth& stereo) {
+                     const geometry::CameraModel& right, const StereoDepth& stereo) {
   const auto& in = left.intrinsics();
   if (left_depth.format() != PixelFormat::kFloat32 || left_depth.width() != in.width() ||
       left_depth.height() != in.height()) {
@@ -233,9 +263,11 @@ Image TruthDisparity(const Image& left_depth, const geometry::CameraModel& left,
   }
   cv::Mat map_x, map_y;
   dense_stereo_internal::RectifyMaps(left, stereo.R1, stereo.rectified, &map_x, &map_y);
-  cv::Mat z_left;
+  cv::Mat z_left, right_x, right_y;
   cv::remap(WrapFloat(left_depth), z_left, map_x, map_y, cv::INTER_NEAREST, cv::BORDER_CONSTANT,
             cv::Scalar(0.0));
+  dense_stereo_internal::RectifyMaps(right, stereo.R2, stereo.rectified, &right_x, &right_y);
+  const int sign = stereo.mirrored ? 1 : -1;
   // A rectified pixel's ray r_L = R1^T K_rect^-1 (u, v, 1); at the left depth z_L its rectified
   // depth is z_L / r_L.z, and its disparity f B r_L.z / z_L.
   const Eigen::Matrix3d back = stereo.R1.transpose() * stereo.rectified.Matrix().inverse();
@@ -247,7 +279,14 @@ Image TruthDisparity(const Image& left_depth, const geometry::CameraModel& left,
     for (int u = 0; u < out.cols; ++u) {
       if (!(z[u] > 0)) continue;
       const double ray_z = back.row(2).dot(Eigen::Vector3d(u, v, 1.0));
-      if (ray_z > 0) d[u] = static_cast<float>(fb * ray_z / z[u]);
+      if (!(ray_z > 0)) continue;
+      const double disparity = fb * ray_z / z[u];
+      const int ur = static_cast<int>(std::lround(u + sign * disparity));
+      if (ur < 0 || ur >= right_x.cols) continue;
+      const float sx = right_x.at<float>(v, ur), sy = right_y.at<float>(v, ur);
+      const auto& rin = right.intrinsics();
+      if (sx < 0 || sy < 0 || sx > rin.width() - 1 || sy > rin.height() - 1) continue;
+      d[u] = static_cast<float>(disparity);
     }
   }
   return FloatImage(out);

@@ -25,6 +25,7 @@ ExploreOptions Short(const std::string& strategy) {
   options.strategy = strategy;
   options.seconds = 2.0;
   options.raster_step = 1.5;
+  options.truth_step = 1.0;
   options.truth_cell_m = 0.02;
   options.map.stride = 4;
   return options;

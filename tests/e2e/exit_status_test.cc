@@ -1,7 +1,7 @@
 // Exit statuses, the same for every subcommand (docs/cli.md, "Exit statuses"): bad input of any
 // kind (an unknown subcommand or option, a value out of range, a missing or wrong file) gives
 // status 1 and a message on stderr that names what was wrong; --help and --version give 0.
-// CLI11 alone would exit 104-114 on usage errors, and 0 for `saccade explore --help`.
+// CLI11 alone would exit 104-114 on usage errors, and 0 for `saccade wander --help`.
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -42,7 +42,7 @@ void ExpectStatusOne(const std::vector<Case>& cases) {
 TEST(ExitStatus, UsageErrorsOfEverySubcommandExitOne) {
   std::vector<Case> cases;
   for (const std::string sub :
-       {"fk", "ik", "camera", "render", "bench", "demo", "gui", "run", "urdf"}) {
+       {"fk", "ik", "camera", "render", "bench", "demo", "gui", "run", "urdf", "explore"}) {
     cases.push_back({sub + " --no-such-option", "--no-such-option"});
   }
   // Values out of range or of the wrong type, one per subcommand (CLI11's checks).
@@ -54,6 +54,7 @@ TEST(ExitStatus, UsageErrorsOfEverySubcommandExitOne) {
   cases.push_back({"demo --duration abc", "--duration"});
   cases.push_back({"gui --port 70000", "--port"});
   cases.push_back({"run", "pipeline"});  // the pipeline file is required
+  cases.push_back({"explore --seconds abc", "--seconds"});
   cases.push_back({"--log-level loud fk --head " + kHead + " --joints 0 0 0 0", "--log-level"});
   ExpectStatusOne(cases);
 }
@@ -94,13 +95,13 @@ TEST(ExitStatus, AFileWithAWrongEntryExitsOneNamingFileLineAndKey) {
 }
 
 TEST(ExitStatus, NoOrAnUnknownSubcommandExitsOneListingThem) {
-  for (const std::string args : {"", "explore", "explore --help", "--log-level debug explore"}) {
+  for (const std::string args : {"", "wander", "wander --help", "--log-level debug wander"}) {
     const CommandRun run = Saccade(args);
     EXPECT_EQ(run.status, 1) << "saccade " << args << "\n" << run.output;
     EXPECT_THAT(run.output, HasSubstr("fk, ik, camera, render, bench, demo, gui, run"))
         << "saccade " << args;
   }
-  EXPECT_THAT(Saccade("explore").output, HasSubstr("'explore' is not a subcommand"));
+  EXPECT_THAT(Saccade("wander").output, HasSubstr("'wander' is not a subcommand"));
   // Alone, one line each: the name and what it does.
   const std::string alone = Saccade("").output;
   EXPECT_THAT(alone, HasSubstr("\n  fk      Forward kinematics\n"));

@@ -15,10 +15,12 @@ namespace {
 TEST(ExploreCli, ReportsAndMapsAShortExploration) {
   const std::filesystem::path dir = testing_helpers::FreshScratchDir("explore");
   const std::filesystem::path settings = dir / "fast.yaml";
-  std::ofstream(settings) << "raster_step: 1.5\nmap: {stride: 4}\nscore: {truth_cell_m: 0.02}\n";
-  const CommandRun run = Saccade("explore --scene scenes/explore_wall.yaml --strategy saliency "
-                                 "--seconds 1.5 --quiet --config " +
-                                 settings.string() + " --json - --map-dir " + dir.string());
+  std::ofstream(settings)
+      << "raster_step: 1.5\nmap: {stride: 4}\nscore: {truth_cell_m: 0.02, truth_step: 1.0}\n";
+  const CommandRun run = Saccade(
+      "explore --scene scenes/explore_wall.yaml --strategy saliency "
+      "--seconds 1.5 --quiet --config " +
+      settings.string() + " --json - --map-dir " + dir.string());
   ASSERT_EQ(run.status, 0) << run.output;
   const nlohmann::json report = nlohmann::json::parse(run.output);
   EXPECT_EQ(report["head"], "popeye");
@@ -49,7 +51,8 @@ TEST(ExploreCli, RefusesBadSettingsWithFileLineAndKey) {
   const std::filesystem::path dir = testing_helpers::FreshScratchDir("explore_bad");
   const std::filesystem::path settings = dir / "bad.yaml";
   std::ofstream(settings) << "seconds: 10\nior:\n  time_constant_s: -1\n";
-  CommandRun run = Saccade("explore --scene scenes/explore_wall.yaml --config " + settings.string());
+  CommandRun run =
+      Saccade("explore --scene scenes/explore_wall.yaml --config " + settings.string());
   EXPECT_EQ(run.status, 1);
   EXPECT_NE(run.output.find("bad.yaml:3: ior.time_constant_s"), std::string::npos) << run.output;
   run = Saccade("explore --strategy spiral");

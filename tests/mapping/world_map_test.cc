@@ -33,7 +33,11 @@ std::vector<Eigen::Vector3d> Wall(double x = 2.0) {
 TEST(WorldMap, HoldsASurfaceWhereItWasSeenFreeSpaceBeforeItAndUnknownBehind) {
   WorldMap map(WorldMap::Options{});
   const std::vector<Eigen::Vector3d> wall = Wall();
-  for (int i = 0; i < 3; ++i) map.FusePoints(wall, Eigen::Vector3d::Zero());
+  map.FusePoints(wall, Eigen::Vector3d::Zero());
+  // One sighting is not enough at the default occupancy threshold (0.75: two hits).
+  EXPECT_EQ(map.At({2.0, 0.1, 0.1}), Occupancy::kFree);
+  EXPECT_EQ(map.occupied_voxels(), 0);
+  for (int i = 0; i < 2; ++i) map.FusePoints(wall, Eigen::Vector3d::Zero());
   EXPECT_EQ(map.At({2.0, 0.1, 0.1}), Occupancy::kOccupied);
   EXPECT_EQ(map.At({1.0, 0.05, 0.05}), Occupancy::kFree);
   EXPECT_EQ(map.At({2.5, 0.1, 0.1}), Occupancy::kUnknown);  // behind the wall
@@ -56,6 +60,7 @@ TEST(WorldMap, HoldsASurfaceWhereItWasSeenFreeSpaceBeforeItAndUnknownBehind) {
 TEST(WorldMap, WritesItsSurfaceAsAPlyPointCloud) {
   WorldMap map(WorldMap::Options{});
   map.FusePoints(Wall(), Eigen::Vector3d::Zero());
+  map.FusePoints(Wall(), Eigen::Vector3d::Zero());  // occupied at the second hit
   const std::filesystem::path file = testing_helpers::ScratchFile("map.ply");
   map.WritePly(file);
   std::ifstream in(file, std::ios::binary);
@@ -92,7 +97,7 @@ TEST(WorldMap, RefusesBadOptionsNamingTheKey) {
 }
 
 // Dense stereo of five fixations of the wall of pictures, fused: the map's points lie within
-// 2 cm RMS of the true surfaces at 1-3 m, and hold most of what the views saw.
+// 2 cm RMS of the true surfaces at 1-3 m, and hold what at least two views saw.
 TEST(WorldMap, MapOfAKnownSceneFromStereoIsWithinTwoCentimetresOfTheTruth) {
   const scene::Scene scene =
       scene::Scene::Load(std::string(SACCADE_SOURCE_DIR) + "/scenes/explore_wall.yaml");
@@ -102,8 +107,10 @@ TEST(WorldMap, MapOfAKnownSceneFromStereoIsWithinTwoCentimetresOfTheTruth) {
   const std::unique_ptr<render::Renderer> renderer = render::MakeRenderer(scene, render_options);
   const head::HeadModel& head = scene.robot()->head;
   head::FixationSolver solver(head);
-  // Measured (2 cm voxels, stride 2): 19.2 mm RMS, completeness 0.92; at 1 cm voxels 16.4 mm
-  // for five times the fusion's cost. The stereo's own error at the wall (2.6 m) dominates.
+  // Measured (2 cm voxels, stride 2, two hits to be occupied): 12.3 mm RMS, 95th percentile
+  // 23 mm, completeness 0.61 (what two of the five views saw). Occupied at the first hit
+  // instead (occupancy_threshold 0.5): 19.2 mm RMS with 3.7 % of the points over 5 cm off,
+  // completeness 0.92.
   WorldMap map(WorldMap::Options{});
   const vision::DenseStereo stereo;
   std::vector<Eigen::Vector3d> truth;
@@ -141,7 +148,8 @@ TEST(WorldMap, MapOfAKnownSceneFromStereoIsWithinTwoCentimetresOfTheTruth) {
             << score.p95_m * 1000 << " mm, outliers " << score.outliers << "; "
             << map.memory_bytes() / 1024 << " KiB\n";
   EXPECT_LT(score.rms_m, 0.02);
-  EXPECT_GT(score.completeness, 0.6);
+  EXPECT_LT(score.outliers, score.map_points / 100);
+  EXPECT_GT(score.completeness, 0.5);
 }
 
 }  // namespace

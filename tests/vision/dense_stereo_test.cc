@@ -62,15 +62,15 @@ TEST(DenseStereo, MatchesTheTruthWithinMiddleburyBoundsAtOneToThreeMetres) {
   for (const Eigen::Vector3d& target : targets) {
     const Pair pair = RenderFixating(target);
     const StereoDepth depth = Match(pair);
-    const Image truth =
-        TruthDisparity(*pair.frames[0].depth, CameraModelOf(*pair.frames[0].color), depth);
+    const Image truth = TruthDisparity(*pair.frames[0].depth, CameraModelOf(*pair.frames[0].color),
+                                       CameraModelOf(*pair.frames[1].color), depth);
     const StereoScore score = ScoreDisparity(depth, truth, {1.0, 2.0, 3.0}, 8);
     std::cout << "target " << target.transpose() << ": density " << score.density << ", bad 1px "
               << score.bad_1px << ", bad 2px " << score.bad_2px << ", rms "
               << score.disparity_rms_px << " px; depth rms 1-2 m " << score.depth_rms_m[0] * 1000
               << " mm (" << score.range_pixels[0] << " px), 2-3 m " << score.depth_rms_m[1] * 1000
               << " mm (" << score.range_pixels[1] << " px)\n";
-    // Measured (2-core machine, llvmpipe): density 0.79-0.89, bad 1 px 2-7 %, bad 2 px
+    // Measured (2-core machine, llvmpipe): density 0.83-0.95, bad 1 px 2-7 %, bad 2 px
     // 0.2-5 %, depth RMS 3-7 mm at 1-2 m and 13-17 mm at 2-3 m (0.25 px of disparity there).
     EXPECT_GT(score.density, 0.7);
     EXPECT_LT(score.bad_1px, 0.10);
@@ -90,8 +90,8 @@ TEST(DenseStereo, LeftRightCheckTradesDensityForFewerBadPixels) {
   unchecked.left_right_check = false;
   const StereoDepth with = Match(pair);
   const StereoDepth without = Match(pair, DenseStereo(unchecked));
-  const Image truth =
-      TruthDisparity(*pair.frames[0].depth, CameraModelOf(*pair.frames[0].color), with);
+  const Image truth = TruthDisparity(*pair.frames[0].depth, CameraModelOf(*pair.frames[0].color),
+                                     CameraModelOf(*pair.frames[1].color), with);
   const StereoScore a = ScoreDisparity(with, truth, {1.0, 3.0}, 8);
   const StereoScore b = ScoreDisparity(without, truth, {1.0, 3.0}, 8);
   std::cout << "checked: density " << a.density << " bad 2px " << a.bad_2px << "; unchecked "

@@ -23,9 +23,9 @@
 //               candidate scores saliency_weight * saliency + novelty_weight * novelty, less
 //               its inhibition of return; the best one is fixated.
 //
-// The ground truth: the renderer's depth from every posture of the raster grid, back-projected
-// and thinned to one sample per truth_cell_m, within the map's range: the surface the head can
-// see. Completeness and accuracy as mapping/map_score.h defines them.
+// The ground truth: the renderer's depth from a dense grid of the head's reach (truth_step),
+// back-projected and thinned to one sample per truth_cell_m, within the map's range: the surface
+// the head can see. Completeness and accuracy as mapping/map_score.h defines them.
 #include <Eigen/Core>
 #include <filesystem>
 #include <functional>
@@ -55,6 +55,9 @@ struct ExploreOptions {
   double ior_radius_m = 0.3;          ///< size of an inhibited place, > 0
   double sample_every_s = 1.0;        ///< completeness is measured this often, > 0
   double truth_cell_m = 0.01;         ///< truth samples: one per cube of this edge, > 0
+  /// The truth is rendered from a grid of the head's reach spaced this many fields of view:
+  /// (0, 2]. Finer than any strategy's views, so that it holds what they could see.
+  double truth_step = 0.375;
   vision::DenseStereo::Options stereo;
   mapping::WorldMap::Options map;
 
@@ -114,6 +117,7 @@ struct ExploreTruth {
   std::vector<Eigen::Vector3d> samples_W;  ///< surface samples (world, m)
   std::vector<Eigen::Vector3d> grid_W;     ///< the raster's targets (world, m), in scan order
   Eigen::Vector3d viewpoint_W = Eigen::Vector3d::Zero();  ///< the head's base origin
+  int views = 0;                                          ///< postures the truth was rendered from
   double render_ms = 0.0;
 };
 

@@ -52,6 +52,10 @@ class WorldMap {
     double edge_ratio = 0.01;
     double hit_probability = 0.7;   ///< OctoMap's sensor model: (0.5, 1)
     double miss_probability = 0.4;  ///< (0, 0.5)
+    /// A voxel is occupied above this probability: (0, 1). 0.75 with the default hit of 0.7
+    /// takes two hits (0.7, then 0.84): a surface seen by two fixations, which a stereo
+    /// mismatch seldom is; 0.5 maps a surface at its first sighting, mismatches too.
+    double occupancy_threshold = 0.75;
 
     static constexpr Interval kResolutions = Interval::Closed(0.001, 1.0);
     static constexpr Interval kRanges = Interval::Above(0.0);
@@ -60,6 +64,7 @@ class WorldMap {
     static constexpr Interval kEdgeRatios = Interval::Above(0.0);
     static constexpr Interval kHits = Interval{0.5, 1.0, true, true};
     static constexpr Interval kMisses = Interval{0.0, 0.5, true, true};
+    static constexpr Interval kThresholds = Interval{0.0, 1.0, true, true};
 
     bool IsValid(std::string* error) const;
   };

@@ -52,8 +52,12 @@ struct StereoDepth {
   geometry::Intrinsics rectified{640, 480, 500.0, 500.0, 319.5, 239.5};
   geometry::Pose X_WR = geometry::Pose::Identity();  ///< the rectified left camera in the world
   Eigen::Matrix3d R1 = Eigen::Matrix3d::Identity();  ///< left optical frame -> rectified frame
-  double baseline_m = 0.0;                           ///< B: distance between optical centres
-  double focal_px = 0.0;                             ///< f of K_rect: d = f B / z
+  Eigen::Matrix3d R2 = Eigen::Matrix3d::Identity();  ///< right optical frame -> its rectified frame
+  /// The left camera lies at +x of the right one in the rectified frame (the views were
+  /// matched mirrored): a left pixel x matches right pixel x + d instead of x - d.
+  bool mirrored = false;
+  double baseline_m = 0.0;  ///< B: distance between optical centres
+  double focal_px = 0.0;    ///< f of K_rect: d = f B / z
 };
 
 /// Disparity and depth measured against the truth (Middlebury's measures).
@@ -116,13 +120,15 @@ class DenseStereo {
   Options options_;
 };
 
-/// The true disparity of the rectified left view (kFloat32, px; -1 where there is no surface)
-/// from the renderer's depth of the left camera (kFloat32 z in the left optical frame, 0 for
-/// none; of `left`'s size): each rectified pixel samples the depth where its ray meets the left
-/// image (nearest pixel, so that no value is blended across an edge). Throws InvalidArgument
-/// when the depth is not kFloat32 of the camera's size.
+/// The true disparity of the rectified left view (kFloat32, px; -1 where there is no surface,
+/// or where the matching pixel of the right view lies off the right camera's image) from the
+/// renderer's depth of the left camera (kFloat32 z in the left optical frame, 0 for none; of
+/// `left`'s size): each rectified pixel samples the depth where its ray meets the left image
+/// (nearest pixel, so that no value is blended across an edge). Occlusions by nearer surfaces
+/// are not removed: they count as unmatched or bad, as in Middlebury's "all" measures. Throws
+/// InvalidArgument when the depth is not kFloat32 of the left camera's size.
 Image TruthDisparity(const Image& left_depth, const geometry::CameraModel& left,
-                     const StereoDepth& stereo);
+                     const geometry::CameraModel& right, const StereoDepth& stereo);
 
 /// Middlebury's measures of `stereo` against the true disparity, with the depth error binned by
 /// `range_edges_m` (ascending). Pixels within `border_px` of the image's edge are left out.
