@@ -134,10 +134,12 @@ DenseStereo::DenseStereo(const Options& options) : options_(options) {
   if (!options.IsValid(&error)) throw InvalidArgument(error);
 }
 
-StereoDepth DenseStereo::Compute(const StereoView& left, const StereoView& right) const {
-  using namespace dense_stereo_internal;
-  CheckView(left, "left");
-  CheckView(right, "right");
+namespace dense_stereo_internal {
+
+// The rectified pair's geometry: K_rect, R1, R2, X_WR, the baseline, whether mirrored. Throws
+// for coinciding centres and a vertical pair.
+StereoDepth Rectification(const StereoView& left, const StereoView& right, double scale) {
+  // scale 0: chosen from the baseline (Options::scale).
   // p_R = R p_L + T (cv::stereoCalibrate's convention).
   const geometry::Pose X_RL = right.X_WC.inverse() * left.X_WC;
   const Eigen::Vector3d T = X_RL.translation();
@@ -153,31 +155,102 @@ StereoDepth DenseStereo::Compute(const StereoView& left, const StereoView& right
   StereoDepth out;
   out.baseline_m = std::abs(rect.T_rect.x());
   const auto& in = left.camera.intrinsics();
-  const int width = std::max(16, static_cast<int>(std::lround(in.width() * options_.scale)));
-  const int height = std::max(8, static_cast<int>(std::lround(in.height() * options_.scale)));
+  if (scale == 0.0) {
+    scale = std::clamp(DenseStereo::Options::kAutoFocalBaseline / (in.fx() * out.baseline_m), 0.25,
+                       1.0);
+  }
+  const int width = std::max(16, static_cast<int>(std::lround(in.width() * scale)));
+  const int height = std::max(8, static_cast<int>(std::lround(in.height() * scale)));
   out.focal_px = in.fx() * width / static_cast<double>(in.width());
   out.rectified = geometry::Intrinsics(width, height, out.focal_px, out.focal_px, (width - 1) / 2.0,
                                        (height - 1) / 2.0);
   out.R1 = rect.R1;
   out.R2 = rect.R2;
   out.X_WR = left.X_WC * geometry::MakePose(rect.R1.transpose(), Eigen::Vector3d::Zero());
-
   // The left camera must be on the left (T_rect.x < 0: its centre at -x seen from the right).
-  const bool swapped = rect.T_rect.x() > 0;
-  out.mirrored = swapped;
+  out.mirrored = rect.T_rect.x() > 0;
+  return out;
+}
+
+// Keeps the left disparities that the right view's (matched on the mirrored pair) confirms
+// within `limit` px, and gives them their confidence.
+void LeftRightCheck(cv::StereoSGBM& sgbm, int num_disparities, const cv::Mat& gray_l,
+                    const cv::Mat& gray_r, double limit, cv::Mat* disparity, cv::Mat* confidence) {
+  cv::Mat mirrored_l, mirrored_r;
+  cv::flip(gray_l, mirrored_l, 1);
+  cv::flip(gray_r, mirrored_r, 1);
+  cv::Mat disparity_r = Match(sgbm, num_disparities, mirrored_r, mirrored_l);
+  cv::flip(disparity_r, disparity_r, 1);
+  for (int y = 0; y < disparity->rows; ++y) {
+    float* d = disparity->ptr<float>(y);
+    const float* dr = disparity_r.ptr<float>(y);
+    float* c = confidence->ptr<float>(y);
+    for (int x = 0; x < disparity->cols; ++x) {
+      if (d[x] <= 0) continue;
+      const int xr = static_cast<int>(std::lround(x - d[x]));
+      const double diff = xr >= 0 ? std::abs(d[x] - dr[xr]) : limit + 1.0;
+      if (xr < 0 || dr[xr] <= 0 || diff > limit) {
+        d[x] = -1.0f;
+      } else {
+        c[x] = static_cast<float>(1.0 - diff / (2.0 * limit));
+      }
+    }
+  }
+}
+
+// Where a rectified view samples outside its camera's image (a verged or distorted pair turns
+// parts of each view off the sensor) it is black, and black matches black: only pixels whose
+// own and matched sources lie inside both images (by `margin` px) are kept.
+void DropOffSensor(const cv::Mat (&maps)[4], const StereoView& left, const StereoView& right,
+                   bool mirrored, double margin, cv::Mat* disparity, cv::Mat* confidence) {
+  const int sign = mirrored ? 1 : -1;  // the right view's column of left column x: x + sign d
+  for (int y = 0; y < disparity->rows; ++y) {
+    float* d = disparity->ptr<float>(y);
+    float* c = confidence->ptr<float>(y);
+    for (int x = 0; x < disparity->cols; ++x) {
+      if (d[x] <= 0) continue;
+      const int xr = static_cast<int>(std::lround(x + sign * d[x]));
+      if (!Inside(maps[0], maps[1], x, y, *left.image, margin) ||
+          !Inside(maps[2], maps[3], xr, y, *right.image, margin)) {
+        d[x] = -1.0f;
+        c[x] = 0.0f;
+      }
+    }
+  }
+}
+
+cv::Mat DepthOf(const cv::Mat& disparity, double fb) {
+  cv::Mat depth(disparity.size(), CV_32FC1, cv::Scalar(0.0f));
+  for (int y = 0; y < disparity.rows; ++y) {
+    const float* d = disparity.ptr<float>(y);
+    float* z = depth.ptr<float>(y);
+    for (int x = 0; x < disparity.cols; ++x) {
+      if (d[x] > 0) z[x] = static_cast<float>(fb / d[x]);
+    }
+  }
+  return depth;
+}
+
+}  // namespace dense_stereo_internal
+
+StereoDepth DenseStereo::Compute(const StereoView& left, const StereoView& right) const {
+  using namespace dense_stereo_internal;
+  CheckView(left, "left");
+  CheckView(right, "right");
+  StereoDepth out = Rectification(left, right, options_.scale);
   cv::Mat maps[4];
-  RectifyMaps(left.camera, rect.R1, out.rectified, &maps[0], &maps[1]);
-  RectifyMaps(right.camera, rect.R2, out.rectified, &maps[2], &maps[3]);
+  RectifyMaps(left.camera, out.R1, out.rectified, &maps[0], &maps[1]);
+  RectifyMaps(right.camera, out.R2, out.rectified, &maps[2], &maps[3]);
   cv::Mat gray_l, gray_r;
   cv::remap(internal::ToGray(*left.image, "DenseStereo::Compute"), gray_l, maps[0], maps[1],
             cv::INTER_LINEAR);
   cv::remap(internal::ToGray(*right.image, "DenseStereo::Compute"), gray_r, maps[2], maps[3],
             cv::INTER_LINEAR);
-  if (swapped) {  // mirror both: the left camera is then on the left
+  if (out.mirrored) {  // mirror both: the left camera is then on the left
     cv::flip(gray_l, gray_l, 1);
     cv::flip(gray_r, gray_r, 1);
   }
-
+  const int width = out.rectified.width();
   const int max_disparity = static_cast<int>(
       std::ceil(out.focal_px * out.baseline_m / options_.min_depth_m / 16.0) * 16.0);
   const int num_disparities = std::clamp(max_disparity, 16, std::max(16, width / 16 * 16));
@@ -188,63 +261,18 @@ StereoDepth DenseStereo::Compute(const StereoView& left, const StereoView& right
   cv::Mat disparity = Match(*sgbm, num_disparities, gray_l, gray_r);
   cv::Mat confidence(disparity.size(), CV_32FC1, cv::Scalar(0.0f));
   if (options_.left_right_check) {
-    // The right view's disparity: the mirrored right view matched against the mirrored left.
-    cv::Mat mirrored_l, mirrored_r;
-    cv::flip(gray_l, mirrored_l, 1);
-    cv::flip(gray_r, mirrored_r, 1);
-    cv::Mat disparity_r = Match(*sgbm, num_disparities, mirrored_r, mirrored_l);
-    cv::flip(disparity_r, disparity_r, 1);
-    const double limit = options_.lr_max_diff_px;
-    for (int y = 0; y < disparity.rows; ++y) {
-      float* d = disparity.ptr<float>(y);
-      const float* dr = disparity_r.ptr<float>(y);
-      float* c = confidence.ptr<float>(y);
-      for (int x = 0; x < disparity.cols; ++x) {
-        if (d[x] <= 0) continue;
-        const int xr = static_cast<int>(std::lround(x - d[x]));
-        const double diff = xr >= 0 ? std::abs(d[x] - dr[xr]) : limit + 1.0;
-        if (xr < 0 || dr[xr] <= 0 || diff > limit) {
-          d[x] = -1.0f;
-        } else {
-          c[x] = static_cast<float>(1.0 - diff / (2.0 * limit));
-        }
-      }
-    }
+    LeftRightCheck(*sgbm, num_disparities, gray_l, gray_r, options_.lr_max_diff_px, &disparity,
+                   &confidence);
   } else {
     confidence.setTo(1.0f, disparity > 0);
   }
-  if (swapped) {
+  if (out.mirrored) {
     cv::flip(disparity, disparity, 1);
     cv::flip(confidence, confidence, 1);
   }
-  // Where a rectified view samples outside its camera's image (a verged or distorted pair turns
-  // parts of each view off the sensor) it is black, and black matches black: only pixels whose
-  // own and matched sources lie inside both images (by half a block) are kept.
-  const double margin = options_.block_size / 2 + 1;
-  const int sign = swapped ? 1 : -1;  // the right view's column of left column x: x + sign d
-  for (int y = 0; y < disparity.rows; ++y) {
-    float* d = disparity.ptr<float>(y);
-    float* c = confidence.ptr<float>(y);
-    for (int x = 0; x < disparity.cols; ++x) {
-      if (d[x] <= 0) continue;
-      const int xr = static_cast<int>(std::lround(x + sign * d[x]));
-      if (!Inside(maps[0], maps[1], x, y, *left.image, margin) ||
-          !Inside(maps[2], maps[3], xr, y, *right.image, margin)) {
-        d[x] = -1.0f;
-        c[x] = 0.0f;
-      }
-    }
-  }
-  cv::Mat depth(disparity.size(), CV_32FC1, cv::Scalar(0.0f));
-  const double fb = out.focal_px * out.baseline_m;
-  for (int y = 0; y < disparity.rows; ++y) {
-    const float* d = disparity.ptr<float>(y);
-    float* z = depth.ptr<float>(y);
-    for (int x = 0; x < disparity.cols; ++x) {
-      if (d[x] > 0) z[x] = static_cast<float>(fb / d[x]);
-    }
-  }
-  out.depth = FloatImage(depth);
+  DropOffSensor(maps, left, right, out.mirrored, options_.block_size / 2 + 1, &disparity,
+                &confidence);
+  out.depth = FloatImage(DepthOf(disparity, out.focal_px * out.baseline_m));
   out.confidence = FloatImage(confidence);
   out.disparity = FloatImage(disparity);
   for (Image* image : {&out.depth, &out.confidence, &out.disparity}) {

@@ -130,10 +130,10 @@ TEST(DenseStereo, WorldPointsLandOnTheTrueSurface) {
 
 TEST(DenseStereo, RefusesBadOptionsAndInputsNamingThem) {
   DenseStereo::Options options;
-  options.scale = 0.0;
+  options.scale = -0.5;
   try {
     DenseStereo stereo(options);
-    FAIL() << "scale 0 accepted";
+    FAIL() << "scale -0.5 accepted";
   } catch (const InvalidArgument& e) {
     EXPECT_NE(std::string(e.what()).find("scale"), std::string::npos) << e.what();
   }
@@ -156,6 +156,61 @@ TEST(DenseStereo, RefusesBadOptionsAndInputsNamingThem) {
     FAIL() << "coinciding cameras accepted";
   } catch (const InvalidArgument& e) {
     EXPECT_NE(std::string(e.what()).find("coincide"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace saccade::vision
+
+namespace saccade::vision {
+namespace {
+
+// Every head saccade ships, on the same wall: its eyes verging on a picture 1.9 m ahead.
+TEST(DenseStereo, MatchesOnEveryHead) {
+  for (const std::string name :
+       {"humanoid", "pan_tilt_vergence", "pan_tilt_fixed", "popeye_urdf"}) {
+    scene::LoadOptions load;
+    load.head = std::string(SACCADE_SOURCE_DIR) + "/robots/" + name + ".yaml";
+    const scene::Scene scene =
+        scene::Scene::Load(std::string(SACCADE_SOURCE_DIR) + "/scenes/explore_wall.yaml", load);
+    render::RendererOptions options;
+    options.cameras = {"left", "right"};
+    options.truth_depth = true;
+    const std::unique_ptr<render::Renderer> renderer = render::MakeRenderer(scene, options);
+    const head::HeadModel& head = scene.robot()->head;
+    head::FixationSolver solver(head);
+    const head::FixationResult fixation = solver.Solve({1.9, -0.6, 1.0});
+    scene::SceneState state = scene.InitialState();
+    state.joints = head.State(fixation.joints);
+    const Pair pair{renderer->Render(state, 0)};
+    const StereoDepth depth = Match(pair);
+    const Image truth = TruthDisparity(*pair.frames[0].depth, CameraModelOf(*pair.frames[0].color),
+                                       CameraModelOf(*pair.frames[1].color), depth);
+    const StereoScore score = ScoreDisparity(depth, truth, {1.0, 2.0, 3.0}, 8);
+    std::cout << name << ": baseline " << depth.baseline_m << " m, " << depth.rectified.width()
+              << " px wide, mirrored " << depth.mirrored << ": density " << score.density
+              << ", bad 2px " << score.bad_2px << ", depth rms 1-2 m "
+              << score.depth_rms_m[0] * 1000 << " mm, 2-3 m " << score.depth_rms_m[1] * 1000
+              << " mm\n";
+    EXPECT_GT(score.density, 0.5) << name;
+    EXPECT_LT(score.bad_2px, 0.1) << name;
+    // Its world points land on the true surface (the depth at their pixel in the left image).
+    const geometry::CameraModel camera = CameraModelOf(*pair.frames[0].color);
+    const geometry::Pose X_CW = CameraPoseOf(*pair.frames[0].color).inverse();
+    const Image& z_true = *pair.frames[0].depth;
+    int close = 0, compared = 0;
+    for (const Eigen::Vector3d& p_W : WorldPoints(depth, 4, 0.5)) {
+      const Eigen::Vector3d p_C = X_CW * p_W;
+      const auto uv = camera.Project(p_C);
+      if (!uv || !camera.Contains(*uv)) continue;
+      const float z = reinterpret_cast<const float*>(
+          z_true.data() + std::lround(uv->y()) * z_true.stride())[std::lround(uv->x())];
+      if (!(z > 0)) continue;
+      ++compared;
+      close += std::abs(p_C.z() - z) < 0.05 * z ? 1 : 0;
+    }
+    std::cout << "  " << close << " of " << compared << " world points within 5 % of the truth\n";
+    EXPECT_GT(close, 0.85 * compared) << name;
   }
 }
 

@@ -80,10 +80,14 @@ struct StereoScore {
 class DenseStereo {
  public:
   struct Options {
-    /// Size of the rectified views against the left camera's: (0, 1]. Half size by default:
-    /// at 1024 x 768 and POPEYE's 0.2 m baseline, 1 px of disparity is 1.2 cm of depth at 1 m
-    /// and 7 cm at 2.5 m before SGBM's 1/16 px interpolation, for a quarter of full size's cost.
-    double scale = 0.5;
+    /// Size of the rectified views against the left camera's: [0, 1]; 0 (the default): the
+    /// smallest size at which f B (the rectified focal length times the baseline) is at least
+    /// kAutoFocalBaseline, at least a quarter and at most full size. On POPEYE (1290 px, 0.2 m)
+    /// that is half size: 1 px of disparity is 0.8 cm of depth at 1 m and 5 cm at 2.5 m before
+    /// SGBM's 1/16 px interpolation, for a quarter of full size's cost; a head with a short
+    /// baseline (the humanoid's 6.8 cm) matches at full size.
+    double scale = 0.0;
+    static constexpr double kAutoFocalBaseline = 129.0;  ///< px m: POPEYE at half size
     /// The nearest depth matched (m): sets the disparity range, f B / min_depth_m (rounded up to
     /// 16). Nearer surfaces are unmatched, not wrong.
     double min_depth_m = 0.6;
@@ -94,7 +98,7 @@ class DenseStereo {
     bool left_right_check = true;  ///< match the mirrored pair too and keep consistent pixels
     double lr_max_diff_px = 1.0;   ///< the largest |d_L - d_R| kept
 
-    static constexpr Interval kScales = Interval::LeftOpen(0.0, 1.0);
+    static constexpr Interval kScales = Interval::Closed(0.0, 1.0);
     static constexpr Interval kMinDepths = Interval::Above(0.0);
     static constexpr Interval kBlockSizes = Interval::Closed(1, 11);
     static constexpr Interval kUniquenessRatios = Interval::Closed(0, 100);
