@@ -18,7 +18,8 @@
 #include "saccade/core/temporary_file.h"
 
 namespace saccade::app {
-namespace {
+// Named, not anonymous: the unity build puts every command's file in one translation unit.
+namespace explore_command {
 
 namespace fs = std::filesystem;
 using components::ExploreReport;
@@ -202,10 +203,10 @@ int RunExplore(const Options& o) {
   return 0;
 }
 
-}  // namespace
+}  // namespace explore_command
 
 Runner AddExploreCommand(CLI::App& app) {
-  auto o = std::make_shared<Options>();
+  auto o = std::make_shared<explore_command::Options>();
   CLI::App* c = app.add_subcommand(
       "explore",
       "Explore a scene and map it (seed 7.2): the head fixates where a strategy says, fuses "
@@ -234,7 +235,7 @@ Runner AddExploreCommand(CLI::App& app) {
   c->add_option("--map-dir", o->map_dir,
                 "write each strategy's final map as FOLDER/<strategy>.ply (points, metres, world)");
   c->add_flag("--quiet", o->quiet, "no progress on standard error");
-  return [o] { return RunExplore(*o); };
+  return [o] { return explore_command::RunExplore(*o); };
 }
 
 }  // namespace saccade::app

@@ -8,7 +8,7 @@
 namespace saccade::components {
 namespace explore_config_internal {
 
-using internal::Entry;
+using ::saccade::internal::Entry;
 
 // A number in `range`, or a FileError at its line naming the key and the range.
 double InRange(const Entry& entry, const Interval& range) {
@@ -68,8 +68,8 @@ constexpr Interval kNonNegative = Interval::AtLeast(0.0);
 ExploreConfig LoadExploreConfig(const std::filesystem::path& path) {
   using namespace explore_config_internal;
   const std::string file = path.string();
-  const std::string text = internal::ReadConfigFile(path, "explore settings");
-  const Entry root(internal::ParseYaml(text, file), "", &file, 1);
+  const std::string text = ::saccade::internal::ReadConfigFile(path, "explore settings");
+  const Entry root(::saccade::internal::ParseYaml(text, file), "", &file, 1);
   ExploreConfig config;
   if (root.IsNull()) return config;
   root.ExpectMap({"strategies", "seconds", "dwell_s", "seed", "target_distance_m", "raster_step",
