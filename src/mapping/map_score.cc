@@ -25,11 +25,13 @@ PointGrid::PointGrid(const std::vector<Eigen::Vector3d>& points, double cell_m)
   }
 }
 
-Eigen::Vector3i PointGrid::Key(const Eigen::Vector3d& p) const {
-  return Eigen::Vector3i(static_cast<int>(std::floor(p.x() / cell_m_)),
-                         static_cast<int>(std::floor(p.y() / cell_m_)),
-                         static_cast<int>(std::floor(p.z() / cell_m_)));
+Eigen::Vector3i PointGrid::KeyOf(const Eigen::Vector3d& p, double cell_m) {
+  return Eigen::Vector3i(static_cast<int>(std::floor(p.x() / cell_m)),
+                         static_cast<int>(std::floor(p.y() / cell_m)),
+                         static_cast<int>(std::floor(p.z() / cell_m)));
 }
+
+Eigen::Vector3i PointGrid::Key(const Eigen::Vector3d& p) const { return KeyOf(p, cell_m_); }
 
 std::optional<double> PointGrid::Nearest(const Eigen::Vector3d& p, double radius_m) const {
   const double radius = std::min(radius_m, cell_m_);
@@ -57,20 +59,10 @@ std::optional<double> PointGrid::Nearest(const Eigen::Vector3d& p, double radius
 
 std::vector<Eigen::Vector3d> Thin(const std::vector<Eigen::Vector3d>& points, double cell_m) {
   if (!(cell_m > 0)) throw InvalidArgument("Thin: cell_m must be > 0");
-  struct Hash {
-    std::size_t operator()(const Eigen::Vector3i& k) const {
-      return (static_cast<std::size_t>(k.x()) * 73856093u) ^
-             (static_cast<std::size_t>(k.y()) * 19349663u) ^
-             (static_cast<std::size_t>(k.z()) * 83492791u);
-    }
-  };
-  std::unordered_set<Eigen::Vector3i, Hash> seen;
+  std::unordered_set<Eigen::Vector3i, PointGrid::KeyHash> seen;
   std::vector<Eigen::Vector3d> out;
   for (const Eigen::Vector3d& p : points) {
-    const Eigen::Vector3i key(static_cast<int>(std::floor(p.x() / cell_m)),
-                              static_cast<int>(std::floor(p.y() / cell_m)),
-                              static_cast<int>(std::floor(p.z() / cell_m)));
-    if (seen.insert(key).second) out.push_back(p);
+    if (seen.insert(PointGrid::KeyOf(p, cell_m)).second) out.push_back(p);
   }
   return out;
 }

@@ -26,10 +26,13 @@ class PointGrid {
   std::optional<double> Nearest(const Eigen::Vector3d& p, double radius_m) const;
   std::size_t size() const { return points_.size(); }
 
- private:
+  /// The cube of edge `cell_m` that holds p, and a hash of such cubes (Thin uses them too).
+  static Eigen::Vector3i KeyOf(const Eigen::Vector3d& p, double cell_m);
   struct KeyHash {
     std::size_t operator()(const Eigen::Vector3i& k) const;
   };
+
+ private:
   Eigen::Vector3i Key(const Eigen::Vector3d& p) const;
   double cell_m_;
   std::vector<Eigen::Vector3d> points_;
