@@ -19,7 +19,8 @@ const scene::Scene& Wall() {
   return scene;
 }
 
-// Short runs: a coarse raster (and truth), two simulated seconds.
+// Short runs: a coarse raster (and truth), two simulated seconds. A coarse raster's views hardly
+// overlap, so one hit makes a voxel occupied here (the default takes two fixations' hits).
 ExploreOptions Short(const std::string& strategy) {
   ExploreOptions options;
   options.strategy = strategy;
@@ -28,6 +29,7 @@ ExploreOptions Short(const std::string& strategy) {
   options.truth_step = 1.0;
   options.truth_cell_m = 0.02;
   options.map.stride = 4;
+  options.map.occupancy_threshold = 0.5;
   return options;
 }
 
