@@ -98,6 +98,15 @@ TEST(Messages, EveryTypeRoundTripsThroughJson) {
   target.p_W = {2.0, 0.1, 1.1};
   target.source = "tracks";
   ExpectRoundTrip(target);
+
+  MapMessage map;
+  map.time = 4.0;
+  map.frame_index = 100;
+  map.resolution_m = 0.02;
+  map.occupied_W = {Eigen::Vector3d(2.01, 0.03, 1.05), Eigen::Vector3d(2.01, 0.05, 1.05)};
+  map.inhibited.push_back({Eigen::Vector3d(2.0, 0.0, 1.0), 0.3, 0.75});
+  map.fused = 12;
+  ExpectRoundTrip(map);
 }
 
 TEST(Messages, BadJsonNamesTheTypeAndTheField) {

@@ -144,6 +144,26 @@ struct TargetMessage {
   double gap_m = 0.0;
 };
 
+/// A place inhibition of return holds (seed 7.2), anchored to the world: the head does not look
+/// within radius_m of p_W while its strength lasts.
+struct InhibitedPlace {
+  Eigen::Vector3d p_W = Eigen::Vector3d::Zero();  ///< m, world
+  double radius_m = 0.0;
+  double strength = 0.0;  ///< 1 when fixated, decaying as exp(-t / time constant) after
+};
+
+/// The map the head has built of the world (mapping.world_map, issue 44): the centres of its
+/// occupied voxels and the places inhibition of return holds, at one step. DDS publishes the
+/// points as sensor_msgs/PointCloud2 (frame "world"); the GUI draws them growing.
+struct MapMessage {
+  double time = 0.0;
+  int64_t frame_index = 0;
+  double resolution_m = 0.0;                ///< voxel edge
+  std::vector<Eigen::Vector3d> occupied_W;  ///< m, world: occupied voxels' centres
+  std::vector<InhibitedPlace> inhibited;    ///< strongest first
+  int64_t fused = 0;                        ///< depth images fused so far
+};
+
 /// Registers every message type above with runtime::MessageRegistry::Global() (idempotent).
 void RegisterMessages();
 
@@ -160,6 +180,14 @@ struct JsonCodec<components::FacesMessage::Face> : JsonObjectCodec<components::F
   static constexpr auto kFields =
       std::make_tuple(JsonField("box", &T::box), JsonField("neighbors", &T::neighbors),
                       JsonField("rejected", &T::rejected), JsonField("reason", &T::reason));
+};
+
+template <>
+struct JsonCodec<components::InhibitedPlace> : JsonObjectCodec<components::InhibitedPlace> {
+  using T = components::InhibitedPlace;
+  static constexpr auto kFields =
+      std::make_tuple(JsonField("p_W", &T::p_W), JsonField("radius_m", &T::radius_m),
+                      JsonField("strength", &T::strength));
 };
 
 template <>
@@ -262,6 +290,16 @@ struct MessageTraits<components::TargetMessage> : FieldMessage<components::Targe
       JsonField("valid", &T::valid), JsonField("target_id", &T::target_id),
       JsonField("p_W", &T::p_W), JsonField("source", &T::source),
       JsonField("reprojection_px", &T::reprojection_px), JsonField("gap_m", &T::gap_m));
+};
+
+template <>
+struct MessageTraits<components::MapMessage> : FieldMessage<components::MapMessage> {
+  using T = components::MapMessage;
+  static constexpr const char* kName = "mapping.map";
+  static constexpr auto kFields = std::make_tuple(
+      JsonField("time", &T::time), JsonField("frame_index", &T::frame_index),
+      JsonField("resolution_m", &T::resolution_m), JsonField("occupied_W", &T::occupied_W),
+      JsonField("inhibited", &T::inhibited), JsonField("fused", &T::fused));
 };
 
 }  // namespace saccade::runtime
