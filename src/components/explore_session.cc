@@ -5,13 +5,13 @@
 #include <cmath>
 #include <random>
 
+#include "saccade/components/explore_attention.h"
 #include "saccade/core/error.h"
 #include "saccade/head/fixation.h"
 #include "saccade/head/joint_profile.h"
 #include "saccade/mapping/inhibition_3d.h"
 #include "saccade/render/renderer.h"
 #include "saccade/vision/image_camera.h"
-#include "saccade/vision/saliency.h"
 
 namespace saccade::components {
 namespace explore_internal {
@@ -20,49 +20,6 @@ using Clock = std::chrono::steady_clock;
 
 double MsSince(Clock::time_point start) {
   return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-}
-
-// A direction from the head's base (azimuth about z, elevation), in the base frame.
-Eigen::Vector3d Direction(double azimuth, double elevation) {
-  return Eigen::Vector3d(std::cos(elevation) * std::cos(azimuth),
-                         std::cos(elevation) * std::sin(azimuth), std::sin(elevation));
-}
-
-// The head's eye field of view (rad): the left camera's.
-Eigen::Vector2d FieldOfView(const head::HeadModel& head) {
-  const geometry::Intrinsics& in = head.camera(0).model.intrinsics();
-  return Eigen::Vector2d(in.HorizontalFov(), in.VerticalFov());
-}
-
-// Where the head's base is, and the target at `distance` along a base-frame direction.
-Eigen::Vector3d Target(const head::HeadModel& head, const Eigen::Vector3d& direction_B,
-                       double distance) {
-  return head.X_WB() * (distance * direction_B);
-}
-
-// The head's reach, sampled: base-frame directions on an azimuth x elevation grid spaced `step`
-// (rad, per axis), kept where fixation reaches a target at `distance`; rows from the top, each
-// row's direction alternating (a boustrophedon).
-std::vector<Eigen::Vector3d> ReachGrid(const head::HeadModel& head, const Eigen::Vector2d& step,
-                                       double distance) {
-  head::FixationSolver solver(head);
-  std::vector<Eigen::Vector3d> out;
-  const int columns = static_cast<int>(std::floor(M_PI / step.x()));
-  const int rows = static_cast<int>(std::floor((M_PI / 2 - 0.05) / step.y()));
-  for (int r = rows; r >= -rows; --r) {
-    std::vector<Eigen::Vector3d> row;
-    for (int c = -columns; c <= columns; ++c) {
-      const double azimuth = c * step.x();
-      if (std::abs(azimuth) > M_PI - 1e-9 && c > -columns) continue;  // +-pi once
-      const Eigen::Vector3d p_W = Target(head, Direction(azimuth, r * step.y()), distance);
-      head::FixationOptions options;
-      options.axis_tolerance = 1e-4;
-      if (solver.Solve(p_W, options).reachable()) row.push_back(p_W);
-    }
-    if ((rows - r) % 2 == 1) std::reverse(row.begin(), row.end());
-    out.insert(out.end(), row.begin(), row.end());
-  }
-  return out;
 }
 
 std::unique_ptr<render::Renderer> EyeRenderer(const scene::Scene& scene, bool truth) {
@@ -113,57 +70,9 @@ double SaccadeTime(const head::HeadModel& head, const Eigen::VectorXd& q0,
   return longest;
 }
 
-// The directions looked at: an azimuth x elevation grid of cells (about 2 degrees) in the
-// head's base frame, each marked once inside a fixation's field of view.
-class ViewCoverage {
- public:
-  explicit ViewCoverage(const head::HeadModel& head) : head_(head) {}
-
-  // The share of the view's cells (a field of view about `direction_B`) not yet looked at.
-  double Novelty(const Eigen::Vector3d& direction_B, const Eigen::Vector2d& fov) const {
-    int cells = 0, fresh = 0;
-    ForEachCell(direction_B, fov, [&](int index) {
-      ++cells;
-      fresh += looked_[index] ? 0 : 1;
-    });
-    return cells > 0 ? static_cast<double>(fresh) / cells : 0.0;
-  }
-  void Look(const Eigen::Vector3d& direction_B, const Eigen::Vector2d& fov) {
-    ForEachCell(direction_B, fov, [&](int index) { looked_[index] = true; });
-  }
-
- private:
-  static constexpr int kColumns = 180;  // 2 degrees of azimuth
-  static constexpr int kRows = 90;      // 2 degrees of elevation
-  template <typename F>
-  void ForEachCell(const Eigen::Vector3d& direction_B, const Eigen::Vector2d& fov, F&& f) const {
-    const double azimuth = std::atan2(direction_B.y(), direction_B.x());
-    const double elevation = std::asin(std::clamp(direction_B.normalized().z(), -1.0, 1.0));
-    const double cell = M_PI / kRows;
-    const int half_columns = static_cast<int>(std::round(fov.x() / 2 / cell));
-    const int half_rows = static_cast<int>(std::round(fov.y() / 2 / cell));
-    const int column0 = static_cast<int>(std::floor((azimuth + M_PI) / cell));
-    const int row0 = static_cast<int>(std::floor((elevation + M_PI / 2) / cell));
-    for (int r = row0 - half_rows; r <= row0 + half_rows; ++r) {
-      if (r < 0 || r >= kRows) continue;
-      for (int c = column0 - half_columns; c <= column0 + half_columns; ++c) {
-        f(r * kColumns + ((c % kColumns) + kColumns) % kColumns);
-      }
-    }
-  }
-  const head::HeadModel& head_;
-  std::vector<bool> looked_ = std::vector<bool>(kColumns * kRows, false);
-};
-
 Eigen::Vector3d InBase(const head::HeadModel& head, const Eigen::Vector3d& p_W) {
   return head.X_WB().inverse() * p_W;
 }
-
-// A target the strategy proposes: where, and its attention score (saliency strategy).
-struct Candidate {
-  Eigen::Vector3d p_W;
-  double score = 0.0;
-};
 
 }  // namespace explore_internal
 
@@ -226,9 +135,9 @@ ExploreTruth MakeExploreTruth(const scene::Scene& scene, const ExploreOptions& o
   ExploreTruth truth;
   truth.viewpoint_W = head.X_WB().translation();
   truth.grid_W =
-      ReachGrid(head, options.raster_step * FieldOfView(head), options.target_distance_m);
+      ReachGrid(head, options.raster_step * EyeFieldOfView(head), options.target_distance_m);
   const std::vector<Eigen::Vector3d> views =
-      ReachGrid(head, options.truth_step * FieldOfView(head), options.target_distance_m);
+      ReachGrid(head, options.truth_step * EyeFieldOfView(head), options.target_distance_m);
   std::unique_ptr<render::Renderer> renderer = EyeRenderer(scene, true);
   head::FixationSolver solver(head);
   std::vector<Eigen::Vector3d> samples;
@@ -253,8 +162,15 @@ class Chooser {
       : head_(scene.robot()->head),
         options_(options),
         truth_(truth),
-        fov_(FieldOfView(head_)),
-        coverage_(head_),
+        fov_(EyeFieldOfView(head_)),
+        attention_(head_, truth.grid_W,
+                   [&] {
+                     ExploreAttention::Options o;
+                     o.saliency_weight = options.saliency_weight;
+                     o.novelty_weight = options.novelty_weight;
+                     o.target_distance_m = options.target_distance_m;
+                     return o;
+                   }()),
         ior_([&] {
           mapping::Inhibition3d::Options o;
           o.time_constant_s = options.ior_time_constant_s;
@@ -263,13 +179,14 @@ class Chooser {
         }()),
         random_(options.seed) {}
 
-  std::vector<Candidate> Next(double time, const vision::StereoDepth* depth, const Image* left) {
+  std::vector<ExploreCandidate> Next(double time, const vision::StereoDepth* depth,
+                                     const Image* left) {
     if (options_.strategy == "raster") {
       const Eigen::Vector3d p = truth_.grid_W[next_raster_++ % truth_.grid_W.size()];
       return {{p, 0.0}};
     }
     if (options_.strategy == "random") {
-      std::vector<Candidate> out;
+      std::vector<ExploreCandidate> out;
       std::uniform_int_distribution<std::size_t> pick(0, truth_.grid_W.size() - 1);
       std::uniform_real_distribution<double> jitter(-0.5, 0.5);
       for (int i = 0; i < 8; ++i) {
@@ -278,76 +195,28 @@ class Chooser {
         const double azimuth = std::atan2(d.y(), d.x()) + jitter(random_) * fov_.x();
         const double elevation = std::asin(d.z()) + jitter(random_) * fov_.y();
         out.push_back(
-            {Target(head_, Direction(azimuth, elevation), options_.target_distance_m), 0.0});
+            {head_.X_WB() * (options_.target_distance_m * DirectionOf(azimuth, elevation)), 0.0});
       }
       return out;
     }
-    return Attend(time, depth, left);
+    return attention_.Rank(depth, left,
+                           [&](const Eigen::Vector3d& p_W) { return ior_.Inhibition(p_W, time); });
   }
 
   void Fixated(const Eigen::Vector3d& p_W, double time) {
-    gaze_B_ = InBase(head_, p_W).normalized();
-    coverage_.Look(gaze_B_, fov_);
+    attention_.Looked(p_W);
     ior_.Visit(p_W, time);
   }
 
  private:
-  // Two-stage attention: saliency zones of the current view and the unexplored directions.
-  std::vector<Candidate> Attend(double time, const vision::StereoDepth* depth, const Image* left) {
-    std::vector<Candidate> out;
-    const auto add = [&](const Eigen::Vector3d& p_W, double saliency) {
-      const Eigen::Vector3d d = InBase(head_, p_W).normalized();
-      const double novelty = coverage_.Novelty(d, fov_);
-      // Among equals, the nearer saccade (a tenth per radian from where the eyes look now).
-      const double turn = std::acos(std::clamp(d.dot(gaze_B_), -1.0, 1.0));
-      const double score = options_.saliency_weight * saliency + options_.novelty_weight * novelty -
-                           ior_.Inhibition(p_W, time) - 0.1 * turn;
-      out.push_back({p_W, score});
-    };
-    if (depth != nullptr && left != nullptr) {
-      const geometry::CameraModel camera = vision::CameraModelOf(*left);
-      const geometry::Pose X_WC = vision::CameraPoseOf(*left);
-      for (const vision::SaliencyZone& zone : saliency_.Compute(*left).zones) {
-        const std::optional<Eigen::Vector3d> ray =
-            camera.Unproject(Eigen::Vector2d(zone.peak.x, zone.peak.y));
-        if (!ray) continue;
-        const Eigen::Vector3d ray_W = X_WC.linear() * ray->normalized();
-        add(X_WC.translation() + DepthAlong(*depth, ray_W) * ray_W, zone.score);
-      }
-    }
-    for (const Eigen::Vector3d& p : truth_.grid_W) add(p, 0.0);
-    std::stable_sort(out.begin(), out.end(),
-                     [](const Candidate& a, const Candidate& b) { return a.score > b.score; });
-    return out;
-  }
-
-  // The range (m) along a world ray from the camera's centre: the stereo depth where the ray
-  // meets the rectified view with a match, the target distance otherwise.
-  double DepthAlong(const vision::StereoDepth& depth, const Eigen::Vector3d& ray_W) const {
-    const Eigen::Vector3d r_R = depth.X_WR.linear().transpose() * ray_W.normalized();
-    if (r_R.z() > 0) {
-      const Eigen::Vector3d uv = depth.rectified.Matrix() * (r_R / r_R.z());
-      const int u = static_cast<int>(std::lround(uv.x())),
-                v = static_cast<int>(std::lround(uv.y()));
-      if (u >= 0 && v >= 0 && u < depth.depth.width() && v < depth.depth.height()) {
-        const float z =
-            reinterpret_cast<const float*>(depth.depth.data() + v * depth.depth.stride())[u];
-        if (z > 0) return z / r_R.z();
-      }
-    }
-    return options_.target_distance_m;
-  }
-
   const head::HeadModel& head_;
   const ExploreOptions& options_;
   const ExploreTruth& truth_;
   Eigen::Vector2d fov_;
-  ViewCoverage coverage_;
+  ExploreAttention attention_;
   mapping::Inhibition3d ior_;
-  vision::SpectralResidualSaliency saliency_;
   std::mt19937_64 random_;
   std::size_t next_raster_ = 0;
-  Eigen::Vector3d gaze_B_ = Eigen::Vector3d::UnitX();
 };
 
 void Sample(const mapping::WorldMap& map, const ExploreTruth& truth, double time, int fixations,
@@ -385,11 +254,11 @@ ExploreReport Explore(const scene::Scene& scene, const ExploreOptions& options,
   std::vector<render::Frame> frames;
   while (time < options.seconds) {
     auto start = Clock::now();
-    const std::vector<Candidate> candidates =
+    const std::vector<ExploreCandidate> candidates =
         chooser.Next(time, depth ? &*depth : nullptr, frames.empty() ? nullptr : &*frames[0].color);
     std::optional<head::FixationResult> fixation;
     Eigen::Vector3d target = Eigen::Vector3d::Zero();
-    for (const Candidate& candidate : candidates) {
+    for (const ExploreCandidate& candidate : candidates) {
       head::FixationOptions fixation_options;
       fixation_options.seed = q;
       fixation_options.axis_tolerance = 1e-4;

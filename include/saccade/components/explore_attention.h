@@ -1,0 +1,89 @@
+#pragma once
+// Two-stage attention for exploration (seed 7.2, issue 44), shared by `saccade explore` (its
+// saliency strategy) and the pipeline component vision.explore:
+//   1. the saliency stage (vision/saliency.h, spectral residual) finds the zones of interest of
+//      the whole left image; each zone's peak, at the stereo depth found there, is a candidate;
+//   2. every direction of the head's reach (a grid, ReachGrid) is a candidate too, at the
+//      target distance.
+// A candidate p scores
+//   saliency_weight * saliency(p) + novelty_weight * novelty(p) - inhibition(p) - turn_weight *
+//   turn
+// where novelty is the share of a field of view about p's direction never looked at (2-degree
+// cells of azimuth and elevation from the head's base), inhibition is inhibition of return in
+// 3D (the caller's: mapping/inhibition_3d.h), and turn the angle (rad) from where the eyes look
+// now, so that among equals the nearer saccade wins. Deterministic: the same inputs give the
+// same ranking.
+#include <Eigen/Core>
+#include <functional>
+#include <vector>
+
+#include "saccade/core/image.h"
+#include "saccade/head/head_model.h"
+#include "saccade/vision/dense_stereo.h"
+#include "saccade/vision/saliency.h"
+
+namespace saccade::components {
+
+/// A base-frame direction (azimuth about z, elevation), unit length.
+Eigen::Vector3d DirectionOf(double azimuth, double elevation);
+
+/// The head's eye field of view (rad): the left camera's, horizontal and vertical.
+Eigen::Vector2d EyeFieldOfView(const head::HeadModel& head);
+
+/// The head's reach, sampled: the points at `distance` (m) along base-frame directions on an
+/// azimuth x elevation grid spaced `step` (rad, per axis) that fixation reaches; rows from the
+/// top, each row's direction alternating (a boustrophedon: the raster's scan order).
+std::vector<Eigen::Vector3d> ReachGrid(const head::HeadModel& head, const Eigen::Vector2d& step,
+                                       double distance);
+
+/// A target attention proposes: where (world, m), and its score.
+struct ExploreCandidate {
+  Eigen::Vector3d p_W = Eigen::Vector3d::Zero();
+  double score = 0.0;
+};
+
+class ExploreAttention {
+ public:
+  struct Options {
+    double saliency_weight = 1.0;
+    double novelty_weight = 1.0;
+    double turn_weight = 0.1;        ///< per radian of saccade
+    double target_distance_m = 2.0;  ///< of a candidate without a depth
+  };
+  /// The inhibition of return of a world point, in [0, 1].
+  using Inhibition = std::function<double(const Eigen::Vector3d& p_W)>;
+
+  /// `grid_W`: the head's reach (ReachGrid), the candidates every ranking has.
+  ExploreAttention(const head::HeadModel& head, std::vector<Eigen::Vector3d> grid_W,
+                   const Options& options);
+
+  /// The candidates, best first: the saliency zones of `left` (a camera image with its
+  /// calibration and pose, vision/image_camera.h) placed at the stereo depth `depth` when both
+  /// are given, and the reach grid.
+  std::vector<ExploreCandidate> Rank(const vision::StereoDepth* depth, const Image* left,
+                                     const Inhibition& inhibition) const;
+
+  /// The eyes fixated p_W: its field of view is no longer novel, and turns start from it.
+  void Looked(const Eigen::Vector3d& p_W);
+
+  /// The share of the field of view about the world point p_W never looked at, in [0, 1].
+  double Novelty(const Eigen::Vector3d& p_W) const;
+
+  const std::vector<Eigen::Vector3d>& grid_W() const { return grid_W_; }
+
+ private:
+  double DepthAlong(const vision::StereoDepth& depth, const Eigen::Vector3d& ray_W) const;
+  template <typename F>
+  void ForEachCell(const Eigen::Vector3d& direction_B, F&& f) const;
+  Eigen::Vector3d InBase(const Eigen::Vector3d& p_W) const;
+
+  const head::HeadModel& head_;
+  std::vector<Eigen::Vector3d> grid_W_;
+  Options options_;
+  Eigen::Vector2d fov_;
+  vision::SpectralResidualSaliency saliency_;
+  std::vector<bool> looked_;  // 2-degree cells, azimuth x elevation
+  Eigen::Vector3d gaze_B_ = Eigen::Vector3d::UnitX();
+};
+
+}  // namespace saccade::components

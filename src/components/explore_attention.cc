@@ -1,0 +1,142 @@
+#include "saccade/components/explore_attention.h"
+
+#include <algorithm>
+#include <cmath>
+#include <optional>
+#include <utility>
+
+#include "saccade/head/fixation.h"
+#include "saccade/vision/image_camera.h"
+
+namespace saccade::components {
+namespace {
+
+constexpr int kColumns = 180;  // 2 degrees of azimuth
+constexpr int kRows = 90;      // 2 degrees of elevation
+
+}  // namespace
+
+Eigen::Vector3d DirectionOf(double azimuth, double elevation) {
+  return Eigen::Vector3d(std::cos(elevation) * std::cos(azimuth),
+                         std::cos(elevation) * std::sin(azimuth), std::sin(elevation));
+}
+
+Eigen::Vector2d EyeFieldOfView(const head::HeadModel& head) {
+  const geometry::Intrinsics& in = head.camera(0).model.intrinsics();
+  return Eigen::Vector2d(in.HorizontalFov(), in.VerticalFov());
+}
+
+std::vector<Eigen::Vector3d> ReachGrid(const head::HeadModel& head, const Eigen::Vector2d& step,
+                                       double distance) {
+  head::FixationSolver solver(head);
+  std::vector<Eigen::Vector3d> out;
+  const int columns = static_cast<int>(std::floor(M_PI / step.x()));
+  const int rows = static_cast<int>(std::floor((M_PI / 2 - 0.05) / step.y()));
+  for (int r = rows; r >= -rows; --r) {
+    std::vector<Eigen::Vector3d> row;
+    for (int c = -columns; c <= columns; ++c) {
+      const double azimuth = c * step.x();
+      if (std::abs(azimuth) > M_PI - 1e-9 && c > -columns) continue;  // +-pi once
+      const Eigen::Vector3d p_W = head.X_WB() * (distance * DirectionOf(azimuth, r * step.y()));
+      head::FixationOptions options;
+      options.axis_tolerance = 1e-4;
+      if (solver.Solve(p_W, options).reachable()) row.push_back(p_W);
+    }
+    if ((rows - r) % 2 == 1) std::reverse(row.begin(), row.end());
+    out.insert(out.end(), row.begin(), row.end());
+  }
+  return out;
+}
+
+ExploreAttention::ExploreAttention(const head::HeadModel& head, std::vector<Eigen::Vector3d> grid_W,
+                                   const Options& options)
+    : head_(head),
+      grid_W_(std::move(grid_W)),
+      options_(options),
+      fov_(EyeFieldOfView(head)),
+      looked_(kColumns * kRows, false) {}
+
+Eigen::Vector3d ExploreAttention::InBase(const Eigen::Vector3d& p_W) const {
+  return head_.X_WB().inverse() * p_W;
+}
+
+// Calls f with the index of every 2-degree cell of the field of view about direction_B.
+template <typename F>
+void ExploreAttention::ForEachCell(const Eigen::Vector3d& direction_B, F&& f) const {
+  const double azimuth = std::atan2(direction_B.y(), direction_B.x());
+  const double elevation = std::asin(std::clamp(direction_B.normalized().z(), -1.0, 1.0));
+  const double cell = M_PI / kRows;
+  const int half_columns = static_cast<int>(std::round(fov_.x() / 2 / cell));
+  const int half_rows = static_cast<int>(std::round(fov_.y() / 2 / cell));
+  const int column0 = static_cast<int>(std::floor((azimuth + M_PI) / cell));
+  const int row0 = static_cast<int>(std::floor((elevation + M_PI / 2) / cell));
+  for (int r = row0 - half_rows; r <= row0 + half_rows; ++r) {
+    if (r < 0 || r >= kRows) continue;
+    for (int c = column0 - half_columns; c <= column0 + half_columns; ++c) {
+      f(r * kColumns + ((c % kColumns) + kColumns) % kColumns);
+    }
+  }
+}
+
+double ExploreAttention::Novelty(const Eigen::Vector3d& p_W) const {
+  int cells = 0, fresh = 0;
+  ForEachCell(InBase(p_W).normalized(), [&](int index) {
+    ++cells;
+    fresh += looked_[index] ? 0 : 1;
+  });
+  return cells > 0 ? static_cast<double>(fresh) / cells : 0.0;
+}
+
+void ExploreAttention::Looked(const Eigen::Vector3d& p_W) {
+  gaze_B_ = InBase(p_W).normalized();
+  ForEachCell(gaze_B_, [&](int index) { looked_[index] = true; });
+}
+
+std::vector<ExploreCandidate> ExploreAttention::Rank(const vision::StereoDepth* depth,
+                                                     const Image* left,
+                                                     const Inhibition& inhibition) const {
+  std::vector<ExploreCandidate> out;
+  const auto add = [&](const Eigen::Vector3d& p_W, double saliency) {
+    const Eigen::Vector3d d = InBase(p_W).normalized();
+    const double turn = std::acos(std::clamp(d.dot(gaze_B_), -1.0, 1.0));
+    const double score = options_.saliency_weight * saliency +
+                         options_.novelty_weight * Novelty(p_W) - inhibition(p_W) -
+                         options_.turn_weight * turn;
+    out.push_back({p_W, score});
+  };
+  if (depth != nullptr && left != nullptr) {
+    const geometry::CameraModel camera = vision::CameraModelOf(*left);
+    const geometry::Pose X_WC = vision::CameraPoseOf(*left);
+    for (const vision::SaliencyZone& zone : saliency_.Compute(*left).zones) {
+      const std::optional<Eigen::Vector3d> ray =
+          camera.Unproject(Eigen::Vector2d(zone.peak.x, zone.peak.y));
+      if (!ray) continue;
+      const Eigen::Vector3d ray_W = X_WC.linear() * ray->normalized();
+      add(X_WC.translation() + DepthAlong(*depth, ray_W) * ray_W, zone.score);
+    }
+  }
+  for (const Eigen::Vector3d& p : grid_W_) add(p, 0.0);
+  std::stable_sort(
+      out.begin(), out.end(),
+      [](const ExploreCandidate& a, const ExploreCandidate& b) { return a.score > b.score; });
+  return out;
+}
+
+// The range (m) along a world ray from the camera's centre: the stereo depth where the ray
+// meets the rectified view with a match, the target distance otherwise.
+double ExploreAttention::DepthAlong(const vision::StereoDepth& depth,
+                                    const Eigen::Vector3d& ray_W) const {
+  const Eigen::Vector3d r_R = depth.X_WR.linear().transpose() * ray_W.normalized();
+  if (r_R.z() > 0) {
+    const Eigen::Vector3d uv = depth.rectified.Matrix() * (r_R / r_R.z());
+    const int u = static_cast<int>(std::lround(uv.x())), v = static_cast<int>(std::lround(uv.y()));
+    if (u >= 0 && v >= 0 && u < depth.depth.width() && v < depth.depth.height()) {
+      const float z =
+          reinterpret_cast<const float*>(depth.depth.data() + v * depth.depth.stride())[u];
+      if (z > 0) return z / r_R.z();
+    }
+  }
+  return options_.target_distance_m;
+}
+
+}  // namespace saccade::components
