@@ -20,6 +20,7 @@ void RegisterMessages() {
   registry.Register<SelectionMessage>();
   registry.Register<TrackMessage>();
   registry.Register<TargetMessage>();
+  registry.Register<DepthMessage>();
   registry.Register<MapMessage>();
 }
 

@@ -4,6 +4,7 @@
 #include <memory>
 
 #include "components/internal_scene.h"
+#include "saccade/components/explore_components.h"
 #include "saccade/components/fixation_component.h"
 #include "saccade/components/hw_components.h"
 #include "saccade/components/messages.h"
@@ -31,6 +32,12 @@ void RegisterComponents(runtime::ComponentRegistry& registry) {
   registry.Register<CamShiftComponent>("vision.camshift", "CamShift track of the selected face");
   registry.Register<TriangulateComponent>("vision.triangulate",
                                           "3D target from the tracks (or detections)");
+  registry.Register<DenseStereoComponent>(
+      "vision.dense_stereo", "dense stereo depth of the eye pair (SGBM, any vergence)");
+  registry.Register<WorldMapComponent>(
+      "mapping.world_map", "occupancy map of the depth (OctoMap), inhibition of return");
+  registry.Register<ExploreComponent>("vision.explore",
+                                      "exploration: saliency, novelty, inhibition of return");
   registry.Register<FixationComponent>("control.fixation",
                                        "inverse kinematics: saccades and smooth pursuit");
   registry.Register<HwHead>("hw.head",

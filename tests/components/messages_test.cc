@@ -99,6 +99,20 @@ TEST(Messages, EveryTypeRoundTripsThroughJson) {
   target.source = "tracks";
   ExpectRoundTrip(target);
 
+  DepthMessage depth;
+  depth.time = 3.0;
+  depth.frame_index = 75;
+  depth.left = image;
+  depth.stereo = std::make_shared<vision::StereoDepth>();
+  depth.matched = 0.83;
+  depth.baseline_m = 0.2;
+  depth.focal_px = 645.1;
+  const nlohmann::json depth_json = MessageTraits<DepthMessage>::ToJson(depth);
+  EXPECT_EQ(depth_json["left"]["frame_index"], 12);  // the image's metadata, never pixels
+  EXPECT_FALSE(depth_json.contains("stereo"));
+  EXPECT_EQ(MessageTraits<DepthMessage>::FromJson(depth_json).stereo, nullptr);
+  EXPECT_DOUBLE_EQ(MessageTraits<DepthMessage>::FromJson(depth_json).matched, 0.83);
+
   MapMessage map;
   map.time = 4.0;
   map.frame_index = 100;

@@ -22,6 +22,7 @@
 #include "saccade/head/head_model.h"
 #include "saccade/head/json.h"
 #include "saccade/runtime/message.h"
+#include "saccade/vision/dense_stereo.h"
 #include "saccade/vision/json.h"
 
 namespace saccade::components {
@@ -142,6 +143,19 @@ struct TargetMessage {
   std::string source;  ///< "tracks" (both eyes' CamShift tracks) or "selection" (detections)
   double reprojection_px = 0.0;
   double gap_m = 0.0;
+};
+
+/// Dense stereo depth of one image pair (vision.dense_stereo, vision/dense_stereo.h): depth in
+/// the rectified left camera, its confidence and the rectification. Its JSON form carries the
+/// left image's metadata and the figures; FromJson gives a null `stereo` (no pixels in text).
+struct DepthMessage {
+  double time = 0.0;
+  int64_t frame_index = 0;
+  std::shared_ptr<const Image> left;                  ///< the left image it was computed from
+  std::shared_ptr<const vision::StereoDepth> stereo;  ///< not in JSON
+  double matched = 0.0;     ///< share of the rectified view's pixels with a depth
+  double baseline_m = 0.0;  ///< of the pair
+  double focal_px = 0.0;    ///< of the rectified camera
 };
 
 /// A place inhibition of return holds (seed 7.2), anchored to the world: the head does not look
@@ -290,6 +304,16 @@ struct MessageTraits<components::TargetMessage> : FieldMessage<components::Targe
       JsonField("valid", &T::valid), JsonField("target_id", &T::target_id),
       JsonField("p_W", &T::p_W), JsonField("source", &T::source),
       JsonField("reprojection_px", &T::reprojection_px), JsonField("gap_m", &T::gap_m));
+};
+
+template <>
+struct MessageTraits<components::DepthMessage> : FieldMessage<components::DepthMessage> {
+  using T = components::DepthMessage;
+  static constexpr const char* kName = "vision.depth";
+  static constexpr auto kFields =
+      std::make_tuple(JsonField("time", &T::time), JsonField("frame_index", &T::frame_index),
+                      JsonField("left", &T::left), JsonField("matched", &T::matched),
+                      JsonField("baseline_m", &T::baseline_m), JsonField("focal_px", &T::focal_px));
 };
 
 template <>
