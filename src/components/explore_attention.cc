@@ -54,7 +54,9 @@ ExploreAttention::ExploreAttention(const head::HeadModel& head, std::vector<Eige
       grid_W_(std::move(grid_W)),
       options_(options),
       fov_(EyeFieldOfView(head)),
-      looked_(kColumns * kRows, false) {}
+      looked_(kColumns * kRows, false) {
+  if (options.second_stage_faces) faces_ = std::make_unique<vision::FaceDetector>();
+}
 
 Eigen::Vector3d ExploreAttention::InBase(const Eigen::Vector3d& p_W) const {
   return head_.X_WB().inverse() * p_W;
@@ -94,32 +96,57 @@ void ExploreAttention::Looked(const Eigen::Vector3d& p_W) {
 
 std::vector<ExploreCandidate> ExploreAttention::Rank(const vision::StereoDepth* depth,
                                                      const Image* left,
-                                                     const Inhibition& inhibition) const {
+                                                     const Inhibition& inhibition) {
   std::vector<ExploreCandidate> out;
-  const auto add = [&](const Eigen::Vector3d& p_W, double saliency) {
+  const auto add = [&](const Eigen::Vector3d& p_W, double saliency,
+                       ExploreCandidate::Source source) {
     const Eigen::Vector3d d = InBase(p_W).normalized();
     const double turn = std::acos(std::clamp(d.dot(gaze_B_), -1.0, 1.0));
     const double score = options_.saliency_weight * saliency +
                          options_.novelty_weight * Novelty(p_W) - inhibition(p_W) -
                          options_.turn_weight * turn;
-    out.push_back({p_W, score});
+    out.push_back({p_W, score, source});
   };
   if (depth != nullptr && left != nullptr) {
     const geometry::CameraModel camera = vision::CameraModelOf(*left);
     const geometry::Pose X_WC = vision::CameraPoseOf(*left);
+    std::optional<std::pair<cv::Rect, double>> best_zone;
     for (const vision::SaliencyZone& zone : saliency_.Compute(*left).zones) {
       const std::optional<Eigen::Vector3d> ray =
           camera.Unproject(Eigen::Vector2d(zone.peak.x, zone.peak.y));
       if (!ray) continue;
       const Eigen::Vector3d ray_W = X_WC.linear() * ray->normalized();
-      add(X_WC.translation() + DepthAlong(*depth, ray_W) * ray_W, zone.score);
+      add(X_WC.translation() + DepthAlong(*depth, ray_W) * ray_W, zone.score,
+          ExploreCandidate::Source::kSaliency);
+      if (!best_zone || out.back().score > best_zone->second) {
+        best_zone = {zone.box, out.back().score};
+      }
     }
+    if (faces_ && best_zone) FacesIn(best_zone->first, *left, *depth, best_zone->second, &out);
   }
-  for (const Eigen::Vector3d& p : grid_W_) add(p, 0.0);
+  for (const Eigen::Vector3d& p : grid_W_) add(p, 0.0, ExploreCandidate::Source::kReach);
   std::stable_sort(
       out.begin(), out.end(),
       [](const ExploreCandidate& a, const ExploreCandidate& b) { return a.score > b.score; });
   return out;
+}
+
+void ExploreAttention::FacesIn(const cv::Rect& zone, const Image& left,
+                               const vision::StereoDepth& depth, double zone_score,
+                               std::vector<ExploreCandidate>* out) {
+  const cv::Rect grown(zone.x - zone.width / 2, zone.y - zone.height / 2, zone.width * 2,
+                       zone.height * 2);
+  const geometry::CameraModel camera = vision::CameraModelOf(left);
+  const geometry::Pose X_WC = vision::CameraPoseOf(left);
+  for (const vision::FaceDetection& face : faces_->Detect(left, {grown})) {
+    if (face.rejected) continue;
+    const std::optional<Eigen::Vector3d> ray = camera.Unproject(
+        Eigen::Vector2d(face.box.x + face.box.width / 2.0, face.box.y + face.box.height / 2.0));
+    if (!ray) continue;
+    const Eigen::Vector3d ray_W = X_WC.linear() * ray->normalized();
+    out->push_back({X_WC.translation() + DepthAlong(depth, ray_W) * ray_W,
+                    zone_score + options_.face_weight, ExploreCandidate::Source::kFace});
+  }
 }
 
 // The range (m) along a world ray from the camera's centre: the stereo depth where the ray

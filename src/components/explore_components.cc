@@ -208,6 +208,11 @@ ExploreComponent::ExploreComponent()
                "a direction without a depth becomes a target this far from the head")
       .Range(0.1, 1e3)
       .Unit("m");
+  DeclareParam("second_stage_faces", &attention_options_.second_stage_faces,
+               "the second stage: search faces at full resolution in the best saliency zone");
+  DeclareParam("face_weight", &attention_options_.face_weight,
+               "a face found by the second stage scores this above its zone")
+      .Range(0.0, 1e6);
   DeclareParam("grid_step", &grid_step_,
                "the head's reach is sampled every this many fields of view")
       .Range(Interval::LeftOpen(0.0, 2.0));
@@ -279,7 +284,10 @@ std::optional<Eigen::Vector3d> ExploreComponent::Choose(const runtime::StepConte
   // The task first: the closest face that no place inhibits.
   if (const CandidatesMessage* faces = candidates_.get(); faces != nullptr) {
     for (const FaceCandidate& face : faces->candidates) {
-      if (inhibition(face.p_W) < 0.5 && reachable(face.p_W)) return face.p_W;
+      if (inhibition(face.p_W) < 0.5 && reachable(face.p_W)) {
+        source_ = "explore_task";
+        return face.p_W;
+      }
     }
   }
   const DepthMessage* depth = depth_.get();
@@ -287,7 +295,11 @@ std::optional<Eigen::Vector3d> ExploreComponent::Choose(const runtime::StepConte
   for (const ExploreCandidate& candidate :
        attention_->Rank(depth != nullptr ? depth->stereo.get() : nullptr,
                         image != nullptr ? image->image.get() : nullptr, inhibition)) {
-    if (reachable(candidate.p_W)) return candidate.p_W;
+    if (!reachable(candidate.p_W)) continue;
+    source_ = candidate.source == ExploreCandidate::Source::kFace       ? "explore_face"
+              : candidate.source == ExploreCandidate::Source::kSaliency ? "explore_saliency"
+                                                                        : "explore_reach";
+    return candidate.p_W;
   }
   log::Warn("vision.explore '{}': step {}: no candidate is reachable", name(), context.step);
   return std::nullopt;
@@ -302,7 +314,7 @@ void ExploreComponent::Send(const runtime::StepContext& context, bool fixating) 
   target.valid = true;
   target.target_id = target_id_;
   target.p_W = *target_W_;
-  target.source = "explore";
+  target.source = source_;
   target_out_.Emit(target);
   SelectionMessage selection;
   selection.time = context.time;

@@ -28,6 +28,7 @@ const std::string kSource = SACCADE_SOURCE_DIR;
 struct ExploreRun {
   std::vector<MapMessage> maps;          // every map emitted
   std::set<int64_t> targets;             // target ids sent
+  std::set<std::string> sources;         // what proposed them
   std::vector<head::JointState> joints;  // per step
   std::shared_ptr<const scene::Scene> scene;
 };
@@ -51,7 +52,10 @@ ExploreRun RunExplore(const std::string& scene_file, int steps,
         m->signal().Connect([&](const MapMessage& map) { out.maps.push_back(map); });
       } else if (auto* t = dynamic_cast<runtime::Output<TargetMessage>*>(o.get())) {
         t->signal().Connect([&](const TargetMessage& target) {
-          if (target.valid && target.source == "explore") out.targets.insert(target.target_id);
+          if (target.valid && target.source.rfind("explore_", 0) == 0) {
+            out.targets.insert(target.target_id);
+            out.sources.insert(target.source);
+          }
         });
       } else if (auto* j = dynamic_cast<runtime::Output<JointStateMessage>*>(o.get())) {
         j->signal().Connect([&](const JointStateMessage& m) { out.joints.push_back(m.positions); });
@@ -75,6 +79,10 @@ TEST(ExplorePipeline, MapsTheWallWithoutTruthAndTheMapLiesOnItsSurfaces) {
       });
   // Four simulated seconds: the head went to many places, fusing a depth at each rest.
   EXPECT_GE(run.targets.size(), 6u);
+  // Proposed by each kind: saliency zones, a face the second stage found in the best zone (the
+  // wall's pictures include portraits) and the reach's novelty.
+  EXPECT_EQ(run.sources,
+            (std::set<std::string>{"explore_face", "explore_reach", "explore_saliency"}));
   ASSERT_GE(run.maps.size(), 5u);
   for (std::size_t i = 1; i < run.maps.size(); ++i) {
     EXPECT_EQ(run.maps[i].fused, run.maps[i - 1].fused + 1);

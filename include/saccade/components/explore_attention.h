@@ -13,13 +13,22 @@
 // 3D (the caller's: mapping/inhibition_3d.h), and turn the angle (rad) from where the eyes look
 // now, so that among equals the nearer saccade wins. Deterministic: the same inputs give the
 // same ranking.
+//
+// The second stage (`second_stage_faces`): only the best-scoring saliency zone is examined
+// further, at the image's full resolution: faces are searched in its box (grown by half on
+// each side), and each accepted face, at the stereo depth of its centre, becomes a candidate
+// scoring face_weight above that zone (the task: faces first). The first stage works on a
+// 64-pixel-wide image; the second searches a crop, not the whole image (the seed's two-stage
+// model, its section 7.2 and reference [15]).
 #include <Eigen/Core>
 #include <functional>
+#include <memory>
 #include <vector>
 
 #include "saccade/core/image.h"
 #include "saccade/head/head_model.h"
 #include "saccade/vision/dense_stereo.h"
+#include "saccade/vision/face_detector.h"
 #include "saccade/vision/saliency.h"
 
 namespace saccade::components {
@@ -36,10 +45,12 @@ Eigen::Vector2d EyeFieldOfView(const head::HeadModel& head);
 std::vector<Eigen::Vector3d> ReachGrid(const head::HeadModel& head, const Eigen::Vector2d& step,
                                        double distance);
 
-/// A target attention proposes: where (world, m), and its score.
+/// A target attention proposes: where (world, m), its score, and what proposed it.
 struct ExploreCandidate {
+  enum class Source { kReach, kSaliency, kFace };
   Eigen::Vector3d p_W = Eigen::Vector3d::Zero();
   double score = 0.0;
+  Source source = Source::kReach;
 };
 
 class ExploreAttention {
@@ -47,8 +58,10 @@ class ExploreAttention {
   struct Options {
     double saliency_weight = 1.0;
     double novelty_weight = 1.0;
-    double turn_weight = 0.1;        ///< per radian of saccade
-    double target_distance_m = 2.0;  ///< of a candidate without a depth
+    double turn_weight = 0.1;         ///< per radian of saccade
+    double target_distance_m = 2.0;   ///< of a candidate without a depth
+    bool second_stage_faces = false;  ///< search faces in the best saliency zone
+    double face_weight = 2.0;         ///< a face scores this above its zone
   };
   /// The inhibition of return of a world point, in [0, 1].
   using Inhibition = std::function<double(const Eigen::Vector3d& p_W)>;
@@ -61,7 +74,7 @@ class ExploreAttention {
   /// calibration and pose, vision/image_camera.h) placed at the stereo depth `depth` when both
   /// are given, and the reach grid.
   std::vector<ExploreCandidate> Rank(const vision::StereoDepth* depth, const Image* left,
-                                     const Inhibition& inhibition) const;
+                                     const Inhibition& inhibition);
 
   /// The eyes fixated p_W: its field of view is no longer novel, and turns start from it.
   void Looked(const Eigen::Vector3d& p_W);
@@ -73,6 +86,9 @@ class ExploreAttention {
 
  private:
   double DepthAlong(const vision::StereoDepth& depth, const Eigen::Vector3d& ray_W) const;
+  // The second stage: faces in `zone` of `left` at full resolution, as candidates.
+  void FacesIn(const cv::Rect& zone, const Image& left, const vision::StereoDepth& depth,
+               double zone_score, std::vector<ExploreCandidate>* out);
   template <typename F>
   void ForEachCell(const Eigen::Vector3d& direction_B, F&& f) const;
   Eigen::Vector3d InBase(const Eigen::Vector3d& p_W) const;
@@ -82,7 +98,8 @@ class ExploreAttention {
   Options options_;
   Eigen::Vector2d fov_;
   vision::SpectralResidualSaliency saliency_;
-  std::vector<bool> looked_;  // 2-degree cells, azimuth x elevation
+  std::unique_ptr<vision::FaceDetector> faces_;  // the second stage's, when on
+  std::vector<bool> looked_;                     // 2-degree cells, azimuth x elevation
   Eigen::Vector3d gaze_B_ = Eigen::Vector3d::UnitX();
 };
 

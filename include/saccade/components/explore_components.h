@@ -25,8 +25,11 @@
 // vision.explore -- two-stage attention for exploration (components/explore_attention.h): at
 //   rest on a target for dwell_s (and, with `depth` connected, once this rest's depth came),
 //   it ranks the saliency zones of the left image and the head's reach by saliency, novelty
-//   and the map's inhibition of return, and sends the head to the best reachable one. Faces
-//   first (the task) when `candidates` is connected: the closest face no place inhibits.
+//   and the map's inhibition of return, and sends the head to the best reachable one. The
+//   second stage (second_stage_faces, on by default) searches faces at full resolution in the
+//   best zone only; a face found there comes first. With `candidates` connected (a face
+//   pipeline's), the closest face no place inhibits comes before all (the task). The target's
+//   source says which: explore_task, explore_face, explore_saliency or explore_reach.
 //   inputs: image (image, required: the left eye's), joints (head.joints, required),
 //           depth (vision.depth), map (mapping.map), candidates (vision.candidates)
 //   outputs: target (vision.target), selection (vision.selection: fixating while at rest on
@@ -110,7 +113,11 @@ class ExploreComponent : public runtime::Component {
   runtime::Output<TargetMessage>& target_out_;
   runtime::Output<SelectionMessage>& selection_out_;
   std::shared_ptr<const scene::Scene> scene_;
-  ExploreAttention::Options attention_options_;
+  ExploreAttention::Options attention_options_ = [] {
+    ExploreAttention::Options o;
+    o.second_stage_faces = true;
+    return o;
+  }();
   std::optional<ExploreAttention> attention_;
   double grid_step_ = 0.75;  // fields of view
   double dwell_s_ = 0.2;
@@ -119,6 +126,7 @@ class ExploreComponent : public runtime::Component {
   int64_t target_id_ = -1;
   int64_t chosen_step_ = 0;
   std::optional<double> rest_since_;
+  std::string source_;  // what proposed the target: explore_face, _saliency, _reach, _task
 };
 
 }  // namespace saccade::components
