@@ -68,7 +68,10 @@ void DenseStereoComponent::Step(const runtime::StepContext& context) {
       computed_this_rest_ = false;
       return;
     }
+    // A new target the head was already at (no motion between) begins a rest too.
+    if (!(joints->targets == rest_targets_)) computed_this_rest_ = false;
     if (once_per_rest_ && computed_this_rest_) return;
+    rest_targets_ = joints->targets;
   } else if (context.step % every_steps_ != 0) {
     return;
   }
@@ -195,6 +198,11 @@ ExploreComponent::ExploreComponent()
   DeclareParam("dwell_s", &dwell_s_, "time at rest on a target before the next is chosen")
       .Range(0.0, 1e6)
       .Unit("s");
+  DeclareParam("settle_timeout_s", &settle_timeout_s_,
+               "a target whose rest (and its depth) has not come this long after it was chosen "
+               "is given up")
+      .Range(Interval::LeftOpen(0.0, 1e6))
+      .Unit("s");
   DeclareParam("saliency_weight", &attention_options_.saliency_weight,
                "weight of a zone's saliency in a candidate's score")
       .Range(0.0, 1e6);
@@ -248,7 +256,11 @@ void ExploreComponent::Step(const runtime::StepContext& context) {
     const DepthMessage* depth = depth_.get();
     const bool depth_ready = !depth_.connected() || (depth != nullptr && rest_since_ &&
                                                      depth->time >= *rest_since_ - 1e-9);
-    if (!rest_since_ || context.time - *rest_since_ < dwell_s_ - 1e-9 || !depth_ready) {
+    // A head that does not come to rest (or a rest without its depth) is given up after
+    // settle_timeout_s: attention chooses again.
+    const bool given_up = context.time - chosen_time_ >= settle_timeout_s_ - 1e-9;
+    if (!given_up &&
+        (!rest_since_ || context.time - *rest_since_ < dwell_s_ - 1e-9 || !depth_ready)) {
       Send(context, rest_since_.has_value());
       return;
     }
@@ -258,6 +270,7 @@ void ExploreComponent::Step(const runtime::StepContext& context) {
     target_W_ = next;
     ++target_id_;
     chosen_step_ = context.step;
+    chosen_time_ = context.time;
     rest_since_.reset();
   }
   Send(context, false);

@@ -11,7 +11,8 @@
 // vision.dense_stereo -- dense stereo depth of the eye pair (vision/dense_stereo.h): the pair
 //   rectified from the images' calibration and pose, matched by SGBM with a left-right check.
 //   With `joints` connected it computes only while the head is at rest (no motion blur), once
-//   per rest (`once_per_rest`); without, every `every_steps` steps.
+//   per rest (`once_per_rest`: a rest begins when the head arrives, or is given new targets
+//   where it already is); without, every `every_steps` steps.
 //   inputs: left, right (image, required), joints (head.joints)
 //   outputs: depth (vision.depth)
 //
@@ -29,7 +30,8 @@
 //   second stage (second_stage_faces, on by default) searches faces at full resolution in the
 //   best zone only; a face found there comes first. With `candidates` connected (a face
 //   pipeline's), the closest face no place inhibits comes before all (the task). The target's
-//   source says which: explore_task, explore_face, explore_saliency or explore_reach.
+//   source says which: explore_task, explore_face, explore_saliency or explore_reach. A target
+//   whose rest (and its depth) has not come settle_timeout_s after it was chosen is given up.
 //   inputs: image (image, required: the left eye's), joints (head.joints, required),
 //           depth (vision.depth), map (mapping.map), candidates (vision.candidates)
 //   outputs: target (vision.target), selection (vision.selection: fixating while at rest on
@@ -67,6 +69,7 @@ class DenseStereoComponent : public runtime::Component {
   bool once_per_rest_ = true;
   int every_steps_ = 5;
   bool computed_this_rest_ = false;
+  head::JointState rest_targets_;  // the targets of the rest computed
 };
 
 class WorldMapComponent : public runtime::Component {
@@ -125,6 +128,8 @@ class ExploreComponent : public runtime::Component {
   std::optional<Eigen::Vector3d> target_W_;
   int64_t target_id_ = -1;
   int64_t chosen_step_ = 0;
+  double chosen_time_ = 0.0;
+  double settle_timeout_s_ = 3.0;
   std::optional<double> rest_since_;
   std::string source_;  // what proposed the target: explore_face, _saliency, _reach, _task
 };
