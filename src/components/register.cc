@@ -4,6 +4,7 @@
 #include <memory>
 
 #include "components/internal_scene.h"
+#include "saccade/components/debug_map.h"
 #include "saccade/components/explore_components.h"
 #include "saccade/components/fixation_component.h"
 #include "saccade/components/hw_components.h"
@@ -49,6 +50,8 @@ void RegisterComponents(runtime::ComponentRegistry& registry) {
   registry.Register<RemoteCameras>("remote.cameras",
                                    "the eye cameras of a robot process, through topics");
   registry.Register<DebugFault>("debug.fault", "throws at a given step (fault injection)");
+  registry.Register<DebugMap>("debug.map",
+                              "a synthetic map that grows (mapping.map), to try the map's viewers");
 }
 
 runtime::ComponentRegistry RegistryWithHead(const std::string& head, const std::string& origin,

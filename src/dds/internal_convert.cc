@@ -5,6 +5,7 @@
 #include <fmt/format.h>
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <bit>
 #include <cstring>
 #include <limits>
@@ -216,6 +217,192 @@ bool FillCameraTransform(const Image& image, Holder& holder,
   const Eigen::Quaterniond q(X_WC->rotation());
   out->transform.translation = {t.x(), t.y(), t.z()};
   out->transform.rotation = {q.x(), q.y(), q.z(), q.w()};
+  return true;
+}
+
+namespace {
+
+// Lays out a cloud of `n` points in frame "world" at `time`, each point the FLOAT32 fields
+// `names` in that order, packed; returns where the points go (in holder.bytes, zeroed).
+uint8_t* FillCloudLayout(double time, const std::vector<const char*>& names, std::size_t n,
+                         Holder& holder, sensor_msgs_msg_dds__PointCloud2_* out) {
+  holder.strings.reserve(8);
+  holder.fields.clear();
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    holder.fields.push_back(
+        {const_cast<char*>(names[i]), static_cast<uint32_t>(4 * i), kPointFieldFloat32, 1});
+  }
+  const auto step = static_cast<uint32_t>(4 * names.size());
+  holder.bytes.assign(n * step, 0);
+  *out = {};
+  out->header = Header(time, Keep(holder, kWorldFrame));
+  out->height = 1;
+  out->width = static_cast<uint32_t>(n);
+  const auto f = static_cast<uint32_t>(holder.fields.size());
+  out->fields = {f, f, holder.fields.data(), false};
+  out->is_bigendian = false;  // the machine's floats: little-endian (CdrSerializer asserts it)
+  out->point_step = step;
+  out->row_step = step * static_cast<uint32_t>(n);
+  const auto size = static_cast<uint32_t>(holder.bytes.size());
+  out->data = {size, size, holder.bytes.data(), false};
+  out->is_dense = true;  // every point is finite
+  return holder.bytes.data();
+}
+
+void PutFloat(uint8_t* at, double value) {
+  const auto f = static_cast<float>(value);
+  std::memcpy(at, &f, sizeof(f));
+}
+
+}  // namespace
+
+uint32_t HeightColor(double t) {
+  // Blue, cyan, green, yellow, red at t = 0, 1/4, 1/2, 3/4, 1, linear between.
+  static constexpr double kStops[5][3] = {{0, 0, 1}, {0, 1, 1}, {0, 1, 0}, {1, 1, 0}, {1, 0, 0}};
+  const double x = std::clamp(std::isfinite(t) ? t : 0.0, 0.0, 1.0) * 4.0;
+  const int i = std::min(3, static_cast<int>(x));
+  const double u = x - i;
+  uint32_t rgb = 0;
+  for (int c = 0; c < 3; ++c) {
+    const double v = kStops[i][c] + u * (kStops[i + 1][c] - kStops[i][c]);
+    rgb = (rgb << 8) | static_cast<uint32_t>(std::lround(255.0 * v));
+  }
+  return rgb;
+}
+
+void FillMapCloud(const components::MapMessage& map, Holder& holder,
+                  sensor_msgs_msg_dds__PointCloud2_* out) {
+  const std::vector<Eigen::Vector3d>& points = map.occupied_W;
+  uint8_t* data = FillCloudLayout(map.time, {"x", "y", "z", "rgb"}, points.size(), holder, out);
+  double z_min = std::numeric_limits<double>::infinity(), z_max = -z_min;
+  for (const Eigen::Vector3d& p : points) {
+    z_min = std::min(z_min, p.z());
+    z_max = std::max(z_max, p.z());
+  }
+  const double range = z_max > z_min ? z_max - z_min : 1.0;
+  for (const Eigen::Vector3d& p : points) {
+    PutFloat(data, p.x());
+    PutFloat(data + 4, p.y());
+    PutFloat(data + 8, p.z());
+    const uint32_t rgb = HeightColor((p.z() - z_min) / range);
+    std::memcpy(data + 12, &rgb, sizeof(rgb));
+    data += 16;
+  }
+}
+
+void FillInhibitedCloud(const components::MapMessage& map, Holder& holder,
+                        sensor_msgs_msg_dds__PointCloud2_* out) {
+  uint8_t* data = FillCloudLayout(map.time, {"x", "y", "z", "strength", "radius"},
+                                  map.inhibited.size(), holder, out);
+  for (const components::InhibitedPlace& place : map.inhibited) {
+    PutFloat(data, place.p_W.x());
+    PutFloat(data + 4, place.p_W.y());
+    PutFloat(data + 8, place.p_W.z());
+    PutFloat(data + 12, place.strength);
+    PutFloat(data + 16, place.radius_m);
+    data += 20;
+  }
+}
+
+bool CloudFields(const sensor_msgs_msg_dds__PointCloud2_& cloud,
+                 const std::vector<std::string>& names, std::vector<double>* values,
+                 std::string* error) {
+  if (cloud.is_bigendian) {
+    *error = "big-endian point clouds are not supported";
+    return false;
+  }
+  struct Where {
+    uint32_t offset;
+    bool is_double;
+  };
+  std::vector<Where> where;
+  for (const std::string& name : names) {
+    const sensor_msgs_msg_dds__PointField_* found = nullptr;
+    std::string known;
+    for (uint32_t i = 0; i < cloud.fields._length; ++i) {
+      const sensor_msgs_msg_dds__PointField_& f = cloud.fields._buffer[i];
+      const std::string field = f.name ? f.name : "";
+      known += (known.empty() ? "" : ", ") + field;
+      if (field == name) found = &f;
+    }
+    if (found == nullptr) {
+      *error = fmt::format("the cloud has no field '{}' (its fields: {})", name, known);
+      return false;
+    }
+    const bool is_double = found->datatype == kPointFieldFloat32 + 1;  // FLOAT64
+    if ((found->datatype != kPointFieldFloat32 && !is_double) || found->count > 1 ||
+        uint64_t{found->offset} + (is_double ? 8 : 4) > cloud.point_step) {
+      *error = fmt::format(
+          "field '{}' is datatype {} count {} at offset {} of a {}-byte point; expected one "
+          "FLOAT32 (7) or FLOAT64 (8) inside the point",
+          name, found->datatype, found->count, found->offset, cloud.point_step);
+      return false;
+    }
+    where.push_back({found->offset, is_double});
+  }
+  const uint64_t width = cloud.width, height = cloud.height;
+  if (uint64_t{cloud.row_step} < width * cloud.point_step ||
+      uint64_t{cloud.data._length} < uint64_t{cloud.row_step} * height) {
+    *error = fmt::format("{}x{} points of {} bytes: row_step {} and {} bytes of data are too short",
+                         width, height, cloud.point_step, cloud.row_step, cloud.data._length);
+    return false;
+  }
+  values->assign(width * height * names.size(), 0.0);
+  double* v = values->data();
+  for (uint64_t row = 0; row < height; ++row) {
+    for (uint64_t col = 0; col < width; ++col) {
+      const uint8_t* point = cloud.data._buffer + row * cloud.row_step + col * cloud.point_step;
+      for (const Where& w : where) {
+        if (w.is_double) {
+          std::memcpy(v++, point + w.offset, sizeof(double));
+        } else {
+          float f = 0;
+          std::memcpy(&f, point + w.offset, sizeof(f));
+          *v++ = f;
+        }
+      }
+    }
+  }
+  return true;
+}
+
+namespace {
+
+bool CheckWorldFrame(const sensor_msgs_msg_dds__PointCloud2_& cloud, std::string* error) {
+  const std::string frame = cloud.header.frame_id ? cloud.header.frame_id : "";
+  if (frame == kWorldFrame) return true;
+  *error = "point cloud in frame '" + frame + "', expected 'world'";
+  return false;
+}
+
+}  // namespace
+
+bool MapOf(const sensor_msgs_msg_dds__PointCloud2_& cloud, components::MapMessage* map,
+           std::string* error) {
+  std::vector<double> v;
+  if (!CheckWorldFrame(cloud, error) || !CloudFields(cloud, {"x", "y", "z"}, &v, error)) {
+    return false;
+  }
+  *map = {};
+  map->time = FromStamp(cloud.header.stamp);
+  map->occupied_W.reserve(v.size() / 3);
+  for (std::size_t i = 0; i + 2 < v.size(); i += 3) {
+    map->occupied_W.emplace_back(v[i], v[i + 1], v[i + 2]);
+  }
+  return true;
+}
+
+bool InhibitedOf(const sensor_msgs_msg_dds__PointCloud2_& cloud,
+                 std::vector<components::InhibitedPlace>* places, std::string* error) {
+  std::vector<double> v;
+  if (!CheckWorldFrame(cloud, error) ||
+      !CloudFields(cloud, {"x", "y", "z", "strength", "radius"}, &v, error)) {
+    return false;
+  }
+  places->clear();
+  for (std::size_t i = 0; i + 4 < v.size(); i += 5) {
+    places->push_back({Eigen::Vector3d(v[i], v[i + 1], v[i + 2]), v[i + 4], v[i + 3]});
+  }
   return true;
 }
 

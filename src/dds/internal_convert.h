@@ -52,6 +52,8 @@ struct Holder {
   std::vector<std::string> strings;
   std::vector<char*> string_pointers;
   std::vector<double> doubles[3];
+  std::vector<sensor_msgs_msg_dds__PointField_> fields;  // a point cloud's
+  std::vector<uint8_t> bytes;                            // a point cloud's points
 };
 
 /// `image` as sensor_msgs/Image, borrowing its pixels and `holder`'s strings. False when its
@@ -134,6 +136,38 @@ class ImagePool {
 /// or a short buffer.
 std::shared_ptr<Image> ImageOf(const sensor_msgs_msg_dds__Image_& msg, std::string* error,
                                ImagePool* pool = nullptr);
+
+/// sensor_msgs/PointField's datatype FLOAT32 (its constant; the others are not used here).
+inline constexpr uint8_t kPointFieldFloat32 = 7;
+
+/// The map's occupied voxels as sensor_msgs/PointCloud2: frame "world", stamped with its time,
+/// height 1, width N, little-endian FLOAT32 fields x, y, z (metres, offsets 0, 4, 8) and rgb
+/// (offset 12: PCL's packed 0x00RRGGBB, coloured by height over the map's own z range with
+/// HeightColor), point_step 16, is_dense. The data lives in `holder`.
+void FillMapCloud(const components::MapMessage& map, Holder& holder,
+                  sensor_msgs_msg_dds__PointCloud2_* out);
+/// The places inhibition of return holds as sensor_msgs/PointCloud2 (the map's sibling topic):
+/// as FillMapCloud, fields x, y, z, strength (0..1], radius (m), point_step 20.
+void FillInhibitedCloud(const components::MapMessage& map, Holder& holder,
+                        sensor_msgs_msg_dds__PointCloud2_* out);
+/// A colour for height `t` in [0, 1] (clamped): blue, cyan, green, yellow, red, as 0x00RRGGBB.
+uint32_t HeightColor(double t);
+
+/// Reads the named fields of every point of `cloud` (FLOAT32 or FLOAT64, count 1, anywhere in
+/// the point), point by point into `*values` (N x names.size()). False (and `*error` says which
+/// field or size is wrong) for a big-endian cloud, a missing or mistyped field, or data
+/// shorter than its rows.
+bool CloudFields(const sensor_msgs_msg_dds__PointCloud2_& cloud,
+                 const std::vector<std::string>& names, std::vector<double>* values,
+                 std::string* error);
+/// The occupied voxels' centres of a PointCloud2 in frame "world" (fields x, y, z); time from its
+/// stamp. False (and `*error` says why) for another frame or what CloudFields refuses. The
+/// cloud does not carry resolution_m, frame_index or fused: they stay 0.
+bool MapOf(const sensor_msgs_msg_dds__PointCloud2_& cloud, components::MapMessage* map,
+           std::string* error);
+/// The inhibited places of a cloud FillInhibitedCloud wrote (fields x, y, z, strength, radius).
+bool InhibitedOf(const sensor_msgs_msg_dds__PointCloud2_& cloud,
+                 std::vector<components::InhibitedPlace>* places, std::string* error);
 
 /// Every link of `head` at `positions` (by name) as TF, as robot_state_publisher sends them:
 /// world -> the root link (the head's pose X_WB), then for each joint its parent link -> child

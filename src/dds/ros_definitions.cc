@@ -33,6 +33,14 @@ const std::map<std::string, std::string>& Definitions() {
       {"sensor_msgs/JointState",
        "std_msgs/Header header\nstring[] name\nfloat64[] position\nfloat64[] velocity\n"
        "float64[] effort\n"},
+      // Constants as the .msg file declares them (rosbag2 stores them with the fields).
+      {"sensor_msgs/PointField",
+       "uint8 INT8=1\nuint8 UINT8=2\nuint8 INT16=3\nuint8 UINT16=4\nuint8 INT32=5\n"
+       "uint8 UINT32=6\nuint8 FLOAT32=7\nuint8 FLOAT64=8\nstring name\nuint32 offset\n"
+       "uint8 datatype\nuint32 count\n"},
+      {"sensor_msgs/PointCloud2",
+       "std_msgs/Header header\nuint32 height\nuint32 width\nsensor_msgs/PointField[] fields\n"
+       "bool is_bigendian\nuint32 point_step\nuint32 row_step\nuint8[] data\nbool is_dense\n"},
       {"geometry_msgs/Point", "float64 x\nfloat64 y\nfloat64 z\n"},
       {"geometry_msgs/PointStamped", "std_msgs/Header header\ngeometry_msgs/Point point\n"},
       {"geometry_msgs/Vector3", "float64 x\nfloat64 y\nfloat64 z\n"},

@@ -26,6 +26,7 @@ namespace saccade::dds {
 
 using components::JointCommand;
 using components::JointStateMessage;
+using components::MapMessage;
 using components::TargetMessage;
 using runtime::ImageMessage;
 using runtime::MessageName;
@@ -382,7 +383,8 @@ class ImageWriter final : public Writer {
   LinkStats stats_;
 };
 
-// head.joints, head.command and vision.target: one ROS message each.
+// head.joints, head.command, vision.target and mapping.map: one ROS message each (and a
+// sibling: joint states' targets, the map's inhibited places).
 template <typename M, typename Sample>
 class SimpleWriter final : public Writer {
  public:
@@ -395,7 +397,7 @@ class SimpleWriter final : public Writer {
     writer_ = make_(descriptor, options.topic, options.qos, lockstep_);
     if constexpr (std::is_same_v<M, JointStateMessage>) {
       if (!options.targets_topic.empty()) {
-        targets_ = make_(descriptor, options.targets_topic, options.qos, false);
+        sibling_ = make_(descriptor, options.targets_topic, options.qos, false);
       }
       if (!options.robot_description_topic.empty()) {
         description_ = make_(&std_msgs_msg_dds__String__desc, options.robot_description_topic,
@@ -407,6 +409,11 @@ class SimpleWriter final : public Writer {
                     {Reliability::kReliable, Durability::kTransientLocal, 100}, false);
       }
     }
+    if constexpr (std::is_same_v<M, MapMessage>) {
+      if (!options.inhibited_topic.empty()) {
+        sibling_ = make_(descriptor, options.inhibited_topic, options.qos, false);
+      }
+    }
   }
   void WriteErased(const void* message) override {
     const M& m = *static_cast<const M*>(message);
@@ -414,14 +421,24 @@ class SimpleWriter final : public Writer {
     if constexpr (std::is_same_v<M, JointStateMessage>) {
       if (m.head) WriteRobot(m);
       // The targets first, so that a reader has them when the state arrives.
-      if (targets_) {
+      if (sibling_) {
         head::JointState targets, velocities;
         internal::TargetsToSend(m, &targets, &velocities);
         internal::Holder holder;
         Sample sample{};
         internal::FillJointState(m.time, targets, &velocities, holder, &sample);
         sample.header.stamp = internal::ShiftStamp(sample.header.stamp, offset_);
-        targets_->Write(&sample, internal::StampNs(sample.header.stamp), stats_);
+        sibling_->Write(&sample, internal::StampNs(sample.header.stamp), stats_);
+      }
+    }
+    if constexpr (std::is_same_v<M, MapMessage>) {
+      // The inhibited places first, so that a reader has them when the map arrives.
+      if (sibling_) {
+        internal::Holder holder;
+        Sample sample{};
+        internal::FillInhibitedCloud(m, holder, &sample);
+        sample.header.stamp = internal::ShiftStamp(sample.header.stamp, offset_);
+        sibling_->Write(&sample, internal::StampNs(sample.header.stamp), stats_);
       }
     }
     internal::Holder holder;
@@ -488,6 +505,7 @@ class SimpleWriter final : public Writer {
   static bool Publishable(const TargetMessage& m) { return m.valid && m.p_W.allFinite(); }
   static bool Publishable(const JointStateMessage&) { return true; }
   static bool Publishable(const JointCommand&) { return true; }
+  static bool Publishable(const MapMessage&) { return true; }
 
   static void Fill(const JointStateMessage& m, internal::Holder& holder,
                    sensor_msgs_msg_dds__JointState_* out) {
@@ -504,10 +522,16 @@ class SimpleWriter final : public Writer {
     out->header = {internal::ToStamp(m.time), holder.strings.back().data()};
     out->point = {m.p_W.x(), m.p_W.y(), m.p_W.z()};
   }
+  static void Fill(const MapMessage& m, internal::Holder& holder,
+                   sensor_msgs_msg_dds__PointCloud2_* out) {
+    internal::FillMapCloud(m, holder, out);
+  }
 
   OutletFactory make_;  // holds the participant: destroyed after the outlets
   std::unique_ptr<Outlet> writer_;
-  std::unique_ptr<Outlet> targets_;  // joint states: their targets (TopicOptions::targets_topic)
+  // Joint states: their targets (TopicOptions::targets_topic); maps: the inhibited places
+  // (inhibited_topic).
+  std::unique_ptr<Outlet> sibling_;
   // Joint states with a head: its URDF (TopicOptions::robot_description_topic) and its links'
   // poses (tf_topic).
   std::unique_ptr<Outlet> description_, tf_;
@@ -760,9 +784,13 @@ class SimpleReader final : public Reader {
         lockstep_(options.lockstep) {
     topic_ = MakeTopic(*participant_, descriptor, options.topic);
     reader_ = MakeReader(*participant_, topic_, options.qos, options.topic);
-    if (std::is_same_v<M, JointStateMessage> && !options.targets_topic.empty()) {
-      targets_topic_ = MakeTopic(*participant_, descriptor, options.targets_topic);
-      targets_ = MakeReader(*participant_, targets_topic_, options.qos, options.targets_topic);
+    // Joint states' targets and the map's inhibited places come on a sibling topic.
+    std::string sibling;
+    if constexpr (std::is_same_v<M, JointStateMessage>) sibling = options.targets_topic;
+    if constexpr (std::is_same_v<M, MapMessage>) sibling = options.inhibited_topic;
+    if (!sibling.empty()) {
+      sibling_topic_ = MakeTopic(*participant_, descriptor, sibling);
+      sibling_ = MakeReader(*participant_, sibling_topic_, options.qos, sibling);
     }
     wait_ = std::make_unique<DataWait>(reader_);
   }
@@ -786,7 +814,9 @@ class SimpleReader final : public Reader {
     if (last_time_ && newest->time < *last_time_) ++stats_.restarts;
     last_time_ = newest->time;
     ++stats_.messages;
-    if constexpr (std::is_same_v<M, JointStateMessage>) Complete(*newest);
+    if constexpr (std::is_same_v<M, JointStateMessage> || std::is_same_v<M, MapMessage>) {
+      Complete(*newest);
+    }
     return newest;
   }
   bool WaitForStep(double time, double timeout_s) override {
@@ -821,25 +851,29 @@ class SimpleReader final : public Reader {
   void Drain() {
     if constexpr (std::is_same_v<M, JointStateMessage>) {
       // Before the states: each state's targets were written before it.
-      if (targets_.get() > 0) {
-        TakeAll<Sample>(targets_, [&](const Sample& sample, const dds_sample_info_t& info) {
+      if (sibling_.get() > 0) {
+        TakeAll<Sample>(sibling_, [&](const Sample& sample, const dds_sample_info_t& info) {
           Target target;
           std::string error;
           if (!internal::JointsOf(sample, &target.positions, &target.velocities, &error)) {
             log::Log(log::Level::kWarn, "dds: {}: targets dropped: {}", topic(), error);
             return;
           }
-          const double time = internal::FromStamp(
-              sample.header.stamp,
-              targets_announcements_.Get(targets_, info.publication_handle).stamp_offset_ns);
-          // The sender restarted (its stamps went back): its earlier targets are of no state.
-          if (!targets_by_time_.empty() && time < targets_by_time_.rbegin()->first) {
-            targets_by_time_.clear();
+          KeepSibling(targets_by_time_, SiblingTime(sample, info), std::move(target));
+        });
+      }
+    }
+    if constexpr (std::is_same_v<M, MapMessage>) {
+      // Before the maps: each map's inhibited places were written before it.
+      if (sibling_.get() > 0) {
+        TakeAll<Sample>(sibling_, [&](const Sample& sample, const dds_sample_info_t& info) {
+          std::vector<components::InhibitedPlace> places;
+          std::string error;
+          if (!internal::InhibitedOf(sample, &places, &error)) {
+            log::Log(log::Level::kWarn, "dds: {}: inhibited places dropped: {}", topic(), error);
+            return;
           }
-          targets_by_time_[time] = target;
-          if (targets_by_time_.size() > kMaxPending) {
-            targets_by_time_.erase(targets_by_time_.begin());
-          }
+          KeepSibling(inhibited_by_time_, SiblingTime(sample, info), std::move(places));
         });
       }
     }
@@ -874,6 +908,21 @@ class SimpleReader final : public Reader {
     });
   }
 
+  // A sibling sample's time: its stamp less the offset its writer announced.
+  double SiblingTime(const Sample& sample, const dds_sample_info_t& info) {
+    return internal::FromStamp(
+        sample.header.stamp,
+        sibling_announcements_.Get(sibling_, info.publication_handle).stamp_offset_ns);
+  }
+  // Keeps what a sibling topic brought for the message of stamp `time`.
+  template <typename T>
+  static void KeepSibling(std::map<double, T>& by_time, double time, T value) {
+    // The sender restarted (its stamps went back): what it sent before is of no message now.
+    if (!by_time.empty() && time < by_time.rbegin()->first) by_time.clear();
+    by_time[time] = std::move(value);
+    if (by_time.size() > kMaxPending) by_time.erase(by_time.begin());
+  }
+
   // The matched writers that announce lockstep in their user data (asked once per writer).
   std::vector<dds_instance_handle_t> LockstepWriters() {
     dds_instance_handle_t handles[kMaxLockstepQuery];
@@ -892,7 +941,7 @@ class SimpleReader final : public Reader {
   void Complete(JointStateMessage& m) {
     const auto it = targets_by_time_.find(m.time);
     if (it == targets_by_time_.end()) {
-      if (targets_.get() > 0) ++stats_.incomplete;
+      if (sibling_.get() > 0) ++stats_.incomplete;
       return;
     }
     m.targets = it->second.positions;
@@ -901,11 +950,24 @@ class SimpleReader final : public Reader {
     targets_by_time_.erase(targets_by_time_.begin(), std::next(it));
   }
 
+  // The inhibited places of the map's stamp; a map without them (lost, or a sender without
+  // them: a ROS 2 node's cloud) has none and is counted incomplete when they were expected.
+  void Complete(MapMessage& m) {
+    const auto it = inhibited_by_time_.find(m.time);
+    if (it == inhibited_by_time_.end()) {
+      if (sibling_.get() > 0) ++stats_.incomplete;
+      return;
+    }
+    m.inhibited = it->second;
+    inhibited_by_time_.erase(inhibited_by_time_.begin(), std::next(it));
+  }
+
   // An empty JointState (no joint named) marks a lockstep writer's step (Writer::MarkStep).
   static bool IsStepMark(const sensor_msgs_msg_dds__JointState_& s) {
     return s.name._length == 0 && s.position._length == 0;
   }
   static bool IsStepMark(const geometry_msgs_msg_dds__PointStamped_&) { return false; }
+  static bool IsStepMark(const sensor_msgs_msg_dds__PointCloud2_&) { return false; }
 
   static bool Convert(const sensor_msgs_msg_dds__JointState_& s, JointStateMessage* m,
                       std::string* error) {
@@ -936,6 +998,10 @@ class SimpleReader final : public Reader {
     m->source = "dds";
     return true;
   }
+  static bool Convert(const sensor_msgs_msg_dds__PointCloud2_& s, MapMessage* m,
+                      std::string* error) {
+    return internal::MapOf(s, m, error);
+  }
 
   // Messages stamped after the time they were asked for (TakeErased's up_to), kept for a later
   // step: at most a reader's deepest history.
@@ -948,14 +1014,16 @@ class SimpleReader final : public Reader {
   static constexpr dds_return_t kMaxLockstepQuery = 64;
   std::map<dds_instance_handle_t, double> reached_;
   // What the matched writers announce: lockstep, their stamps' offset.
-  Announcements announcements_, targets_announcements_;
+  Announcements announcements_, sibling_announcements_;
   // Joint states: the targets received, by stamp (TopicOptions::targets_topic).
   struct Target {
     head::JointState positions, velocities;
   };
   std::map<double, Target> targets_by_time_;
+  // Maps: the inhibited places received, by stamp (TopicOptions::inhibited_topic).
+  std::map<double, std::vector<components::InhibitedPlace>> inhibited_by_time_;
   Entity topic_, reader_;
-  Entity targets_topic_, targets_;
+  Entity sibling_topic_, sibling_;  // targets_topic or inhibited_topic
   std::unique_ptr<DataWait> wait_;
   std::optional<double> last_time_;
   LinkStats stats_;
@@ -995,6 +1063,7 @@ void CheckOptions(const TopicOptions& options) {
     throw InvalidArgument("dds: QoS of " + options.topic + ": " + error);
   }
   if (!options.tf_topic.empty()) DdsTopicName(options.tf_topic);
+  if (!options.inhibited_topic.empty()) DdsTopicName(options.inhibited_topic);
   if (options.compressed_format != "" && options.compressed_format != "jpeg" &&
       options.compressed_format != "png") {
     throw InvalidArgument("dds: compressed images of " + options.topic +
@@ -1023,7 +1092,7 @@ std::string SupportedList() {
 
 std::vector<std::string> SupportedMessageTypes() {
   return {MessageName<ImageMessage>(), MessageName<JointStateMessage>(),
-          MessageName<JointCommand>(), MessageName<TargetMessage>()};
+          MessageName<JointCommand>(), MessageName<TargetMessage>(), MessageName<MapMessage>()};
 }
 
 std::string RosTypeOf(const std::string& message_type) {
@@ -1031,6 +1100,7 @@ std::string RosTypeOf(const std::string& message_type) {
   if (message_type == MessageName<JointStateMessage>()) return "sensor_msgs/msg/JointState";
   if (message_type == MessageName<JointCommand>()) return "sensor_msgs/msg/JointState";
   if (message_type == MessageName<TargetMessage>()) return "geometry_msgs/msg/PointStamped";
+  if (message_type == MessageName<MapMessage>()) return "sensor_msgs/msg/PointCloud2";
   throw InvalidArgument("dds: message type '" + message_type +
                         "' has no ROS 2 form; DDS topics carry " + SupportedList());
 }
@@ -1082,6 +1152,10 @@ std::unique_ptr<Writer> MakeTypedWriter(OutletFactory make, const std::string& m
     return std::make_unique<SimpleWriter<JointCommand, sensor_msgs_msg_dds__JointState_>>(
         std::move(make), options, &sensor_msgs_msg_dds__JointState__desc);
   }
+  if (message_type == MessageName<MapMessage>()) {
+    return std::make_unique<SimpleWriter<MapMessage, sensor_msgs_msg_dds__PointCloud2_>>(
+        std::move(make), options, &sensor_msgs_msg_dds__PointCloud2__desc);
+  }
   return std::make_unique<SimpleWriter<TargetMessage, geometry_msgs_msg_dds__PointStamped_>>(
       std::move(make), options, &geometry_msgs_msg_dds__PointStamped__desc);
 }
@@ -1113,13 +1187,10 @@ namespace {
 // The ROS 2 types saccade's IDL declares, by their ROS 2 names.
 const std::vector<const dds_topic_descriptor_t*>& Descriptors() {
   static const std::vector<const dds_topic_descriptor_t*> descriptors = {
-      &sensor_msgs_msg_dds__Image__desc,
-      &sensor_msgs_msg_dds__CameraInfo__desc,
-      &sensor_msgs_msg_dds__CompressedImage__desc,
-      &sensor_msgs_msg_dds__JointState__desc,
-      &geometry_msgs_msg_dds__PointStamped__desc,
-      &tf2_msgs_msg_dds__TFMessage__desc,
-      &std_msgs_msg_dds__String__desc,
+      &sensor_msgs_msg_dds__Image__desc,           &sensor_msgs_msg_dds__CameraInfo__desc,
+      &sensor_msgs_msg_dds__CompressedImage__desc, &sensor_msgs_msg_dds__JointState__desc,
+      &sensor_msgs_msg_dds__PointCloud2__desc,     &geometry_msgs_msg_dds__PointStamped__desc,
+      &tf2_msgs_msg_dds__TFMessage__desc,          &std_msgs_msg_dds__String__desc,
       &rosgraph_msgs_msg_dds__Clock__desc};
   return descriptors;
 }
@@ -1209,6 +1280,10 @@ std::unique_ptr<Reader> Reader::Create(std::shared_ptr<Participant> participant,
   if (message_type == MessageName<JointCommand>()) {
     return std::make_unique<SimpleReader<JointCommand, sensor_msgs_msg_dds__JointState_>>(
         std::move(participant), options, &sensor_msgs_msg_dds__JointState__desc);
+  }
+  if (message_type == MessageName<MapMessage>()) {
+    return std::make_unique<SimpleReader<MapMessage, sensor_msgs_msg_dds__PointCloud2_>>(
+        std::move(participant), options, &sensor_msgs_msg_dds__PointCloud2__desc);
   }
   return std::make_unique<SimpleReader<TargetMessage, geometry_msgs_msg_dds__PointStamped_>>(
       std::move(participant), options, &geometry_msgs_msg_dds__PointStamped__desc);

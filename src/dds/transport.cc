@@ -22,6 +22,7 @@ namespace {
 
 using components::JointCommand;
 using components::JointStateMessage;
+using components::MapMessage;
 using components::TargetMessage;
 using runtime::ImageMessage;
 using runtime::MessageName;
@@ -125,6 +126,10 @@ Endpoint Resolve(const runtime::TopicEndpoint& endpoint, const std::set<std::str
   // Joint states carry their targets on a sibling topic (TopicOptions::targets_topic).
   const bool joints = endpoint.message_type == MessageName<JointStateMessage>();
   if (joints) out.options.targets_topic = SiblingTopic(out.options.topic, kTargetsSibling);
+  // Maps carry the places inhibition of return holds on `<topic>/inhibited`.
+  if (endpoint.message_type == MessageName<MapMessage>()) {
+    out.options.inhibited_topic = out.options.topic + "/inhibited";
+  }
   // And the head's URDF on robot_description (TopicOptions::robot_description_topic).
   if (joints) out.options.robot_description_topic = ResolveTopic(kRobotDescription, ns);
   if (const auto it = endpoint.options.find(kRobotDescription); it != endpoint.options.end()) {
@@ -343,6 +348,7 @@ auto Dispatch(const std::string& type, F&& f) {
   if (type == MessageName<JointStateMessage>()) return f(JointStateMessage{});
   if (type == MessageName<JointCommand>()) return f(JointCommand{});
   if (type == MessageName<TargetMessage>()) return f(TargetMessage{});
+  if (type == MessageName<MapMessage>()) return f(MapMessage{});
   RosTypeOf(type);  // throws, naming the supported types
   SACCADE_ASSERT(false, "unreachable");
 }
@@ -431,6 +437,8 @@ DomainOptions ParseTransport(const nlohmann::json& transport, std::string* ns,
 Qos DefaultQos(const std::string& message_type) {
   if (message_type == MessageName<ImageMessage>()) return Qos::Images();
   if (message_type == MessageName<JointStateMessage>()) return Qos::Latched();
+  // A viewer that comes later (rviz2) gets the newest map at once; a large map is never queued.
+  if (message_type == MessageName<MapMessage>()) return Qos::Latched();
   return Qos::Default();
 }
 

@@ -99,7 +99,7 @@ vertices and I indices: V x 3 float32 positions, V x 3 float32 normals, V x 2 fl
 
 inline constexpr const char* kWebSocketProse = R"md(## WebSocket `/ws`
 Text messages are JSON objects with a `type`. On connecting, the server sends `hello`, then the
-latest `state`.
+latest `state` (and the newest `map`, when the pipeline has one).
 
 Every message each way is declared below, field by field. A message breaks the protocol when a
 field is missing or of another kind (null only where it says so), a number is not finite or

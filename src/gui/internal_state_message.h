@@ -1,7 +1,7 @@
 #pragma once
-// The state message of the GUI protocol (docs/gui-protocol.md, `state`), built from what the
-// session gathered after a step: apart from the session so that tests build it and check it
-// against the protocol's table (tests/gui/protocol_test.cc).
+// The state and map messages of the GUI protocol (docs/gui-protocol.md, `state`, `map`), built
+// from what the session gathered after a step: apart from the session so that tests build them
+// and check them against the protocol's table (tests/gui/protocol_test.cc).
 #include <cstdint>
 #include <nlohmann/json.hpp>
 #include <optional>
@@ -38,5 +38,10 @@ struct StateParts {
 /// The state message: the joints with the head's frames (forward kinematics), the target with
 /// each optical axis's error to it, and the poses of `scene`'s moving objects at `parts.time`.
 nlohmann::json StateJson(const StateParts& parts, const scene::Scene& scene);
+
+/// The map message of `m`: every voxel, or every k-th beyond protocol::kMaxMapPoints (k =
+/// ceil(total / kMaxMapPoints)), to the millimetre; points and places that are not finite left
+/// out, strengths clamped to [0, 1].
+nlohmann::json MapJson(const components::MapMessage& m);
 
 }  // namespace saccade::gui::internal

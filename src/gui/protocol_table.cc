@@ -2,6 +2,8 @@
 // checks commands and its own messages against it; docs/gui-protocol.md and
 // web/public/app/protocol.js are generated from it (`saccade gui --protocol-markdown`,
 // `--protocol-js`).
+#include <fmt/format.h>
+
 #include <utility>
 
 #include "saccade/gui/protocol.h"
@@ -230,6 +232,33 @@ Message State() {
                 "the recording the page or --record started; null when none")});
 }
 
+Message Map() {
+  const Schema place =
+      Object({Required("p_W", Point(), "the place (m, world)"),
+              Required("radius_m", Number(0), "the head does not look within it (m)"),
+              Required("strength", Number(0, 1), "1 when fixated, decaying after")});
+  return ServerMessage(
+      "map", Channel::kText,
+      fmt::format("the map a pipeline builds (mapping.map): when it changed, at most once "
+                  "every {} steps (a slow client gets only the newest)",
+                  kMapEverySteps),
+      {Required("time", Number(), "the map's time (s)"),
+       Required("frame", Integer(), "the map's frame index"),
+       Required("resolution_m", Number(0), "voxel edge (m); 0: not known (a map from DDS)"),
+       Required("fused", Integer(0), "depth images fused into it so far"),
+       Required("total", Integer(0), "occupied voxels in the map"),
+       Required("points", Array(Number()),
+                fmt::format("occupied voxels' centres, [x0, y0, z0, x1, ...] (m, world, to the "
+                            "mm): every one, or every k-th when there are more than {} (k = "
+                            "ceil(total / {}))",
+                            kMaxMapPoints, kMaxMapPoints)),
+       Required("inhibited", Array(place),
+                "the places inhibition of return holds, strongest first")},
+      "Sent only by pipelines with a `mapping.map` output (the first one); a client that "
+      "connects later gets the newest. The page draws the points coloured by height and the "
+      "inhibited places as spheres whose opacity is their strength.");
+}
+
 void AddServerMessages(std::vector<Message>& out) {
   out.push_back(ServerMessage(
       "hello", Channel::kText, "the first message on connecting; the newest state follows",
@@ -238,6 +267,7 @@ void AddServerMessages(std::vector<Message>& out) {
        Required("client", Integer(1), "this connection's number (as in /api/status)"),
        Required("mode", String({"demo", "gui"}), "`saccade demo --gui` or `saccade gui`")}));
   out.push_back(State());
+  out.push_back(Map());
   out.push_back(ServerMessage(
       "reply", Channel::kText, "a command was accepted; its fields depend on the command",
       {Required("id", Integer(), "the command's id"), Required("ok", Const(true), "accepted")},

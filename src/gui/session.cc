@@ -94,6 +94,7 @@ GuiSession::GuiSession(runtime::Pipeline& pipeline, const scene::Scene& scene,
   Tap<HeadStatusMessage>(pipeline, [this](const HeadStatusMessage& m) {
     head_status_ = runtime::MessageTraits<HeadStatusMessage>::ToJson(m);
   });
+  TapMap(pipeline);
   if (scene_.robot()) targets_ = scene_.robot()->initial_joints;
 
   server::ServerOptions server_options;
@@ -504,6 +505,7 @@ void GuiSession::AfterStep(const runtime::StepContext& context, const Latest& la
   last_latest_ = &latest;
   ApplyQueued();
   server_->PublishState(StateJson(context, latest));
+  PublishMap(context.step, control_.paused());
 
   // The newest images to the encoder (it drops what it has not started on).
   const auto left = latest.images.find("left");
@@ -539,9 +541,40 @@ void GuiSession::AfterStep(const runtime::StepContext& context, const Latest& la
       // Commands while paused take effect (targets) and the page sees them.
       ApplyQueued();
       server_->PublishState(StateJson(context, latest));
+      PublishMap(context.step, true);
     }
   });
   last_return_wall_ = WallNow();
+}
+
+void GuiSession::TapMap(runtime::Pipeline& pipeline) {
+  for (const auto& component : pipeline.components()) {
+    for (const auto& output : component->outputs()) {
+      auto* typed = dynamic_cast<runtime::Output<components::MapMessage>*>(output.get());
+      if (typed == nullptr) continue;
+      typed->signal().Connect([this](const components::MapMessage& m) {
+        auto copy = std::make_shared<const components::MapMessage>(m);
+        std::lock_guard lock(map_mutex_);
+        map_ = std::move(copy);
+        map_pending_ = true;
+      });
+      return;  // the first one
+    }
+  }
+}
+
+void GuiSession::PublishMap(int64_t step, bool now) {
+  std::shared_ptr<const components::MapMessage> map;
+  {
+    std::lock_guard lock(map_mutex_);
+    if (!map_pending_ || (!now && step - map_sent_step_ < protocol::kMapEverySteps)) return;
+    map = map_;
+    map_pending_ = false;
+    map_sent_step_ = step;
+  }
+  const json message = internal::MapJson(*map);
+  Conform(protocol::CheckServerMessage(message));
+  server_->PublishLatest("map", message);
 }
 
 void GuiSession::WhileWaiting() {

@@ -5,6 +5,7 @@
 #include "gui/internal_state_message.h"
 #include "saccade/core/units.h"
 #include "saccade/geometry/json.h"
+#include "saccade/gui/protocol.h"
 #include "saccade/head/fixation.h"
 #include "saccade/head/json.h"
 
@@ -68,6 +69,42 @@ json StateJson(const StateParts& parts, const scene::Scene& scene) {
   state["head_status"] = parts.head_status;
   state["recording"] = parts.recording;
   return state;
+}
+
+}  // namespace saccade::gui::internal
+
+namespace saccade::gui::internal {
+
+json MapJson(const components::MapMessage& m) {
+  const std::size_t total = m.occupied_W.size();
+  const std::size_t max = protocol::kMaxMapPoints;
+  const std::size_t every = total <= max ? 1 : (total + max - 1) / max;
+  const auto Mm = [](double v) { return std::round(v * 1000.0) / 1000.0; };
+  std::vector<double> xyz;
+  xyz.reserve(3 * std::min(total, max));
+  for (std::size_t i = 0; i < total; i += every) {
+    const Eigen::Vector3d& p = m.occupied_W[i];
+    if (!p.allFinite()) continue;
+    xyz.insert(xyz.end(), {Mm(p.x()), Mm(p.y()), Mm(p.z())});
+  }
+  json inhibited = json::array();
+  for (const components::InhibitedPlace& place : m.inhibited) {
+    if (!place.p_W.allFinite() || !std::isfinite(place.radius_m) ||
+        !std::isfinite(place.strength)) {
+      continue;
+    }
+    inhibited.push_back({{"p_W", {Mm(place.p_W.x()), Mm(place.p_W.y()), Mm(place.p_W.z())}},
+                         {"radius_m", std::max(0.0, place.radius_m)},
+                         {"strength", std::clamp(place.strength, 0.0, 1.0)}});
+  }
+  return {{"type", "map"},
+          {"time", std::isfinite(m.time) ? m.time : 0.0},
+          {"frame", m.frame_index},
+          {"resolution_m", std::isfinite(m.resolution_m) ? std::max(0.0, m.resolution_m) : 0.0},
+          {"fused", std::max<int64_t>(0, m.fused)},
+          {"total", total},
+          {"points", std::move(xyz)},
+          {"inhibited", std::move(inhibited)}};
 }
 
 }  // namespace saccade::gui::internal

@@ -178,6 +178,16 @@ void GuiServer::PublishState(const nlohmann::json& state) {
   for (const auto& session : impl_->core.Snapshot()) session->OfferState(text);
 }
 
+void GuiServer::PublishLatest(const std::string& kind, const nlohmann::json& message) {
+  const auto text = std::make_shared<const std::string>(
+      message.dump(-1, ' ', false, json::error_handler_t::replace));
+  {
+    std::lock_guard lock(impl_->core.config_mutex);
+    impl_->core.latest_of_kind[kind] = text;
+  }
+  for (const auto& session : impl_->core.Snapshot()) session->OfferLatest(kind, text);
+}
+
 void GuiServer::PublishFrame(const std::string& camera, const nlohmann::json& header,
                              std::shared_ptr<const std::string> payload) {
   const std::string header_text = header.dump(-1, ' ', false, json::error_handler_t::replace);

@@ -215,6 +215,7 @@ struct ServerCore {
   std::map<std::string, std::shared_ptr<const Document>, std::less<>> documents;
   std::function<std::vector<std::string>()> welcome;
   Text latest_state;  // the newest published state, for clients that connect later
+  std::map<std::string, Text> latest_of_kind;  // PublishLatest's, for clients that come later
 
   mutable std::mutex clients_mutex;
   std::map<int64_t, std::shared_ptr<WsSession>> clients;

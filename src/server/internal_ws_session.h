@@ -18,6 +18,9 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
   // Any thread: replaces the pending state.
   void OfferState(const Text& state);
 
+  // Any thread: replaces the pending message of `kind` (GuiServer::PublishLatest).
+  void OfferLatest(const std::string& kind, const Text& text);
+
   // Any thread: replaces the pending frame of `camera`.
   void OfferFrame(const std::string& camera, const Frame& frame);
 
@@ -79,6 +82,7 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
   ClientStats stats_;
   std::deque<Text> texts_;
   Text state_;
+  std::map<std::string, Text> latest_;  // PublishLatest's, by kind
   std::map<std::string, Frame> frames_;
   std::string last_camera_;
   std::size_t queued_bytes_ = 0;  // texts_, state_, frames_ and the write in flight

@@ -35,6 +35,20 @@ void WsSession::OfferState(const Text& state) {
   if (kick) PostKick();
 }
 
+void WsSession::OfferLatest(const std::string& kind, const Text& text) {
+  bool kick = false;
+  {
+    std::lock_guard lock(mutex_);
+    if (closed_) return;
+    Text& slot = latest_[kind];
+    if (slot) queued_bytes_ -= slot->size();
+    slot = text;
+    queued_bytes_ += text->size();
+    kick = NeedsKickLocked();
+  }
+  if (kick) PostKick();
+}
+
 void WsSession::OfferFrame(const std::string& camera, const Frame& frame) {
   bool kick = false;
   {
@@ -77,6 +91,7 @@ void WsSession::Close() {
     closed_ = true;
     texts_.clear();
     state_.reset();
+    latest_.clear();
     frames_.clear();
     queued_bytes_ = in_flight_bytes_;
   }
@@ -101,10 +116,12 @@ void WsSession::OnAccept(beast::error_code ec) {
   hello["client"] = stats_.id;
   std::function<std::vector<std::string>()> welcome;
   Text latest_state;
+  std::map<std::string, Text> latest_of_kind;
   {
     std::lock_guard lock(server_->config_mutex);
     welcome = server_->welcome;
     latest_state = server_->latest_state;
+    latest_of_kind = server_->latest_of_kind;
   }
   std::vector<Text> texts{std::make_shared<const std::string>(
       hello.dump(-1, ' ', false, json::error_handler_t::replace))};
@@ -130,6 +147,9 @@ void WsSession::OnAccept(beast::error_code ec) {
     if (!state_ && latest_state) {
       state_ = latest_state;
       queued_bytes_ += state_->size();
+    }
+    for (const auto& [kind, text] : latest_of_kind) {
+      if (latest_.try_emplace(kind, text).second) queued_bytes_ += text->size();
     }
     open_ = true;
   }
@@ -326,6 +346,11 @@ void WsSession::MaybeWrite() {
       kind = Kind::kState;
       out_text_ = std::move(state_);
       state_.reset();
+      in_flight_bytes_ = out_text_->size();
+    } else if (!latest_.empty()) {
+      kind = Kind::kText;
+      out_text_ = std::move(latest_.begin()->second);
+      latest_.erase(latest_.begin());
       in_flight_bytes_ = out_text_->size();
     } else if (!frames_.empty() && FrameRoomLocked()) {
       kind = Kind::kFrame;

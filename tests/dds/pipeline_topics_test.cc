@@ -319,6 +319,62 @@ TEST_F(PipelineTopics, LockstepCommandsAnswerEveryStep) {
                                           ::testing::Pair(0u, 80000000u)));
 }
 
+// Stands in for mapping.world_map (issue 44): a map of `step + 1` voxels and one inhibited
+// place each step.
+class MapSource final : public runtime::Component {
+ public:
+  MapSource() : map_(AddOutput<components::MapMessage>("map")) {}
+  void Step(const runtime::StepContext& context) override {
+    components::MapMessage m;
+    m.time = context.time;
+    m.frame_index = context.step;
+    m.resolution_m = 0.05;
+    for (int64_t i = 0; i <= context.step; ++i) m.occupied_W.emplace_back(0.05 * i, 1.0, 0.5);
+    m.inhibited = {{{1.0, 0.0, 1.0}, 0.2, 1.0}};
+    map_.Emit(m);
+  }
+
+ private:
+  runtime::Output<components::MapMessage>& map_;
+};
+
+// `map: {topic: map}` on a component's mapping.map output publishes sensor_msgs/PointCloud2 on
+// /saccade/map and the inhibited places on /saccade/map/inhibited, latched: a viewer that comes
+// after the run still gets the newest map.
+TEST_F(PipelineTopics, MapOutputPublishesPointCloud2AndItsInhibitedPlaces) {
+  constexpr int kDomain = 188;
+  runtime::ComponentRegistry registry;
+  components::RegisterComponents(registry);
+  RegisterDdsTransport(registry);
+  registry.Register<MapSource>("test.map_source");
+  runtime::Pipeline pipeline = runtime::Pipeline::LoadString(
+      "clock: {mode: simulated, step: 0.04, steps: 3}\n"
+      "transport: {domain: 188, namespace: /saccade, clock: \"\"}\n"
+      "components:\n"
+      "  - name: mapper\n"
+      "    type: test.map_source\n"
+      "    outputs: {map: {topic: map}}\n",
+      "map.yaml", registry);
+  const runtime::RunSummary summary = runtime::RunPipeline(pipeline);
+  ASSERT_EQ(summary.errors_total, 0) << summary.FullReport();
+
+  Raw raw(RawParticipant(kDomain));
+  const auto Latest = [&](const char* topic) {
+    Raw reader(RawReader(raw.get(), &ref_sensor_msgs_msg_dds__PointCloud2__desc, topic, 1,
+                         /*transient_local=*/true));
+    ref_sensor_msgs_msg_dds__PointCloud2_ cloud{};
+    std::pair<uint32_t, std::string> got{0, "(nothing)"};
+    if (TakeSample(reader.get(), &cloud)) {
+      got = {cloud.width, cloud.header.frame_id};
+      dds_sample_free(&cloud, &ref_sensor_msgs_msg_dds__PointCloud2__desc, DDS_FREE_CONTENTS);
+    }
+    return got;
+  };
+  // The last step's map: 3 voxels; its one inhibited place.
+  EXPECT_EQ(Latest("rt/saccade/map"), std::make_pair(3u, std::string("world")));
+  EXPECT_EQ(Latest("rt/saccade/map/inhibited"), std::make_pair(1u, std::string("world")));
+}
+
 TEST_F(PipelineTopics, OutputsMustExistAndHaveARosForm) {
   const std::string base =
       "clock: {mode: simulated, step: 0.04, steps: 1}\n"

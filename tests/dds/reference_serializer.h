@@ -25,6 +25,22 @@ inline std::string Hex(const std::vector<uint8_t>& bytes) {
   return text;
 }
 
+/// `n` bytes in base64, as the reference takes a uint8[] field ({"base64": ...}).
+inline std::string Base64(const uint8_t* d, std::size_t n) {
+  static const char* k = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  std::string out;
+  for (std::size_t i = 0; i < n; i += 3) {
+    const uint32_t v = (uint32_t{d[i]} << 16) | (i + 1 < n ? uint32_t{d[i + 1]} << 8 : 0) |
+                       (i + 2 < n ? uint32_t{d[i + 2]} : 0);
+    out += k[(v >> 18) & 63];
+    out += k[(v >> 12) & 63];
+    out += i + 1 < n ? k[(v >> 6) & 63] : '=';
+    out += i + 2 < n ? k[v & 63] : '=';
+  }
+  return out;
+}
+inline std::string Base64(const std::vector<uint8_t>& d) { return Base64(d.data(), d.size()); }
+
 /// Serializes each {"type", "message"} with Foxglove's ROS 2 writer under Node; the hex of
 /// each, in order. Fails the test (and returns {}) when Node or its packages are missing.
 inline std::vector<std::string> ReferenceSerialize(const nlohmann::json& inputs) {

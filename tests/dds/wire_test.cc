@@ -27,6 +27,7 @@ namespace {
 using namespace saccade::dds::testing;
 using components::JointCommand;
 using components::JointStateMessage;
+using components::MapMessage;
 using components::TargetMessage;
 using nlohmann::json;
 using runtime::ImageMessage;
@@ -71,20 +72,7 @@ json Header(double seconds, const std::string& frame) {
 
 // The ROS 2 message saccade's documented mapping (topics.h, docs/dds.md) makes of each.
 json ExpectedImage(const Image& image) {
-  std::string base64;
-  {
-    static const char* k = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-    const uint8_t* d = image.data();
-    const std::size_t n = image.size_bytes();
-    for (std::size_t i = 0; i < n; i += 3) {
-      const uint32_t v = (uint32_t{d[i]} << 16) | (i + 1 < n ? uint32_t{d[i + 1]} << 8 : 0) |
-                         (i + 2 < n ? uint32_t{d[i + 2]} : 0);
-      base64 += k[(v >> 18) & 63];
-      base64 += k[(v >> 12) & 63];
-      base64 += i + 1 < n ? k[(v >> 6) & 63] : '=';
-      base64 += i + 2 < n ? k[v & 63] : '=';
-    }
-  }
+  const std::string base64 = Base64(image.data(), image.size_bytes());
   const char* encoding = image.format() == PixelFormat::kRgb8 ? "rgb8" : "mono8";
   return {{"header", Header(image.metadata().time, "left_optical")},
           {"height", image.height()},
@@ -315,6 +303,148 @@ TEST_F(WireTest, BytesEqualAnIndependentRos2Serializer) {
   EXPECT_EQ(types[8], "geometry_msgs/msg/PointStamped");
   EXPECT_EQ(stamps[5], 120'000'000);
   EXPECT_EQ(stamps[6], 7'040'000'000);
+}
+
+// A map of three voxels (z 0.75, 1.75 and 1.25: the bottom, the top and half way) and two
+// inhibited places.
+MapMessage ThreeVoxelMap(double time) {
+  MapMessage map;
+  map.time = time;
+  map.resolution_m = 0.05;
+  map.occupied_W = {{1.25, -0.5, 0.75}, {1.5, 0.25, 1.75}, {-2.0, 3.0, 1.25}};
+  map.inhibited = {{{1.0, 0.5, 1.2}, 0.15, 1.0}, {{-0.5, 2.0, 0.8}, 0.3, 0.25}};
+  map.fused = 4;
+  return map;
+}
+
+// The PointCloud2 docs/dds.md says a map becomes: FLOAT32 fields packed little-endian in this
+// order, `rgb` as PCL's 0x00RRGGBB (here blue, red and green by height), frame world, height 1.
+json ExpectedCloud(double time, const std::vector<std::string>& names,
+                   const std::vector<std::vector<double>>& points,
+                   const std::vector<uint32_t>& rgb = {}) {
+  const uint32_t step = 4 * static_cast<uint32_t>(names.size());
+  std::vector<uint8_t> data;
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    for (std::size_t f = 0; f < names.size(); ++f) {
+      uint8_t bytes[4];
+      if (names[f] == "rgb") {
+        for (int b = 0; b < 4; ++b) bytes[b] = static_cast<uint8_t>(rgb[i] >> (8 * b));
+      } else {
+        const auto v = static_cast<float>(points[i][f]);
+        std::memcpy(bytes, &v, 4);  // this machine is little-endian, as the cloud says
+      }
+      data.insert(data.end(), bytes, bytes + 4);
+    }
+  }
+  json fields = json::array();
+  for (std::size_t f = 0; f < names.size(); ++f) {
+    fields.push_back({{"name", names[f]}, {"offset", 4 * f}, {"datatype", 7}, {"count", 1}});
+  }
+  return {{"header", Header(time, "world")},
+          {"height", 1},
+          {"width", points.size()},
+          {"fields", fields},
+          {"is_bigendian", false},
+          {"point_step", step},
+          {"row_step", step * points.size()},
+          {"data", {{"base64", Base64(data)}}},
+          {"is_dense", true}};
+}
+
+TEST_F(WireTest, MapCloudBytesEqualAnIndependentRos2Serializer) {
+  constexpr int kDomain = 172;
+  auto participant = Participant::Create(Domain(kDomain));
+  Raw raw(RawParticipant(kDomain));
+  Raw map_reader(
+      RawReader(raw.get(), &ref_sensor_msgs_msg_dds__PointCloud2__desc, "rt/saccade/map"));
+  Raw inhibited_reader(RawReader(raw.get(), &ref_sensor_msgs_msg_dds__PointCloud2__desc,
+                                 "rt/saccade/map/inhibited"));
+  TopicOptions options = Topic("/saccade/map");
+  options.inhibited_topic = "/saccade/map/inhibited";
+  auto writer = Writer::Create(participant, "mapping.map", options);
+  ASSERT_TRUE(WaitReaderMatched(map_reader.get()));
+  ASSERT_TRUE(WaitReaderMatched(inhibited_reader.get()));
+  EXPECT_EQ(RosTypeOf("mapping.map"), "sensor_msgs/msg/PointCloud2");
+
+  const MapMessage map = ThreeVoxelMap(7.04);
+  writer->Write(map);
+  const std::vector<std::vector<uint8_t>> ours = {TakeCdr(inhibited_reader.get()),
+                                                  TakeCdr(map_reader.get())};
+  const json inputs = {
+      {{"type", "sensor_msgs/PointCloud2"},
+       {"message", ExpectedCloud(7.04, {"x", "y", "z", "strength", "radius"},
+                                 {{1.0, 0.5, 1.2, 1.0, 0.15}, {-0.5, 2.0, 0.8, 0.25, 0.3}})}},
+      {{"type", "sensor_msgs/PointCloud2"},
+       {"message", ExpectedCloud(7.04, {"x", "y", "z", "rgb"},
+                                 {{1.25, -0.5, 0.75}, {1.5, 0.25, 1.75}, {-2.0, 3.0, 1.25}},
+                                 {0x0000ff, 0xff0000, 0x00ff00})}}};
+  const std::vector<std::string> reference = ReferenceSerialize(inputs);
+  ASSERT_EQ(reference.size(), 2u);
+  ExpectSameCdr(ours[0], reference[0], "PointCloud2 (inhibited)");
+  ExpectSameCdr(ours[1], reference[1], "PointCloud2 (map)");
+
+  // Serialized for a recording: the same bytes, the inhibited places first.
+  std::vector<std::vector<uint8_t>> serialized;
+  std::vector<std::string> topics, types;
+  Writer::CreateSerializing("mapping.map", options, [&](const SerializedMessage& m) {
+    serialized.emplace_back(m.data, m.data + m.size);
+    topics.push_back(m.topic);
+    types.push_back(m.ros_type);
+    EXPECT_EQ(m.stamp_ns, 7'040'000'000);
+  })->Write(map);
+  ASSERT_EQ(serialized.size(), 2u);
+  ExpectSameCdr(serialized[0], reference[0], "PointCloud2 (inhibited, serialized)");
+  ExpectSameCdr(serialized[1], reference[1], "PointCloud2 (map, serialized)");
+  EXPECT_EQ(topics, (std::vector<std::string>{"/saccade/map/inhibited", "/saccade/map"}));
+  EXPECT_EQ(types, (std::vector<std::string>{"sensor_msgs/msg/PointCloud2",
+                                             "sensor_msgs/msg/PointCloud2"}));
+  const std::string definition = RosMessageDefinition("sensor_msgs/msg/PointCloud2");
+  EXPECT_NE(definition.find("sensor_msgs/PointField[] fields\n"), std::string::npos);
+  EXPECT_NE(definition.find("MSG: sensor_msgs/PointField\n"), std::string::npos);
+}
+
+// saccade to saccade: the Reader gives the map back from the two clouds, joined by stamp.
+TEST_F(WireTest, MapRoundTripKeepsPointsAndInhibitedPlaces) {
+  constexpr int kDomain = 173;
+  auto participant = Participant::Create(Domain(kDomain));
+  TopicOptions options = Topic("/saccade/map", Qos::Latched());
+  options.inhibited_topic = "/saccade/map/inhibited";
+  auto reader = Reader::Create(participant, "mapping.map", options);
+  auto writer = Writer::Create(participant, "mapping.map", options);
+  ASSERT_TRUE(writer->WaitForReaders(1, 10));
+  // A map of many points (more than one UDP fragment) at odd coordinates.
+  MapMessage map = ThreeVoxelMap(2.5);
+  std::mt19937 random(5);
+  std::uniform_real_distribution<double> coordinate(-3.0, 3.0);
+  for (int i = 0; i < 20000; ++i) {
+    map.occupied_W.emplace_back(coordinate(random), coordinate(random), coordinate(random));
+  }
+  writer->Write(map);
+  const auto got = reader->Take<MapMessage>(10.0);
+  ASSERT_TRUE(got);
+  EXPECT_EQ(got->time, 2.5);
+  ASSERT_EQ(got->occupied_W.size(), map.occupied_W.size());
+  for (std::size_t i = 0; i < map.occupied_W.size(); ++i) {
+    // The cloud's floats: each coordinate the float nearest the double.
+    EXPECT_EQ(got->occupied_W[i], map.occupied_W[i].cast<float>().cast<double>()) << i;
+  }
+  ASSERT_EQ(got->inhibited.size(), 2u);
+  EXPECT_EQ(got->inhibited[1].p_W, Eigen::Vector3d(-0.5, 2.0, static_cast<float>(0.8)));
+  EXPECT_EQ(got->inhibited[1].strength, 0.25);
+  EXPECT_EQ(got->inhibited[1].radius_m, static_cast<float>(0.3));
+  EXPECT_EQ(got->resolution_m, 0.0) << "not in a PointCloud2";
+  EXPECT_EQ(reader->stats().incomplete, 0);
+
+  // A map without inhibited places sent (another publisher's cloud): none, counted incomplete.
+  auto plain = Writer::Create(participant, "mapping.map", Topic("/saccade/map", Qos::Latched()));
+  ASSERT_TRUE(plain->WaitForReaders(1, 10));
+  plain->Write(ThreeVoxelMap(3.0));
+  const auto bare = reader->Take<MapMessage>(10.0);
+  ASSERT_TRUE(bare);
+  EXPECT_EQ(bare->time, 3.0);
+  EXPECT_EQ(bare->occupied_W.size(), 3u);
+  EXPECT_TRUE(bare->inhibited.empty());
+  EXPECT_EQ(reader->stats().incomplete, 1);
 }
 
 TEST(RosMessageDefinition, IsTheMsgFileWithItsDependenciesAsRosbag2StoresIt) {

@@ -65,7 +65,7 @@ TEST(GuiProtocol, DeclaresEveryMessageEachWay) {
                                    "step", "record", "speed", "stop", "estop", "clear", "ping",
                                    "frame_window", "frame_ack"}));
   EXPECT_EQ(types[protocol::Channel::kText],
-            (std::set<std::string>{"hello", "state", "reply", "error", "event"}));
+            (std::set<std::string>{"hello", "state", "map", "reply", "error", "event"}));
   EXPECT_EQ(types[protocol::Channel::kFrame], std::set<std::string>{"frame"});
   EXPECT_EQ(types[protocol::Channel::kDocument], std::set<std::string>{"scene"});
   // The server module answers flow control itself, within its own bound.
@@ -155,6 +155,35 @@ TEST(GuiProtocol, ThePageNamesEveryMessageAndEveryField) {
   const std::string js = protocol::JavaScript();
   EXPECT_NE(js.find("export const table = "), std::string::npos);
   EXPECT_NE(js.find("\"frame_window\""), std::string::npos);
+}
+
+// The map message: bounded, to the millimetre, conforming to the table however the map is.
+TEST(GuiMapMessage, SendsEveryKthVoxelBeyondTheBoundToTheMillimetre) {
+  components::MapMessage m;
+  m.time = 2.5;
+  m.frame_index = 62;
+  m.resolution_m = 0.02;
+  m.fused = 63;
+  m.occupied_W = {{1.23456, -0.0004, 2.0}, {0.5, std::nan(""), 1.0}, {1.0, 1.0, 1.0}};
+  m.inhibited = {{{1.0, 2.0, 0.5}, 0.15, 1.0}, {{0.0, 0.0, 0.0}, 0.1, 1.7}};
+  json small = internal::MapJson(m);
+  EXPECT_EQ(protocol::CheckServerMessage(small), "") << small.dump();
+  EXPECT_EQ(small["total"], 3);
+  EXPECT_EQ(small["points"], json({1.235, -0.0, 2.0, 1.0, 1.0, 1.0})) << "NaN point left out";
+  EXPECT_EQ(small["inhibited"][1]["strength"], 1.0) << "clamped to the table's [0, 1]";
+  EXPECT_EQ(small["resolution_m"], 0.02);
+
+  // 120,001 voxels: every 3rd (ceil(120001 / 50000)), 40,001 points, the first and the last.
+  m.occupied_W.clear();
+  constexpr int kVoxels = 120001;
+  for (int i = 0; i < kVoxels; ++i) m.occupied_W.emplace_back(0.001 * i, 0.0, 1.0);
+  const json large = internal::MapJson(m);
+  EXPECT_EQ(protocol::CheckServerMessage(large), "");
+  EXPECT_EQ(large["total"], kVoxels);
+  ASSERT_EQ(large["points"].size(), 3u * 40001);
+  EXPECT_LE(large["points"].size() / 3, static_cast<std::size_t>(protocol::kMaxMapPoints));
+  EXPECT_EQ(large["points"][3], 0.003);
+  EXPECT_EQ(large["points"][3 * 40000], 120.0);
 }
 
 }  // namespace

@@ -921,6 +921,34 @@ TEST_F(ServerTest, ManyClientsAllReceiveTheNewestState) {
   }
 }
 
+// PublishLatest (the GUI's map): a client that does not read holds at most the newest message
+// of the kind besides the one being written, never a queue of them; a client that connects later
+// gets the newest.
+TEST_F(ServerTest, LatestOfAKindReplacesTheUnsentAndReachesLateClients) {
+  auto client = Connect();
+  const std::string bulk(100 * 1024, 'x');  // 20 MB in all: more than the sockets hold
+  constexpr int kMessages = 200;
+  for (int n = 1; n <= kMessages; ++n) {
+    server_->PublishLatest("map", {{"type", "map"}, {"n", n}, {"bulk", bulk}});
+  }
+  const std::vector<server::ClientStats> stats = server_->clients();
+  ASSERT_EQ(stats.size(), 1u);
+  EXPECT_LE(stats[0].queued_bytes, 2 * (bulk.size() + 100)) << "a queue of maps, not one slot";
+  int received = 0, last = 0;
+  while (last < kMessages) {
+    const auto message = client->Read();
+    ASSERT_TRUE(message.has_value());
+    const json parsed = json::parse(message->data);
+    if (parsed.at("type") != "map") continue;
+    ++received;
+    EXPECT_GT(parsed.at("n").get<int>(), last) << "in order, never an older one again";
+    last = parsed.at("n").get<int>();
+  }
+  EXPECT_LT(received, kMessages) << "none replaced";
+  auto late = Connect();
+  EXPECT_EQ(late->ReadType("map").value("n", 0), kMessages);
+}
+
 // Parses a frame message: [uint32 LE n][n bytes JSON header][payload].
 bool ParseFrame(const std::string& data, json* header, std::string* payload) {
   if (data.size() < 4) return false;

@@ -21,6 +21,7 @@ import { chromium } from 'playwright-core';
 const kRepo = path.resolve(path.dirname(fileURLToPath(import.meta.url)), '..', '..');
 const kBinary = process.env.SACCADE_BINARY || path.join(kRepo, 'build', 'bin', 'saccade');
 const kScene = path.join(kRepo, 'scenes', 'portraits.yaml');
+const kMapPipeline = path.join(kRepo, 'pipelines', 'debug_map.yaml');
 const kReference = path.join(kRepo, 'web', 'tests', 'reference', 'world.png');
 const kOutput = fs.mkdtempSync(path.join(os.tmpdir(), 'saccade-gui-test-'));
 const kViewport = { width: 1280, height: 800 };
@@ -825,6 +826,84 @@ function rotationBetweenDeg(A, B) {
   for (let i = 0; i < 3; i++) for (let k = 0; k < 3; k++) trace += B[i][k] * A[i][k];
   return Math.acos(Math.max(-1, Math.min(1, (trace - 1) / 2))) * 180 / Math.PI;
 }
+
+describe('saccade gui with a map (pipelines/debug_map.yaml: debug.map, a wall that grows)', () => {
+  let browser, server, page;
+  // debug.map's parameters in pipelines/debug_map.yaml.
+  const kVoxelsPerStep = 20, kMaxVoxels = 2000, kResolution = 0.05, kRadius = 0.15;
+  const kMapEverySteps = 5;   // the server's bound (gui/protocol.h kMapEverySteps)
+  const kMaxOpacity = 0.6;    // map.js: a place of strength s is drawn at opacity 0.6 s
+
+  before(async () => {
+    browser = await chromium.launch({ executablePath: '/usr/bin/chromium', args: kChromiumArgs });
+    server = await startSaccade(['gui', '--scene', kScene, '--pipeline', kMapPipeline, '--port', '0']);
+    page = await openPage(browser, server.url.href);
+  });
+
+  after(async () => {
+    await page?.close().catch(() => {});
+    await browser?.close().catch(() => {});
+    await stopSaccade(server);
+  });
+
+  test('the map appears in the 3D view and grows: its points, and its inhibited places as spheres', async () => {
+    await waitReady(page);
+    assert.deepEqual(await page.evaluate(() => window.saccadeGui.mapCounts().points), 0,
+      'no map before the mapper runs (perception is off at start)');
+    const on = await send(page, 'perception', { enabled: true });
+    assert.equal(on.type, 'reply', JSON.stringify(on));
+    await send(page, 'resume');
+    // Counted from the page's 3D scene: the points object's vertices, the spheres' meshes.
+    await page.waitForFunction(() => {
+      const c = window.saccadeGui.mapCounts();
+      return c.points >= 100 && c.inhibited >= 1;
+    }, null, { timeout: kMoveTimeoutMs, polling: 100 });
+    const first = await page.evaluate(() => window.saccadeGui.mapCounts());
+    const m = first.message;
+    // kVoxelsPerStep a step since perception came on, at most one per step of the run.
+    assert.ok(m.total % kVoxelsPerStep === 0 && m.total <= Math.min(kMaxVoxels, kVoxelsPerStep * (m.frame + 1)),
+      JSON.stringify(m));
+    assert.equal(first.points, m.total, 'every voxel drawn (below the cap)');
+    assert.equal(m.points, m.total);
+    assert.ok(Math.abs(first.pointSize - kResolution) < 1e-9, `point size ${first.pointSize}`);
+    assert.equal(first.inhibited, m.inhibited);
+    for (const r of first.radii) assert.ok(Math.abs(r - kRadius) < 1e-9, `radius ${r}`);
+    // Opacity follows strength: at most kMaxOpacity (just fixated), strongest first.
+    for (const o of first.opacities) assert.ok(o > 0 && o <= kMaxOpacity + 1e-9, `opacity ${o}`);
+    assert.deepEqual(first.opacities, [...first.opacities].sort((a, b) => b - a));
+
+    // It grows, and the page is sent a map at most every kMapEverySteps steps.
+    await page.waitForFunction((n) => window.saccadeGui.mapCounts().points > n, first.points,
+      { timeout: kMoveTimeoutMs, polling: 100 });
+    const later = await page.evaluate(() => ({
+      counts: window.saccadeGui.mapCounts(), maps: window.saccadeGui.mapsReceived,
+      step: window.saccadeGui.state.step, refused: window.saccadeGui.protocolErrors }));
+    assert.ok(later.counts.message.frame > m.frame);
+    assert.ok(later.maps <= Math.floor(later.step / kMapEverySteps) + 2,
+      `${later.maps} maps in ${later.step} steps`);
+    assert.deepEqual(later.refused, [], 'map messages that break docs/gui-protocol.md');
+    await page.screenshot({ path: path.join(kOutput, 'map.png') });
+
+    // A page that connects later, while paused (no new map comes), gets the newest at once.
+    await send(page, 'pause');
+    const newest = await page.evaluate(async () => {
+      await new Promise((r) => setTimeout(r, 1000));  // a map sent as the pause came
+      return window.saccadeGui.mapCounts();
+    });
+    const other = await openPage(browser, server.url.href);
+    try {
+      await other.waitForFunction(() => window.saccadeGui?.mapsReceived >= 1, null,
+        { timeout: kReadyTimeoutMs, polling: 100 });
+      const got = await other.evaluate(() => window.saccadeGui.mapCounts());
+      assert.equal(got.points, newest.points);
+      assert.equal(got.inhibited, newest.inhibited);
+      assert.equal(got.message.frame, newest.message.frame);
+    } finally {
+      await other.close();
+    }
+    await send(page, 'resume');
+  });
+});
 
 describe('saccade gui with the humanoid head (--head robots/humanoid.yaml)', () => {
   let browser, server, page;

@@ -37,7 +37,7 @@ describe('the page checks the GUI protocol as the server does', () => {
     assert.equal(kVersion, 2);
     const count = (channel) => table.messages.filter((m) => m.channel === channel).length;
     assert.equal(count('command'), 15);
-    assert.equal(count('text'), 5);
+    assert.equal(count('text'), 6);  // hello, state, map, reply, error, event
     assert.equal(count('frame'), 1);
     assert.equal(count('document'), 1);
     assert.equal(validate, checkServerMessage);

@@ -13,6 +13,11 @@
 //                                                          the sibling joint_targets topic
 //   head.command           sensor_msgs/JointState          positions, velocities
 //   vision.target          geometry_msgs/PointStamped      frame "world"; only valid targets
+//   mapping.map            sensor_msgs/PointCloud2         frame "world": the occupied voxels'
+//                                                          centres (x, y, z, rgb by height);
+//                                                          the inhibited places as a second
+//                                                          PointCloud2 (x, y, z, strength,
+//                                                          radius) on `<topic>/inhibited`
 //   (the simulated clock)  rosgraph_msgs/Clock on /clock   ClockWriter, as Gazebo publishes it
 //
 // Images also go out JPEG- or PNG-compressed as sensor_msgs/CompressedImage on
@@ -64,6 +69,10 @@ struct TopicOptions {
   /// moves), so that a reader knows whether the head has arrived exactly as the sender does
   /// (a joint state has no targets). "" : none.
   std::string targets_topic;
+  /// Maps (mapping.map): where the places inhibition of return holds go, as a PointCloud2 of
+  /// the same stamp written just before the map's (the pipeline's transport: `<topic>/inhibited`).
+  /// A reader joins them to the map of that stamp. "" : none.
+  std::string inhibited_topic;
   /// Images received: the frame index is round(stamp / frame_period_s) when > 0 (the
   /// sender's clock step), else a count of the frames received.
   double frame_period_s = 0.0;

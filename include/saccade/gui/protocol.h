@@ -77,6 +77,11 @@ Field Required(std::string name, Schema schema, std::string doc);
 /// A field that may be missing.
 Field Optional(std::string name, Schema schema, std::string doc);
 
+/// The `map` message's bounds: at most this many points (a larger map sends every k-th voxel),
+/// and at most one map every this many steps (only when the map changed).
+inline constexpr int kMaxMapPoints = 50000;
+inline constexpr int kMapEverySteps = 5;
+
 /// Which way a message goes, and how.
 enum class Channel {
   kCommand,   ///< client to server, WebSocket text: {"type", "id", ...}

@@ -2,7 +2,9 @@
 // The browser GUI of a running pipeline (issue 6): serves the page (web/public), the scene's
 // meshes and textures, and speaks docs/gui-protocol.md over the server module: the state after
 // every step, both eyes' annotated images as JPEG, and the commands (joints, fixate, effects,
-// perception, pause, step, speed, stop, estop, clear).
+// perception, pause, step, speed, stop, estop, clear), and the map of a pipeline with a
+// mapping.map output (the `map` message: when it changed, at most every
+// protocol::kMapEverySteps steps, at most protocol::kMaxMapPoints points).
 //
 // Threads: commands arrive on the server's I/O thread; they are checked there (joint limits,
 // reachability, well-formed values: a bad one gets an error reply and changes nothing) and
@@ -15,6 +17,7 @@
 #include <atomic>
 #include <condition_variable>
 #include <functional>
+#include <limits>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -25,6 +28,7 @@
 #include <vector>
 
 #include "saccade/components/demo/overlay.h"
+#include "saccade/components/messages.h"
 #include "saccade/components/roles.h"
 #include "saccade/render/renderer.h"
 #include "saccade/runtime/pipeline.h"
@@ -121,6 +125,10 @@ class GuiSession {
   int ApplyQueued();  // how many commands it applied
   nlohmann::json StateJson(const runtime::StepContext& context, const Latest& latest);
   void EncodeLoop();
+  // Sends the newest map when there is one the page has not had, and `step` is at least
+  // kMapEverySteps after the last sent (or `now`: paused, the steps may not come).
+  void PublishMap(int64_t step, bool now);
+  void TapMap(runtime::Pipeline& pipeline);  // the first mapping.map output, when there is one
   head::JointState CurrentTargets() const;
   void SetPerception(bool enabled);  // simulation thread
 
@@ -151,6 +159,13 @@ class GuiSession {
   std::optional<JointStateMessage> commanded_;
   mutable std::mutex joints_mutex_;
   head::JointState targets_;  // the latest targets, for partial joint commands (joints_mutex_)
+
+  // The newest map of the pipeline's first mapping.map output (emitted on any thread), whether
+  // the page has had it, and the step it was last sent at.
+  std::mutex map_mutex_;
+  std::shared_ptr<const components::MapMessage> map_;
+  bool map_pending_ = false;
+  int64_t map_sent_step_ = std::numeric_limits<int64_t>::min() / 2;
 
   // The recording (simulation thread) and what the state says of it.
   std::shared_ptr<GuiRecording> recording_;

@@ -159,6 +159,11 @@ class GuiServer {
   /// the same camera not yet sent. The payload is shared, never copied per client.
   void PublishFrame(const std::string& camera, const nlohmann::json& header,
                     std::shared_ptr<const std::string> payload);
+  /// The newest message of `kind` (a JSON text, e.g. the map) for every client: replaces one
+  /// of that kind not yet sent, so that a slow client holds at most one of each kind. A client
+  /// that connects later gets it too, after the state. Sent after queued texts and the state,
+  /// before frames.
+  void PublishLatest(const std::string& kind, const nlohmann::json& message);
   /// An event (JSON text) queued for every client (oldest dropped when the queue is full).
   void Broadcast(const nlohmann::json& event);
 

@@ -11,6 +11,7 @@
 #include <deque>
 #include <exception>
 #include <mutex>
+#include <optional>
 #include <thread>
 #include <vector>
 
@@ -80,6 +81,15 @@ struct PipelineRecorder::Impl {
       : path(p), options(std::move(o)), writer(p, internal::WriterOptions(options)) {}
 
   void Tap(runtime::Pipeline& pipeline);
+  // Keeps each message of `output` (one of dds::SupportedMessageTypes) for `source`.
+  runtime::ConnectionId ConnectRos(runtime::OutputBase& output, Source* source);
+  template <runtime::Message M>
+  std::optional<runtime::ConnectionId> ConnectAs(runtime::OutputBase& output, Source* source) {
+    auto* typed = dynamic_cast<runtime::Output<M>*>(&output);
+    if (typed == nullptr) return std::nullopt;
+    return typed->signal().Connect(
+        [this, source](const M& m) { Add(source, std::make_shared<M>(m)); });
+  }
   void Add(Source* source, std::shared_ptr<const void> message) {
     std::lock_guard lock(step_mutex);
     step.push_back({source, std::move(message), {}, 0});
@@ -130,31 +140,13 @@ void PipelineRecorder::Impl::Tap(runtime::Pipeline& pipeline) {
           t.targets_topic = dds::ResolveTopic("joint_targets", options.ns);
           t.robot_description_topic = dds::ResolveTopic("robot_description", options.ns);
           t.tf_topic = "/tf";
+        } else if (type == runtime::MessageName<components::MapMessage>()) {
+          t.inhibited_topic = topic + "/inhibited";  // as the pipeline's transport sends it
         }
         raw->ros = dds::Writer::CreateSerializing(
             type, t, [this](const dds::SerializedMessage& m) { channels.Write(m, log_time); });
         // Typed: images are kept by their shared pixels, not converted during the step.
-        if (type == image_type) {
-          auto* typed = dynamic_cast<runtime::Output<runtime::ImageMessage>*>(output.get());
-          id = typed->signal().Connect([this, raw](const runtime::ImageMessage& m) {
-            Add(raw, std::make_shared<runtime::ImageMessage>(m));
-          });
-        } else if (type == joints_type) {
-          auto* typed = dynamic_cast<runtime::Output<components::JointStateMessage>*>(output.get());
-          id = typed->signal().Connect([this, raw](const components::JointStateMessage& m) {
-            Add(raw, std::make_shared<components::JointStateMessage>(m));
-          });
-        } else if (type == runtime::MessageName<components::JointCommand>()) {
-          auto* typed = dynamic_cast<runtime::Output<components::JointCommand>*>(output.get());
-          id = typed->signal().Connect([this, raw](const components::JointCommand& m) {
-            Add(raw, std::make_shared<components::JointCommand>(m));
-          });
-        } else {
-          auto* typed = dynamic_cast<runtime::Output<components::TargetMessage>*>(output.get());
-          id = typed->signal().Connect([this, raw](const components::TargetMessage& m) {
-            Add(raw, std::make_shared<components::TargetMessage>(m));
-          });
-        }
+        id = ConnectRos(*output, raw);
       } else {
         raw->json_topic = topic;
         id = output->ConnectJson([this, raw](const nlohmann::json& json) {
@@ -167,6 +159,18 @@ void PipelineRecorder::Impl::Tap(runtime::Pipeline& pipeline) {
       sources.push_back(std::move(source));
     }
   }
+}
+
+runtime::ConnectionId PipelineRecorder::Impl::ConnectRos(runtime::OutputBase& output,
+                                                         Source* source) {
+  std::optional<runtime::ConnectionId> id = ConnectAs<runtime::ImageMessage>(output, source);
+  if (!id) id = ConnectAs<components::JointStateMessage>(output, source);
+  if (!id) id = ConnectAs<components::JointCommand>(output, source);
+  if (!id) id = ConnectAs<components::TargetMessage>(output, source);
+  if (!id) id = ConnectAs<components::MapMessage>(output, source);
+  SACCADE_ASSERT(id.has_value(),
+                 "record: a ROS 2 type the recorder cannot keep: " + output.message_type());
+  return *id;
 }
 
 void PipelineRecorder::Impl::WriteStep(Step& s) {

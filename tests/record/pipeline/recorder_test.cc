@@ -194,6 +194,51 @@ TEST(PipelineRecorder, TheDemosRecordingDecodesInFoxglovesReadersToWhatItSent) {
   EXPECT_EQ(by_topic["/saccade/left/image_raw"][5]["log_time"], "200000000");
 }
 
+// A map output (mapping.map, here debug.map's) is recorded as the DDS writer sends it:
+// sensor_msgs/PointCloud2 on its topic and the inhibited places on `<topic>/inhibited`, with a
+// schema that Foxglove's reader parses and finds equal to common_interfaces' definition.
+TEST(PipelineRecorder, MapsAreRecordedAsPointCloud2WithTheirInhibitedPlaces) {
+  components::RegisterComponents();
+  runtime::Pipeline pipeline = runtime::Pipeline::LoadString(
+      "clock: {mode: simulated, step: 0.1, steps: 3}\n"
+      "components:\n"
+      "  - {name: mapper, type: debug.map, params: {voxels_per_step: 4, inhibit_every_steps: 1}}\n",
+      "map.yaml");
+  const fs::path file = TempFile("map.mcap");
+  PipelineRecorder recorder(pipeline, file);
+  runtime::RunOptions run;
+  run.steps = 3;
+  run.after_step = [&](const runtime::StepContext& context) { recorder.AfterStep(context); };
+  const runtime::RunSummary summary = runtime::RunPipeline(pipeline, run);
+  ASSERT_TRUE(summary.errors.empty());
+  recorder.Close();
+
+  int status = 0;
+  const std::string out = Node("decode", file, &status);
+  ASSERT_EQ(status, 0) << out.substr(0, 2000);
+  const json decoded = json::parse(out);
+  ASSERT_TRUE(decoded["schemas"].contains("sensor_msgs/msg/PointCloud2"));
+  EXPECT_EQ(decoded["schemas"]["sensor_msgs/msg/PointCloud2"], json::array());
+  std::map<std::string, std::vector<json>> by_topic;
+  for (const json& m : decoded["messages"]) {
+    by_topic[m["topic"].get<std::string>()].push_back(m);
+  }
+  const auto& maps = by_topic["/saccade/mapper/map"];
+  const auto& inhibited = by_topic["/saccade/mapper/map/inhibited"];
+  ASSERT_EQ(maps.size(), 3u);
+  ASSERT_EQ(inhibited.size(), 3u);
+  const json& last = maps[2]["value"];
+  EXPECT_EQ(last["header"]["frame_id"], "world");
+  EXPECT_EQ(StampNs(last["header"]["stamp"]), 200'000'000);
+  EXPECT_EQ(last["width"], 12);  // 4 voxels a step
+  EXPECT_EQ(last["point_step"], 16);
+  std::vector<std::string> fields;
+  for (const json& f : last["fields"]) fields.push_back(f["name"]);
+  EXPECT_EQ(fields, (std::vector<std::string>{"x", "y", "z", "rgb"}));
+  EXPECT_EQ(inhibited[2]["value"]["width"], 3);  // a place a step, none forgotten yet
+  EXPECT_EQ(inhibited[2]["value"]["point_step"], 20);
+}
+
 TEST(PipelineRecorder, OptionsOutOfRangeAndUnwritableFilesAreRefused) {
   components::RegisterComponents();
   runtime::PipelineSpec spec = runtime::LoadPipelineFile(kSource + "/pipelines/demo.yaml");

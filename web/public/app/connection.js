@@ -86,6 +86,7 @@ export class Connection {
     switch (message.type) {
       case 'hello': h.onHello?.(message); break;
       case 'state': h.onState?.(message); break;
+      case 'map': h.onMap?.(message); break;
       case 'event': h.onEvent?.(message); break;
       case 'reply':
       case 'error': {

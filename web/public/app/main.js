@@ -7,6 +7,7 @@ import { AccessError, Connection, fetchApi, token } from './connection.js';
 import { checkSceneDocument } from './protocol.js';
 import { buildWorld, loadModels, updateObjects } from './scene.js';
 import { Head } from './head.js';
+import { MapView } from './map.js';
 import { installInteraction, kDragGainDegPerPx } from './interact.js';
 import { CameraView, Controls, log } from './views.js';
 import { Plot } from './plots.js';
@@ -25,6 +26,7 @@ const gui = window.saccadeGui = {
   framesReceived: { left: 0, right: 0 },
   framesShown: { left: 0, right: 0 },
   framesDone: 0,             // frames the page finished with (acknowledged: frame_ack)
+  mapsReceived: 0,           // `map` messages drawn
   pageFps: { left: 0, right: 0 },
   lastClick: null,
   errors: [],
@@ -74,6 +76,7 @@ async function start() {
   const world = buildWorld(scene, doc, models);
   const images = { left: $('image-left'), right: $('image-right') };
   const head = new Head(scene, doc, models, images);
+  const mapView = new MapView(scene);  // the pipeline's map, when it has one
 
   let dirty = true;
   const redraw = () => { dirty = true; };
@@ -175,6 +178,11 @@ async function start() {
         (state.paused ? ' · paused' : '') + (state.manual ? ' · manual' : '');
       redraw();
       maybeReady();
+    },
+    onMap: (m) => {
+      gui.mapsReceived++;
+      mapView.update(m);
+      redraw();
     },
     onFrame: (header, blob) => {
       if (!(header.camera in views)) { frameDone(); return; }  // world cameras: not shown
@@ -323,6 +331,14 @@ async function start() {
   gui.send = (type, fields) => send(type, fields);
   gui.imagePlane = (name) => head.imagePlane(name);
   gui.render = render;
+  // The map as the 3D scene holds it: points and inhibited places counted from its objects.
+  gui.mapCounts = () => {
+    const root = scene.getObjectByName('map');
+    const points = root?.getObjectByName('map-points');
+    const places = root?.getObjectByName('map-inhibited');
+    return { ...mapView.counts(), points: points?.geometry.getAttribute('position').count ?? 0,
+      inhibited: places?.children.filter((s) => s.isMesh && s.visible).length ?? 0 };
+  };
   gui.setImageDistance = (d) => {
     const slider = $('plane-distance');
     slider.value = String(d);

@@ -398,6 +398,43 @@ export const table = {
       }
     },
     {
+      "type": "map",
+      "channel": "text",
+      "body": {
+        "kind": "object",
+        "fields": [
+          {"name":"type","required":true,"schema":{"kind":"string","const":"map"}},
+          {"name":"time","required":true,"schema":{"kind":"number"}},
+          {"name":"frame","required":true,"schema":{"kind":"integer"}},
+          {"name":"resolution_m","required":true,"schema":{"kind":"number","min":0.0}},
+          {"name":"fused","required":true,"schema":{"kind":"integer","min":0.0}},
+          {"name":"total","required":true,"schema":{"kind":"integer","min":0.0}},
+          {"name":"points","required":true,"schema":{"kind":"array","items":[{"kind":"number"}]}},
+          {
+            "name": "inhibited",
+            "required": true,
+            "schema": {
+              "kind": "array",
+              "items": [
+                {
+                  "kind": "object",
+                  "fields": [
+                    {"name":"p_W","required":true,"schema":{"ref":"point"}},
+                    {"name":"radius_m","required":true,"schema":{"kind":"number","min":0.0}},
+                    {
+                      "name": "strength",
+                      "required": true,
+                      "schema": {"kind":"number","min":0.0,"max":1.0}
+                    }
+                  ]
+                }
+              ]
+            }
+          }
+        ]
+      }
+    },
+    {
       "type": "reply",
       "channel": "text",
       "body": {
