@@ -33,7 +33,7 @@ enum class Occupancy { kUnknown, kFree, kOccupied };
 struct FuseStats {
   int64_t rays = 0;          ///< depth samples inserted (after stride, confidence and range)
   int64_t occupied = 0;      ///< occupied voxels in the map afterwards
-  int64_t known_voxels = 0;  ///< leaves known (occupied or free) afterwards
+  int64_t known_voxels = 0;  ///< finest voxels known (occupied or free) afterwards
 };
 
 /// The occupancy map. Not thread-safe; copyable only through Clone.
@@ -93,6 +93,8 @@ class WorldMap {
   bool RayMeetsUnknown(const Eigen::Vector3d& origin_W, const Eigen::Vector3d& direction_W,
                        double max_range_m, double* distance_m = nullptr) const;
 
+  /// The finest voxels occupied, and known (occupied or free): counts kept by every insertion,
+  /// constant time.
   int64_t occupied_voxels() const;
   int64_t known_voxels() const;
   std::size_t memory_bytes() const;  ///< the octree's own estimate
