@@ -114,22 +114,19 @@ double SaccadeTime(const head::HeadModel& head, const Eigen::VectorXd& q0,
 }
 
 // The directions looked at: an azimuth x elevation grid of cells (about 2 degrees) in the
-// head's base frame, each marked once inside a fixation's field of view.
+// head's base frame, each counting the fixations whose field of view held it.
 class ViewCoverage {
  public:
-  explicit ViewCoverage(const head::HeadModel& head) : head_(head) {}
-
-  // The share of the view's cells (a field of view about `direction_B`) not yet looked at.
-  double Novelty(const Eigen::Vector3d& direction_B, const Eigen::Vector2d& fov) const {
-    int cells = 0, fresh = 0;
-    ForEachCell(direction_B, fov, [&](int index) {
-      ++cells;
-      fresh += looked_[index] ? 0 : 1;
-    });
-    return cells > 0 ? static_cast<double>(fresh) / cells : 0.0;
-  }
   void Look(const Eigen::Vector3d& direction_B, const Eigen::Vector2d& fov) {
-    ForEachCell(direction_B, fov, [&](int index) { looked_[index] = true; });
+    ForEachCell(direction_B, fov, [&](int index) {
+      looks_[index] = static_cast<uint8_t>(std::min(looks_[index] + 1, 255));
+    });
+  }
+  // How many fixations looked along `direction_B`.
+  int Looks(const Eigen::Vector3d& direction_B) const {
+    int n = 0;
+    ForEachCell(direction_B, Eigen::Vector2d::Zero(), [&](int index) { n = looks_[index]; });
+    return n;
   }
 
  private:
@@ -151,8 +148,7 @@ class ViewCoverage {
       }
     }
   }
-  const head::HeadModel& head_;
-  std::vector<bool> looked_ = std::vector<bool>(kColumns * kRows, false);
+  std::vector<uint8_t> looks_ = std::vector<uint8_t>(kColumns * kRows, 0);
 };
 
 Eigen::Vector3d InBase(const head::HeadModel& head, const Eigen::Vector3d& p_W) {
@@ -168,6 +164,21 @@ struct Candidate {
 }  // namespace explore_internal
 
 using namespace explore_internal;
+
+double RayNovelty(const mapping::WorldMap& map, const Eigen::Vector3d& origin_W,
+                  const Eigen::Vector3d& direction_W, double max_range_m, int looks,
+                  double tentative_value) {
+  switch (map.FirstAlong(origin_W, direction_W, max_range_m)) {
+    case mapping::RayEnd::kUnknown:
+      return std::ldexp(1.0, -looks);
+    case mapping::RayEnd::kTentative:
+      return tentative_value;
+    case mapping::RayEnd::kOccupied:
+    case mapping::RayEnd::kNothing:
+      break;
+  }
+  return 0.0;
+}
 
 const std::vector<std::string>& ExploreStrategies() {
   static const std::vector<std::string> names = {"raster", "random", "saliency"};
@@ -195,11 +206,14 @@ bool ExploreOptions::IsValid(std::string* error) const {
   if (what.empty() && !(raster_step > 0 && raster_step <= 2)) {
     what = "raster_step: " + std::to_string(raster_step) + ", expected (0, 2] fields of view";
   }
+  if (what.empty() && !(candidate_step > 0 && candidate_step <= 2)) {
+    what = "candidate_step: " + std::to_string(candidate_step) + ", expected (0, 2] fields of view";
+  }
   if (what.empty() && !(truth_step > 0 && truth_step <= 2)) {
     what = "truth_step: " + std::to_string(truth_step) + ", expected (0, 2] fields of view";
   }
-  if (what.empty() && !(saliency_weight >= 0 && novelty_weight >= 0)) {
-    what = "saliency_weight, novelty_weight: expected numbers >= 0";
+  if (what.empty() && !(saliency_weight >= 0 && novelty_weight >= 0 && tentative_value >= 0)) {
+    what = "saliency_weight, novelty_weight, tentative_value: expected numbers >= 0";
   }
   std::string nested;
   if (what.empty() && !stereo.IsValid(&nested)) what = nested;
@@ -254,16 +268,20 @@ class Chooser {
         options_(options),
         truth_(truth),
         fov_(FieldOfView(head_)),
-        coverage_(head_),
         ior_([&] {
           mapping::Inhibition3d::Options o;
           o.time_constant_s = options.ior_time_constant_s;
           o.radius_m = options.ior_radius_m;
           return o;
         }()),
-        random_(options.seed) {}
+        random_(options.seed) {
+    if (options.strategy == "saliency") {
+      candidates_ = ReachGrid(head_, options.candidate_step * fov_, options.target_distance_m);
+    }
+  }
 
-  std::vector<Candidate> Next(double time, const vision::StereoDepth* depth, const Image* left) {
+  std::vector<Candidate> Next(double time, const vision::StereoDepth* depth, const Image* left,
+                              const mapping::WorldMap* map) {
     if (options_.strategy == "raster") {
       const Eigen::Vector3d p = truth_.grid_W[next_raster_++ % truth_.grid_W.size()];
       return {{p, 0.0}};
@@ -282,7 +300,7 @@ class Chooser {
       }
       return out;
     }
-    return Attend(time, depth, left);
+    return Attend(time, depth, left, map);
   }
 
   void Fixated(const Eigen::Vector3d& p_W, double time) {
@@ -293,11 +311,12 @@ class Chooser {
 
  private:
   // Two-stage attention: saliency zones of the current view and the unexplored directions.
-  std::vector<Candidate> Attend(double time, const vision::StereoDepth* depth, const Image* left) {
+  std::vector<Candidate> Attend(double time, const vision::StereoDepth* depth, const Image* left,
+                                const mapping::WorldMap* map) {
     std::vector<Candidate> out;
     const auto add = [&](const Eigen::Vector3d& p_W, double saliency) {
       const Eigen::Vector3d d = InBase(head_, p_W).normalized();
-      const double novelty = coverage_.Novelty(d, fov_);
+      const double novelty = map != nullptr ? ViewNovelty(*map, d) : 1.0;
       // Among equals, the nearer saccade (a tenth per radian from where the eyes look now).
       const double turn = std::acos(std::clamp(d.dot(gaze_B_), -1.0, 1.0));
       const double score = options_.saliency_weight * saliency + options_.novelty_weight * novelty -
@@ -315,10 +334,31 @@ class Chooser {
         add(X_WC.translation() + DepthAlong(*depth, ray_W) * ray_W, zone.score);
       }
     }
-    for (const Eigen::Vector3d& p : truth_.grid_W) add(p, 0.0);
+    for (const Eigen::Vector3d& p : candidates_) add(p, 0.0);
     std::stable_sort(out.begin(), out.end(),
                      [](const Candidate& a, const Candidate& b) { return a.score > b.score; });
     return out;
+  }
+
+  // The frontier novelty of a view about base-frame direction `d_B`: the mean RayNovelty of a
+  // grid of kNoveltyRays x kNoveltyRays rays spanning 0.8 of the field of view, from the head's
+  // base (each ray from kNoveltyStart_m out, beyond the head's own body).
+  double ViewNovelty(const mapping::WorldMap& map, const Eigen::Vector3d& d_B) const {
+    const double azimuth = std::atan2(d_B.y(), d_B.x());
+    const double elevation = std::asin(std::clamp(d_B.z(), -1.0, 1.0));
+    const Eigen::Vector3d origin_W = head_.X_WB().translation();
+    double sum = 0.0;
+    for (int i = 0; i < kNoveltyRays; ++i) {
+      for (int j = 0; j < kNoveltyRays; ++j) {
+        const double a = 0.9 * (static_cast<double>(i) / (kNoveltyRays - 1) - 0.5);
+        const double e = 0.9 * (static_cast<double>(j) / (kNoveltyRays - 1) - 0.5);
+        const Eigen::Vector3d r_B = Direction(azimuth + a * fov_.x(), elevation + e * fov_.y());
+        const Eigen::Vector3d r_W = head_.X_WB().linear() * r_B;
+        sum += RayNovelty(map, origin_W + kNoveltyStart_m * r_W, r_W, options_.map.max_range_m,
+                          coverage_.Looks(r_B), options_.tentative_value);
+      }
+    }
+    return sum / (kNoveltyRays * kNoveltyRays);
   }
 
   // The range (m) along a world ray from the camera's centre: the stereo depth where the ray
@@ -338,6 +378,8 @@ class Chooser {
     return options_.target_distance_m;
   }
 
+  static constexpr int kNoveltyRays = 7;
+  static constexpr double kNoveltyStart_m = 0.3;
   const head::HeadModel& head_;
   const ExploreOptions& options_;
   const ExploreTruth& truth_;
@@ -346,6 +388,7 @@ class Chooser {
   mapping::Inhibition3d ior_;
   vision::SpectralResidualSaliency saliency_;
   std::mt19937_64 random_;
+  std::vector<Eigen::Vector3d> candidates_;  // the saliency strategy's directions of the reach
   std::size_t next_raster_ = 0;
   Eigen::Vector3d gaze_B_ = Eigen::Vector3d::UnitX();
 };
@@ -385,8 +428,8 @@ ExploreReport Explore(const scene::Scene& scene, const ExploreOptions& options,
   std::vector<render::Frame> frames;
   while (time < options.seconds) {
     auto start = Clock::now();
-    const std::vector<Candidate> candidates =
-        chooser.Next(time, depth ? &*depth : nullptr, frames.empty() ? nullptr : &*frames[0].color);
+    const std::vector<Candidate> candidates = chooser.Next(
+        time, depth ? &*depth : nullptr, frames.empty() ? nullptr : &*frames[0].color, &map);
     std::optional<head::FixationResult> fixation;
     Eigen::Vector3d target = Eigen::Vector3d::Zero();
     for (const Candidate& candidate : candidates) {

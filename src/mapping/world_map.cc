@@ -80,7 +80,7 @@ struct WorldMap::Impl {
   explicit Impl(double resolution) : tree(resolution) {}
   octomap::OcTree tree;
   std::vector<uint64_t> scratch;  // the radix sort's buffer, kept between insertions
-  octomap::KeyRay ray;            // the voxels of one ray (OctoMap's buffer is 600 KB)
+  mutable octomap::KeyRay ray;    // the voxels of one ray (OctoMap's buffer is 600 KB)
   int64_t occupied = 0;           // finest voxels occupied
   int64_t known = 0;              // finest voxels known (free or occupied)
 
@@ -268,6 +268,31 @@ bool WorldMap::RayMeetsUnknown(const Eigen::Vector3d& origin_W, const Eigen::Vec
   if (hit) return false;  // an occupied voxel first
   // castRay stops at an unknown voxel (false) or at max_range (false, end beyond it).
   return along < max_range_m - impl_->tree.getResolution() && impl_->tree.search(end) == nullptr;
+}
+
+RayEnd WorldMap::FirstAlong(const Eigen::Vector3d& origin_W, const Eigen::Vector3d& direction_W,
+                            double max_range_m, double* distance_m) const {
+  const octomap::OcTree& tree = impl_->tree;
+  const Eigen::Vector3d d = direction_W.normalized();
+  const octomap::point3d origin = ToOcto(origin_W);
+  octomap::KeyRay& ray = impl_->ray;
+  RayEnd what = RayEnd::kNothing;
+  double along = max_range_m;
+  if (tree.computeRayKeys(origin, ToOcto(origin_W + max_range_m * d), ray)) {
+    for (std::size_t i = 1; i < ray.size(); ++i) {  // after the origin's voxel
+      const octomap::OcTreeKey& key = ray.begin()[i];
+      const octomap::OcTreeNode* node = tree.search(key);
+      if (node != nullptr && node->getLogOdds() <= 0) continue;  // free
+      what = node == nullptr             ? RayEnd::kUnknown
+             : tree.isNodeOccupied(node) ? RayEnd::kOccupied
+                                         : RayEnd::kTentative;
+      const octomap::point3d c = tree.keyToCoord(key);
+      along = std::min(max_range_m, (Eigen::Vector3d(c.x(), c.y(), c.z()) - origin_W).dot(d));
+      break;
+    }
+  }
+  if (distance_m != nullptr) *distance_m = along;
+  return what;
 }
 
 int64_t WorldMap::occupied_voxels() const { return impl_->occupied; }
