@@ -91,9 +91,10 @@ TEST(RayNovelty, IsHighTowardUnknownSpaceAndLowTowardTheMap) {
   EXPECT_EQ(RayNovelty(map, origin, to_wall, 5.0, 0, 0.7), 1.0);  // nothing mapped yet
   map.FusePoints(wall, origin);
   EXPECT_EQ(RayNovelty(map, origin, aside, 5.0, 0, 0.7), 1.0);
-  EXPECT_EQ(RayNovelty(map, origin, aside, 5.0, 2, 0.7), 0.25);   // looked at twice, nothing
-  EXPECT_EQ(RayNovelty(map, origin, to_wall, 5.0, 1, 0.7), 0.7);  // seen once
-  EXPECT_EQ(RayNovelty(map, origin, to_wall, 1.5, 1, 0.7), 0.0);  // free to the range
+  EXPECT_EQ(RayNovelty(map, origin, aside, 5.0, 2, 0.7), 0.25);     // looked at twice, nothing
+  EXPECT_EQ(RayNovelty(map, origin, to_wall, 5.0, 1, 0.7), 0.7);    // seen once
+  EXPECT_EQ(RayNovelty(map, origin, to_wall, 5.0, 4, 0.7), 0.175);  // looked 4 times, still once
+  EXPECT_EQ(RayNovelty(map, origin, to_wall, 1.5, 1, 0.7), 0.0);    // free to the range
   map.FusePoints(wall, origin);
   EXPECT_EQ(RayNovelty(map, origin, to_wall, 5.0, 2, 0.7), 0.0);  // mapped
 }

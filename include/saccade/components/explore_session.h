@@ -112,7 +112,9 @@ struct ExploreReport {
 /// `direction_W` meets first in the map (mapping::WorldMap::FirstAlong) within `max_range_m`:
 /// unknown space (a frontier) 1, halved for each of the `looks` fixations that already looked
 /// that way without mapping it (stereo found nothing there: sky, a textureless floor); a surface
-/// seen once, not yet occupied, `tentative_value`; the map's surface, or nothing within range, 0.
+/// seen once, not yet occupied, `tentative_value`, halved for each look past the second (two
+/// sightings that still fall in different voxels: far, noisy stereo); the map's surface, or
+/// nothing within range, 0.
 double RayNovelty(const mapping::WorldMap& map, const Eigen::Vector3d& origin_W,
                   const Eigen::Vector3d& direction_W, double max_range_m, int looks,
                   double tentative_value);
