@@ -80,7 +80,7 @@ struct WorldMap::Impl {
   explicit Impl(double resolution) : tree(resolution) {}
   octomap::OcTree tree;
   std::vector<uint64_t> scratch;  // the radix sort's buffer, kept between insertions
-  mutable octomap::KeyRay ray;    // the voxels of one ray (OctoMap's buffer is 600 KB)
+  octomap::KeyRay ray;            // the voxels of one ray (OctoMap's buffer is 600 KB)
   int64_t occupied = 0;           // finest voxels occupied
   int64_t known = 0;              // finest voxels known (free or occupied)
 
@@ -275,7 +275,8 @@ RayEnd WorldMap::FirstAlong(const Eigen::Vector3d& origin_W, const Eigen::Vector
   const octomap::OcTree& tree = impl_->tree;
   const Eigen::Vector3d d = direction_W.normalized();
   const octomap::point3d origin = ToOcto(origin_W);
-  octomap::KeyRay& ray = impl_->ray;
+  // A buffer per thread: queries (const) may run concurrently, as long as nothing is fused.
+  thread_local octomap::KeyRay ray;
   RayEnd what = RayEnd::kNothing;
   double along = max_range_m;
   if (tree.computeRayKeys(origin, ToOcto(origin_W + max_range_m * d), ray)) {

@@ -105,7 +105,8 @@ class WorldMap {
   /// constant time.
   /// The first voxel along a ray from `origin_W` (direction_W need not be unit) that is not
   /// free, within `max_range_m`; *distance_m (when not null) is set to its distance (max_range_m
-  /// for kNothing). The voxel holding the origin is not looked at.
+  /// for kNothing). The voxel holding the origin is not looked at. Safe to call from several
+  /// threads at once while nothing is fused.
   RayEnd FirstAlong(const Eigen::Vector3d& origin_W, const Eigen::Vector3d& direction_W,
                     double max_range_m, double* distance_m = nullptr) const;
 
