@@ -94,9 +94,11 @@ ExploreConfig LoadExploreConfig(const std::filesystem::path& path) {
   ReadIf(root, "target_distance_m", kPositive, &o.target_distance_m);
   ReadIf(root, "raster_step", Interval::LeftOpen(0.0, 2.0), &o.raster_step);
   if (const std::optional<Entry> e = root.Find("attention")) {
-    e->ExpectMap({"saliency_weight", "novelty_weight"});
+    e->ExpectMap({"candidate_step", "saliency_weight", "novelty_weight", "tentative_value"});
+    ReadIf(*e, "candidate_step", Interval::LeftOpen(0.0, 2.0), &o.candidate_step);
     ReadIf(*e, "saliency_weight", kNonNegative, &o.saliency_weight);
     ReadIf(*e, "novelty_weight", kNonNegative, &o.novelty_weight);
+    ReadIf(*e, "tentative_value", kNonNegative, &o.tentative_value);
   }
   if (const std::optional<Entry> e = root.Find("ior")) {
     e->ExpectMap({"time_constant_s", "radius_m"});

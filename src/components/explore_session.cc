@@ -104,11 +104,14 @@ bool ExploreOptions::IsValid(std::string* error) const {
   if (what.empty() && !(raster_step > 0 && raster_step <= 2)) {
     what = "raster_step: " + std::to_string(raster_step) + ", expected (0, 2] fields of view";
   }
+  if (what.empty() && !(candidate_step > 0 && candidate_step <= 2)) {
+    what = "candidate_step: " + std::to_string(candidate_step) + ", expected (0, 2] fields of view";
+  }
   if (what.empty() && !(truth_step > 0 && truth_step <= 2)) {
     what = "truth_step: " + std::to_string(truth_step) + ", expected (0, 2] fields of view";
   }
-  if (what.empty() && !(saliency_weight >= 0 && novelty_weight >= 0)) {
-    what = "saliency_weight, novelty_weight: expected numbers >= 0";
+  if (what.empty() && !(saliency_weight >= 0 && novelty_weight >= 0 && tentative_value >= 0)) {
+    what = "saliency_weight, novelty_weight, tentative_value: expected numbers >= 0";
   }
   std::string nested;
   if (what.empty() && !stereo.IsValid(&nested)) what = nested;
@@ -163,12 +166,17 @@ class Chooser {
         options_(options),
         truth_(truth),
         fov_(EyeFieldOfView(head_)),
-        attention_(head_, truth.grid_W,
+        attention_(head_,
+                   options.strategy == "saliency"
+                       ? ReachGrid(head_, options.candidate_step * fov_, options.target_distance_m)
+                       : std::vector<Eigen::Vector3d>{},
                    [&] {
                      ExploreAttention::Options o;
                      o.saliency_weight = options.saliency_weight;
                      o.novelty_weight = options.novelty_weight;
                      o.target_distance_m = options.target_distance_m;
+                     o.tentative_value = options.tentative_value;
+                     o.max_range_m = options.map.max_range_m;
                      return o;
                    }()),
         ior_([&] {
@@ -180,7 +188,7 @@ class Chooser {
         random_(options.seed) {}
 
   std::vector<ExploreCandidate> Next(double time, const vision::StereoDepth* depth,
-                                     const Image* left) {
+                                     const Image* left, const mapping::WorldMap* map) {
     if (options_.strategy == "raster") {
       const Eigen::Vector3d p = truth_.grid_W[next_raster_++ % truth_.grid_W.size()];
       return {{p, 0.0}};
@@ -199,8 +207,8 @@ class Chooser {
       }
       return out;
     }
-    return attention_.Rank(depth, left,
-                           [&](const Eigen::Vector3d& p_W) { return ior_.Inhibition(p_W, time); });
+    return attention_.Rank(
+        depth, left, [&](const Eigen::Vector3d& p_W) { return ior_.Inhibition(p_W, time); }, map);
   }
 
   void Fixated(const Eigen::Vector3d& p_W, double time) {
@@ -254,8 +262,8 @@ ExploreReport Explore(const scene::Scene& scene, const ExploreOptions& options,
   std::vector<render::Frame> frames;
   while (time < options.seconds) {
     auto start = Clock::now();
-    const std::vector<ExploreCandidate> candidates =
-        chooser.Next(time, depth ? &*depth : nullptr, frames.empty() ? nullptr : &*frames[0].color);
+    const std::vector<ExploreCandidate> candidates = chooser.Next(
+        time, depth ? &*depth : nullptr, frames.empty() ? nullptr : &*frames[0].color, &map);
     std::optional<head::FixationResult> fixation;
     Eigen::Vector3d target = Eigen::Vector3d::Zero();
     for (const ExploreCandidate& candidate : candidates) {

@@ -77,6 +77,28 @@ TEST(Explore, TheSeedChangesRandomSaccadesOnly) {
   EXPECT_EQ(c.fixation_points_W, d.fixation_points_W);
 }
 
+// The saliency strategy's novelty, on a constructed map (a wall 1 x 1 m at x = 2 m): high toward
+// unknown space, less where fixations looked and stereo mapped nothing, the tentative value toward
+// a surface seen once, none toward the mapped surface or free space to the range.
+TEST(RayNovelty, IsHighTowardUnknownSpaceAndLowTowardTheMap) {
+  std::vector<Eigen::Vector3d> wall;
+  for (double y = -0.5; y <= 0.5; y += 0.005) {
+    for (double z = -0.5; z <= 0.5; z += 0.005) wall.emplace_back(2.0, y, z);
+  }
+  mapping::WorldMap map(mapping::WorldMap::Options{});
+  const Eigen::Vector3d origin = Eigen::Vector3d::Zero();
+  const Eigen::Vector3d to_wall(1, 0, 0), aside(0, 1, 0);
+  EXPECT_EQ(RayNovelty(map, origin, to_wall, 5.0, 0, 0.7), 1.0);  // nothing mapped yet
+  map.FusePoints(wall, origin);
+  EXPECT_EQ(RayNovelty(map, origin, aside, 5.0, 0, 0.7), 1.0);
+  EXPECT_EQ(RayNovelty(map, origin, aside, 5.0, 2, 0.7), 0.25);     // looked at twice, nothing
+  EXPECT_EQ(RayNovelty(map, origin, to_wall, 5.0, 1, 0.7), 0.7);    // seen once
+  EXPECT_EQ(RayNovelty(map, origin, to_wall, 5.0, 4, 0.7), 0.175);  // looked 4 times, still once
+  EXPECT_EQ(RayNovelty(map, origin, to_wall, 1.5, 1, 0.7), 0.0);    // free to the range
+  map.FusePoints(wall, origin);
+  EXPECT_EQ(RayNovelty(map, origin, to_wall, 5.0, 2, 0.7), 0.0);  // mapped
+}
+
 std::string ErrorOf(const std::string& yaml) {
   const std::filesystem::path file = testing_helpers::ScratchFile("explore.yaml");
   std::ofstream(file) << yaml;
@@ -101,6 +123,12 @@ TEST(ExploreConfig, RefusesBadSettingsNamingFileLineAndKey) {
   EXPECT_NE(spiral.find("'spiral' is not a strategy"), std::string::npos) << spiral;
   EXPECT_NE(ErrorOf("map: {voxel: 0.1}\n").find("voxel"), std::string::npos);
   EXPECT_NE(ErrorOf("stereo: {block_size: 4}\n").find("stereo.block_size"), std::string::npos);
+  EXPECT_NE(ErrorOf("attention: {tentative_value: -1}\n")
+                .find("explore.yaml:1: attention.tentative_value"),
+            std::string::npos);
+  EXPECT_NE(
+      ErrorOf("attention: {candidate_step: 0}\n").find("explore.yaml:1: attention.candidate_step"),
+      std::string::npos);
   EXPECT_EQ(ErrorOf("seconds: 5\nmap: {resolution_m: 0.05}\n"), "(accepted)");
   // The shipped settings are the defaults.
   const ExploreConfig shipped =
@@ -111,6 +139,8 @@ TEST(ExploreConfig, RefusesBadSettingsNamingFileLineAndKey) {
   EXPECT_EQ(shipped.options.map.resolution_m, defaults.map.resolution_m);
   EXPECT_EQ(shipped.options.ior_time_constant_s, defaults.ior_time_constant_s);
   EXPECT_EQ(shipped.options.stereo.min_depth_m, defaults.stereo.min_depth_m);
+  EXPECT_EQ(shipped.options.candidate_step, defaults.candidate_step);
+  EXPECT_EQ(shipped.options.tentative_value, defaults.tentative_value);
 }
 
 TEST(ExploreOptions, RefusesAStrategyThatDoesNotExist) {

@@ -4,11 +4,13 @@
 #include "saccade/mapping/world_map.h"
 
 #include <gtest/gtest.h>
+#include <octomap/OcTree.h>
 
 #include <cmath>
 #include <fstream>
 #include <iostream>
 #include <memory>
+#include <random>
 
 #include "saccade/core/error.h"
 #include "saccade/head/fixation.h"
@@ -55,6 +57,85 @@ TEST(WorldMap, HoldsASurfaceWhereItWasSeenFreeSpaceBeforeItAndUnknownBehind) {
       map.RayMeetsUnknown(Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitX(), 4.0, &distance));
   EXPECT_NEAR(distance, 2.0, 0.05);
   EXPECT_TRUE(map.RayMeetsUnknown(Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitY(), 4.0));
+}
+
+// Fusion is OctoMap's discretized insertion (insertPointCloud with discretize), done faster: the
+// same map, voxel for voxel, over clouds from several origins (hits, misses and the range cut).
+TEST(WorldMap, FusesTheSameMapAsOctoMapsDiscretizedInsertion) {
+  WorldMap::Options options;
+  options.max_range_m = 3.0;
+  WorldMap map(options);
+  octomap::OcTree reference(options.resolution_m);
+  reference.setProbHit(options.hit_probability);
+  reference.setProbMiss(options.miss_probability);
+  reference.setOccupancyThres(options.occupancy_threshold);
+  std::mt19937 random(7);
+  std::uniform_real_distribution<double> along(-0.6, 0.6), depth(1.5, 3.5);
+  for (int scan = 0; scan < 4; ++scan) {
+    const Eigen::Vector3d origin(0.0, 0.1 * scan, 0.05 * scan);
+    std::vector<Eigen::Vector3d> points;
+    octomap::Pointcloud cloud;
+    for (int i = 0; i < 4000; ++i) {
+      // Two walls (one partly beyond the range) with jitter, so that hits and misses interleave.
+      const Eigen::Vector3d p(i % 2 == 0 ? 2.0 + 0.02 * along(random) : depth(random),
+                              along(random), along(random));
+      points.push_back(p);
+      if ((p - origin).norm() <= options.max_range_m) {
+        cloud.push_back(static_cast<float>(p.x()), static_cast<float>(p.y()),
+                        static_cast<float>(p.z()));
+      }
+    }
+    map.FusePoints(points, origin);
+    reference.insertPointCloud(cloud, octomap::point3d(origin.x(), origin.y(), origin.z()),
+                               options.max_range_m, false, true);
+  }
+  int64_t known = 0, occupied = 0, differ = 0;
+  for (double x = -0.2; x <= 3.6; x += 0.01) {
+    for (double y = -0.7; y <= 0.7; y += 0.01) {
+      for (double z = -0.7; z <= 0.7; z += 0.02) {
+        // Looked up as At does (in float): a point on a voxel's face falls in the same voxel.
+        const octomap::OcTreeNode* node = reference.search(
+            octomap::point3d(static_cast<float>(x), static_cast<float>(y), static_cast<float>(z)));
+        const Occupancy expected = node == nullptr                  ? Occupancy::kUnknown
+                                   : reference.isNodeOccupied(node) ? Occupancy::kOccupied
+                                                                    : Occupancy::kFree;
+        known += expected != Occupancy::kUnknown ? 1 : 0;
+        occupied += expected == Occupancy::kOccupied ? 1 : 0;
+        differ += map.At({x, y, z}) != expected ? 1 : 0;
+      }
+    }
+  }
+  EXPECT_GT(known, 100000);
+  EXPECT_GT(occupied, 1000);
+  EXPECT_EQ(differ, 0);
+  // The counts kept by each update are the octree's.
+  int64_t reference_occupied = 0;
+  for (auto it = reference.begin_leafs(); it != reference.end_leafs(); ++it) {
+    if (!reference.isNodeOccupied(*it)) continue;
+    const int64_t edge = std::lround(it.getSize() / options.resolution_m);
+    reference_occupied += edge * edge * edge;
+  }
+  EXPECT_EQ(map.occupied_voxels(), reference_occupied);
+  EXPECT_EQ(static_cast<int64_t>(map.OccupiedCentres().size()), reference_occupied);
+}
+
+// What a ray meets first: unknown space off to the side, a wall seen once (tentative), the same
+// wall seen three times (occupied), and nothing within a range short of the wall.
+TEST(WorldMap, FirstAlongTellsUnknownTentativeOccupiedAndNothing) {
+  WorldMap map(WorldMap::Options{});
+  const std::vector<Eigen::Vector3d> wall = Wall();
+  map.FusePoints(wall, Eigen::Vector3d::Zero());
+  double distance = 0;
+  EXPECT_EQ(map.FirstAlong(Eigen::Vector3d::Zero(), {1, 0, 0}, 4.0, &distance), RayEnd::kTentative);
+  EXPECT_NEAR(distance, 2.0, 0.03);
+  EXPECT_EQ(map.FirstAlong(Eigen::Vector3d::Zero(), {0, 1, 0}, 4.0, &distance), RayEnd::kUnknown);
+  EXPECT_LT(distance, 0.05);
+  EXPECT_EQ(map.FirstAlong(Eigen::Vector3d::Zero(), {1, 0, 0}, 1.5, &distance), RayEnd::kNothing);
+  EXPECT_EQ(distance, 1.5);
+  for (int i = 0; i < 2; ++i) map.FusePoints(wall, Eigen::Vector3d::Zero());
+  EXPECT_EQ(map.FirstAlong(Eigen::Vector3d::Zero(), {2, 0.1, 0.1}, 4.0, &distance),
+            RayEnd::kOccupied);
+  EXPECT_NEAR(distance, 2.0, 0.03);
 }
 
 TEST(WorldMap, WritesItsSurfaceAsAPlyPointCloud) {

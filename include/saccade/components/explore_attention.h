@@ -21,12 +21,14 @@
 // 64-pixel-wide image; the second searches a crop, not the whole image (the seed's two-stage
 // model, its section 7.2 and reference [15]).
 #include <Eigen/Core>
+#include <cstdint>
 #include <functional>
 #include <memory>
 #include <vector>
 
 #include "saccade/core/image.h"
 #include "saccade/head/head_model.h"
+#include "saccade/mapping/world_map.h"
 #include "saccade/vision/dense_stereo.h"
 #include "saccade/vision/face_detector.h"
 #include "saccade/vision/saliency.h"
@@ -45,6 +47,16 @@ Eigen::Vector2d EyeFieldOfView(const head::HeadModel& head);
 std::vector<Eigen::Vector3d> ReachGrid(const head::HeadModel& head, const Eigen::Vector2d& step,
                                        double distance);
 
+/// The novelty of one direction from the map: what a ray from `origin_W` along `direction_W`
+/// meets first (mapping::WorldMap::FirstAlong) within `max_range_m`: unknown space (a frontier)
+/// 1, halved for each of the `looks` fixations that already looked that way without mapping it
+/// (stereo found nothing there: sky, a textureless floor); a surface seen once, not yet
+/// occupied, `tentative_value`, halved for each look past the second (two sightings that still
+/// fall in different voxels: far, noisy stereo); the map's surface, or nothing within range, 0.
+double RayNovelty(const mapping::WorldMap& map, const Eigen::Vector3d& origin_W,
+                  const Eigen::Vector3d& direction_W, double max_range_m, int looks,
+                  double tentative_value);
+
 /// A target attention proposes: where (world, m), its score, and what proposed it.
 struct ExploreCandidate {
   enum class Source { kReach, kSaliency, kFace };
@@ -58,8 +70,11 @@ class ExploreAttention {
   struct Options {
     double saliency_weight = 1.0;
     double novelty_weight = 1.0;
-    double turn_weight = 0.1;         ///< per radian of saccade
-    double target_distance_m = 2.0;   ///< of a candidate without a depth
+    double turn_weight = 0.1;        ///< per radian of saccade
+    double target_distance_m = 2.0;  ///< of a candidate without a depth
+    /// Novelty from a map: a ray meeting a surface seen once (RayNovelty), against unknown's 1.
+    double tentative_value = 2.0;
+    double max_range_m = 5.0;         ///< novelty rays: the map's range
     bool second_stage_faces = false;  ///< search faces in the best saliency zone
     double face_weight = 2.0;         ///< a face scores this above its zone
   };
@@ -73,14 +88,19 @@ class ExploreAttention {
   /// The candidates, best first: the saliency zones of `left` (a camera image with its
   /// calibration and pose, vision/image_camera.h) placed at the stereo depth `depth` when both
   /// are given, and the reach grid.
+  /// With `map`, novelty is the map's (ViewNovelty); without, the share of the view never
+  /// looked at.
   std::vector<ExploreCandidate> Rank(const vision::StereoDepth* depth, const Image* left,
-                                     const Inhibition& inhibition);
+                                     const Inhibition& inhibition,
+                                     const mapping::WorldMap* map = nullptr);
 
   /// The eyes fixated p_W: its field of view is no longer novel, and turns start from it.
   void Looked(const Eigen::Vector3d& p_W);
 
-  /// The share of the field of view about the world point p_W never looked at, in [0, 1].
-  double Novelty(const Eigen::Vector3d& p_W) const;
+  /// The novelty of the view about the world point p_W: with a map, the mean RayNovelty of a
+  /// 7 x 7 grid of rays across 0.9 of the field of view from the head's base (0.3 m out);
+  /// without, the share of the view's 2-degree cells never looked at, in [0, 1].
+  double Novelty(const Eigen::Vector3d& p_W, const mapping::WorldMap* map = nullptr) const;
 
   const std::vector<Eigen::Vector3d>& grid_W() const { return grid_W_; }
 
@@ -90,7 +110,8 @@ class ExploreAttention {
   void FacesIn(const cv::Rect& zone, const Image& left, const vision::StereoDepth& depth,
                double zone_score, std::vector<ExploreCandidate>* out);
   template <typename F>
-  void ForEachCell(const Eigen::Vector3d& direction_B, F&& f) const;
+  void ForEachCell(const Eigen::Vector3d& direction_B, const Eigen::Vector2d& fov, F&& f) const;
+  int Looks(const Eigen::Vector3d& direction_B) const;  // fixations that looked along it
   Eigen::Vector3d InBase(const Eigen::Vector3d& p_W) const;
 
   const head::HeadModel& head_;
@@ -99,7 +120,7 @@ class ExploreAttention {
   Eigen::Vector2d fov_;
   vision::SpectralResidualSaliency saliency_;
   std::unique_ptr<vision::FaceDetector> faces_;  // the second stage's, when on
-  std::vector<bool> looked_;                     // 2-degree cells, azimuth x elevation
+  std::vector<uint8_t> looks_;  // 2-degree cells, azimuth x elevation: the fixations that held each
   Eigen::Vector3d gaze_B_ = Eigen::Vector3d::UnitX();
 };
 

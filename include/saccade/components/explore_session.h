@@ -18,10 +18,13 @@
 //   random   -- random saccades to reachable directions (seeded);
 //   saliency -- two-stage attention: the spectral-residual saliency of the whole left image
 //               proposes zones (the first stage), each zone's peak becomes a 3D candidate
-//               through the stereo depth; the directions of the reach that no fixation has
-//               yet looked at are candidates too (novelty: the frontier of what was seen); each
-//               candidate scores saliency_weight * saliency + novelty_weight * novelty, less
-//               its inhibition of return; the best one is fixated.
+//               through the stereo depth; a grid of the reach spaced `candidate_step` fields of
+//               view gives candidates too; each candidate scores saliency_weight * saliency +
+//               novelty_weight * novelty, less its inhibition of return and 0.1 per radian of
+//               turn from the current gaze; the best one is fixated. Novelty comes from the map:
+//               a grid of rays across the candidate's view, each scored by what it meets first
+//               (RayNovelty: unknown space, the map's frontier, 1; a surface seen once and not
+//               yet occupied, tentative_value; the mapped surface or free space to the range, 0).
 //
 // The ground truth: the renderer's depth from a dense grid of the head's reach (truth_step),
 // back-projected and thinned to one sample per truth_cell_m, within the map's range: the surface
@@ -32,6 +35,7 @@
 #include <string>
 #include <vector>
 
+#include "saccade/components/explore_attention.h"
 #include "saccade/mapping/map_score.h"
 #include "saccade/mapping/world_map.h"
 #include "saccade/scene/scene.h"
@@ -49,8 +53,14 @@ struct ExploreOptions {
   uint64_t seed = 1;                  ///< random saccades' and tie-breaking seed
   double target_distance_m = 2.0;     ///< directions become targets at this distance, > 0
   double raster_step = 0.75;          ///< raster spacing, in fields of view: (0, 2]
-  double saliency_weight = 1.0;       ///< >= 0
-  double novelty_weight = 1.0;        ///< >= 0
+  /// The saliency strategy's candidates beside its saliency zones: a grid of the reach spaced
+  /// this many fields of view: (0, 2].
+  double candidate_step = 0.375;
+  double saliency_weight = 1.0;  ///< >= 0
+  double novelty_weight = 1.0;   ///< >= 0
+  /// Novelty of a ray that meets a surface seen once (hit, not yet occupied: one more sighting
+  /// maps it) against one that meets unknown space (1): >= 0. See RayNovelty.
+  double tentative_value = 2.0;
   double ior_time_constant_s = 10.0;  ///< inhibition of a fixated place decays so, > 0
   double ior_radius_m = 0.3;          ///< size of an inhibited place, > 0
   double sample_every_s = 1.0;        ///< completeness is measured this often, > 0

@@ -29,11 +29,19 @@ namespace saccade::mapping {
 /// What a voxel of the map holds.
 enum class Occupancy { kUnknown, kFree, kOccupied };
 
+/// What a ray through the map meets first (WorldMap::FirstAlong).
+enum class RayEnd {
+  kUnknown,    ///< unknown space: a frontier of the map lies that way
+  kTentative,  ///< a voxel hit more than missed but not yet occupied (a surface seen once)
+  kOccupied,   ///< the map's surface
+  kNothing,    ///< free space all the way to the range
+};
+
 /// What one insertion did.
 struct FuseStats {
   int64_t rays = 0;          ///< depth samples inserted (after stride, confidence and range)
   int64_t occupied = 0;      ///< occupied voxels in the map afterwards
-  int64_t known_voxels = 0;  ///< leaves known (occupied or free) afterwards
+  int64_t known_voxels = 0;  ///< finest voxels known (occupied or free) afterwards
 };
 
 /// The occupancy map. Not thread-safe; copyable only through Clone.
@@ -93,6 +101,15 @@ class WorldMap {
   bool RayMeetsUnknown(const Eigen::Vector3d& origin_W, const Eigen::Vector3d& direction_W,
                        double max_range_m, double* distance_m = nullptr) const;
 
+  /// The first voxel along a ray from `origin_W` (direction_W need not be unit) that is not
+  /// free, within `max_range_m`; *distance_m (when not null) is set to its distance (max_range_m
+  /// for kNothing). The voxel holding the origin is not looked at. Safe to call from several
+  /// threads at once while nothing is fused.
+  RayEnd FirstAlong(const Eigen::Vector3d& origin_W, const Eigen::Vector3d& direction_W,
+                    double max_range_m, double* distance_m = nullptr) const;
+
+  /// The finest voxels occupied, and known (occupied or free): counts kept by every insertion,
+  /// constant time.
   int64_t occupied_voxels() const;
   int64_t known_voxels() const;
   std::size_t memory_bytes() const;  ///< the octree's own estimate
