@@ -215,7 +215,8 @@ Runner AddExploreCommand(CLI::App& app) {
       "visible surface within 2 cm of the map), accuracy (mean, RMS, 95th percentile), the "
       "fixations and their saccade amplitudes. Strategies, compared in one report: raster (a "
       "boustrophedon scan of the head's reach), random (random saccades), saliency (two-stage "
-      "attention: spectral-residual saliency zones, novelty of unexplored directions, "
+      "attention: spectral-residual saliency zones, novelty from the map's unknown space and "
+      "once-seen surfaces, "
       "inhibition of return in 3D). Deterministic in simulated time.");
   c->add_option("--scene", o->scene,
                 "scene file (scenes/explore_wall.yaml, explore_shelf.yaml, "

@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <vector>
 
@@ -144,7 +145,7 @@ WorldMapComponent::WorldMapComponent()
 }
 
 void WorldMapComponent::Configured() {
-  map_.emplace(map_options_);
+  map_ = std::make_shared<mapping::WorldMap>(map_options_);
   ior_.emplace(ior_options_);
 }
 
@@ -155,7 +156,14 @@ void WorldMapComponent::Step(const runtime::StepContext& context) {
   }
   const DepthMessage* depth = depth_.get();
   if (depth == nullptr || !depth_.fresh() || !depth->stereo) return;
+  // The last map emitted stays as its readers saw it (copy on write).
+  const auto start = std::chrono::steady_clock::now();
+  if (map_.use_count() > 1) map_ = std::make_shared<mapping::WorldMap>(*map_);
+  const auto copied = std::chrono::steady_clock::now();
   map_->Fuse(*depth->stereo);
+  copy_ms_ += std::chrono::duration<double, std::milli>(copied - start).count();
+  fuse_ms_ +=
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - copied).count();
   if (++fused_ % publish_every_ != 0) return;
   MapMessage out;
   out.time = context.time;
@@ -163,6 +171,8 @@ void WorldMapComponent::Step(const runtime::StepContext& context) {
   out.resolution_m = map_options_.resolution_m;
   out.occupied_W = map_->OccupiedCentres();
   out.fused = fused_;
+  out.map = map_;
+  out.ior = std::make_shared<const mapping::Inhibition3d>(*ior_);
   for (const mapping::Inhibition3d::Place& place : ior_->places()) {
     const double level = ior_->Level(place, context.time);
     if (level > 0) out.inhibited.push_back({place.p_W, ior_options_.radius_m, level});
@@ -177,8 +187,9 @@ void WorldMapComponent::Stop() {
   if (!map_) return;
   log::Info(
       "mapping.world_map '{}': {} depths fused, {} occupied voxels of {:g} m, {} places "
-      "inhibited",
-      name(), fused_, map_->occupied_voxels(), map_options_.resolution_m, ior_->places().size());
+      "inhibited; fusion {:.0f} ms a depth, the readers' snapshot {:.0f} ms (wall clock)",
+      name(), fused_, map_->occupied_voxels(), map_options_.resolution_m, ior_->places().size(),
+      fuse_ms_ / std::max<int64_t>(fused_, 1), copy_ms_ / std::max<int64_t>(fused_, 1));
   if (ply_.empty()) return;
   map_->WritePly(ply_);
   log::Info("mapping.world_map '{}': the map is in {}", name(), ply_);
@@ -207,7 +218,12 @@ ExploreComponent::ExploreComponent()
                "weight of a zone's saliency in a candidate's score")
       .Range(0.0, 1e6);
   DeclareParam("novelty_weight", &attention_options_.novelty_weight,
-               "weight of the share of a candidate's view never looked at")
+               "weight of a candidate's novelty: with the map connected (in one process), the "
+               "unknown space and once-seen surfaces its view's rays meet first; else the share "
+               "of its view never looked at")
+      .Range(0.0, 1e6);
+  DeclareParam("tentative_value", &attention_options_.tentative_value,
+               "novelty of a ray meeting a surface seen once (unknown space: 1)")
       .Range(0.0, 1e6);
   DeclareParam("turn_weight", &attention_options_.turn_weight,
                "score lost per radian of saccade (nearer targets first among equals)")
@@ -282,6 +298,8 @@ std::optional<Eigen::Vector3d> ExploreComponent::Choose(const runtime::StepConte
   const auto inhibition = [&](const Eigen::Vector3d& p_W) {
     double most = 0.0;
     if (map == nullptr) return most;
+    if (map->ior) return map->ior->Inhibition(p_W, context.time);
+    // A map from another process (DDS): its places at the strength they had when it was sent.
     for (const InhibitedPlace& place : map->inhibited) {
       if ((p_W - place.p_W).norm() <= place.radius_m) most = std::max(most, place.strength);
     }
@@ -307,7 +325,8 @@ std::optional<Eigen::Vector3d> ExploreComponent::Choose(const runtime::StepConte
   const runtime::ImageMessage* image = image_.get();
   for (const ExploreCandidate& candidate :
        attention_->Rank(depth != nullptr ? depth->stereo.get() : nullptr,
-                        image != nullptr ? image->image.get() : nullptr, inhibition)) {
+                        image != nullptr ? image->image.get() : nullptr, inhibition,
+                        map != nullptr ? map->map.get() : nullptr)) {
     if (!reachable(candidate.p_W)) continue;
     source_ = candidate.source == ExploreCandidate::Source::kFace       ? "explore_face"
               : candidate.source == ExploreCandidate::Source::kSaliency ? "explore_saliency"

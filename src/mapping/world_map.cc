@@ -78,6 +78,7 @@ using world_map_internal::ToOcto;
 
 struct WorldMap::Impl {
   explicit Impl(double resolution) : tree(resolution) {}
+  explicit Impl(const octomap::OcTree& other) : tree(other) {}  // its sensor model too
   octomap::OcTree tree;
   std::vector<uint64_t> scratch;  // the radix sort's buffer, kept between insertions
   octomap::KeyRay ray;            // the voxels of one ray (OctoMap's buffer is 600 KB)
@@ -161,6 +162,12 @@ WorldMap::WorldMap(const Options& options) : options_(options) {
 }
 
 WorldMap::~WorldMap() = default;
+// The octree and the counts; the scratch buffers start empty.
+WorldMap::WorldMap(const WorldMap& other)
+    : options_(other.options_), impl_(std::make_unique<Impl>(other.impl_->tree)) {
+  impl_->occupied = other.impl_->occupied;
+  impl_->known = other.impl_->known;
+}
 WorldMap::WorldMap(WorldMap&&) noexcept = default;
 WorldMap& WorldMap::operator=(WorldMap&&) noexcept = default;
 
@@ -255,19 +262,6 @@ std::vector<Eigen::Vector3d> WorldMap::OccupiedCentres() const {
     }
   }
   return out;
-}
-
-bool WorldMap::RayMeetsUnknown(const Eigen::Vector3d& origin_W, const Eigen::Vector3d& direction_W,
-                               double max_range_m, double* distance_m) const {
-  octomap::point3d end;
-  const Eigen::Vector3d d = direction_W.normalized();
-  const bool hit = impl_->tree.castRay(ToOcto(origin_W), ToOcto(d), end, false, max_range_m);
-  const Eigen::Vector3d e(end.x(), end.y(), end.z());
-  const double along = std::min((e - origin_W).dot(d), max_range_m);
-  if (distance_m != nullptr) *distance_m = along;
-  if (hit) return false;  // an occupied voxel first
-  // castRay stops at an unknown voxel (false) or at max_range (false, end beyond it).
-  return along < max_range_m - impl_->tree.getResolution() && impl_->tree.search(end) == nullptr;
 }
 
 RayEnd WorldMap::FirstAlong(const Eigen::Vector3d& origin_W, const Eigen::Vector3d& direction_W,

@@ -23,7 +23,14 @@ using geometry::Pose;
 // solver converges to |u - e_z| ~ 1e-13, so both hold with margin.
 constexpr double kAxisTolerance = 1e-9;
 constexpr double kAppendixATolerance = 1e-9;
+// Random targets per head: 10,000 in the release build, whose figures the issue asked for;
+// 2,000 under AddressSanitizer (CI's second run, there for memory errors, not the statistics),
+// where the humanoid's 10,000 took 130 s of CI's 2 cores against 5 s in the release build.
+#if defined(__SANITIZE_ADDRESS__)
+constexpr int kTargets = 2000;
+#else
 constexpr int kTargets = 10000;
+#endif
 
 const fs::path kSource = SACCADE_SOURCE_DIR;
 
@@ -56,7 +63,7 @@ Vector3d RandomTarget(const HeadModel& head, std::mt19937_64* random) {
 
 class EveryHead : public ::testing::TestWithParam<std::string> {};
 
-TEST_P(EveryHead, TenThousandTargetsAreFixatedOrRefusedWithAReasonNeverANan) {
+TEST_P(EveryHead, RandomTargetsAreFixatedOrRefusedWithAReasonNeverANan) {
   const HeadModel head = HeadModel::FromFile(kSource / GetParam());
   FixationSolver solver(head);
   std::mt19937_64 random(2042);
@@ -90,7 +97,7 @@ TEST_P(EveryHead, TenThousandTargetsAreFixatedOrRefusedWithAReasonNeverANan) {
     worst = std::max(worst, error);
     ASSERT_LE(error, kAxisTolerance) << GetParam() << ": " << p_W.transpose();
   }
-  EXPECT_GT(ahead, 100);
+  EXPECT_GT(ahead, kTargets / 100);
   EXPECT_EQ(ahead_reachable, ahead);
   EXPECT_GT(reachable, kTargets / 4) << GetParam();
   RecordProperty("reachable", reachable);

@@ -53,10 +53,39 @@ TEST(WorldMap, HoldsASurfaceWhereItWasSeenFreeSpaceBeforeItAndUnknownBehind) {
   EXPECT_LT(score.rms_m, 0.5 * 0.02 * std::sqrt(3.0));  // within half a voxel's diagonal
   // A ray towards the wall meets it; one to the side meets unknown space.
   double distance = 0;
-  EXPECT_FALSE(
-      map.RayMeetsUnknown(Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitX(), 4.0, &distance));
+  EXPECT_EQ(map.FirstAlong(Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitX(), 4.0, &distance),
+            RayEnd::kOccupied);
   EXPECT_NEAR(distance, 2.0, 0.05);
-  EXPECT_TRUE(map.RayMeetsUnknown(Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitY(), 4.0));
+  EXPECT_EQ(map.FirstAlong(Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitY(), 4.0),
+            RayEnd::kUnknown);
+}
+
+// A copy is a snapshot: the same map, voxel for voxel, that later fusions into the original
+// leave as it was (mapping.world_map hands its readers copies).
+TEST(WorldMap, ACopyIsASnapshotThatLaterFusionsLeaveAsItWas) {
+  WorldMap map(WorldMap::Options{});
+  std::vector<Eigen::Vector3d> wall, side;
+  for (double y = -0.5; y <= 0.5; y += 0.01) {
+    for (double z = -0.5; z <= 0.5; z += 0.01) {
+      wall.emplace_back(2.0, y, z);
+      side.emplace_back(y, 2.0, z);
+    }
+  }
+  for (int i = 0; i < 2; ++i) map.FusePoints(wall, Eigen::Vector3d::Zero());
+  const WorldMap copy(map);
+  EXPECT_EQ(copy.occupied_voxels(), map.occupied_voxels());
+  EXPECT_EQ(copy.known_voxels(), map.known_voxels());
+  EXPECT_EQ(copy.OccupiedCentres(), map.OccupiedCentres());
+  for (int i = 0; i < 2; ++i) map.FusePoints(side, Eigen::Vector3d::Zero());
+  EXPECT_GT(map.occupied_voxels(), copy.occupied_voxels());
+  EXPECT_EQ(map.At({0.0, 2.0, 0.0}), Occupancy::kOccupied);
+  EXPECT_EQ(copy.At({0.0, 2.0, 0.0}), Occupancy::kUnknown);
+  EXPECT_EQ(copy.FirstAlong(Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitY(), 4.0),
+            RayEnd::kUnknown);
+  // The copy fuses as the original would (its sensor model came along).
+  WorldMap again(copy);
+  for (int i = 0; i < 2; ++i) again.FusePoints(side, Eigen::Vector3d::Zero());
+  EXPECT_EQ(again.OccupiedCentres(), map.OccupiedCentres());
 }
 
 // Fusion is OctoMap's discretized insertion (insertPointCloud with discretize), done faster: the

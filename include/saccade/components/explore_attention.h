@@ -8,11 +8,12 @@
 // A candidate p scores
 //   saliency_weight * saliency(p) + novelty_weight * novelty(p) - inhibition(p) - turn_weight *
 //   turn
-// where novelty is the share of a field of view about p's direction never looked at (2-degree
-// cells of azimuth and elevation from the head's base), inhibition is inhibition of return in
-// 3D (the caller's: mapping/inhibition_3d.h), and turn the angle (rad) from where the eyes look
-// now, so that among equals the nearer saccade wins. Deterministic: the same inputs give the
-// same ranking.
+// where novelty is, with a map, what the rays across p's view meet first (RayNovelty: unknown
+// space, a surface seen once), and without one the share of a field of view about p's direction
+// never looked at (2-degree cells of azimuth and elevation from the head's base), inhibition is
+// inhibition of return in 3D (the caller's: mapping/inhibition_3d.h), and turn the angle (rad)
+// from where the eyes look now, so that among equals the nearer saccade wins. Deterministic: the
+// same inputs give the same ranking.
 //
 // The second stage (`second_stage_faces`): only the best-scoring saliency zone is examined
 // further, at the image's full resolution: faces are searched in its box (grown by half on

@@ -19,14 +19,18 @@
 // mapping.world_map -- the occupancy map (mapping/world_map.h, OctoMap) of every depth, and
 //   the places inhibition of return holds (mapping/inhibition_3d.h), world-anchored and
 //   decaying: each place a `selection` fixates. Emits the map (occupied voxels' centres and the
-//   places) after every `publish_every` depths fused; writes it as PLY (`ply`) at the end.
+//   places; in one process the map itself and the inhibition too, as snapshots) after every
+//   `publish_every` depths fused; writes it as PLY (`ply`) at the end.
 //   inputs: depth (vision.depth, required), selection (vision.selection)
 //   outputs: map (mapping.map)
 //
 // vision.explore -- two-stage attention for exploration (components/explore_attention.h): at
 //   rest on a target for dwell_s (and, with `depth` connected, once this rest's depth came),
 //   it ranks the saliency zones of the left image and the head's reach by saliency, novelty
-//   and the map's inhibition of return, and sends the head to the best reachable one. The
+//   and the map's inhibition of return, and sends the head to the best reachable one. Novelty
+//   is the map's (RayNovelty: unknown space and surfaces seen once that the candidate view's
+//   rays meet first) when the map comes from this process; a map from DDS carries no free or
+//   unknown space, and novelty is then the share of the view never looked at. The
 //   second stage (second_stage_faces, on by default) searches faces at full resolution in the
 //   best zone only; a face found there comes first. With `candidates` connected (a face
 //   pipeline's), the closest face no place inhibits comes before all (the task). The target's
@@ -87,11 +91,13 @@ class WorldMapComponent : public runtime::Component {
   runtime::Output<MapMessage>& map_out_;
   mapping::WorldMap::Options map_options_;
   mapping::Inhibition3d::Options ior_options_;
-  std::optional<mapping::WorldMap> map_;
+  // Shared with the readers of the last map emitted: copied before a fusion while they hold it.
+  std::shared_ptr<mapping::WorldMap> map_;
   std::optional<mapping::Inhibition3d> ior_;
   int publish_every_ = 1;
   std::string ply_;
   int64_t fused_ = 0;
+  double fuse_ms_ = 0.0, copy_ms_ = 0.0;  // wall clock, for the log at Stop
 };
 
 class ExploreComponent : public runtime::Component {
@@ -122,7 +128,7 @@ class ExploreComponent : public runtime::Component {
     return o;
   }();
   std::optional<ExploreAttention> attention_;
-  double grid_step_ = 0.75;  // fields of view
+  double grid_step_ = 0.375;  // fields of view
   double dwell_s_ = 0.2;
   // The target: where, its id, when the head came to rest on it (nullopt: moving).
   std::optional<Eigen::Vector3d> target_W_;

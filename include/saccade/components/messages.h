@@ -25,6 +25,11 @@
 #include "saccade/vision/dense_stereo.h"
 #include "saccade/vision/json.h"
 
+namespace saccade::mapping {
+class WorldMap;
+class Inhibition3d;
+}  // namespace saccade::mapping
+
 namespace saccade::components {
 
 /// The head's joints at `time` (sim.head's output, and a real head's): where the eye cameras
@@ -168,14 +173,19 @@ struct InhibitedPlace {
 
 /// The map the head has built of the world (mapping.world_map, issue 44): the centres of its
 /// occupied voxels and the places inhibition of return holds, at one step. DDS publishes the
-/// points as sensor_msgs/PointCloud2 (frame "world"); the GUI draws them growing.
+/// points as sensor_msgs/PointCloud2 (frame "world"); the GUI draws them growing. In one
+/// process it carries the map itself too (free and unknown space, which novelty is made of) and
+/// the inhibition of return, as snapshots that later fusions leave as they are; neither is in
+/// JSON or on DDS, where they arrive null.
 struct MapMessage {
   double time = 0.0;
   int64_t frame_index = 0;
-  double resolution_m = 0.0;                ///< voxel edge
-  std::vector<Eigen::Vector3d> occupied_W;  ///< m, world: occupied voxels' centres
-  std::vector<InhibitedPlace> inhibited;    ///< strongest first
-  int64_t fused = 0;                        ///< depth images fused so far
+  double resolution_m = 0.0;                         ///< voxel edge
+  std::vector<Eigen::Vector3d> occupied_W;           ///< m, world: occupied voxels' centres
+  std::vector<InhibitedPlace> inhibited;             ///< strongest first
+  int64_t fused = 0;                                 ///< depth images fused so far
+  std::shared_ptr<const mapping::WorldMap> map;      ///< not in JSON or on DDS
+  std::shared_ptr<const mapping::Inhibition3d> ior;  ///< not in JSON or on DDS
 };
 
 /// Registers every message type above with runtime::MessageRegistry::Global() (idempotent).

@@ -44,7 +44,8 @@ struct FuseStats {
   int64_t known_voxels = 0;  ///< finest voxels known (occupied or free) afterwards
 };
 
-/// The occupancy map. Not thread-safe; copyable only through Clone.
+/// The occupancy map. Not thread-safe. A copy is a snapshot: fusing into one changes nothing
+/// in the other (mapping.world_map hands its readers one each time it has fused).
 class WorldMap {
  public:
   struct Options {
@@ -80,8 +81,10 @@ class WorldMap {
   /// Throws InvalidArgument with IsValid's message.
   explicit WorldMap(const Options& options);
   ~WorldMap();
+  WorldMap(const WorldMap& other);
   WorldMap(WorldMap&&) noexcept;
   WorldMap& operator=(WorldMap&&) noexcept;
+  WorldMap& operator=(const WorldMap&) = delete;
 
   /// Inserts a stereo depth image (its rays start at X_WR's origin): every stride-th sample of
   /// at least min_confidence that is not on a depth edge (edge_ratio).
@@ -95,12 +98,6 @@ class WorldMap {
   /// The centres of the occupied voxels (the map's surface), in the octree's order
   /// (deterministic for the same insertions).
   std::vector<Eigen::Vector3d> OccupiedCentres() const;
-  /// Whether a ray from `origin_W` along `direction_W` meets unknown space before an occupied
-  /// voxel within `max_range_m` (a frontier lies that way). Sets *distance_m (when not null) to
-  /// where it stopped: the first unknown or occupied voxel, or max_range_m.
-  bool RayMeetsUnknown(const Eigen::Vector3d& origin_W, const Eigen::Vector3d& direction_W,
-                       double max_range_m, double* distance_m = nullptr) const;
-
   /// The first voxel along a ray from `origin_W` (direction_W need not be unit) that is not
   /// free, within `max_range_m`; *distance_m (when not null) is set to its distance (max_range_m
   /// for kNothing). The voxel holding the origin is not looked at. Safe to call from several
