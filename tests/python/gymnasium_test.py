@@ -1,4 +1,5 @@
 # tier: gl
+# cost: 80  (seconds on CI's 2 cores: ctest -j starts the longest first; tests/python/python_tests.cmake)
 """saccade.envs judged by Gymnasium 1.4.0's own code (../shared/third_party/gymnasium beside the
 checkout, not a Debian package): check_env on every documented construction of FixationEnv,
 gymnasium.make / make_vec with the standard wrappers, VectorFixationEnv step for step against

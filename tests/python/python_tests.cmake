@@ -21,5 +21,11 @@ foreach(_file ${_python_tests})
   set_tests_properties(python.${_name} PROPERTIES
     LABELS ${_tier} TIMEOUT 600
     ENVIRONMENT "PYTHONPATH=${SACCADE_PYTHON_DIR};PYTHONDONTWRITEBYTECODE=1;SACCADE_SOURCE_DIR=${PROJECT_SOURCE_DIR}")
+  # The longest files start first under ctest -j (seconds on CI's 2 cores; see tests/CMakeLists.txt).
+  file(STRINGS ${_file} _cost_line LIMIT_COUNT 1 REGEX "^# cost: ")
+  if(_cost_line)
+    string(REGEX REPLACE "^# cost: *([0-9]+).*" "\\1" _cost "${_cost_line}")
+    set_tests_properties(python.${_name} PROPERTIES COST ${_cost})
+  endif()
   add_dependencies(tests_${_tier} _saccade)
 endforeach()

@@ -1,4 +1,5 @@
 # tier: gl
+# cost: 35  (seconds on CI's 2 cores: ctest -j starts the longest first; tests/python/python_tests.cmake)
 """saccade.render: frames as numpy arrays without a copy (ground truth included),
 render(out=), batch rendering against single renders, the GIL released while rendering."""
 
