@@ -14,7 +14,7 @@ namespace saccade::render {
 
 namespace {
 
-std::string LowerCase(std::string_view text) {
+std::string LowerCaseColorName(std::string_view text) {
   std::string out(text);
   for (char& c : out) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
   return out;
@@ -37,7 +37,7 @@ std::array<int, 4> CellOf(CfaPattern pattern) {
   return {-1, -1, -1, -1};
 }
 
-void CheckGain(double gain, const char* field) {
+void CheckWhiteBalanceGain(double gain, const char* field) {
   if (!std::isfinite(gain) || gain <= 0.0) {
     throw InvalidArgument(fmt::format("{}: expected a finite gain > 0, got {}", field, gain));
   }
@@ -121,7 +121,7 @@ const char* ToString(CfaPattern pattern) {
 }
 
 CfaPattern ParseCfaPattern(std::string_view text, std::string_view field) {
-  std::string name = LowerCase(text);
+  std::string name = LowerCaseColorName(text);
   for (const char* suffix : {"8", "16"}) {
     const std::string prefix = "bayer_";
     if (name.starts_with(prefix) && name.ends_with(suffix) &&
@@ -204,7 +204,7 @@ const char* ToString(DemosaicMethod method) {
 }
 
 DemosaicMethod ParseDemosaicMethod(std::string_view text, std::string_view field) {
-  const std::string name = LowerCase(text);
+  const std::string name = LowerCaseColorName(text);
   if (name == "bilinear") return DemosaicMethod::kBilinear;
   if (name == "edge_aware" || name == "ea") return DemosaicMethod::kEdgeAware;
   throw InvalidArgument(fmt::format(
@@ -253,9 +253,9 @@ Image Demosaic(const ImageView& mosaic, DemosaicMethod method) {
 }
 
 void WhiteBalance::Validate() const {
-  CheckGain(red, "white_balance.red");
-  CheckGain(green, "white_balance.green");
-  CheckGain(blue, "white_balance.blue");
+  CheckWhiteBalanceGain(red, "white_balance.red");
+  CheckWhiteBalanceGain(green, "white_balance.green");
+  CheckWhiteBalanceGain(blue, "white_balance.blue");
 }
 
 const char* ToString(ToneCurveKind kind) {
@@ -271,7 +271,7 @@ const char* ToString(ToneCurveKind kind) {
 }
 
 ToneCurveKind ParseToneCurveKind(std::string_view text, std::string_view field) {
-  const std::string name = LowerCase(text);
+  const std::string name = LowerCaseColorName(text);
   for (ToneCurveKind k : {ToneCurveKind::kLinear, ToneCurveKind::kGamma, ToneCurveKind::kSrgb}) {
     if (name == ToString(k)) return k;
   }
@@ -302,7 +302,7 @@ double ToneCurve::Encode(double linear) const {
 
 std::array<uint8_t, 256> ToneTable(const ToneCurve& curve, double gain) {
   curve.Validate();
-  CheckGain(gain, "ToneTable: gain");
+  CheckWhiteBalanceGain(gain, "ToneTable: gain");
   std::array<uint8_t, 256> table{};
   for (int v = 0; v < 256; ++v) {
     const double encoded = curve.Encode(std::min(1.0, gain * v / 255.0));

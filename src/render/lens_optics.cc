@@ -23,7 +23,7 @@ namespace {
 // float depth's rounding, below any gap between objects that matters at the scale of a disc.
 constexpr float kNearerFraction = 1e-3f;
 
-void CheckPositive(double value, const char* field) {
+void CheckLensPositive(double value, const char* field) {
   if (!std::isfinite(value) || value <= 0.0) {
     throw InvalidArgument(fmt::format("{}: expected a finite number > 0, got {}", field, value));
   }
@@ -227,8 +227,8 @@ void ApplyVignetting(Image& rgb, const Image& factors) {
 }
 
 void ThinLensOptions::Validate() const {
-  CheckPositive(focal_length_m, "thin_lens.focal_length_m");
-  CheckPositive(f_number, "thin_lens.f_number");
+  CheckLensPositive(focal_length_m, "thin_lens.focal_length_m");
+  CheckLensPositive(f_number, "thin_lens.f_number");
   if (!std::isfinite(focus_distance_m) || focus_distance_m <= focal_length_m) {
     throw InvalidArgument(fmt::format(
         "thin_lens.focus_distance_m: expected a finite distance beyond the focal length ({} m), "
