@@ -206,6 +206,36 @@ TEST(DepthOfField, ABlurredForegroundSpreadsOverAnInFocusBackgroundOnBothSidesOf
   EXPECT_GT(row[3 * 49], 120);
 }
 
+TEST(DepthOfField, TheCircleIsAnEllipseInPixelsWhenFxAndFyDiffer) {
+  // fy = fx / 2: pixels twice as tall as wide (pitch f / fy down), so the circle on the sensor
+  // spans half as many rows as columns. A horizontal edge (dark above row 20, bright below),
+  // transposed from Edge's vertical one.
+  const geometry::Intrinsics k(96, 40, 1000.0, 500.0, 47.5, 19.5);
+  const double d = 0.5;
+  const double across_px = CircleOfConfusionPx(Lens(), k, d);  // 16.26, in columns
+  const EdgeScene s = Edge(96, 40, d, d);
+  const Image out = ApplyDepthOfField(s.rgb.view(), s.depth.view(), Lens(), k);
+  const double measured_across = EdgeWidth(out, 20, 20, 220) / DiscWidthPerDiameter();
+  EXPECT_NEAR(measured_across / across_px, 1.0, kCocTolerance);
+  Image rows(40, 96, PixelFormat::kRgb8);  // the same edge, turned: a column profile
+  Image rows_depth(40, 96, PixelFormat::kFloat32);
+  for (int y = 0; y < 96; ++y) {
+    for (int x = 0; x < 40; ++x) {
+      std::fill(rows.row(y) + 3 * x, rows.row(y) + 3 * x + 3, y < 48 ? 20 : 220);
+      reinterpret_cast<float*>(rows_depth.row(y))[x] = static_cast<float>(d);
+    }
+  }
+  const geometry::Intrinsics k_rows(40, 96, 1000.0, 500.0, 19.5, 47.5);
+  const Image down = ApplyDepthOfField(rows.view(), rows_depth.view(), Lens(), k_rows);
+  Image column(96, 1, PixelFormat::kRgb8);  // column 20 as a row, for EdgeWidth
+  for (int y = 0; y < 96; ++y) std::copy(down.row(y) + 60, down.row(y) + 63, column.row(0) + 3 * y);
+  const double measured_down = EdgeWidth(column, 0, 20, 220) / DiscWidthPerDiameter();
+  EXPECT_NEAR(measured_down / (across_px / 2), 1.0, kCocTolerance)
+      << measured_down << " rows against " << across_px / 2;
+  RecordProperty("ellipse_across_ratio", std::to_string(measured_across / across_px));
+  RecordProperty("ellipse_down_ratio", std::to_string(measured_down / (across_px / 2)));
+}
+
 TEST(DepthOfField, PixelsWithoutASurfaceAreAtInfinityAndBigCirclesAreCapped) {
   ThinLensOptions lens = Lens();
   EXPECT_NEAR(CircleOfConfusion(lens, 0.0), 0.016 * 0.016 / (1.0 - 0.016), 1e-12);
