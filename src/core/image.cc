@@ -16,6 +16,16 @@ int BytesPerPixel(PixelFormat format) {
       return 4;
     case PixelFormat::kGray16:
       return 2;
+    case PixelFormat::kBayerRggb8:
+    case PixelFormat::kBayerBggr8:
+    case PixelFormat::kBayerGbrg8:
+    case PixelFormat::kBayerGrbg8:
+      return 1;
+    case PixelFormat::kBayerRggb16:
+    case PixelFormat::kBayerBggr16:
+    case PixelFormat::kBayerGbrg16:
+    case PixelFormat::kBayerGrbg16:
+      return 2;
     case PixelFormat::kFloat32:
     case PixelFormat::kUint32:
       return 4;
@@ -37,8 +47,40 @@ const char* ToString(PixelFormat format) {
       return "float32";
     case PixelFormat::kUint32:
       return "uint32";
+    case PixelFormat::kBayerRggb8:
+      return "bayer_rggb8";
+    case PixelFormat::kBayerBggr8:
+      return "bayer_bggr8";
+    case PixelFormat::kBayerGbrg8:
+      return "bayer_gbrg8";
+    case PixelFormat::kBayerGrbg8:
+      return "bayer_grbg8";
+    case PixelFormat::kBayerRggb16:
+      return "bayer_rggb16";
+    case PixelFormat::kBayerBggr16:
+      return "bayer_bggr16";
+    case PixelFormat::kBayerGbrg16:
+      return "bayer_gbrg16";
+    case PixelFormat::kBayerGrbg16:
+      return "bayer_grbg16";
   }
   return "unknown";
+}
+
+bool IsBayer(PixelFormat format) {
+  switch (format) {
+    case PixelFormat::kBayerRggb8:
+    case PixelFormat::kBayerBggr8:
+    case PixelFormat::kBayerGbrg8:
+    case PixelFormat::kBayerGrbg8:
+    case PixelFormat::kBayerRggb16:
+    case PixelFormat::kBayerBggr16:
+    case PixelFormat::kBayerGbrg16:
+    case PixelFormat::kBayerGrbg16:
+      return true;
+    default:
+      return false;
+  }
 }
 
 ImageView::ImageView(const uint8_t* data, int width, int height, PixelFormat format,

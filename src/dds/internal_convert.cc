@@ -74,6 +74,15 @@ std::optional<std::string> RosEncoding(PixelFormat format) {
       return "32FC1";
     case PixelFormat::kUint32:
       return std::nullopt;
+    case PixelFormat::kBayerRggb8:
+    case PixelFormat::kBayerBggr8:
+    case PixelFormat::kBayerGbrg8:
+    case PixelFormat::kBayerGrbg8:
+    case PixelFormat::kBayerRggb16:
+    case PixelFormat::kBayerBggr16:
+    case PixelFormat::kBayerGbrg16:
+    case PixelFormat::kBayerGrbg16:
+      return std::string(ToString(format));  // ROS's names (sensor_msgs/image_encodings.hpp)
   }
   return std::nullopt;
 }
@@ -84,6 +93,12 @@ std::optional<PixelFormat> FormatOfEncoding(const std::string& encoding) {
   if (encoding == "rgba8" || encoding == "8UC4") return PixelFormat::kRgba8;
   if (encoding == "mono16" || encoding == "16UC1") return PixelFormat::kGray16;
   if (encoding == "32FC1") return PixelFormat::kFloat32;
+  for (PixelFormat bayer :
+       {PixelFormat::kBayerRggb8, PixelFormat::kBayerBggr8, PixelFormat::kBayerGbrg8,
+        PixelFormat::kBayerGrbg8, PixelFormat::kBayerRggb16, PixelFormat::kBayerBggr16,
+        PixelFormat::kBayerGbrg16, PixelFormat::kBayerGrbg16}) {
+    if (encoding == ToString(bayer)) return bayer;
+  }
   return std::nullopt;
 }
 
@@ -647,7 +662,8 @@ std::shared_ptr<Image> ImageOf(const sensor_msgs_msg_dds__Image_& msg, std::stri
   const std::string encoding = msg.encoding ? msg.encoding : "";
   const std::optional<PixelFormat> format = FormatOfEncoding(encoding);
   if (!format) {
-    *error = "encoding '" + encoding + "' is not one of mono8, rgb8, rgba8, mono16, 32FC1";
+    *error = "encoding '" + encoding +
+             "' is not one of mono8, rgb8, rgba8, mono16, 32FC1, bayer_{rggb,bggr,gbrg,grbg}{8,16}";
     return nullptr;
   }
   if (msg.is_bigendian && BytesPerPixel(*format) > 1) {

@@ -42,8 +42,8 @@ std::string OpticalFrame(const std::string& camera);
 /// The camera of an optical frame ("left_optical" -> "left"; other names as they are).
 std::string CameraOfFrame(const std::string& frame);
 
-/// sensor_msgs/Image encodings of saccade's pixel formats ("rgb8", "mono8", ...); nullopt for
-/// a format ROS has no encoding for.
+/// sensor_msgs/Image encodings of saccade's pixel formats ("rgb8", "mono8", "bayer_rggb8", ...);
+/// nullopt for a format ROS has no encoding for.
 std::optional<std::string> RosEncoding(PixelFormat format);
 std::optional<PixelFormat> FormatOfEncoding(const std::string& encoding);
 

@@ -32,6 +32,16 @@ PixelLayout LayoutOf(PixelFormat format) {
       return {1, 4, py::format_descriptor<float>::format()};
     case PixelFormat::kUint32:
       return {1, 4, py::format_descriptor<uint32_t>::format()};
+    case PixelFormat::kBayerRggb8:
+    case PixelFormat::kBayerBggr8:
+    case PixelFormat::kBayerGbrg8:
+    case PixelFormat::kBayerGrbg8:
+      return {1, 1, py::format_descriptor<uint8_t>::format()};
+    case PixelFormat::kBayerRggb16:
+    case PixelFormat::kBayerBggr16:
+    case PixelFormat::kBayerGbrg16:
+    case PixelFormat::kBayerGrbg16:
+      return {1, 2, py::format_descriptor<uint16_t>::format()};
   }
   return {1, 1, py::format_descriptor<uint8_t>::format()};
 }

@@ -27,12 +27,16 @@ py::array Bytes(std::span<const uint8_t> bytes) {
 }
 
 // An Image's pixels: height x width [x channels] of its encoding's type, rows re-packed when
-// its step is wider; nullopt for an encoding without a fixed layout (then the bytes, 1-D).
+// its step is wider (a raw Bayer mosaic: height x width, its pattern in the encoding); nullopt
+// for an encoding without a fixed layout (then the bytes, 1-D).
 std::optional<py::array> Pixels(const nlohmann::json& image, std::span<const uint8_t> data) {
   static const std::map<std::string, std::pair<int, std::string>> layouts = {
-      {"rgb8", {3, "u1"}},   {"bgr8", {3, "u1"}},   {"rgba8", {4, "u1"}}, {"bgra8", {4, "u1"}},
-      {"mono8", {1, "u1"}},  {"8UC1", {1, "u1"}},   {"8UC3", {3, "u1"}},  {"mono16", {1, "<u2"}},
-      {"16UC1", {1, "<u2"}}, {"32FC1", {1, "<f4"}},
+      {"rgb8", {3, "u1"}},          {"bgr8", {3, "u1"}},          {"rgba8", {4, "u1"}},
+      {"bgra8", {4, "u1"}},         {"mono8", {1, "u1"}},         {"8UC1", {1, "u1"}},
+      {"8UC3", {3, "u1"}},          {"mono16", {1, "<u2"}},       {"16UC1", {1, "<u2"}},
+      {"32FC1", {1, "<f4"}},        {"bayer_rggb8", {1, "u1"}},   {"bayer_bggr8", {1, "u1"}},
+      {"bayer_gbrg8", {1, "u1"}},   {"bayer_grbg8", {1, "u1"}},   {"bayer_rggb16", {1, "<u2"}},
+      {"bayer_bggr16", {1, "<u2"}}, {"bayer_gbrg16", {1, "<u2"}}, {"bayer_grbg16", {1, "<u2"}},
   };
   const auto layout = layouts.find(image.value("encoding", ""));
   if (layout == layouts.end() || image.value("is_bigendian", 0) != 0) return std::nullopt;

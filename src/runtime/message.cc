@@ -73,8 +73,12 @@ ImageMessage MessageTraits<ImageMessage>::FromJson(const nlohmann::json& j) {
   PixelFormat format = PixelFormat::kRgb8;
   bool known = false;
   std::string expected;
-  for (PixelFormat f : {PixelFormat::kGray8, PixelFormat::kRgb8, PixelFormat::kRgba8,
-                        PixelFormat::kGray16, PixelFormat::kFloat32, PixelFormat::kUint32}) {
+  for (PixelFormat f :
+       {PixelFormat::kGray8, PixelFormat::kRgb8, PixelFormat::kRgba8, PixelFormat::kGray16,
+        PixelFormat::kFloat32, PixelFormat::kUint32, PixelFormat::kBayerRggb8,
+        PixelFormat::kBayerBggr8, PixelFormat::kBayerGbrg8, PixelFormat::kBayerGrbg8,
+        PixelFormat::kBayerRggb16, PixelFormat::kBayerBggr16, PixelFormat::kBayerGbrg16,
+        PixelFormat::kBayerGrbg16}) {
     expected += (expected.empty() ? "" : ", ") + std::string(ToString(f));
     if (format_name == ToString(f)) {
       format = f;

@@ -47,7 +47,10 @@ TEST(ImageViewOfCdr, ReadsAnIndependentSerializersImagesExactly) {
   // image with rows padded (step wider than a row).
   const Case cases[] = {{5, 3, "rgb8", 3, 0, "left_optical", 12, 345678901},
                         {7, 2, "mono8", 1, 3, "r", 0, 120000000},
-                        {1, 1, "rgba8", 4, 0, "", 1700000000, 999999999}};
+                        {1, 1, "rgba8", 4, 0, "", 1700000000, 999999999},
+                        // Raw colour filter array mosaics (issue 45): one sample a pixel.
+                        {6, 3, "bayer_rggb8", 1, 1, "left_optical", 2, 5},
+                        {5, 2, "bayer_gbrg16", 2, 0, "right_optical", 3, 7}};
   json inputs = json::array();
   std::vector<std::vector<uint8_t>> pixels;
   for (const Case& c : cases) {
@@ -87,6 +90,7 @@ TEST(ImageViewOfCdr, ReadsAnIndependentSerializersImagesExactly) {
     internal::ImagePool pool;
     const std::shared_ptr<Image> image = internal::ImageOf(msg, &error, &pool);
     ASSERT_NE(image, nullptr) << error;
+    EXPECT_EQ(internal::RosEncoding(image->format()), c.encoding);  // and back to its name
     for (int y = 0; y < c.height; ++y) {
       EXPECT_EQ(std::memcmp(image->row(y), &pixels[k][y * msg.step], image->stride()), 0) << y;
     }

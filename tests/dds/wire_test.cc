@@ -175,6 +175,43 @@ TEST_F(WireTest, PlainCycloneSubscriberDecodesTheImageBitExactly) {
   dds_sample_free(&got, &ref_sensor_msgs_msg_dds__Image__desc, DDS_FREE_CONTENTS);
 }
 
+// A raw Bayer mosaic (issue 45) is a sensor_msgs/Image with ROS's Bayer encoding, one sample a
+// pixel: a plain Cyclone subscriber reads its encoding and bytes, and saccade's reader makes
+// the same Bayer image of it again.
+TEST_F(WireTest, BayerMosaicsTravelWithTheirRosEncodingBothWays) {
+  constexpr int kDomain = 189;
+  auto participant = Participant::Create(Domain(kDomain));
+  Raw raw(RawParticipant(kDomain));
+  const struct {
+    PixelFormat format;
+    const char* encoding;
+    const char* topic;
+  } cases[] = {{PixelFormat::kBayerGrbg8, "bayer_grbg8", "/saccade/left/image_raw"},
+               {PixelFormat::kBayerRggb16, "bayer_rggb16", "/saccade/right/image_raw"}};
+  for (const auto& c : cases) {
+    Raw plain(
+        RawReader(raw.get(), &ref_sensor_msgs_msg_dds__Image__desc, std::string("rt") + c.topic));
+    auto reader = Reader::Create(participant, "runtime.image", Topic(c.topic, Qos::Images()));
+    auto writer = Writer::Create(participant, "runtime.image", Topic(c.topic, Qos::Images()));
+    ASSERT_TRUE(writer->WaitForReaders(2, 10)) << c.encoding;
+    const auto image = MakeImage(37, 21, c.format, 11, RationalDistortion());
+    writer->Write(ImageMessage{image});
+    ref_sensor_msgs_msg_dds__Image_ got{};
+    ASSERT_TRUE(TakeSample(plain.get(), &got)) << c.encoding;
+    EXPECT_STREQ(got.encoding, c.encoding);
+    EXPECT_EQ(got.step, 37u * BytesPerPixel(c.format));
+    EXPECT_EQ(got.is_bigendian, 0);
+    ASSERT_EQ(got.data._length, image->size_bytes());
+    EXPECT_EQ(std::memcmp(got.data._buffer, image->data(), image->size_bytes()), 0);
+    dds_sample_free(&got, &ref_sensor_msgs_msg_dds__Image__desc, DDS_FREE_CONTENTS);
+    auto back = reader->Take<ImageMessage>(10.0);
+    ASSERT_TRUE(back && back->image) << c.encoding;
+    EXPECT_EQ(back->image->format(), c.format) << ToString(back->image->format());
+    ASSERT_EQ(back->image->size_bytes(), image->size_bytes());
+    EXPECT_EQ(std::memcmp(back->image->data(), image->data(), image->size_bytes()), 0);
+  }
+}
+
 TEST_F(WireTest, TypeNamesAreRos2s) {
   // rmw_cyclonedds matches on these names (no XTypes type information: idlc -t).
   EXPECT_STREQ(ref_sensor_msgs_msg_dds__Image__desc.m_typename, "sensor_msgs::msg::dds_::Image_");

@@ -78,6 +78,19 @@ TEST(MessageTest, ImageJsonCarriesMetadataNotPixels) {
   EXPECT_EQ(MessageTraits<ImageMessage>::ToJson(back), json);
 }
 
+TEST(MessageTest, BayerImageJsonNamesItsRosEncoding) {
+  // A raw colour filter array mosaic (issue 45): its format is ROS's encoding, both ways.
+  for (PixelFormat format : {PixelFormat::kBayerRggb8, PixelFormat::kBayerGbrg16}) {
+    auto image = std::make_shared<Image>(6, 4, format);
+    const nlohmann::json json = MessageTraits<ImageMessage>::ToJson({image});
+    EXPECT_EQ(json["format"], format == PixelFormat::kBayerRggb8 ? "bayer_rggb8" : "bayer_gbrg16");
+    const ImageMessage back = MessageTraits<ImageMessage>::FromJson(json);
+    ASSERT_TRUE(back.image);
+    EXPECT_EQ(back.image->format(), format);
+    EXPECT_EQ(back.image->size_bytes(), 6u * 4u * (format == PixelFormat::kBayerRggb8 ? 1 : 2));
+  }
+}
+
 TEST(MessageTest, NullImageIsJsonNull) {
   EXPECT_TRUE(MessageTraits<ImageMessage>::ToJson({}).is_null());
   EXPECT_FALSE(MessageTraits<ImageMessage>::FromJson(nullptr).image);

@@ -22,12 +22,25 @@ enum class PixelFormat {
   kGray16,   ///< 1 x uint16 (depth in mm, 16-bit PNG)
   kFloat32,  ///< 1 x float (depth in metres)
   kUint32,   ///< 1 x uint32 (instance ids)
+  // A colour filter array's raw mosaic, one sample a pixel, named as ROS names the encodings
+  // (sensor_msgs/image_encodings.hpp): the 2 x 2 cell read row by row from pixel (0, 0), so
+  // bayer_rggb8 has R at (0, 0), G at (1, 0) and (0, 1), B at (1, 1) (render/color_filter.h).
+  kBayerRggb8,   ///< 1 x uint8, R G / G B
+  kBayerBggr8,   ///< 1 x uint8, B G / G R
+  kBayerGbrg8,   ///< 1 x uint8, G B / R G
+  kBayerGrbg8,   ///< 1 x uint8, G R / B G
+  kBayerRggb16,  ///< 1 x uint16, R G / G B
+  kBayerBggr16,  ///< 1 x uint16, B G / G R
+  kBayerGbrg16,  ///< 1 x uint16, G B / R G
+  kBayerGrbg16,  ///< 1 x uint16, G R / B G
 };
 
 /// Bytes of one pixel of the format.
 int BytesPerPixel(PixelFormat format);
-/// "gray8", "rgb8", ...
+/// "gray8", "rgb8", ..., and the Bayer formats by their ROS encodings ("bayer_rggb8", ...).
 const char* ToString(PixelFormat format);
+/// Whether the format is a colour filter array's raw mosaic (kBayer*).
+bool IsBayer(PixelFormat format);
 
 /// Values of other layers' types that a frame carries, one per type, found by type (no
 /// string round trip): geometry's camera model and pose (geometry/image_camera.h). They are

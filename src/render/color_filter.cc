@@ -1,0 +1,379 @@
+#include "saccade/render/color_filter.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <cstdlib>
+#include <string>
+
+#include "saccade/core/error.h"
+
+namespace saccade::render {
+
+namespace {
+
+std::string LowerCaseColorName(std::string_view text) {
+  std::string out(text);
+  for (char& c : out) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return out;
+}
+
+// The colours of a pattern's 2 x 2 cell, row by row (0 red, 1 green, 2 blue).
+std::array<int, 4> CellOf(CfaPattern pattern) {
+  switch (pattern) {
+    case CfaPattern::kRggb:
+      return {0, 1, 1, 2};
+    case CfaPattern::kBggr:
+      return {2, 1, 1, 0};
+    case CfaPattern::kGrbg:
+      return {1, 0, 2, 1};
+    case CfaPattern::kGbrg:
+      return {1, 2, 0, 1};
+    case CfaPattern::kNone:
+      break;
+  }
+  return {-1, -1, -1, -1};
+}
+
+void CheckWhiteBalanceGain(double gain, const char* field) {
+  if (!std::isfinite(gain) || gain <= 0.0) {
+    throw InvalidArgument(fmt::format("{}: expected a finite gain > 0, got {}", field, gain));
+  }
+}
+
+// A mosaic's 8-bit samples with their colours, read with the pattern's cell.
+struct MosaicReader {
+  const ImageView& in;
+  std::array<int, 4> cell;
+  int Channel(int x, int y) const { return cell[(y & 1) * 2 + (x & 1)]; }
+  int At(int x, int y) const { return in.row(y)[x]; }
+};
+
+// One interior pixel of cv::demosaicing's bilinear code (demosaicing.cpp, Bayer2RGB_): the
+// pixel's own colour as it is, a missing colour of two neighbours (a + b + 1) >> 1, of four
+// (a + b + c + d + 2) >> 2.
+void BilinearPixel(const MosaicReader& m, int x, int y, uint8_t* rgb) {
+  const int own = m.Channel(x, y);
+  rgb[own] = static_cast<uint8_t>(m.At(x, y));
+  if (own == 1) {
+    rgb[m.Channel(x + 1, y)] = static_cast<uint8_t>((m.At(x - 1, y) + m.At(x + 1, y) + 1) >> 1);
+    rgb[m.Channel(x, y + 1)] = static_cast<uint8_t>((m.At(x, y - 1) + m.At(x, y + 1) + 1) >> 1);
+    return;
+  }
+  const int cross = m.At(x - 1, y) + m.At(x + 1, y) + m.At(x, y - 1) + m.At(x, y + 1);
+  const int diagonal =
+      m.At(x - 1, y - 1) + m.At(x + 1, y - 1) + m.At(x - 1, y + 1) + m.At(x + 1, y + 1);
+  rgb[1] = static_cast<uint8_t>((cross + 2) >> 2);
+  rgb[2 - own] = static_cast<uint8_t>((diagonal + 2) >> 2);
+}
+
+// One interior pixel of cv::demosaicing's edge-aware code (Bayer2RGB_EdgeAware_T): rounded
+// as the bilinear code, but green at a red or blue pixel from one pair only, the pair across
+// the smaller difference (the vertical pair when the horizontal difference is larger).
+void EdgeAwarePixel(const MosaicReader& m, int x, int y, uint8_t* rgb) {
+  const int own = m.Channel(x, y);
+  const int left = m.At(x - 1, y), right = m.At(x + 1, y);
+  const int up = m.At(x, y - 1), down = m.At(x, y + 1);
+  rgb[own] = static_cast<uint8_t>(m.At(x, y));
+  if (own == 1) {
+    rgb[m.Channel(x + 1, y)] = static_cast<uint8_t>((left + right + 1) >> 1);
+    rgb[m.Channel(x, y + 1)] = static_cast<uint8_t>((up + down + 1) >> 1);
+    return;
+  }
+  const bool vertical = std::abs(left - right) > std::abs(down - up);
+  rgb[1] = static_cast<uint8_t>(((vertical ? down + up : left + right) + 1) >> 1);
+  const int diagonal =
+      m.At(x - 1, y - 1) + m.At(x + 1, y - 1) + m.At(x - 1, y + 1) + m.At(x + 1, y + 1);
+  rgb[2 - own] = static_cast<uint8_t>((diagonal + 2) >> 2);
+}
+
+// OpenCV's borders: the first and last columns of the interior rows copied from their
+// neighbours, then the first and last rows from theirs.
+void CopyBorders(Image& out) {
+  const int w = out.width(), h = out.height();
+  for (int y = 1; y < h - 1; ++y) {
+    uint8_t* row = out.row(y);
+    std::copy(row + 3, row + 6, row);
+    std::copy(row + 3 * (w - 2), row + 3 * (w - 1), row + 3 * (w - 1));
+  }
+  std::copy(out.row(1), out.row(1) + out.stride(), out.row(0));
+  std::copy(out.row(h - 2), out.row(h - 2) + out.stride(), out.row(h - 1));
+}
+
+}  // namespace
+
+const char* ToString(CfaPattern pattern) {
+  switch (pattern) {
+    case CfaPattern::kNone:
+      return "none";
+    case CfaPattern::kRggb:
+      return "rggb";
+    case CfaPattern::kBggr:
+      return "bggr";
+    case CfaPattern::kGrbg:
+      return "grbg";
+    case CfaPattern::kGbrg:
+      return "gbrg";
+  }
+  return "unknown";
+}
+
+CfaPattern ParseCfaPattern(std::string_view text, std::string_view field) {
+  std::string name = LowerCaseColorName(text);
+  for (const char* suffix : {"8", "16"}) {
+    const std::string prefix = "bayer_";
+    if (name.starts_with(prefix) && name.ends_with(suffix) &&
+        name.size() == prefix.size() + 4 + std::string_view(suffix).size()) {
+      name = name.substr(prefix.size(), 4);
+    }
+  }
+  for (CfaPattern p : {CfaPattern::kNone, CfaPattern::kRggb, CfaPattern::kBggr, CfaPattern::kGrbg,
+                       CfaPattern::kGbrg}) {
+    if (name == ToString(p)) return p;
+  }
+  throw InvalidArgument(fmt::format(
+      "{}: unknown colour filter pattern '{}', expected none, rggb, bggr, grbg, gbrg or a ROS "
+      "Bayer encoding (bayer_rggb8, bayer_bggr16, ...)",
+      field, text));
+}
+
+PixelFormat BayerFormat(CfaPattern pattern, int bits) {
+  if (bits != 8 && bits != 16) {
+    throw InvalidArgument(fmt::format("BayerFormat: bits: expected 8 or 16, got {}", bits));
+  }
+  const bool wide = bits == 16;
+  switch (pattern) {
+    case CfaPattern::kRggb:
+      return wide ? PixelFormat::kBayerRggb16 : PixelFormat::kBayerRggb8;
+    case CfaPattern::kBggr:
+      return wide ? PixelFormat::kBayerBggr16 : PixelFormat::kBayerBggr8;
+    case CfaPattern::kGrbg:
+      return wide ? PixelFormat::kBayerGrbg16 : PixelFormat::kBayerGrbg8;
+    case CfaPattern::kGbrg:
+      return wide ? PixelFormat::kBayerGbrg16 : PixelFormat::kBayerGbrg8;
+    case CfaPattern::kNone:
+      break;
+  }
+  throw InvalidArgument(
+      "BayerFormat: pattern: 'none' has no mosaic, expected rggb, bggr, grbg "
+      "or gbrg");
+}
+
+CfaPattern PatternOf(PixelFormat format) {
+  switch (format) {
+    case PixelFormat::kBayerRggb8:
+    case PixelFormat::kBayerRggb16:
+      return CfaPattern::kRggb;
+    case PixelFormat::kBayerBggr8:
+    case PixelFormat::kBayerBggr16:
+      return CfaPattern::kBggr;
+    case PixelFormat::kBayerGrbg8:
+    case PixelFormat::kBayerGrbg16:
+      return CfaPattern::kGrbg;
+    case PixelFormat::kBayerGbrg8:
+    case PixelFormat::kBayerGbrg16:
+      return CfaPattern::kGbrg;
+    default:
+      return CfaPattern::kNone;
+  }
+}
+
+int CfaChannel(CfaPattern pattern, int x, int y) { return CellOf(pattern)[(y & 1) * 2 + (x & 1)]; }
+
+const char* OpenCVBayerCodeName(CfaPattern pattern) {
+  // OpenCV names a code by the cell at (1, 1): one step along the diagonal.
+  switch (pattern) {
+    case CfaPattern::kRggb:
+      return "COLOR_BayerBG2RGB";
+    case CfaPattern::kBggr:
+      return "COLOR_BayerRG2RGB";
+    case CfaPattern::kGrbg:
+      return "COLOR_BayerGB2RGB";
+    case CfaPattern::kGbrg:
+      return "COLOR_BayerGR2RGB";
+    case CfaPattern::kNone:
+      break;
+  }
+  return "";
+}
+
+const char* ToString(DemosaicMethod method) {
+  return method == DemosaicMethod::kEdgeAware ? "edge_aware" : "bilinear";
+}
+
+DemosaicMethod ParseDemosaicMethod(std::string_view text, std::string_view field) {
+  const std::string name = LowerCaseColorName(text);
+  if (name == "bilinear") return DemosaicMethod::kBilinear;
+  if (name == "edge_aware" || name == "ea") return DemosaicMethod::kEdgeAware;
+  throw InvalidArgument(fmt::format(
+      "{}: unknown demosaicing method '{}', expected bilinear or edge_aware", field, text));
+}
+
+Image Mosaic(const ImageView& rgb, CfaPattern pattern) {
+  if (rgb.format() != PixelFormat::kRgb8) {
+    throw InvalidArgument(
+        fmt::format("Mosaic: image format {}, expected rgb8", ToString(rgb.format())));
+  }
+  Image out(rgb.width(), rgb.height(), BayerFormat(pattern, 8));
+  const std::array<int, 4> cell = CellOf(pattern);
+  for (int y = 0; y < rgb.height(); ++y) {
+    const uint8_t* in = rgb.row(y);
+    uint8_t* row = out.row(y);
+    for (int x = 0; x < rgb.width(); ++x) row[x] = in[3 * x + cell[(y & 1) * 2 + (x & 1)]];
+  }
+  if (rgb.metadata() != nullptr) out.metadata() = *rgb.metadata();
+  return out;
+}
+
+Image Demosaic(const ImageView& mosaic, DemosaicMethod method) {
+  const CfaPattern pattern = PatternOf(mosaic.format());
+  if (pattern == CfaPattern::kNone || BytesPerPixel(mosaic.format()) != 1) {
+    throw InvalidArgument(fmt::format(
+        "Demosaic: image format {}, expected an 8-bit Bayer mosaic (bayer_rggb8, bayer_bggr8, "
+        "bayer_grbg8 or bayer_gbrg8)",
+        ToString(mosaic.format())));
+  }
+  Image out(mosaic.width(), mosaic.height(), PixelFormat::kRgb8);
+  if (mosaic.metadata() != nullptr) out.metadata() = *mosaic.metadata();
+  const int w = mosaic.width(), h = mosaic.height();
+  if (w < 3 || h < 3) return out;  // black, as OpenCV leaves it
+  const MosaicReader reader{mosaic, CellOf(pattern)};
+  for (int y = 1; y < h - 1; ++y) {
+    uint8_t* row = out.row(y);
+    if (method == DemosaicMethod::kBilinear) {
+      for (int x = 1; x < w - 1; ++x) BilinearPixel(reader, x, y, row + 3 * x);
+    } else {
+      for (int x = 1; x < w - 1; ++x) EdgeAwarePixel(reader, x, y, row + 3 * x);
+    }
+  }
+  CopyBorders(out);
+  return out;
+}
+
+void WhiteBalance::Validate() const {
+  CheckWhiteBalanceGain(red, "white_balance.red");
+  CheckWhiteBalanceGain(green, "white_balance.green");
+  CheckWhiteBalanceGain(blue, "white_balance.blue");
+}
+
+const char* ToString(ToneCurveKind kind) {
+  switch (kind) {
+    case ToneCurveKind::kLinear:
+      return "linear";
+    case ToneCurveKind::kGamma:
+      return "gamma";
+    case ToneCurveKind::kSrgb:
+      return "srgb";
+  }
+  return "unknown";
+}
+
+ToneCurveKind ParseToneCurveKind(std::string_view text, std::string_view field) {
+  const std::string name = LowerCaseColorName(text);
+  for (ToneCurveKind k : {ToneCurveKind::kLinear, ToneCurveKind::kGamma, ToneCurveKind::kSrgb}) {
+    if (name == ToString(k)) return k;
+  }
+  throw InvalidArgument(
+      fmt::format("{}: unknown tone curve '{}', expected linear, gamma or srgb", field, text));
+}
+
+void ToneCurve::Validate() const {
+  if (kind == ToneCurveKind::kGamma && (!std::isfinite(gamma) || gamma <= 0.0)) {
+    throw InvalidArgument(
+        fmt::format("tone_curve.gamma: expected a finite number > 0, got {}", gamma));
+  }
+}
+
+double ToneCurve::Encode(double linear) const {
+  const double l = std::clamp(linear, 0.0, 1.0);
+  switch (kind) {
+    case ToneCurveKind::kLinear:
+      return l;
+    case ToneCurveKind::kGamma:
+      return std::pow(l, 1.0 / gamma);
+    case ToneCurveKind::kSrgb:
+      // IEC 61966-2-1:1999, the encoding (inverse) transfer function.
+      return l <= 0.0031308 ? 12.92 * l : 1.055 * std::pow(l, 1.0 / 2.4) - 0.055;
+  }
+  return l;
+}
+
+std::array<uint8_t, 256> ToneTable(const ToneCurve& curve, double gain) {
+  curve.Validate();
+  CheckWhiteBalanceGain(gain, "ToneTable: gain");
+  std::array<uint8_t, 256> table{};
+  for (int v = 0; v < 256; ++v) {
+    const double encoded = curve.Encode(std::min(1.0, gain * v / 255.0));
+    table[v] = static_cast<uint8_t>(std::lround(std::clamp(encoded, 0.0, 1.0) * 255.0));
+  }
+  return table;
+}
+
+void ApplyWhiteBalanceAndTone(Image& rgb, const WhiteBalance& balance, const ToneCurve& curve) {
+  if (rgb.format() != PixelFormat::kRgb8) {
+    throw InvalidArgument(fmt::format("ApplyWhiteBalanceAndTone: image format {}, expected rgb8",
+                                      ToString(rgb.format())));
+  }
+  balance.Validate();
+  const std::array<std::array<uint8_t, 256>, 3> tables = {ToneTable(curve, balance.red),
+                                                          ToneTable(curve, balance.green),
+                                                          ToneTable(curve, balance.blue)};
+  uint8_t* p = rgb.data();
+  const std::size_t pixels = static_cast<std::size_t>(rgb.width()) * rgb.height();
+  for (std::size_t i = 0; i < pixels; ++i, p += 3) {
+    p[0] = tables[0][p[0]];
+    p[1] = tables[1][p[1]];
+    p[2] = tables[2][p[2]];
+  }
+}
+
+void ApplyWhiteBalanceToMosaic(Image& mosaic, const WhiteBalance& balance) {
+  const CfaPattern pattern = PatternOf(mosaic.format());
+  if (pattern == CfaPattern::kNone || BytesPerPixel(mosaic.format()) != 1) {
+    throw InvalidArgument(
+        fmt::format("ApplyWhiteBalanceToMosaic: image format {}, expected an 8-bit Bayer mosaic",
+                    ToString(mosaic.format())));
+  }
+  balance.Validate();
+  const ToneCurve linear;
+  const std::array<std::array<uint8_t, 256>, 3> tables = {ToneTable(linear, balance.red),
+                                                          ToneTable(linear, balance.green),
+                                                          ToneTable(linear, balance.blue)};
+  const std::array<int, 4> cell = CellOf(pattern);
+  for (int y = 0; y < mosaic.height(); ++y) {
+    uint8_t* row = mosaic.row(y);
+    for (int x = 0; x < mosaic.width(); ++x) {
+      row[x] = tables[cell[(y & 1) * 2 + (x & 1)]][row[x]];
+    }
+  }
+}
+
+void ColorOptions::Validate() const {
+  white_balance.Validate();
+  tone_curve.Validate();
+}
+
+ColorImages ApplyColorPipeline(const ImageView& linear_rgb, const ColorOptions& options) {
+  options.Validate();
+  if (linear_rgb.format() != PixelFormat::kRgb8) {
+    throw InvalidArgument(fmt::format("ApplyColorPipeline: image format {}, expected rgb8",
+                                      ToString(linear_rgb.format())));
+  }
+  ColorImages out;
+  if (options.cfa == CfaPattern::kNone) {
+    out.rgb = Image(linear_rgb.width(), linear_rgb.height(), PixelFormat::kRgb8, linear_rgb.data(),
+                    linear_rgb.stride());
+    if (linear_rgb.metadata() != nullptr) out.rgb.metadata() = *linear_rgb.metadata();
+    ApplyWhiteBalanceAndTone(out.rgb, options.white_balance, options.tone_curve);
+    return out;
+  }
+  out.raw = Mosaic(linear_rgb, options.cfa);
+  ApplyWhiteBalanceToMosaic(out.raw, options.white_balance);
+  out.rgb = Demosaic(out.raw.view(), options.demosaic);
+  ApplyWhiteBalanceAndTone(out.rgb, WhiteBalance{}, options.tone_curve);
+  return out;
+}
+
+}  // namespace saccade::render
