@@ -19,8 +19,9 @@ const scene::Scene& Wall() {
   return scene;
 }
 
-// Short runs: a coarse raster (and truth), two simulated seconds. A coarse raster's views hardly
-// overlap, so one hit makes a voxel occupied here (the default takes two fixations' hits).
+// Short runs: a coarse raster (and truth), two simulated seconds, stereo at half size (a quarter
+// of full size's cost). A coarse raster's views hardly overlap, so one hit makes a voxel
+// occupied here (the default takes two fixations' hits).
 ExploreOptions Short(const std::string& strategy) {
   ExploreOptions options;
   options.strategy = strategy;
@@ -30,6 +31,7 @@ ExploreOptions Short(const std::string& strategy) {
   options.truth_cell_m = 0.02;
   options.map.stride = 4;
   options.map.occupancy_threshold = 0.5;
+  options.stereo.scale = 0.5;
   return options;
 }
 
@@ -139,6 +141,7 @@ TEST(ExploreConfig, RefusesBadSettingsNamingFileLineAndKey) {
   EXPECT_EQ(shipped.options.map.resolution_m, defaults.map.resolution_m);
   EXPECT_EQ(shipped.options.ior_time_constant_s, defaults.ior_time_constant_s);
   EXPECT_EQ(shipped.options.stereo.min_depth_m, defaults.stereo.min_depth_m);
+  EXPECT_EQ(shipped.options.stereo.scale, defaults.stereo.scale);
   EXPECT_EQ(shipped.options.candidate_step, defaults.candidate_step);
   EXPECT_EQ(shipped.options.tentative_value, defaults.tentative_value);
 }

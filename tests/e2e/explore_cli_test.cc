@@ -16,7 +16,8 @@ TEST(ExploreCli, ReportsAndMapsAShortExploration) {
   const std::filesystem::path dir = testing_helpers::FreshScratchDir("explore");
   const std::filesystem::path settings = dir / "fast.yaml";
   std::ofstream(settings)
-      << "raster_step: 1.5\nmap: {stride: 4}\nscore: {truth_cell_m: 0.02, truth_step: 1.0}\n";
+      << "raster_step: 1.5\nmap: {stride: 4}\nstereo: {scale: 0.5}\n"
+         "score: {truth_cell_m: 0.02, truth_step: 1.0}\n";
   const CommandRun run = Saccade(
       "explore --scene scenes/explore_wall.yaml --strategy saliency "
       "--seconds 1.5 --quiet --config " +
