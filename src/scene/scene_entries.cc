@@ -164,9 +164,10 @@ SensorSpec ReadSensor(const Entry& e) {
   if (const auto x = e.Find("emva")) {
     sensor.emva = ReadEmva(*x);
     if (sensor.HasNoise()) {
-      x->Fail(
-          "give either the noise figures (read_noise_dn, gain_dn_per_e) or an emva sensor, not "
-          "both");
+      (e.Find("read_noise_dn") ? *e.Find("read_noise_dn") : *e.Find("gain_dn_per_e"))
+          .Fail(
+              "give either the noise figures (read_noise_dn, gain_dn_per_e) or an emva sensor, not "
+              "both");
     }
     if (!(sensor.exposure > 0.0)) {
       x->Fail(
