@@ -7,11 +7,15 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "saccade/core/error.h"
 #include "saccade/render/emva_measurement.h"
+#include "saccade/render/renderer.h"
+#include "saccade/scene/scene.h"
 
 namespace saccade::render {
 namespace {
@@ -194,6 +198,66 @@ TEST(SensorModelTest, BadParametersNameTheField) {
   s.saturation_e = 10.0;  // below 10 x the dark noise of 2.5 e-
   EXPECT_THROW(SensorModel(s, 0, "cam", 8, 8, 1), InvalidArgument);
   EXPECT_THROW(SensorModel(scene::EmvaSensor{}, 0, "cam", 8, 8, 2), InvalidArgument);
+}
+
+// --- the renderer's hook: a camera with an emva sensor --------------------------------------
+
+// A camera that sees only the sky, 128 DN in every channel, through an 8-bit sensor of K = 1
+// and eta = 1: 204 photons a pixel at full white, so the sky gives 102.4 electrons.
+scene::Scene EmvaFlatScene() {
+  return scene::Scene::FromYamlString(R"(
+background: [0.50196078431372549, 0.50196078431372549, 0.50196078431372549]
+lights: [{type: ambient, intensity: 1}]
+ground: {enabled: false}
+cameras:
+  - name: flat
+    calibration: {width: 160, height: 120, fx: 100, fy: 100}
+    pose: {position: [0, 0, 1]}
+    sensor:
+      exposure: 0.01
+      seed: 5
+      emva: {quantum_efficiency: 1, gain_dn_per_e: 1, dark_noise_e: 2, saturation_e: 250,
+             bit_depth: 8, black_level_dn: 0, photons_per_second: 20400}
+)",
+                                      "emva_render_test.yaml",
+                                      std::filesystem::temp_directory_path());
+}
+
+TEST(SensorRenderTest, RendersTheEmvaSensorOnTheFrameDeterministically) {
+  const scene::Scene world = EmvaFlatScene();
+  std::unique_ptr<Renderer> renderer = MakeRenderer(world, {});
+  const std::vector<Frame> a = renderer->Render(world.InitialState(), 3);
+  const std::vector<Frame> b = renderer->Render(world.InitialState(), 4);
+  const Image& fa = *a[0].color;
+  const Image& fb = *b[0].color;
+  const double n = static_cast<double>(fa.size_bytes());
+  double sum = 0.0;
+  double diff = 0.0;
+  double diff2 = 0.0;
+  for (std::size_t i = 0; i < fa.size_bytes(); ++i) {
+    sum += fa.data()[i];
+    const double d = static_cast<double>(fa.data()[i]) - fb.data()[i];
+    diff += d;
+    diff2 += d * d;
+  }
+  // Mean: eta mu_p = 128 / 255 * 204 = 102.4 e- = 102.4 DN (standard error ~0.04 DN).
+  constexpr double kMeanToleranceDn = 0.3;
+  EXPECT_NEAR(sum / n, 102.4, kMeanToleranceDn);
+  // Temporal variance: shot (102.4) + dark (4) + rounding (1/12) DN^2.
+  const double variance = (diff2 / n - (diff / n) * (diff / n)) / 2.0;
+  EXPECT_NEAR(variance / (102.4 + 4.0 + 1.0 / 12.0), 1.0, kVarianceTolerance / 2.0) << variance;
+  // The same frame index in a new renderer: the same bits.
+  std::unique_ptr<Renderer> again = MakeRenderer(world, {});
+  const std::vector<Frame> a2 = again->Render(world.InitialState(), 3);
+  EXPECT_EQ(std::vector<uint8_t>(fa.data(), fa.data() + fa.size_bytes()),
+            std::vector<uint8_t>(a2[0].color->data(), a2[0].color->data() + fa.size_bytes()));
+  // Noise off: the rendered value itself.
+  RendererOptions clean;
+  clean.noise = false;
+  const std::vector<Frame> off = MakeRenderer(world, clean)->Render(world.InitialState(), 3);
+  for (std::size_t i = 0; i < off[0].color->size_bytes(); ++i) {
+    ASSERT_EQ(off[0].color->data()[i], 128);
+  }
 }
 
 }  // namespace
