@@ -38,7 +38,7 @@ struct EmvaOptions {
       photons_per_second;
   std::optional<int> bit_depth;
   uint64_t seed = 0;
-  int size = 128;
+  int size = 256;
   render::EmvaSeriesOptions series;
   std::string write_images;
   std::string images;
@@ -180,8 +180,8 @@ render::EmvaResult MeasureSimulated(const EmvaOptions& o, const scene::EmvaSenso
   const render::SensorModel sensor(params, seed, name, o.size, o.size, 1);
   render::EmvaFrameSink sink;
   std::ofstream photons_csv;
+  const fs::path dir(o.write_images);  // outlives the sink, which refers to it
   if (!o.write_images.empty()) {
-    const fs::path dir(o.write_images);
     if (fs::exists(dir) && !fs::is_empty(dir)) {
       throw FileError(dir.string(), 0, "", "--write-images: expected a new or empty folder");
     }
@@ -195,8 +195,8 @@ render::EmvaResult MeasureSimulated(const EmvaOptions& o, const scene::EmvaSenso
                            PixelFormat::kGray16);
       WritePng(view, file);
       if (kind == "flat" && index == 0) {
-        const std::string name = render::EmvaFileName(kind, exposure_s, index);
-        const std::string us = name.substr(5, name.size() - 5 - 6);  // flat_<us>_0.png
+        const std::string flat = render::EmvaFileName(kind, exposure_s, index);
+        const std::string us = flat.substr(5, flat.size() - 5 - 6);  // flat_<us>_0.png
         photons_csv << fmt::format("{},{}\n", us, params.photons_per_second * exposure_s);
       }
     };
@@ -264,7 +264,8 @@ Runner AddEmvaCommand(CLI::App& app) {
       "A sensor preset: " + fmt::format("{}", fmt::join(scene::EmvaPresetNames(), ", ")));
   AddSensorOptions(emva, o.get());
   emva->add_option("--seed", o->seed, "Noise seed without --scene (default 0)");
-  emva->add_option("--size", o->size, "Side of the simulated sensor's square region, px")
+  emva->add_option("--size", o->size,
+                   "Side of the simulated sensor's square region, px (default 256)")
       ->check(CLI::Range(8, 2048));
   emva->add_option("--points", o->series.points, "Exposures of the even series (default 40)");
   emva->add_option("--refine", o->series.refine_points,

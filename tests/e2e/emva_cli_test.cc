@@ -59,7 +59,7 @@ TEST(EmvaCli, MeasuresASensorGivenAsOptions) {
   const fs::path dir = Fresh("options");
   const CommandRun run = Saccade(
       "emva --gain 0.5 --dark-noise 3 --saturation 9000 --dsnu 2 --prnu 0.8 --bit-depth 14 "
-      "--black-level 100 --quantum-efficiency 0.5 --json " +
+      "--black-level 100 --quantum-efficiency 0.5 --size 128 --json " +
       (dir / "out.json").string());
   ASSERT_EQ(run.status, 0) << run.output;
   EXPECT_NE(run.output.find("Photon transfer curve"), std::string::npos) << run.output;
@@ -87,8 +87,9 @@ TEST(EmvaCli, MeasuresASceneCamerasSensor) {
       seed: 9
       emva: {preset: imx264, gain_dn_per_e: 0.3}
 )";
-  const CommandRun run = Saccade("emva --scene " + (dir / "scene.yaml").string() +
-                                 " --camera lab --quiet --json " + (dir / "out.json").string());
+  const CommandRun run =
+      Saccade("emva --scene " + (dir / "scene.yaml").string() +
+              " --camera lab --size 128 --quiet --json " + (dir / "out.json").string());
   ASSERT_EQ(run.status, 0) << run.output;
   EXPECT_EQ(run.output, "");  // --quiet
   const json doc = ReadJson(dir / "out.json");
@@ -97,6 +98,34 @@ TEST(EmvaCli, MeasuresASceneCamerasSensor) {
   ExpectFigure(doc["result"], "gain_dn_per_e", 0.3);  // the key, not the preset's 0.36
   ExpectFigure(doc["result"], "dark_noise_e", 2.3);
   ExpectFigure(doc["result"], "saturation_e", 10500.0);
+}
+
+// The simulated series written as files measures as the simulation did: the naming of
+// --write-images is the naming of --images.
+TEST(EmvaCli, WrittenImagesMeasureAsTheSimulatedSensor) {
+  const fs::path dir = Fresh("written");
+  const CommandRun simulated =
+      Saccade("emva --preset imx174 --size 64 --points 20 --refine 8 --stack 4 --quiet --json " +
+              (dir / "a.json").string() + " --write-images " + (dir / "frames").string());
+  ASSERT_EQ(simulated.status, 0) << simulated.output;
+  EXPECT_TRUE(fs::exists(dir / "frames" / "dark_0_0.png"));
+  const CommandRun files = Saccade("emva --images " + (dir / "frames").string() + " --photons " +
+                                   (dir / "frames" / "photons.csv").string() + " --quiet --json " +
+                                   (dir / "b.json").string());
+  ASSERT_EQ(files.status, 0) << files.output;
+  const json a = ReadJson(dir / "a.json")["result"];
+  const json b = ReadJson(dir / "b.json")["result"];
+  // The same frames, one more point (the stacks' exposure): the figures agree closely.
+  constexpr double kSameFramesTolerance = 0.01;
+  for (const char* key : {"gain_dn_per_e", "dark_noise_e", "saturation_e", "dsnu_e", "prnu_percent",
+                          "quantum_efficiency"}) {
+    EXPECT_NEAR(b[key].get<double>() / a[key].get<double>(), 1.0, kSameFramesTolerance) << key;
+  }
+  // A second write into the same folder is refused, its files kept.
+  const CommandRun again =
+      Saccade("emva --preset imx174 --size 64 --write-images " + (dir / "frames").string());
+  EXPECT_EQ(again.status, 1) << again.output;
+  EXPECT_NE(again.output.find("expected a new or empty folder"), std::string::npos) << again.output;
 }
 
 // --- mode B: files -------------------------------------------------------------------------
