@@ -30,6 +30,7 @@ Runner AddRunCommand(CLI::App& app);
 Runner AddUrdfCommand(CLI::App& app);
 Runner AddMcapCommand(CLI::App& app);
 Runner AddExploreCommand(CLI::App& app);
+Runner AddEmvaCommand(CLI::App& app);
 
 // Shared helpers.
 inline constexpr double kDegToRad = M_PI / 180.0;

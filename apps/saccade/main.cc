@@ -80,9 +80,10 @@ int main(int argc, char** argv) {
   namespace a = saccade::app;
   const std::vector<std::pair<CLI::App*, a::Runner>> commands = [&] {
     std::vector<std::pair<CLI::App*, a::Runner>> list;
-    for (auto add : {a::AddFkCommand, a::AddIkCommand, a::AddCameraCommand, a::AddRenderCommand,
-                     a::AddBenchCommand, a::AddDemoCommand, a::AddGuiCommand, a::AddRunCommand,
-                     a::AddUrdfCommand, a::AddMcapCommand, a::AddExploreCommand}) {
+    for (auto add :
+         {a::AddFkCommand, a::AddIkCommand, a::AddCameraCommand, a::AddRenderCommand,
+          a::AddBenchCommand, a::AddDemoCommand, a::AddGuiCommand, a::AddRunCommand,
+          a::AddUrdfCommand, a::AddMcapCommand, a::AddExploreCommand, a::AddEmvaCommand}) {
       a::Runner run = add(app);
       list.emplace_back(app.get_subcommands([](CLI::App*) { return true; }).back(), std::move(run));
     }

@@ -204,7 +204,8 @@ void AddRendererOptions(CLI::App* command, render::RendererOptions* options) {
       "(the frames' metadata and calibration files then say distortion none)");
   command->add_flag_callback(
       "--no-noise", [options] { options->noise = false; },
-      "No sensor noise (the scene's sensor: read_noise_dn, gain_dn_per_e)");
+      "No sensor noise (the scene's sensor: read_noise_dn, gain_dn_per_e, or its EMVA 1288 "
+      "sensor, emva)");
   command->add_flag_callback(
       "--no-blur", [options] { options->motion_blur = false; },
       "No motion blur (the scene's sensor: exposure, blur_samples): each frame an instant");

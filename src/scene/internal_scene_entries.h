@@ -98,7 +98,10 @@ geometry::ClipPlanes ReadClip(const Entry& e);
 // A number in [0, max]; `what` says what it is ("an exposure in seconds").
 double ReadInRange(const Entry& e, double max, const char* what);
 
-// {exposure | exposure_ms, blur_samples, read_noise_dn, gain_dn_per_e, seed}: SensorSpec.
+// {preset, quantum_efficiency, gain_dn_per_e, ...}: an EMVA 1288 sensor (a sensor's `emva`).
+EmvaSensor ReadEmva(const Entry& e);
+
+// {exposure | exposure_ms, blur_samples, read_noise_dn, gain_dn_per_e, seed, emva}: SensorSpec.
 SensorSpec ReadSensor(const Entry& e);
 
 // The optical frame (x right, y down, z forward) at `eye` looking at `target`.

@@ -173,6 +173,18 @@ void SensorSpec::Validate() const {
     throw InvalidArgument(
         fmt::format("SensorSpec: blur_samples must be in [1, 64], got {}", blur_samples));
   }
+  if (emva) {
+    if (HasNoise()) {
+      throw InvalidArgument(
+          "SensorSpec: give either the noise figures (read_noise_dn, gain_dn_per_e) or an emva "
+          "sensor, not both");
+    }
+    if (!(exposure > 0.0)) {
+      throw InvalidArgument("SensorSpec: an emva sensor needs an exposure > 0 s, got " +
+                            fmt::format("{}", exposure));
+    }
+    emva->Validate();
+  }
 }
 
 SceneState Scene::InitialState() const {

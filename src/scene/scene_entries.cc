@@ -1,3 +1,5 @@
+#include <fmt/ranges.h>
+
 #include <algorithm>
 #include <cmath>
 
@@ -45,11 +47,100 @@ double ReadInRange(const Entry& e, double max, const char* what) {
   return value;
 }
 
-// {exposure | exposure_ms, blur_samples, read_noise_dn, gain_dn_per_e, seed}: SensorSpec.
+namespace {
+
+// A number in (min, max] (`open`) or [min, max]; `what` says what it is.
+double ReadEmvaNumber(const Entry& e, double min, double max, bool open, const char* what) {
+  const double value = e.AsDouble();
+  if (!(open ? value > min : value >= min) || !(value <= max)) {
+    e.Fail(fmt::format("expected {} in {}{}, {}], got {}", what, open ? "(" : "[", min, max,
+                       e.Describe()));
+  }
+  return value;
+}
+
+// The cross-field rules of EmvaSensor::Validate, each failing at the key that breaks it.
+void CheckEmvaTogether(const Entry& e, const EmvaSensor& s) {
+  const auto at = [&e](const char* key) { return e.Find(key) ? *e.Find(key) : e; };
+  if (!(s.black_level_dn < s.MaxDn())) {
+    at(e.Find("black_level_dn") ? "black_level_dn" : "bit_depth")
+        .Fail(fmt::format("expected a black level below the largest {}-bit DN ({}), got {} DN",
+                          s.bit_depth, s.MaxDn(), s.black_level_dn));
+  }
+  if (!(s.saturation_e >= kMinDynamicRange * s.dark_noise_e)) {
+    at(e.Find("saturation_e") ? "saturation_e" : "dark_noise_e")
+        .Fail(fmt::format(
+            "expected a saturation of at least {} times the dark noise, got a saturation of {} "
+            "e- against a dark noise of {} e-: the saturation lies below the dark level's noise",
+            kMinDynamicRange, s.saturation_e, s.dark_noise_e));
+  }
+  if (!(s.dsnu_e <= s.saturation_e / 10.0)) {
+    at(e.Find("dsnu_e") ? "dsnu_e" : "dsnu_dn")
+        .Fail(fmt::format("expected a DSNU of at most a tenth of the saturation ({} e-), got {} e-",
+                          s.saturation_e / 10.0, s.dsnu_e));
+  }
+}
+
+}  // namespace
+
+// {preset, quantum_efficiency, gain_dn_per_e, dark_noise_e, saturation_e, dsnu_e | dsnu_dn,
+// prnu_percent, bit_depth, black_level_dn, photons_per_second}: an EmvaSensor, the preset's
+// figures (if any) replaced by the keys given.
+EmvaSensor ReadEmva(const Entry& e) {
+  e.ExpectMap(
+      {"preset", "quantum_efficiency", "gain_dn_per_e", "dark_noise_e", "saturation_e", "dsnu_e",
+       "dsnu_dn", "prnu_percent", "bit_depth", "black_level_dn", "photons_per_second"},
+      "an EMVA 1288 sensor {preset, quantum_efficiency, gain_dn_per_e, dark_noise_e, "
+      "saturation_e, dsnu_e | dsnu_dn, prnu_percent, bit_depth, black_level_dn, "
+      "photons_per_second}");
+  EmvaSensor s;
+  if (const auto p = e.Find("preset")) {
+    const std::optional<EmvaSensor> preset = FindEmvaPreset(p->AsString());
+    if (!preset) {
+      p->Fail(fmt::format("unknown sensor preset {}; the presets are: {}", p->Describe(),
+                          fmt::join(EmvaPresetNames(), ", ")));
+    }
+    s = *preset;
+  }
+  if (const auto x = e.Find("quantum_efficiency")) {
+    s.quantum_efficiency = ReadEmvaNumber(*x, 0.0, 1.0, true, "a quantum efficiency");
+  }
+  if (const auto x = e.Find("gain_dn_per_e")) {
+    s.gain_dn_per_e = ReadEmvaNumber(*x, 0.0, kMaxGainDnPerE, true, "a gain in DN per electron");
+  }
+  if (const auto x = e.Find("dark_noise_e")) {
+    s.dark_noise_e = ReadEmvaNumber(*x, 0.0, 1000.0, false, "a dark noise in electrons");
+  }
+  if (const auto x = e.Find("saturation_e")) {
+    s.saturation_e = ReadEmvaNumber(*x, 0.0, 1e7, true, "a saturation capacity in electrons");
+  }
+  const auto dsnu_e = e.Find("dsnu_e");
+  const auto dsnu_dn = e.Find("dsnu_dn");
+  if (dsnu_e && dsnu_dn) dsnu_dn->Fail("give either 'dsnu_e' (electrons) or 'dsnu_dn', not both");
+  if (dsnu_e) s.dsnu_e = ReadEmvaNumber(*dsnu_e, 0.0, 1e6, false, "a DSNU in electrons");
+  if (dsnu_dn) {
+    s.dsnu_e = ReadEmvaNumber(*dsnu_dn, 0.0, 65535.0, false, "a DSNU in DN") / s.gain_dn_per_e;
+  }
+  if (const auto x = e.Find("prnu_percent")) {
+    s.prnu_percent = ReadEmvaNumber(*x, 0.0, 20.0, false, "a PRNU in percent");
+  }
+  if (const auto x = e.Find("bit_depth")) s.bit_depth = static_cast<int>(x->AsInteger(8, 16));
+  if (const auto x = e.Find("black_level_dn")) {
+    s.black_level_dn = ReadEmvaNumber(*x, 0.0, 65535.0, false, "a black level in DN");
+  }
+  if (const auto x = e.Find("photons_per_second")) {
+    s.photons_per_second = ReadEmvaNumber(*x, 0.0, 1e12, true, "photons per second");
+  }
+  CheckEmvaTogether(e, s);
+  return s;
+}
+
+// {exposure | exposure_ms, blur_samples, read_noise_dn, gain_dn_per_e, seed, emva}: SensorSpec.
 SensorSpec ReadSensor(const Entry& e) {
-  e.ExpectMap({"exposure", "exposure_ms", "blur_samples", "read_noise_dn", "gain_dn_per_e", "seed"},
-              "a sensor {exposure | exposure_ms, blur_samples, read_noise_dn, gain_dn_per_e, "
-              "seed}");
+  e.ExpectMap(
+      {"exposure", "exposure_ms", "blur_samples", "read_noise_dn", "gain_dn_per_e", "seed", "emva"},
+      "a sensor {exposure | exposure_ms, blur_samples, read_noise_dn, gain_dn_per_e, "
+      "seed, emva}");
   SensorSpec sensor;
   const auto seconds = e.Find("exposure");
   const auto ms = e.Find("exposure_ms");
@@ -70,6 +161,20 @@ SensorSpec ReadSensor(const Entry& e) {
     sensor.gain_dn_per_e = ReadInRange(*x, kMaxGainDnPerE, "a gain in DN per electron");
   }
   if (const auto x = e.Find("seed")) sensor.seed = x->AsUint64();
+  if (const auto x = e.Find("emva")) {
+    sensor.emva = ReadEmva(*x);
+    if (sensor.HasNoise()) {
+      (e.Find("read_noise_dn") ? *e.Find("read_noise_dn") : *e.Find("gain_dn_per_e"))
+          .Fail(
+              "give either the noise figures (read_noise_dn, gain_dn_per_e) or an emva sensor, not "
+              "both");
+    }
+    if (!(sensor.exposure > 0.0)) {
+      x->Fail(
+          "an emva sensor needs an exposure > 0 (photons = photons_per_second x exposure): give "
+          "the sensor's 'exposure' or 'exposure_ms'");
+    }
+  }
   try {
     sensor.Validate();  // a safety net: every range was checked above, with its line
   } catch (const InvalidArgument& error) {

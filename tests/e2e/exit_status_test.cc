@@ -42,7 +42,7 @@ void ExpectStatusOne(const std::vector<Case>& cases) {
 TEST(ExitStatus, UsageErrorsOfEverySubcommandExitOne) {
   std::vector<Case> cases;
   for (const std::string sub :
-       {"fk", "ik", "camera", "render", "bench", "demo", "gui", "run", "urdf", "explore"}) {
+       {"fk", "ik", "camera", "render", "bench", "demo", "gui", "run", "urdf", "explore", "emva"}) {
     cases.push_back({sub + " --no-such-option", "--no-such-option"});
   }
   // Values out of range or of the wrong type, one per subcommand (CLI11's checks).
@@ -53,6 +53,7 @@ TEST(ExitStatus, UsageErrorsOfEverySubcommandExitOne) {
   cases.push_back({"bench --scene " + kSource + "/scenes/bench.yaml --frames -3", "--frames"});
   cases.push_back({"demo --duration abc", "--duration"});
   cases.push_back({"gui --port 70000", "--port"});
+  cases.push_back({"emva --size 4", "--size"});
   cases.push_back({"run", "pipeline"});  // the pipeline file is required
   cases.push_back({"explore --seconds abc", "--seconds"});
   cases.push_back({"--log-level loud fk --head " + kHead + " --joints 0 0 0 0", "--log-level"});

@@ -685,6 +685,94 @@ TEST_F(SceneLoaderTest, BadSensorsNameTheFileLineAndKey) {
               "robot.cameras.left.sensor.blur_samples", {"expected an integer in [1, 64]"});
 }
 
+// Issue 45: an EMVA 1288 sensor under a camera's `sensor: emva:`, from a preset or figures.
+const std::string kEmvaSensor = R"(      exposure_ms: 10
+      seed: 3
+      emva:
+        quantum_efficiency: 0.6
+        gain_dn_per_e: 0.3
+        dark_noise_e: 2.5
+        saturation_e: 12000
+        dsnu_dn: 0.6
+        prnu_percent: 0.8
+        bit_depth: 12
+        black_level_dn: 64
+        photons_per_second: 2.0e6
+)";
+const std::string kEmvaEyeSensor = R"(        exposure_ms: 10
+        emva: {preset: imx174, bit_depth: 14}
+)";
+
+TEST_F(SceneLoaderTest, EmvaSensorsAreReadFromFiguresAndPresets) {
+  const Scene scene = Load(WithSensors(kEmvaSensor, kEmvaEyeSensor));
+  const SensorSpec& rig = scene.FindCamera("rig")->sensor;
+  ASSERT_TRUE(rig.HasEmva());
+  EXPECT_FALSE(rig.HasNoise());
+  EXPECT_EQ(rig.emva->quantum_efficiency, 0.6);
+  EXPECT_EQ(rig.emva->gain_dn_per_e, 0.3);
+  EXPECT_EQ(rig.emva->dark_noise_e, 2.5);
+  EXPECT_EQ(rig.emva->saturation_e, 12000.0);
+  EXPECT_NEAR(rig.emva->dsnu_e, 2.0, kParseTolerance);  // 0.6 DN / 0.3 DN/e-
+  EXPECT_EQ(rig.emva->prnu_percent, 0.8);
+  EXPECT_EQ(rig.emva->bit_depth, 12);
+  EXPECT_EQ(rig.emva->black_level_dn, 64.0);
+  EXPECT_EQ(rig.emva->photons_per_second, 2.0e6);
+  const SensorSpec& left = scene.FindCamera("left")->sensor;
+  ASSERT_TRUE(left.HasEmva());
+  const EmvaSensor imx174 = *FindEmvaPreset("imx174");
+  EXPECT_EQ(left.emva->preset, "imx174");
+  EXPECT_EQ(left.emva->saturation_e, imx174.saturation_e);
+  EXPECT_EQ(left.emva->dark_noise_e, imx174.dark_noise_e);
+  EXPECT_EQ(left.emva->bit_depth, 14);  // the key replaces the preset's 12
+  EXPECT_FALSE(scene.FindCamera("right")->sensor.HasEmva());
+}
+
+TEST_F(SceneLoaderTest, BadEmvaSensorsNameTheFileLineAndKey) {
+  const auto world = [&](const std::string& from, const std::string& to) {
+    return WithSensors(Replace(kEmvaSensor, from, to), kEmvaEyeSensor);
+  };
+  const std::string key = "cameras[0].sensor.emva.";
+  ExpectError(world("gain_dn_per_e: 0.3", "gain_dn_per_e: -0.3"), "gain_dn_per_e: -0.3",
+              key + "gain_dn_per_e",
+              {"expected a gain in DN per electron in (0, 64]", "got '-0.3'"});
+  ExpectError(world("gain_dn_per_e: 0.3", "gain_dn_per_e: 0"), "gain_dn_per_e: 0",
+              key + "gain_dn_per_e", {"in (0, 64]", "got '0'"});
+  ExpectError(world("quantum_efficiency: 0.6", "quantum_efficiency: 1.2"),
+              "quantum_efficiency: 1.2", key + "quantum_efficiency",
+              {"expected a quantum efficiency in (0, 1]", "got '1.2'"});
+  ExpectError(world("saturation_e: 12000", "saturation_e: 20"), "saturation_e: 20",
+              key + "saturation_e",
+              {"expected a saturation of at least 10 times the dark noise",
+               "the saturation lies below the dark level's noise"});
+  ExpectError(world("saturation_e: 12000", "saturation_e: -5"), "saturation_e: -5",
+              key + "saturation_e", {"expected a saturation capacity in electrons in (0,"});
+  ExpectError(world("black_level_dn: 64", "black_level_dn: 5000"), "black_level_dn: 5000",
+              key + "black_level_dn",
+              {"expected a black level below the largest 12-bit DN (4095), got 5000 DN"});
+  ExpectError(world("bit_depth: 12", "bit_depth: 20"), "bit_depth: 20", key + "bit_depth",
+              {"expected an integer in [8, 16]", "got '20'"});
+  ExpectError(world("prnu_percent: 0.8", "prnu_percent: 30"), "prnu_percent: 30",
+              key + "prnu_percent", {"expected a PRNU in percent in [0, 20]"});
+  ExpectError(world("dsnu_dn: 0.6", "dsnu_dn: 0.6\n        dsnu_e: 2"), "dsnu_dn: 0.6",
+              key + "dsnu_dn", {"give either 'dsnu_e' (electrons) or 'dsnu_dn', not both"});
+  ExpectError(world("photons_per_second: 2.0e6", "photons_per_second: 0"), "photons_per_second: 0",
+              key + "photons_per_second", {"expected photons per second in (0, 1000000000000]"});
+  ExpectError(world("bit_depth: 12", "bit_depth: 12\n        full_well: 3"), "full_well: 3",
+              key + "full_well",
+              {"unknown key 'full_well'", "expected one of: preset, quantum_efficiency"});
+  // The emva block against the rest of the sensor.
+  ExpectError(world("seed: 3\n", "seed: 3\n      read_noise_dn: 1\n"), "read_noise_dn: 1",
+              "cameras[0].sensor.read_noise_dn",
+              {"give either the noise figures (read_noise_dn, gain_dn_per_e) or an emva sensor"});
+  // A block map's line is its first key's.
+  ExpectError(world("      exposure_ms: 10\n", ""), "quantum_efficiency: 0.6",
+              "cameras[0].sensor.emva", {"an emva sensor needs an exposure > 0"});
+  // A preset by an unknown name, on the eye camera.
+  ExpectError(WithSensors(kEmvaSensor, Replace(kEmvaEyeSensor, "imx174", "imx999")), "imx999",
+              "robot.cameras.left.sensor.emva.preset",
+              {"unknown sensor preset 'imx999'", "the presets are: imx174, imx264"});
+}
+
 }  // namespace
 }  // namespace saccade::scene
 

@@ -56,7 +56,9 @@ struct RendererOptions {
   /// or a cube for lenses beyond 120 degrees, remapped). Off: every camera renders as the
   /// pinhole of its K, and the frames' metadata says distortion "none".
   bool distortion = true;
-  /// Sensor noise (SensorSpec: read and shot noise, seeded per camera and frame).
+  /// Sensor noise (SensorSpec: read and shot noise, seeded per camera and frame), and a
+  /// camera's EMVA 1288 sensor (SensorSpec::emva, on the CPU after readback; false: the
+  /// rendered values as they are).
   bool noise = true;
   /// Where the noise is added when nothing else is left for the final pass (no lens, no float
   /// accumulation, no ground truth): on the CPU, into the pixels read back, so that the pass is

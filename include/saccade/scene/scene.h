@@ -23,6 +23,7 @@
 #include "saccade/geometry/pose.h"
 #include "saccade/head/head_model.h"
 #include "saccade/head/joint_state.h"
+#include "saccade/scene/emva_sensor.h"
 
 namespace saccade::scene {
 
@@ -125,7 +126,7 @@ struct Ground {
 };
 
 /// What the sensor does after the lens: exposure (motion blur) and noise, in digital numbers
-/// (DN: the 0..255 scale of the 8-bit image). All off by default.
+/// (DN: the 0..255 scale of the 8-bit image), or an EMVA 1288 sensor. All off by default.
 struct SensorSpec {
   /// Exposure time, seconds, >= 0 (at most 1). The frame of time t integrates the scene over
   /// [t - exposure / 2, t + exposure / 2]: moving objects and a moving head blur; a still
@@ -143,8 +144,14 @@ struct SensorSpec {
   /// Seed of the noise. Each camera and frame draws its own stream from the seed, the
   /// camera's name and the frame index: the same seed gives the same frames.
   uint64_t seed = 0;
+  /// An EMVA 1288 sensor (emva_sensor.h, docs/sensor.md) instead of the two noise figures
+  /// above (which must then be 0): photons from the rendered value and `exposure` (> 0),
+  /// shot and dark noise, DSNU/PRNU fixed per camera from `seed`, full well, gain, bit depth.
+  std::optional<EmvaSensor> emva;
 
+  /// The legacy noise (read_noise_dn, gain_dn_per_e), not the EMVA sensor.
   bool HasNoise() const { return read_noise_dn > 0.0 || gain_dn_per_e > 0.0; }
+  bool HasEmva() const { return emva.has_value(); }
   bool HasBlur() const { return exposure > 0.0 && blur_samples > 1; }
   /// Throws InvalidArgument naming the field and the value when one is out of range.
   void Validate() const;

@@ -27,6 +27,7 @@
 #include "saccade/core/error.h"
 #include "saccade/head/kinematics.h"
 #include "saccade/render/renderer.h"
+#include "saccade/render/sensor_model.h"
 
 namespace saccade::render::gl {
 
@@ -300,6 +301,9 @@ class GlRenderer final : public Renderer {
   // its lens (`lens`: Pending::cpu_lens) or through its turn (`turn`: Pending::cpu_turn,
   // null: none) and with its noise (null: none; one of them at least).
   const uint8_t* LevelsFor(const NoiseParams& noise);
+  // A camera's EMVA 1288 sensor (scene::SensorSpec::emva) on its colour frame, in place: on
+  // the CPU after readback, on every device (render/sensor_model.h); the model made once.
+  void ApplySensor(int camera, Image* image);
   void ConvertRows(int camera, bool lens, const CpuTurn* turn, const uint8_t* pixels,
                    const CpuNoise* noise, Image* image, int first_row, int end_row) const;
 
@@ -325,6 +329,8 @@ class GlRenderer final : public Renderer {
   bool turn_on_cpu_ = false;              // RendererOptions::turn_blur_on_cpu, resolved
   // NoiseLevels by (read sigma, gain), made as cameras need them.
   std::map<std::pair<float, float>, std::vector<uint8_t>> noise_levels_;
+  // Per camera: its EMVA 1288 sensor, made at its first frame (null: none yet, or none).
+  std::vector<std::unique_ptr<SensorModel>> sensor_models_;
   std::vector<DrawItem> items_;
   std::vector<Eigen::Isometry3d> item_poses_;  // X_WO (X_WLink X_LinkPart) per item, this state
   std::vector<std::pair<double, int>> order_;  // per view: depth, item

@@ -106,6 +106,7 @@ std::vector<Frame> GlRenderer::Retrieve() {
     } else {
       targets_[i]->Unmap();
     }
+    if (options_.noise && cameras_[i]->sensor.emva) ApplySensor(static_cast<int>(i), image.get());
     Frame frame{std::move(image), nullptr, nullptr, {}};
     if (truth_) FillTruth(static_cast<int>(i), pending, slot, &frame);
     frames.push_back(std::move(frame));
@@ -115,6 +116,19 @@ std::vector<Frame> GlRenderer::Retrieve() {
   stats_.readback_ms += Milliseconds(start, end);
   stats_.total_ms += Milliseconds(start, end);
   return frames;
+}
+
+void GlRenderer::ApplySensor(int camera, Image* image) {
+  const Clock::time_point start = Clock::now();
+  const scene::CameraSpec& spec = *cameras_[camera];
+  if (sensor_models_.size() != cameras_.size()) sensor_models_.resize(cameras_.size());
+  std::unique_ptr<SensorModel>& model = sensor_models_[camera];
+  if (!model) {
+    model = std::make_unique<SensorModel>(*spec.sensor.emva, spec.sensor.seed, spec.name,
+                                          image->width(), image->height(), 3);
+  }
+  model->ExposeRendered(image->view(), spec.sensor.exposure, image->metadata().frame_index, image);
+  stats_.cpu_effects_ms += Milliseconds(start, Clock::now());
 }
 
 const uint8_t* GlRenderer::LevelsFor(const NoiseParams& noise) {
