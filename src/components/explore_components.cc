@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -106,6 +107,7 @@ void DenseStereoComponent::Step(const runtime::StepContext& context) {
 WorldMapComponent::WorldMapComponent()
     : depth_(AddInput<DepthMessage>("depth", /*required=*/true)),
       selection_(AddInput<SelectionMessage>("selection")),
+      candidates_(AddInput<CandidatesMessage>("candidates")),
       map_out_(AddOutput<MapMessage>("map")) {
   using O = mapping::WorldMap::Options;
   DeclareParam("resolution_m", &map_options_.resolution_m, "voxel edge")
@@ -139,6 +141,15 @@ WorldMapComponent::WorldMapComponent()
   DeclareParam("ior_radius_m", &ior_options_.radius_m, "a fixated place inhibits this far")
       .Range(I::kRadii)
       .Unit("m");
+  using T = mapping::PointTracker::Options;
+  DeclareParam("track_gate_m", &track_options_.gate_m,
+               "a face of `candidates` continues the track nearest it within this distance")
+      .Range(T::kGates)
+      .Unit("m");
+  DeclareParam("track_lost_after_s", &track_options_.lost_after_s,
+               "a face unseen this long is a new object when it comes back")
+      .Range(T::kLostAfter)
+      .Unit("s");
   DeclareParam("publish_every", &publish_every_, "the map is emitted after every this many depths")
       .Range(1, 1e6);
   DeclareParam("ply", &ply_, "write the final map here (PLY points, metres, world); \"\": none");
@@ -147,12 +158,30 @@ WorldMapComponent::WorldMapComponent()
 void WorldMapComponent::Configured() {
   map_ = std::make_shared<mapping::WorldMap>(map_options_);
   ior_.emplace(ior_options_);
+  tracker_.emplace(track_options_);
 }
 
 void WorldMapComponent::Step(const runtime::StepContext& context) {
+  // Faces move: the places anchored to one follow its track (mapping/point_tracker.h).
+  const CandidatesMessage* faces = candidates_.get();
+  if (faces != nullptr && candidates_.fresh()) {
+    std::vector<Eigen::Vector3d> points;
+    for (const FaceCandidate& face : faces->candidates) points.push_back(face.p_W);
+    const std::vector<int> ids = tracker_->Update(points, context.time);
+    for (std::size_t i = 0; i < ids.size(); ++i) {
+      if (ids[i] >= 0) ior_->MoveObject(ids[i], Eigen::Isometry3d(Eigen::Translation3d(points[i])));
+    }
+  }
   const SelectionMessage* selection = selection_.get();
   if (selection != nullptr && selection_.fresh() && selection->valid && selection->fixating) {
-    ior_->Visit(selection->p_W, context.time);
+    // A fixated face (a track seen now within the inhibited radius) holds its place on it.
+    const auto face = tracker_->SeenNear(selection->p_W, ior_options_.radius_m);
+    if (face) {
+      ior_->Visit(selection->p_W, context.time, face->id,
+                  Eigen::Isometry3d(Eigen::Translation3d(face->p_W)));
+    } else {
+      ior_->Visit(selection->p_W, context.time);
+    }
   }
   const DepthMessage* depth = depth_.get();
   if (depth == nullptr || !depth_.fresh() || !depth->stereo) return;

@@ -3,6 +3,7 @@
 // it builds is then scored against the scene's ground truth (components/explore_session.h).
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
 #include <functional>
 #include <iostream>
@@ -18,6 +19,7 @@
 #include "saccade/mapping/inhibition_3d.h"
 #include "saccade/mapping/map_score.h"
 #include "saccade/mapping/world_map.h"
+#include "saccade/runtime/component_registry.h"
 #include "saccade/runtime/pipeline.h"
 #include "saccade/runtime/scheduler.h"
 #include "scratch_dir.h"
@@ -157,6 +159,76 @@ TEST(ExplorePipeline, RunsOnTheHumanoidHead) {
   EXPECT_GE(run.targets.size(), 3u);
   ASSERT_GE(run.maps.size(), 2u);
   EXPECT_GT(run.maps.back().fused, 1);
+}
+
+// The map's inhibition of return on a moving face: a place fixated on a face of `candidates`
+// moves with the face's track, so the face stays inhibited where it walks to and where it was
+// is free; without `candidates` the place stays where the face was.
+TEST(ExplorePipeline, APlaceFixatedOnAFaceMovesWithIt) {
+  RegisterComponents();
+  const auto run = [](bool with_faces) {
+    std::unique_ptr<runtime::Component> map =
+        runtime::ComponentRegistry::Global().Create("mapping.world_map");
+    map->Initialise("map", 1, {}, nullptr);
+    map->Configure({{"ior_time_constant_s", 10.0}, {"ior_radius_m", 0.3}});
+    auto& selection = dynamic_cast<runtime::Input<SelectionMessage>&>(*map->FindInput("selection"));
+    auto& faces = dynamic_cast<runtime::Input<CandidatesMessage>&>(*map->FindInput("candidates"));
+    auto& depth = dynamic_cast<runtime::Input<DepthMessage>&>(*map->FindInput("depth"));
+    std::optional<MapMessage> last;
+    dynamic_cast<runtime::Output<MapMessage>&>(*map->FindOutput("map"))
+        .signal()
+        .Connect([&](const MapMessage& m) { last = m; });
+    const Eigen::Vector3d start(2.0, -0.6, 1.5), step(0.0, 0.04, 0.0);  // 1 m/s at 25 Hz
+    runtime::StepContext context;
+    context.dt = 0.04;
+    for (int k = 0; k <= 30; ++k) {
+      context.step = k;
+      context.time = k * context.dt;
+      const Eigen::Vector3d face = start + k * step;
+      if (with_faces) {
+        CandidatesMessage seen;
+        seen.time = context.time;
+        seen.candidates.push_back(FaceCandidate{});
+        seen.candidates.back().p_W = face;
+        seen.candidates.push_back(FaceCandidate{});  // another face, never fixated
+        seen.candidates.back().p_W = Eigen::Vector3d(2.0, 1.5, 1.5);
+        faces.Deliver(seen);
+      }
+      if (k == 0) {
+        SelectionMessage fixated;
+        fixated.valid = fixated.fixating = true;
+        fixated.p_W = face + Eigen::Vector3d(0.0, 0.0, 0.05);  // on the face, a little off
+        selection.Deliver(fixated);
+      }
+      if (k == 30) {  // an empty depth: a map is emitted
+        DepthMessage empty;
+        auto stereo = std::make_shared<vision::StereoDepth>();
+        stereo->rectified = geometry::Intrinsics(8, 6, 5.0, 5.0, 3.5, 2.5);
+        stereo->depth = Image(8, 6, PixelFormat::kFloat32);
+        stereo->confidence = Image(8, 6, PixelFormat::kFloat32);
+        stereo->disparity = Image(8, 6, PixelFormat::kFloat32);
+        empty.stereo = stereo;
+        depth.Deliver(empty);
+      }
+      map->Step(context);
+      for (const auto& input : map->inputs()) input->MarkSeen();  // as the scheduler does
+    }
+    return last;
+  };
+  const Eigen::Vector3d start(2.0, -0.6, 1.5), end(2.0, 0.6, 1.5);
+  const double decay = std::exp(-1.2 / 10.0);
+  const std::optional<MapMessage> moving = run(true);
+  ASSERT_TRUE(moving.has_value());
+  ASSERT_TRUE(moving->ior);
+  EXPECT_NEAR(moving->ior->Inhibition(end, 1.2), decay, 1e-9);
+  EXPECT_EQ(moving->ior->Inhibition(start, 1.2), 0.0);
+  EXPECT_EQ(moving->ior->Inhibition(Eigen::Vector3d(2.0, 1.5, 1.5), 1.2), 0.0);
+  ASSERT_EQ(moving->inhibited.size(), 1u);
+  EXPECT_NEAR((moving->inhibited[0].p_W - (end + Eigen::Vector3d(0, 0, 0.05))).norm(), 0.0, 1e-9);
+  const std::optional<MapMessage> still = run(false);
+  ASSERT_TRUE(still.has_value());
+  EXPECT_EQ(still->ior->Inhibition(end, 1.2), 0.0);
+  EXPECT_NEAR(still->ior->Inhibition(start, 1.2), decay, 1e-9);
 }
 
 TEST(ExplorePipeline, BadParametersAreRefusedNamingTheComponentAndTheKey) {

@@ -18,10 +18,13 @@
 //
 // mapping.world_map -- the occupancy map (mapping/world_map.h, OctoMap) of every depth, and
 //   the places inhibition of return holds (mapping/inhibition_3d.h), world-anchored and
-//   decaying: each place a `selection` fixates. Emits the map (occupied voxels' centres and the
-//   places; in one process the map itself and the inhibition too, as snapshots) after every
-//   `publish_every` depths fused; writes it as PLY (`ply`) at the end.
-//   inputs: depth (vision.depth, required), selection (vision.selection)
+//   decaying: each place a `selection` fixates; a place on a face of `candidates` (a face
+//   pipeline's triangulated faces) is anchored to that face's track (mapping/point_tracker.h)
+//   and moves with it. Emits the map (occupied voxels' centres and the places; in one process
+//   the map itself and the inhibition too, as snapshots) after every `publish_every` depths
+//   fused; writes it as PLY (`ply`) at the end.
+//   inputs: depth (vision.depth, required), selection (vision.selection),
+//           candidates (vision.candidates)
 //   outputs: map (mapping.map)
 //
 // vision.explore -- two-stage attention for exploration (components/explore_attention.h): at
@@ -48,6 +51,7 @@
 #include "saccade/components/explore_attention.h"
 #include "saccade/components/messages.h"
 #include "saccade/mapping/inhibition_3d.h"
+#include "saccade/mapping/point_tracker.h"
 #include "saccade/mapping/world_map.h"
 #include "saccade/runtime/component.h"
 #include "saccade/scene/scene.h"
@@ -88,12 +92,15 @@ class WorldMapComponent : public runtime::Component {
  private:
   runtime::Input<DepthMessage>& depth_;
   runtime::Input<SelectionMessage>& selection_;
+  runtime::Input<CandidatesMessage>& candidates_;
   runtime::Output<MapMessage>& map_out_;
   mapping::WorldMap::Options map_options_;
   mapping::Inhibition3d::Options ior_options_;
+  mapping::PointTracker::Options track_options_;
   // Shared with the readers of the last map emitted: copied before a fusion while they hold it.
   std::shared_ptr<mapping::WorldMap> map_;
   std::optional<mapping::Inhibition3d> ior_;
+  std::optional<mapping::PointTracker> tracker_;
   int publish_every_ = 1;
   std::string ply_;
   int64_t fused_ = 0;
