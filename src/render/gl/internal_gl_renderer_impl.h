@@ -26,6 +26,7 @@
 #include "render/gl/internal_pixels.h"
 #include "saccade/core/error.h"
 #include "saccade/head/kinematics.h"
+#include "saccade/render/camera_chain.h"
 #include "saccade/render/renderer.h"
 #include "saccade/render/sensor_model.h"
 
@@ -200,9 +201,16 @@ class GlRenderer final : public Renderer {
     std::unique_ptr<EffectTarget> effects;  // null: the plain path (CameraTarget only)
     bool distorted = false;                 // the frames carry the lens's distortion
     std::shared_ptr<const geometry::CameraModel> rendered;  // every frame's camera model
-    bool noise = false;
-    bool blur = false;  // blur configured (sub-frames as many as the image motion needs)
+    bool noise = false;  // the legacy noise in the final pass or fused with the readback
+    bool blur = false;   // blur configured (sub-frames as many as the image motion needs)
+    // The photometric chain (vignetting, depth of field, colour; null: none of them), and
+    // whether the legacy noise comes after its optics, on the CPU (`noise` is then false).
+    std::unique_ptr<CameraChain> chain;
+    bool late_noise = false;
+    bool truth = false;  // the truth pass is drawn: truth asked, or the depth of field's depth
   };
+  // The chain of camera `i` (setup.rendered made), and the noise and truth it implies.
+  void SetChain(std::size_t i, CameraSetup* setup) const;
 
   MeshProgram& GetMeshProgram(int variant);
   void BuildGroundProgram();
@@ -288,7 +296,17 @@ class GlRenderer final : public Renderer {
   static Eigen::Isometry3d EyeFromWorld(const geometry::Pose& X_WV);
   void SortItems(const Eigen::Isometry3d& X_EW);
   double PixelsPerModelUnit(const DrawItem& item, double depth, double focal, double near) const;
-  void FillTruth(int camera, const Pending& pending, int slot, Frame* frame);
+  // `depth`, when not null, receives the depth image whether or not the frame asks for it
+  // (the depth of field's).
+  void FillTruth(int camera, const Pending& pending, int slot, Frame* frame,
+                 std::shared_ptr<Image>* depth);
+  // The photometric chain of a frame read back, in place, light first: the lens (vignetting,
+  // depth of field from `depth`), the legacy noise when it comes after them, the EMVA sensor,
+  // then the colour (the raw mosaic into frame->raw).
+  void ApplyChain(int camera, const Pending& pending, const Image* depth, Image* image,
+                  Frame* frame);
+  // The legacy noise of a camera (the final pass's, bit for bit) on an RGB image in place.
+  void ApplyLateNoise(int camera, int64_t frame_index, Image* image);
   uint32_t ItemId(const DrawItem& item) const;
   // The lights' colours and the ambient term, once when a program is built (the program in
   // use); SetLights then sends what moves with the camera, each camera pass: directions and

@@ -106,9 +106,11 @@ std::vector<Frame> GlRenderer::Retrieve() {
     } else {
       targets_[i]->Unmap();
     }
-    if (options_.noise && cameras_[i]->sensor.emva) ApplySensor(static_cast<int>(i), image.get());
-    Frame frame{std::move(image), nullptr, nullptr, {}};
-    if (truth_) FillTruth(static_cast<int>(i), pending, slot, &frame);
+    Frame frame{image, nullptr, nullptr, {}, nullptr};
+    std::shared_ptr<Image> depth;  // the depth of field's
+    const bool dof = setup.chain && setup.chain->depth_of_field();
+    if (setup.truth) FillTruth(static_cast<int>(i), pending, slot, &frame, dof ? &depth : nullptr);
+    ApplyChain(static_cast<int>(i), pending, depth.get(), image.get(), &frame);
     frames.push_back(std::move(frame));
   }
   ++stats_.frames;
@@ -116,6 +118,46 @@ std::vector<Frame> GlRenderer::Retrieve() {
   stats_.readback_ms += Milliseconds(start, end);
   stats_.total_ms += Milliseconds(start, end);
   return frames;
+}
+
+void GlRenderer::ApplyChain(int camera, const Pending& pending, const Image* depth, Image* image,
+                            Frame* frame) {
+  const CameraSetup& setup = setups_[camera];
+  const CameraChain* chain = setup.chain.get();
+  if (chain != nullptr && chain->optics()) {
+    const Clock::time_point start = Clock::now();
+    // The frame's values, resolved once: the scene's (a per-frame command may replace them).
+    const FrameOptics optics = chain->FrameDefaults();
+    chain->ApplyOptics(image, depth, optics);
+    stats_.cpu_effects_ms += Milliseconds(start, Clock::now());
+  }
+  if (setup.late_noise) ApplyLateNoise(camera, pending.frame_index, image);
+  if (options_.noise && cameras_[camera]->sensor.emva) ApplySensor(camera, image);
+  if (chain != nullptr && chain->color()) {
+    const Clock::time_point start = Clock::now();
+    frame->raw = chain->ApplyColor(image);
+    stats_.cpu_effects_ms += Milliseconds(start, Clock::now());
+  }
+}
+
+void GlRenderer::ApplyLateNoise(int camera, int64_t frame_index, Image* image) {
+  const Clock::time_point start = Clock::now();
+  const scene::CameraSpec& spec = *cameras_[camera];
+  NoiseParams params;
+  params.read_sigma_dn = static_cast<float>(spec.sensor.read_noise_dn);
+  params.gain_dn_per_e = static_cast<float>(spec.sensor.gain_dn_per_e);
+  params.key = NoiseKey(spec.sensor.seed, spec.name, frame_index);
+  const CpuNoise noise{params.key, params.read_sigma_dn, params.gain_dn_per_e,
+                       PackedGaussianTable().data(), LevelsFor(params)};
+  const int width = image->width();
+  std::vector<uint8_t> rgba(4 * static_cast<std::size_t>(width), 255);
+  for (int y = 0; y < image->height(); ++y) {
+    uint8_t* row = image->row(y);
+    for (int x = 0; x < width; ++x)
+      std::memcpy(&rgba[4 * static_cast<std::size_t>(x)], row + 3 * x, 3);
+    RgbaRowToRgbWithNoise(rgba.data(), row, width, y, noise);
+  }
+  stats_.cpu_effects_ms += Milliseconds(start, Clock::now());
 }
 
 void GlRenderer::ApplySensor(int camera, Image* image) {
