@@ -266,8 +266,10 @@ void ApplyVignetting(Image& rgb, const Image& factors) {
     const float* f = reinterpret_cast<const float*>(factors.row(y));
     for (int x = 0; x < rgb.width(); ++x) {
       for (int ch = 0; ch < 3; ++ch) {
-        const float value = row[3 * x + ch] * f[x];
-        row[3 * x + ch] = static_cast<uint8_t>(std::lround(std::clamp(value, 0.0f, 255.0f)));
+        const float value = std::clamp(row[3 * x + ch] * f[x], 0.0f, 255.0f);
+        // lround of a value in [0, 255]: value + 0.5 is exact in double, its floor the
+        // rounding half away from zero (and it vectorises).
+        row[3 * x + ch] = static_cast<uint8_t>(static_cast<double>(value) + 0.5);
       }
     }
   }
