@@ -210,6 +210,13 @@ void AddRendererOptions(CLI::App* command, render::RendererOptions* options) {
       "--no-blur", [options] { options->motion_blur = false; },
       "No motion blur (the scene's sensor: exposure, blur_samples): each frame an instant");
   command->add_flag_callback(
+      "--no-optics", [options] { options->optics = false; },
+      "No lens photometry (the scene's lens: vignetting, depth of field)");
+  command->add_flag_callback(
+      "--no-color", [options] { options->color = false; },
+      "No sensor colour (the scene's sensor color: colour filter array, white balance, "
+      "demosaicing, tone curve): the plain rendered RGB, and no raw mosaic");
+  command->add_flag_callback(
       "--no-turn-blur", [options] { options->turn_blur = false; },
       "Motion blur of a turning camera draws every sub-frame, instead of a few drawn instants "
       "seen through the turn (used while the parallax and moving items depart from drawing by "
@@ -225,6 +232,7 @@ Runner AddRenderCommand(CLI::App& app) {
       "Render a scene headless to a data set with ground truth: its calibrated cameras, with "
       "lens distortion, sensor noise and motion blur as the scene describes them, to "
       "DIR/<camera>/<frame>.png, each camera's "
+      "raw Bayer mosaic (DIR/<camera>/raw/<frame>.png) when the camera has a colour filter, its "
       "calibration as OpenCV YAML with the distortion that was rendered (DIR/<camera>.yaml, "
       "DIR/stereo.yaml for a head), and DIR/frames.jsonl with every frame's metadata; or to an "
       "MCAP recording of the same (--record FILE.mcap), or both. Ctrl-C stops after the frame "

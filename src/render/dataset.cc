@@ -19,6 +19,7 @@
 #include "saccade/geometry/image_camera.h"
 #include "saccade/geometry/json.h"
 #include "saccade/head/json.h"
+#include "saccade/render/color_filter.h"
 
 namespace saccade::render {
 namespace {
@@ -126,6 +127,9 @@ std::string DepthFile(const std::string& camera, int64_t index) {
 std::string IdsFile(const std::string& camera, int64_t index) {
   return fmt::format("{}/ids/{:06d}.png", camera, index);
 }
+std::string RawFile(const std::string& camera, int64_t index) {
+  return fmt::format("{}/raw/{:06d}.png", camera, index);
+}
 
 /// The camera model a frame was rendered with (it carries it: geometry/image_camera.h).
 const geometry::CameraModel& RenderedModel(const ImageMetadata& m) {
@@ -156,6 +160,11 @@ json FrameRecord(int64_t index, double time, const std::vector<Frame>& frames,
         joints[(*m.joint_names)[i]] = m.joints[i];
       }
       entry["joints"] = joints;
+    }
+    if (frame.raw) {
+      // The raw mosaic (RendererOptions::color with a filter array): 8-bit, one sample a pixel.
+      entry["cfa"] = ToString(PatternOf(frame.raw->format()));
+      if (files) entry["raw"] = RawFile(m.camera, index);
     }
     if (truth.depth && files) entry["depth"] = DepthFile(m.camera, index);
     if (truth.ids && files) entry["ids"] = IdsFile(m.camera, index);
@@ -194,7 +203,7 @@ void PrepareOutput(const fs::path& out, const std::vector<std::string>& cameras,
   int stale = RemoveStaleTemporaries(out);
   for (const auto& camera : cameras) {
     stale += RemoveStaleTemporaries(out / camera);
-    for (const char* truth_folder : {"depth", "ids"}) {
+    for (const char* truth_folder : {"depth", "ids", "raw"}) {
       stale += RemoveStaleTemporaries(out / camera / truth_folder);
     }
   }
@@ -212,7 +221,7 @@ void PrepareOutput(const fs::path& out, const std::vector<std::string>& cameras,
   for (const auto& path : existing) {
     if (fs::is_directory(path)) {
       remove_frames(path);
-      for (const char* truth_folder : {"depth", "ids"}) {
+      for (const char* truth_folder : {"depth", "ids", "raw"}) {
         remove_frames(path / truth_folder);
         std::error_code ignored;
         fs::remove(path / truth_folder, ignored);  // only when left empty
@@ -279,6 +288,16 @@ void WriteFrameImages(const Frame& frame, int i, const TruthRequest& truth, cons
   writes.push_back(std::async(std::launch::async, [&] {
     WritePng(frame.color->view(), out / camera / fmt::format("{:06d}.png", i));
   }));
+  if (frame.raw) {
+    writes.push_back(std::async(std::launch::async, [&] {
+      const Image& raw = *frame.raw;
+      fs::create_directories(out / camera / "raw");
+      // The mosaic's bytes as an 8-bit grey image: its pattern is in frames.jsonl ("cfa").
+      const ImageView gray{raw.data(),          raw.width(),  raw.height(),
+                           PixelFormat::kGray8, raw.stride(), &raw.metadata()};
+      WritePng(gray, out / RawFile(camera, i));
+    }));
+  }
   if (truth.depth) {
     const Image& depth = TruthImage(frame.depth, frame, "depth", PixelFormat::kFloat32);
     writes.push_back(std::async(std::launch::async, [&] {

@@ -101,7 +101,15 @@ double ReadInRange(const Entry& e, double max, const char* what);
 // {preset, quantum_efficiency, gain_dn_per_e, ...}: an EMVA 1288 sensor (a sensor's `emva`).
 EmvaSensor ReadEmva(const Entry& e);
 
-// {exposure | exposure_ms, blur_samples, read_noise_dn, gain_dn_per_e, seed, emva}: SensorSpec.
+// {cfa, demosaic, white_balance, tone_curve}: a sensor's colour (camera_optics.h).
+ColorSpec ReadColor(const Entry& e);
+
+// {vignetting, f_number, focal_length_mm, focus_distance, pixel_pitch_um, max_coc_px}: a
+// camera's lens (camera_optics.h).
+LensSpec ReadLens(const Entry& e);
+
+// {exposure | exposure_ms, blur_samples, read_noise_dn, gain_dn_per_e, seed, emva, color}:
+// SensorSpec.
 SensorSpec ReadSensor(const Entry& e);
 
 // The optical frame (x right, y down, z forward) at `eye` looking at `target`.

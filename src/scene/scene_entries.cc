@@ -1,6 +1,7 @@
 #include <fmt/ranges.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 #include "internal_scene_entries.h"
@@ -135,13 +136,142 @@ EmvaSensor ReadEmva(const Entry& e) {
   return s;
 }
 
-// {exposure | exposure_ms, blur_samples, read_noise_dn, gain_dn_per_e, seed, emva}: SensorSpec.
+namespace {
+
+// A name of `names` (lower case), the index of the name in it; fails naming the names.
+template <class Enum, std::size_t N>
+Enum ReadName(const Entry& e, const std::array<const char*, N>& names, const char* what) {
+  const std::string text = e.AsString();
+  for (std::size_t i = 0; i < N; ++i) {
+    if (text == names[i]) return static_cast<Enum>(i);
+  }
+  e.Fail(fmt::format("expected {} ({}), got {}", what, fmt::join(names, ", "), e.Describe()));
+}
+
+// A finite number > 0 (at most `max`); `what` says what it is.
+double ReadPositiveAtMost(const Entry& e, double max, const char* what) {
+  const double value = e.AsDouble();
+  if (!(value > 0.0 && value <= max)) {
+    e.Fail(fmt::format("expected {} in (0, {}], got {}", what, max, e.Describe()));
+  }
+  return value;
+}
+
+constexpr double kMaxColorGain = 16.0;
+constexpr double kMaxGamma = 10.0;
+
+}  // namespace
+
+// {cfa, demosaic, white_balance: {red, green, blue}, tone_curve: linear | srgb | {gamma}}.
+ColorSpec ReadColor(const Entry& e) {
+  e.ExpectMap({"cfa", "demosaic", "white_balance", "tone_curve"},
+              "a sensor's colour {cfa, demosaic, white_balance, tone_curve}");
+  ColorSpec color;
+  if (const auto x = e.Find("cfa")) {
+    color.cfa =
+        ReadName<CfaPattern>(*x, std::array<const char*, 5>{"none", "rggb", "bggr", "grbg", "gbrg"},
+                             "a colour filter pattern");
+  }
+  if (const auto x = e.Find("demosaic")) {
+    color.demosaic = ReadName<DemosaicMethod>(
+        *x, std::array<const char*, 2>{"bilinear", "edge_aware"}, "a demosaicing method");
+  }
+  if (const auto wb = e.Find("white_balance")) {
+    wb->ExpectMap({"red", "green", "blue"}, "white balance gains {red, green, blue}");
+    const char* keys[3] = {"red", "green", "blue"};
+    for (int c = 0; c < 3; ++c) {
+      if (const auto gain = wb->Find(keys[c])) {
+        color.white_balance[c] = ReadPositiveAtMost(*gain, kMaxColorGain, "a gain");
+      }
+    }
+  }
+  if (const auto tone = e.Find("tone_curve")) {
+    if (tone->IsMap()) {
+      tone->ExpectMap({"gamma"}, "a tone curve {gamma}");
+      color.tone_curve = ToneCurveKind::kGamma;
+      color.gamma = ReadPositiveAtMost(tone->Get("gamma"), kMaxGamma, "a display gamma");
+    } else {
+      color.tone_curve =
+          ReadName<ToneCurveKind>(*tone, std::array<const char*, 3>{"linear", "gamma", "srgb"},
+                                  "a tone curve (or {gamma: 2.2})");
+    }
+  }
+  return color;
+}
+
+// {vignetting: cos4 | {polynomial: [a1, a2, a3]}, f_number, focal_length_mm, focus_distance,
+// pixel_pitch_um, max_coc_px}: LensSpec. Depth of field with f_number, which needs
+// focal_length_mm and focus_distance.
+LensSpec ReadLens(const Entry& e) {
+  e.ExpectMap({"vignetting", "f_number", "focal_length_mm", "focus_distance", "pixel_pitch_um",
+               "max_coc_px"},
+              "a lens {vignetting, f_number, focal_length_mm, focus_distance, pixel_pitch_um, "
+              "max_coc_px}");
+  LensSpec lens;
+  if (const auto v = e.Find("vignetting")) {
+    if (v->IsMap()) {
+      v->ExpectMap({"polynomial"}, "a vignetting model (cos4, none or {polynomial: [a1, a2, a3]})");
+      const Entry poly = v->Get("polynomial");
+      const std::vector<double> a = poly.AsDoubles(3, "[a1, a2, a3]");
+      lens.vignetting = VignettingModel::kPolynomial;
+      lens.vignetting_coefficients = {a[0], a[1], a[2]};
+      // Relative illumination 1 + a1 r^2 + a2 r^4 + a3 r^6 must stay >= 0 on r in [0, 1].
+      for (int i = 0; i <= 1000; ++i) {
+        const double r2 = (i / 1000.0) * (i / 1000.0);
+        const double f = 1.0 + r2 * (a[0] + r2 * (a[1] + r2 * a[2]));
+        if (!(f >= 0.0)) {
+          poly.Fail(fmt::format(
+              "expected a relative illumination 1 + a1 r^2 + a2 r^4 + a3 r^6 >= 0 for r in "
+              "[0, 1], got {} at r = {}",
+              f, i / 1000.0));
+        }
+      }
+    } else {
+      lens.vignetting =
+          ReadName<VignettingModel>(*v, std::array<const char*, 2>{"none", "cos4"},
+                                    "a vignetting model (or {polynomial: [a1, a2, a3]})");
+    }
+  }
+  const auto n = e.Find("f_number");
+  const auto f = e.Find("focal_length_mm");
+  const auto s = e.Find("focus_distance");
+  for (const auto& other : {f, s, e.Find("pixel_pitch_um"), e.Find("max_coc_px")}) {
+    if (other && !n) other->Fail("depth of field needs the lens's 'f_number'");
+  }
+  if (!n) return lens;
+  lens.f_number = ReadPositiveAtMost(*n, 1000.0, "an f-number");
+  if (!f) n->Fail("depth of field needs the lens's 'focal_length_mm'");
+  if (!s) n->Fail("depth of field needs the lens's 'focus_distance' (metres)");
+  lens.focal_length_m = ReadPositiveAtMost(*f, 1000.0, "a focal length in millimetres") / 1e3;
+  lens.focus_distance_m = s->AsDouble();
+  if (!(lens.focus_distance_m > lens.focal_length_m && lens.focus_distance_m <= 1e6)) {
+    s->Fail(
+        fmt::format("expected a focus distance in metres beyond the focal length ({} m), "
+                    "at most 1e6, got {}",
+                    lens.focal_length_m, s->Describe()));
+  }
+  if (const auto x = e.Find("pixel_pitch_um")) {
+    lens.pixel_pitch_m = ReadInRange(*x, 1000.0, "a pixel pitch in micrometres") / 1e6;
+  }
+  if (const auto x = e.Find("max_coc_px")) {
+    lens.max_coc_px = x->AsDouble();
+    if (!(lens.max_coc_px >= 1.0 && lens.max_coc_px <= 256.0)) {
+      x->Fail(fmt::format("expected a largest circle of confusion in pixels in [1, 256], got {}",
+                          x->Describe()));
+    }
+  }
+  return lens;
+}
+
+// {exposure | exposure_ms, blur_samples, read_noise_dn, gain_dn_per_e, seed, emva, color}:
+// SensorSpec.
 SensorSpec ReadSensor(const Entry& e) {
-  e.ExpectMap(
-      {"exposure", "exposure_ms", "blur_samples", "read_noise_dn", "gain_dn_per_e", "seed", "emva"},
-      "a sensor {exposure | exposure_ms, blur_samples, read_noise_dn, gain_dn_per_e, "
-      "seed, emva}");
+  e.ExpectMap({"exposure", "exposure_ms", "blur_samples", "read_noise_dn", "gain_dn_per_e", "seed",
+               "emva", "color"},
+              "a sensor {exposure | exposure_ms, blur_samples, read_noise_dn, gain_dn_per_e, "
+              "seed, emva, color}");
   SensorSpec sensor;
+  if (const auto c = e.Find("color")) sensor.color = ReadColor(*c);
   const auto seconds = e.Find("exposure");
   const auto ms = e.Find("exposure_ms");
   if (seconds && ms) {

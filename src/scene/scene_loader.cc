@@ -477,8 +477,8 @@ class SceneReader {
   }
 
   CameraSpec ReadWorldCamera(const Entry& e, std::map<std::string, std::string>& names) {
-    e.ExpectMap({"name", "calibration", "pose", "look_at", "clip", "sensor"},
-                "a camera {name, calibration, pose | look_at, clip, sensor}");
+    e.ExpectMap({"name", "calibration", "pose", "look_at", "clip", "sensor", "lens"},
+                "a camera {name, calibration, pose | look_at, clip, sensor, lens}");
     const Entry name_entry = e.Get("name");
     const std::string name = name_entry.AsNonEmptyString();
     CheckCameraName(name_entry, name, names);
@@ -494,6 +494,7 @@ class SceneReader {
                       SensorSpec{}};
     if (const auto clip = e.Find("clip")) camera.clip = ReadClip(*clip);
     if (const auto sensor = e.Find("sensor")) camera.sensor = ReadSensor(*sensor);
+    if (const auto lens = e.Find("lens")) camera.lens = ReadLens(*lens);
     return camera;
   }
 
@@ -521,6 +522,7 @@ class SceneReader {
 
     geometry::ClipPlanes clips[2];
     SensorSpec sensors[2];
+    LensSpec lenses[2];
     for (int i = 0; i < 2; ++i) {
       const auto& clip = model->camera(i).clip;
       clips[i] = clip ? geometry::ClipPlanes{clip->first, clip->second}
@@ -531,14 +533,15 @@ class SceneReader {
       for (int i = 0; i < 2; ++i) {
         const auto camera = c->Find(i == 0 ? "left" : "right");
         if (!camera) continue;
-        camera->ExpectMap({"calibration", "clip", "sensor"},
-                          "an eye camera {calibration, clip, sensor}");
+        camera->ExpectMap({"calibration", "clip", "sensor", "lens"},
+                          "an eye camera {calibration, clip, sensor, lens}");
         if (const auto calibration = camera->Find("calibration")) {
           const geometry::CameraModel eye = ReadCalibration(*calibration);
           if (!replaced) model.emplace(model->WithCamera(i, eye));
         }
         if (const auto clip = camera->Find("clip")) clips[i] = ReadClip(*clip);
         if (const auto sensor = camera->Find("sensor")) sensors[i] = ReadSensor(*sensor);
+        if (const auto lens = camera->Find("lens")) lenses[i] = ReadLens(*lens);
       }
     }
     Robot robot{*model, model->Home(), true, {}, 0};
@@ -555,9 +558,9 @@ class SceneReader {
       head_entry.Fail(fmt::format("cannot build the robot's body: {}", error.what()));
     }
     cameras->push_back(CameraSpec{"left", robot.head.camera(0).model, CameraMount::kLeftEye,
-                                  geometry::Pose::Identity(), clips[0], sensors[0]});
+                                  geometry::Pose::Identity(), clips[0], sensors[0], lenses[0]});
     cameras->push_back(CameraSpec{"right", robot.head.camera(1).model, CameraMount::kRightEye,
-                                  geometry::Pose::Identity(), clips[1], sensors[1]});
+                                  geometry::Pose::Identity(), clips[1], sensors[1], lenses[1]});
     return robot;
   }
 

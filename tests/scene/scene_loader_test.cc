@@ -727,6 +727,97 @@ TEST_F(SceneLoaderTest, EmvaSensorsAreReadFromFiguresAndPresets) {
   EXPECT_FALSE(scene.FindCamera("right")->sensor.HasEmva());
 }
 
+// Issue 45: a sensor's colour and a camera's lens (camera_optics.h), on world and eye cameras.
+std::string WithOptics(const std::string& world, const std::string& eye) {
+  std::string text = Replace(kValid, "    clip: {near: 0.1, far: 20}\n",
+                             "    clip: {near: 0.1, far: 20}\n" + world);
+  return Replace(text, "  visible: false\n", "  visible: false\n  cameras:\n    left:\n" + eye);
+}
+const std::string kWorldOptics = R"(    sensor:
+      color:
+        cfa: grbg
+        demosaic: edge_aware
+        white_balance: {red: 1.5, blue: 2}
+        tone_curve: {gamma: 1.8}
+    lens:
+      vignetting: {polynomial: [-0.3, 0.05, 0]}
+      f_number: 2.8
+      focal_length_mm: 6
+      focus_distance: 1.5
+      pixel_pitch_um: 3.45
+      max_coc_px: 16
+)";
+const std::string kEyeOptics = R"(      sensor:
+        color: {cfa: rggb, tone_curve: srgb}
+      lens: {vignetting: cos4}
+)";
+
+TEST_F(SceneLoaderTest, ColorAndLensAreReadForWorldAndEyeCameras) {
+  const Scene scene = Load(WithOptics(kWorldOptics, kEyeOptics));
+  const CameraSpec& rig = *scene.FindCamera("rig");
+  EXPECT_EQ(rig.sensor.color.cfa, CfaPattern::kGrbg);
+  EXPECT_EQ(rig.sensor.color.demosaic, DemosaicMethod::kEdgeAware);
+  EXPECT_EQ(rig.sensor.color.white_balance, (std::array<double, 3>{1.5, 1.0, 2.0}));
+  EXPECT_EQ(rig.sensor.color.tone_curve, ToneCurveKind::kGamma);
+  EXPECT_EQ(rig.sensor.color.gamma, 1.8);
+  EXPECT_EQ(rig.lens.vignetting, VignettingModel::kPolynomial);
+  EXPECT_EQ(rig.lens.vignetting_coefficients, (std::array<double, 3>{-0.3, 0.05, 0.0}));
+  EXPECT_TRUE(rig.lens.HasDepthOfField());
+  EXPECT_EQ(rig.lens.f_number, 2.8);
+  EXPECT_NEAR(rig.lens.focal_length_m, 0.006, kParseTolerance);
+  EXPECT_EQ(rig.lens.focus_distance_m, 1.5);
+  EXPECT_NEAR(rig.lens.pixel_pitch_m, 3.45e-6, kParseTolerance);
+  EXPECT_EQ(rig.lens.max_coc_px, 16.0);
+  const CameraSpec& left = *scene.FindCamera("left");
+  EXPECT_EQ(left.sensor.color.cfa, CfaPattern::kRggb);
+  EXPECT_EQ(left.sensor.color.tone_curve, ToneCurveKind::kSrgb);
+  EXPECT_EQ(left.lens.vignetting, VignettingModel::kCos4);
+  EXPECT_FALSE(left.lens.HasDepthOfField());
+  // Cameras without the keys: everything off.
+  for (const char* name : {"right", "top"}) {
+    EXPECT_FALSE(scene.FindCamera(name)->sensor.color.Enabled()) << name;
+    EXPECT_FALSE(scene.FindCamera(name)->lens.Enabled()) << name;
+  }
+}
+
+TEST_F(SceneLoaderTest, BadColorAndLensNameTheFileLineAndKey) {
+  const auto world = [&](const std::string& from, const std::string& to) {
+    return WithOptics(Replace(kWorldOptics, from, to), kEyeOptics);
+  };
+  ExpectError(world("cfa: grbg", "cfa: rgbg"), "cfa: rgbg", "cameras[0].sensor.color.cfa",
+              {"expected a colour filter pattern (none, rggb, bggr, grbg, gbrg)", "got 'rgbg'"});
+  ExpectError(world("demosaic: edge_aware", "demosaic: vng"), "demosaic: vng",
+              "cameras[0].sensor.color.demosaic",
+              {"expected a demosaicing method (bilinear, edge_aware)"});
+  ExpectError(world("red: 1.5", "red: -1.5"), "red: -1.5",
+              "cameras[0].sensor.color.white_balance.red",
+              {"expected a gain in (0, 16]", "got '-1.5'"});
+  ExpectError(world("{gamma: 1.8}", "{gamma: 0}"), "{gamma: 0}",
+              "cameras[0].sensor.color.tone_curve.gamma", {"expected a display gamma in (0, 10]"});
+  ExpectError(world("{gamma: 1.8}", "log"), "tone_curve: log", "cameras[0].sensor.color.tone_curve",
+              {"expected a tone curve (or {gamma: 2.2}) (linear, gamma, srgb)", "got 'log'"});
+  ExpectError(world("f_number: 2.8", "f_number: 0"), "f_number: 0", "cameras[0].lens.f_number",
+              {"expected an f-number in (0, 1000]", "got '0'"});
+  ExpectError(world("focus_distance: 1.5", "focus_distance: 0.004"), "focus_distance: 0.004",
+              "cameras[0].lens.focus_distance",
+              {"expected a focus distance in metres beyond the focal length (0.006 m)"});
+  ExpectError(world("      focal_length_mm: 6\n", ""), "f_number: 2.8", "cameras[0].lens.f_number",
+              {"depth of field needs the lens's 'focal_length_mm'"});
+  ExpectError(world("      f_number: 2.8\n", ""), "focal_length_mm: 6",
+              "cameras[0].lens.focal_length_mm", {"depth of field needs the lens's 'f_number'"});
+  ExpectError(world("max_coc_px: 16", "max_coc_px: 0.5"), "max_coc_px: 0.5",
+              "cameras[0].lens.max_coc_px",
+              {"expected a largest circle of confusion in pixels in [1, 256]"});
+  ExpectError(world("[-0.3, 0.05, 0]", "[-2, 0, 0]"), "[-2, 0, 0]",
+              "cameras[0].lens.vignetting.polynomial",
+              {"expected a relative illumination 1 + a1 r^2 + a2 r^4 + a3 r^6 >= 0"});
+  ExpectError(world("f_number: 2.8", "aperture: 2.8"), "aperture: 2.8", "cameras[0].lens.aperture",
+              {"unknown key 'aperture'"});
+  ExpectError(WithOptics(kWorldOptics, Replace(kEyeOptics, "cos4", "cos3")), "cos3",
+              "robot.cameras.left.lens.vignetting",
+              {"expected a vignetting model (or {polynomial: [a1, a2, a3]}) (none, cos4)"});
+}
+
 TEST_F(SceneLoaderTest, BadEmvaSensorsNameTheFileLineAndKey) {
   const auto world = [&](const std::string& from, const std::string& to) {
     return WithSensors(Replace(kEmvaSensor, from, to), kEmvaEyeSensor);

@@ -19,12 +19,13 @@
 #include <string_view>
 
 #include "saccade/core/image.h"
+#include "saccade/scene/camera_optics.h"
 
 namespace saccade::render {
 
 /// A colour filter array's 2 x 2 cell, read row by row from pixel (0, 0); kNone: no filter
-/// (the image stays RGB).
-enum class CfaPattern { kNone, kRggb, kBggr, kGrbg, kGbrg };
+/// (the image stays RGB). The scene's type (scene/camera_optics.h), which its files name.
+using CfaPattern = scene::CfaPattern;
 
 /// "none", "rggb", "bggr", "grbg", "gbrg".
 const char* ToString(CfaPattern pattern);
@@ -43,11 +44,9 @@ int CfaChannel(CfaPattern pattern, int x, int y);
 /// ("COLOR_BayerBG2RGB" for kRggb, ...; "" for kNone): for documents and messages.
 const char* OpenCVBayerCodeName(CfaPattern pattern);
 
-/// How a mosaic is demosaiced; both reproduce cv::demosaicing bit for bit.
-enum class DemosaicMethod {
-  kBilinear,   ///< cv::COLOR_Bayer**2RGB: each missing colour the mean of its 2 or 4 nearest
-  kEdgeAware,  ///< cv::COLOR_Bayer**2RGB_EA: green along the smaller gradient
-};
+/// How a mosaic is demosaiced (kBilinear, kEdgeAware); both reproduce cv::demosaicing bit for
+/// bit. The scene's type (scene/camera_optics.h).
+using DemosaicMethod = scene::DemosaicMethod;
 /// "bilinear", "edge_aware".
 const char* ToString(DemosaicMethod method);
 /// A method from "bilinear" or "edge_aware" (also "ea"); throws InvalidArgument naming `field`.
@@ -79,12 +78,9 @@ struct WhiteBalance {
   double Gain(int channel) const { return channel == 0 ? red : (channel == 1 ? green : blue); }
 };
 
-/// How linear values are encoded into the image's 8 bits.
-enum class ToneCurveKind {
-  kLinear,  ///< V = L
-  kGamma,   ///< V = L^(1 / gamma)
-  kSrgb,    ///< IEC 61966-2-1: V = 12.92 L for L <= 0.0031308, else 1.055 L^(1/2.4) - 0.055
-};
+/// How linear values are encoded into the image's 8 bits (kLinear, kGamma, kSrgb). The
+/// scene's type (scene/camera_optics.h).
+using ToneCurveKind = scene::ToneCurveKind;
 /// "linear", "gamma", "srgb".
 const char* ToString(ToneCurveKind kind);
 /// A kind from "linear", "gamma" or "srgb"; throws InvalidArgument naming `field`.

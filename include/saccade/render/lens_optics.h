@@ -26,11 +26,13 @@
 #include "saccade/core/image.h"
 #include "saccade/geometry/camera_model.h"
 #include "saccade/geometry/intrinsics.h"
+#include "saccade/scene/camera_optics.h"
 
 namespace saccade::render {
 
-/// How vignetting is modelled.
-enum class VignettingModel { kNone, kCos4, kPolynomial };
+/// How vignetting is modelled (kNone, kCos4, kPolynomial). The scene's type
+/// (scene/camera_optics.h).
+using VignettingModel = scene::VignettingModel;
 /// "none", "cos4", "polynomial".
 const char* ToString(VignettingModel model);
 /// A model from "none", "cos4" or "polynomial"; throws InvalidArgument naming `field`.
@@ -98,8 +100,10 @@ struct DepthOfFieldSummary {
 ///    is behind it.
 /// On one depth it is exactly a blur by the disc of that depth (pixels weighted by their
 /// coverage of the disc, anti-aliased over one pixel). `depth` is kFloat32 of the same size (a
-/// renderer's Frame::depth); `intrinsics` give the pitch when pixel_pitch_m is 0. Throws
-/// InvalidArgument on invalid options, formats or sizes.
+/// renderer's Frame::depth); `intrinsics` give the pitch when pixel_pitch_m is 0. Each pixel
+/// visits only the offsets that a disc near it can reach, and the rows run on two threads where
+/// there are two cores (the same bits either way). Throws InvalidArgument on invalid options,
+/// formats or sizes.
 Image ApplyDepthOfField(const ImageView& rgb, const ImageView& depth, const ThinLensOptions& lens,
                         const geometry::Intrinsics& intrinsics,
                         DepthOfFieldSummary* summary = nullptr);

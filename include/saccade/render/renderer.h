@@ -75,6 +75,13 @@ struct RendererOptions {
   std::optional<bool> lens_on_cpu;
   /// Motion blur over the exposure (SensorSpec::exposure, blur_samples).
   bool motion_blur = true;
+  /// The lens's photometric effects (scene::LensSpec: vignetting, depth of field), on the CPU
+  /// after readback, before the sensor (render/camera_chain.h). Depth of field draws the
+  /// camera's depth (the ground-truth pass) whether or not truth_depth asks for it.
+  bool optics = true;
+  /// The sensor's colour (scene::ColorSpec: filter array, white balance, demosaicing, tone
+  /// curve), on the CPU after the sensor; Frame::raw carries the mosaic. Off: the plain RGB.
+  bool color = true;
   /// Motion blur of a turning camera (a saccade): the exposure is cut into the fewest
   /// stretches whose sub-frames are each the instant drawn at the stretch's middle seen
   /// through the turn's homographies (a scene pass and a pass of fetches a stretch, instead of
@@ -141,6 +148,10 @@ struct Frame {
   std::shared_ptr<const Image> ids;
   /// Every object and the robot (when drawn), in scene order then the robot.
   std::vector<ObjectTruth> objects;
+  /// The raw mosaic of a camera with a colour filter array (scene::ColorSpec::cfa, and
+  /// RendererOptions::color): kBayer*8 (its pattern), white balanced, before demosaicing and
+  /// the tone curve, with `color`'s metadata; null otherwise. `color` is its demosaiced image.
+  std::shared_ptr<const Image> raw{};
 };
 
 /// One head of a batch (Renderer::RenderBatch): its state (time, joints) and, optionally, its

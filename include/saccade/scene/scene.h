@@ -23,6 +23,7 @@
 #include "saccade/geometry/pose.h"
 #include "saccade/head/head_model.h"
 #include "saccade/head/joint_state.h"
+#include "saccade/scene/camera_optics.h"
 #include "saccade/scene/emva_sensor.h"
 
 namespace saccade::scene {
@@ -148,6 +149,9 @@ struct SensorSpec {
   /// above (which must then be 0): photons from the rendered value and `exposure` (> 0),
   /// shot and dark noise, DSNU/PRNU fixed per camera from `seed`, full well, gain, bit depth.
   std::optional<EmvaSensor> emva;
+  /// The sensor's colour: filter array, demosaicing, white balance, tone curve (camera_optics.h,
+  /// docs/camera-pixels.md); applied after the noise. Default: none.
+  ColorSpec color{};
 
   /// The legacy noise (read_noise_dn, gain_dn_per_e), not the EMVA sensor.
   bool HasNoise() const { return read_noise_dn > 0.0 || gain_dn_per_e > 0.0; }
@@ -169,6 +173,9 @@ struct CameraSpec {
   geometry::Pose X_WC = geometry::Pose::Identity();
   geometry::ClipPlanes clip{0.05, 50.0};
   SensorSpec sensor;
+  /// The lens's photometric side: vignetting and depth of field (camera_optics.h), applied
+  /// before the sensor. Default: none.
+  LensSpec lens{};
 };
 
 /// A piece of the robot's drawn body, rigidly attached to one link of the head's tree.

@@ -190,10 +190,11 @@ void GlRenderer::BuildCameraSetups(std::vector<CameraSetup> reuse, bool reuse_di
     CameraSetup setup;
     if (i < reuse.size() && reuse[i].effects && reuse_distortion == options_.distortion) {
       setup = std::move(reuse[i]);
-      setup.noise = options_.noise && camera->sensor.HasNoise();
+      SetChain(i, &setup);
       setup.blur = options_.motion_blur && camera->sensor.HasBlur();
       if (setup.blur) setup.effects->EnableBlur();
-      if (setup.distorted || setup.noise || setup.blur || truth_) {
+      if ((setup.distorted || setup.noise || setup.blur || setup.truth) &&
+          setup.effects->has_truth() == setup.truth) {
         PrebuildFinal(setup);
         targets_.push_back(nullptr);
         setups_.push_back(std::move(setup));
@@ -210,7 +211,7 @@ void GlRenderer::BuildCameraSetups(std::vector<CameraSetup> reuse, bool reuse_di
     // The frames' camera model: the image as rendered (a pinhole of K without distortion).
     setup.rendered = std::make_shared<const geometry::CameraModel>(
         setup.distorted ? camera->model : geometry::CameraModel(K));
-    setup.noise = options_.noise && camera->sensor.HasNoise();
+    SetChain(i, &setup);
     setup.blur = options_.motion_blur && camera->sensor.HasBlur();
     for (const geometry::SourceView& source : lens.views) {
       ViewSetup view;
@@ -224,18 +225,34 @@ void GlRenderer::BuildCameraSetups(std::vector<CameraSetup> reuse, bool reuse_di
               .cast<float>();
       setup.views.push_back(view);
     }
-    if (setup.distorted || setup.noise || setup.blur || truth_) {
+    if (setup.distorted || setup.noise || setup.blur || setup.truth) {
       if (!effect_programs_) effect_programs_ = std::make_unique<EffectPrograms>();
       setup.effects =
-          std::make_unique<EffectTarget>(lens, samples_, setup.blur, truth_, lens_on_cpu_);
+          std::make_unique<EffectTarget>(lens, samples_, setup.blur, setup.truth, lens_on_cpu_);
       PrebuildFinal(setup);
-      if (truth_) effect_programs_->GetTruthRemap(!setup.distorted);
+      if (setup.truth) effect_programs_->GetTruthRemap(!setup.distorted);
       targets_.push_back(nullptr);
     } else {
       targets_.push_back(std::make_unique<CameraTarget>(K.width(), K.height(), samples_, GL_RGBA));
     }
     setups_.push_back(std::move(setup));
   }
+}
+
+void GlRenderer::SetChain(std::size_t i, CameraSetup* setup) const {
+  const scene::CameraSpec& camera = *cameras_[i];
+  setup->chain.reset();
+  if ((options_.optics && camera.lens.Enabled()) ||
+      (options_.color && camera.sensor.color.Enabled())) {
+    setup->chain =
+        std::make_unique<CameraChain>(camera, *setup->rendered, options_.optics, options_.color);
+  }
+  const bool noise = options_.noise && camera.sensor.HasNoise();
+  // The lens's light comes before the sensor: the noise after vignetting and depth of field,
+  // on the CPU, not fused with the readback or the final pass.
+  setup->late_noise = noise && setup->chain && setup->chain->optics();
+  setup->noise = noise && !setup->late_noise;
+  setup->truth = truth_ || (setup->chain && setup->chain->depth_of_field());
 }
 
 void GlRenderer::SetEffects(bool distortion, bool noise, bool motion_blur) {

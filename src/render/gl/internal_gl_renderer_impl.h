@@ -26,6 +26,7 @@
 #include "render/gl/internal_pixels.h"
 #include "saccade/core/error.h"
 #include "saccade/head/kinematics.h"
+#include "saccade/render/camera_chain.h"
 #include "saccade/render/renderer.h"
 #include "saccade/render/sensor_model.h"
 
@@ -200,9 +201,16 @@ class GlRenderer final : public Renderer {
     std::unique_ptr<EffectTarget> effects;  // null: the plain path (CameraTarget only)
     bool distorted = false;                 // the frames carry the lens's distortion
     std::shared_ptr<const geometry::CameraModel> rendered;  // every frame's camera model
-    bool noise = false;
-    bool blur = false;  // blur configured (sub-frames as many as the image motion needs)
+    bool noise = false;  // the legacy noise in the final pass or fused with the readback
+    bool blur = false;   // blur configured (sub-frames as many as the image motion needs)
+    // The photometric chain (vignetting, depth of field, colour; null: none of them), and
+    // whether the legacy noise comes after its optics, on the CPU (`noise` is then false).
+    std::unique_ptr<CameraChain> chain;
+    bool late_noise = false;
+    bool truth = false;  // the truth pass is drawn: truth asked, or the depth of field's depth
   };
+  // The chain of camera `i` (setup.rendered made), and the noise and truth it implies.
+  void SetChain(std::size_t i, CameraSetup* setup) const;
 
   MeshProgram& GetMeshProgram(int variant);
   void BuildGroundProgram();
@@ -288,7 +296,28 @@ class GlRenderer final : public Renderer {
   static Eigen::Isometry3d EyeFromWorld(const geometry::Pose& X_WV);
   void SortItems(const Eigen::Isometry3d& X_EW);
   double PixelsPerModelUnit(const DrawItem& item, double depth, double focal, double near) const;
-  void FillTruth(int camera, const Pending& pending, int slot, Frame* frame);
+  // `depth`, when not null, receives the depth image whether or not the frame asks for it
+  // (the depth of field's).
+  void FillTruth(int camera, const Pending& pending, int slot, Frame* frame,
+                 std::shared_ptr<Image>* depth);
+  // The photometric chain of a frame read back, in place, light first: the lens (vignetting,
+  // depth of field from the job's depth), the legacy noise when it comes after them, the EMVA
+  // sensor, then the colour (the raw mosaic into frame->raw). ApplyChains runs it for every
+  // camera that has any of it (HasChainWork), two cameras at once where there are two cores:
+  // what a camera's chain touches is its own (LevelsFor and the sensor models' slots are made
+  // before), and the time goes into RenderStats::cpu_effects_ms.
+  struct ChainJob {
+    Image* image = nullptr;
+    std::shared_ptr<Image> depth;     // the depth of field's
+    const uint8_t* levels = nullptr;  // the late noise's NoiseLevels
+    int64_t frame_index = 0;
+  };
+  bool HasChainWork(int camera) const;
+  void ApplyChains(std::vector<ChainJob>* jobs, std::vector<Frame>* frames);
+  void ApplyChain(int camera, const ChainJob& job, Frame* frame);
+  // The legacy noise of a camera (the final pass's, bit for bit) on an RGB image in place.
+  NoiseParams LateNoiseParams(int camera, int64_t frame_index) const;
+  void ApplyLateNoise(int camera, int64_t frame_index, const uint8_t* levels, Image* image) const;
   uint32_t ItemId(const DrawItem& item) const;
   // The lights' colours and the ambient term, once when a program is built (the program in
   // use); SetLights then sends what moves with the camera, each camera pass: directions and
@@ -302,7 +331,8 @@ class GlRenderer final : public Renderer {
   // null: none) and with its noise (null: none; one of them at least).
   const uint8_t* LevelsFor(const NoiseParams& noise);
   // A camera's EMVA 1288 sensor (scene::SensorSpec::emva) on its colour frame, in place: on
-  // the CPU after readback, on every device (render/sensor_model.h); the model made once.
+  // the CPU after readback, on every device (render/sensor_model.h); the model made once (its
+  // slot in sensor_models_ made by ApplyChains).
   void ApplySensor(int camera, Image* image);
   void ConvertRows(int camera, bool lens, const CpuTurn* turn, const uint8_t* pixels,
                    const CpuNoise* noise, Image* image, int first_row, int end_row) const;

@@ -4,6 +4,7 @@
 
 #include <atomic>
 #include <cstring>
+#include <exception>
 #include <thread>
 
 #include "render/gl/internal_cpu_lens.h"
@@ -52,6 +53,7 @@ std::vector<Frame> GlRenderer::Retrieve() {
 
   std::vector<Frame> frames;
   frames.reserve(cameras_.size());
+  std::vector<ChainJob> jobs(cameras_.size());
   for (std::size_t i = 0; i < cameras_.size(); ++i) {
     const CameraSetup& setup = setups_[i];
     std::shared_ptr<Image> image = NewImage(static_cast<int>(i));
@@ -106,11 +108,18 @@ std::vector<Frame> GlRenderer::Retrieve() {
     } else {
       targets_[i]->Unmap();
     }
-    if (options_.noise && cameras_[i]->sensor.emva) ApplySensor(static_cast<int>(i), image.get());
-    Frame frame{std::move(image), nullptr, nullptr, {}};
-    if (truth_) FillTruth(static_cast<int>(i), pending, slot, &frame);
+    Frame frame{image, nullptr, nullptr, {}, nullptr};
+    ChainJob& job = jobs[i];
+    const bool dof = setup.chain && setup.chain->depth_of_field();
+    if (setup.truth)
+      FillTruth(static_cast<int>(i), pending, slot, &frame, dof ? &job.depth : nullptr);
+    job.image = image.get();
+    job.frame_index = pending.frame_index;
+    if (setup.late_noise)
+      job.levels = LevelsFor(LateNoiseParams(static_cast<int>(i), job.frame_index));
     frames.push_back(std::move(frame));
   }
+  ApplyChains(&jobs, &frames);
   ++stats_.frames;
   const Clock::time_point end = Clock::now();
   stats_.readback_ms += Milliseconds(start, end);
@@ -118,17 +127,94 @@ std::vector<Frame> GlRenderer::Retrieve() {
   return frames;
 }
 
-void GlRenderer::ApplySensor(int camera, Image* image) {
-  const Clock::time_point start = Clock::now();
-  const scene::CameraSpec& spec = *cameras_[camera];
+bool GlRenderer::HasChainWork(int camera) const {
+  const CameraSetup& setup = setups_[camera];
+  return setup.chain != nullptr || setup.late_noise ||
+         (options_.noise && cameras_[camera]->sensor.emva.has_value());
+}
+
+void GlRenderer::ApplyChains(std::vector<ChainJob>* jobs, std::vector<Frame>* frames) {
+  std::vector<std::size_t> work;
+  for (std::size_t i = 0; i < jobs->size(); ++i) {
+    if (HasChainWork(static_cast<int>(i))) work.push_back(i);
+  }
+  if (work.empty()) return;
   if (sensor_models_.size() != cameras_.size()) sensor_models_.resize(cameras_.size());
-  std::unique_ptr<SensorModel>& model = sensor_models_[camera];
+  const Clock::time_point start = Clock::now();
+  // Every camera's chain is its own (its image, its frame, its sensor model): two cameras at
+  // once where there are two cores (a stereo head's eyes), the same bits either way.
+  std::exception_ptr errors[2];
+  const auto run = [&](int worker, int workers) {
+    try {
+      for (std::size_t k = static_cast<std::size_t>(worker); k < work.size(); k += workers) {
+        const std::size_t i = work[k];
+        ApplyChain(static_cast<int>(i), (*jobs)[i], &(*frames)[i]);
+      }
+    } catch (...) {
+      errors[worker] = std::current_exception();
+    }
+  };
+  static const bool cores = std::thread::hardware_concurrency() >= 2;  // asked once
+  if (cores && work.size() >= 2) {
+    std::thread other(run, 1, 2);
+    run(0, 2);
+    other.join();
+  } else {
+    run(0, 1);
+  }
+  for (const std::exception_ptr& error : errors) {
+    if (error) std::rethrow_exception(error);
+  }
+  stats_.cpu_effects_ms += Milliseconds(start, Clock::now());
+}
+
+void GlRenderer::ApplyChain(int camera, const ChainJob& job, Frame* frame) {
+  const CameraSetup& setup = setups_[camera];
+  const CameraChain* chain = setup.chain.get();
+  Image* image = job.image;
+  if (chain != nullptr && chain->optics()) {
+    // The frame's values, resolved once: the scene's (a per-frame command may replace them).
+    const FrameOptics optics = chain->FrameDefaults();
+    chain->ApplyOptics(image, job.depth.get(), optics);
+  }
+  if (setup.late_noise) ApplyLateNoise(camera, job.frame_index, job.levels, image);
+  if (options_.noise && cameras_[camera]->sensor.emva) ApplySensor(camera, image);
+  if (chain != nullptr && chain->color()) frame->raw = chain->ApplyColor(image);
+}
+
+NoiseParams GlRenderer::LateNoiseParams(int camera, int64_t frame_index) const {
+  const scene::CameraSpec& spec = *cameras_[camera];
+  NoiseParams params;
+  params.read_sigma_dn = static_cast<float>(spec.sensor.read_noise_dn);
+  params.gain_dn_per_e = static_cast<float>(spec.sensor.gain_dn_per_e);
+  params.key = NoiseKey(spec.sensor.seed, spec.name, frame_index);
+  return params;
+}
+
+void GlRenderer::ApplyLateNoise(int camera, int64_t frame_index, const uint8_t* levels,
+                                Image* image) const {
+  const NoiseParams params = LateNoiseParams(camera, frame_index);
+  const CpuNoise noise{params.key, params.read_sigma_dn, params.gain_dn_per_e,
+                       PackedGaussianTable().data(), levels};
+  const int width = image->width();
+  std::vector<uint8_t> rgba(4 * static_cast<std::size_t>(width), 255);
+  for (int y = 0; y < image->height(); ++y) {
+    uint8_t* row = image->row(y);
+    for (int x = 0; x < width; ++x) {
+      std::memcpy(&rgba[4 * static_cast<std::size_t>(x)], row + 3 * x, 3);
+    }
+    RgbaRowToRgbWithNoise(rgba.data(), row, width, y, noise);
+  }
+}
+
+void GlRenderer::ApplySensor(int camera, Image* image) {
+  const scene::CameraSpec& spec = *cameras_[camera];
+  std::unique_ptr<SensorModel>& model = sensor_models_[camera];  // sized by ApplyChains
   if (!model) {
     model = std::make_unique<SensorModel>(*spec.sensor.emva, spec.sensor.seed, spec.name,
                                           image->width(), image->height(), 3);
   }
   model->ExposeRendered(image->view(), spec.sensor.exposure, image->metadata().frame_index, image);
-  stats_.cpu_effects_ms += Milliseconds(start, Clock::now());
 }
 
 const uint8_t* GlRenderer::LevelsFor(const NoiseParams& noise) {

@@ -9,7 +9,8 @@
 
 namespace saccade::render::gl {
 
-void GlRenderer::FillTruth(int camera, const Pending& pending, int slot, Frame* frame) {
+void GlRenderer::FillTruth(int camera, const Pending& pending, int slot, Frame* frame,
+                           std::shared_ptr<Image>* depth) {
   const EffectTarget& effects = *setups_[camera].effects;
   const int width = frame->color->width();
   const int height = frame->color->height();
@@ -21,9 +22,14 @@ void GlRenderer::FillTruth(int camera, const Pending& pending, int slot, Frame* 
     buffers.Unmap();
     return image;
   };
+  if (options_.truth_depth || depth != nullptr) {
+    std::shared_ptr<Image> z = copy(effects.depth_buffers(), PixelFormat::kFloat32);
+    if (options_.truth_depth) frame->depth = z;
+    if (depth != nullptr) *depth = std::move(z);
+  }
+  if (!options_.truth_ids && !options_.truth_objects) return;
   std::shared_ptr<Image> ids = copy(effects.id_buffers(), PixelFormat::kUint32);
-  if (options_.truth_depth) frame->depth = copy(effects.depth_buffers(), PixelFormat::kFloat32);
-  if (options_.truth_ids || options_.truth_objects) frame->ids = ids;
+  frame->ids = ids;
   if (!options_.truth_objects) return;
 
   // Poses at the frame's time, and boxes from the id image.

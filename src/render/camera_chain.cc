@@ -1,0 +1,77 @@
+#include "saccade/render/camera_chain.h"
+
+#include <cstring>
+
+#include "saccade/core/error.h"
+
+namespace saccade::render {
+
+ColorOptions ToColorOptions(const scene::ColorSpec& color) {
+  ColorOptions options;
+  options.cfa = color.cfa;
+  options.demosaic = color.demosaic;
+  options.white_balance = {color.white_balance[0], color.white_balance[1], color.white_balance[2]};
+  options.tone_curve.kind = color.tone_curve;
+  options.tone_curve.gamma = color.gamma;
+  return options;
+}
+
+VignettingOptions ToVignettingOptions(const scene::LensSpec& lens) {
+  VignettingOptions options;
+  options.model = lens.vignetting;
+  options.coefficients = lens.vignetting_coefficients;
+  return options;
+}
+
+ThinLensOptions ToThinLensOptions(const scene::LensSpec& lens, double focus_distance_m) {
+  ThinLensOptions options;
+  options.focal_length_m = lens.focal_length_m;
+  options.f_number = lens.f_number;
+  options.focus_distance_m = focus_distance_m;
+  options.pixel_pitch_m = lens.pixel_pitch_m;
+  options.max_coc_px = lens.max_coc_px;
+  return options;
+}
+
+CameraChain::CameraChain(const scene::CameraSpec& camera, const geometry::CameraModel& rendered,
+                         bool optics, bool color)
+    : lens_(camera.lens),
+      intrinsics_(rendered.intrinsics()),
+      options_(ToColorOptions(camera.sensor.color)),
+      vignetting_(optics && camera.lens.HasVignetting()),
+      depth_of_field_(optics && camera.lens.HasDepthOfField()),
+      color_(color && camera.sensor.color.Enabled()) {
+  if (color_) options_.Validate();
+  if (depth_of_field_) ToThinLensOptions(lens_, lens_.focus_distance_m).Validate();
+  if (vignetting_) factors_ = VignettingFactors(rendered, ToVignettingOptions(lens_));
+}
+
+FrameOptics CameraChain::FrameDefaults() const {
+  FrameOptics frame;
+  frame.focus_distance_m = lens_.focus_distance_m;
+  return frame;
+}
+
+void CameraChain::ApplyOptics(Image* rgb, const Image* depth, const FrameOptics& frame) const {
+  if (vignetting_) ApplyVignetting(*rgb, factors_);
+  if (!depth_of_field_) return;
+  if (depth == nullptr) throw Error("CameraChain::ApplyOptics: depth of field without a depth");
+  const Image blurred = ApplyDepthOfField(
+      rgb->view(), depth->view(), ToThinLensOptions(lens_, frame.focus_distance_m), intrinsics_);
+  for (int y = 0; y < rgb->height(); ++y) {
+    std::memcpy(rgb->row(y), blurred.row(y), 3 * static_cast<std::size_t>(rgb->width()));
+  }
+}
+
+std::shared_ptr<Image> CameraChain::ApplyColor(Image* rgb) const {
+  if (!color_) return nullptr;
+  ColorImages images = ApplyColorPipeline(rgb->view(), options_);
+  for (int y = 0; y < rgb->height(); ++y) {
+    std::memcpy(rgb->row(y), images.rgb.row(y), 3 * static_cast<std::size_t>(rgb->width()));
+  }
+  if (options_.cfa == CfaPattern::kNone) return nullptr;
+  images.raw.metadata() = rgb->metadata();
+  return std::make_shared<Image>(std::move(images.raw));
+}
+
+}  // namespace saccade::render
