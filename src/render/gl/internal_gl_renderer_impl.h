@@ -302,8 +302,11 @@ class GlRenderer final : public Renderer {
   // null: none) and with its noise (null: none; one of them at least).
   const uint8_t* LevelsFor(const NoiseParams& noise);
   // A camera's EMVA 1288 sensor (scene::SensorSpec::emva) on its colour frame, in place: on
-  // the CPU after readback, on every device (render/sensor_model.h); the model made once.
-  void ApplySensor(int camera, Image* image);
+  // the CPU after readback, on every device (render/sensor_model.h); the model made once. With
+  // the frame's commanded exposure and gain (`controls`); without an EMVA sensor (or with the
+  // noise off) a commanded exposure and gain scale the 8-bit values instead
+  // (AppliedControls::BrightnessFactor); nothing commanded: nothing changes.
+  void ApplySensor(int camera, const scene::AppliedControls& controls, Image* image);
   void ConvertRows(int camera, bool lens, const CpuTurn* turn, const uint8_t* pixels,
                    const CpuNoise* noise, Image* image, int first_row, int end_row) const;
 

@@ -2,7 +2,10 @@
 // from its pixel buffer objects into a pooled image, with the frame's metadata.
 #include <fmt/format.h>
 
+#include <algorithm>
+#include <array>
 #include <atomic>
+#include <cmath>
 #include <cstring>
 #include <thread>
 
@@ -13,6 +16,20 @@
 #include "saccade/geometry/image_camera.h"
 
 namespace saccade::render::gl {
+namespace {
+
+// A commanded exposure and gain without an EMVA sensor: every 8-bit value times `factor`,
+// rounded and clipped at 255 (the sensor saturates), through a table.
+void ScaleBrightness(double factor, Image* image) {
+  std::array<uint8_t, 256> table;
+  for (int v = 0; v < 256; ++v) {
+    table[v] = static_cast<uint8_t>(std::min(255.0, std::round(v * factor)));
+  }
+  uint8_t* p = image->data();
+  for (std::size_t i = 0, n = image->size_bytes(); i < n; ++i) p[i] = table[p[i]];
+}
+
+}  // namespace
 
 std::shared_ptr<Image> GlRenderer::NewImage(int camera) {
   const geometry::Intrinsics& K = cameras_[camera]->model.intrinsics();
@@ -106,7 +123,7 @@ std::vector<Frame> GlRenderer::Retrieve() {
     } else {
       targets_[i]->Unmap();
     }
-    if (options_.noise && cameras_[i]->sensor.emva) ApplySensor(static_cast<int>(i), image.get());
+    ApplySensor(static_cast<int>(i), scene_.ControlsOf(*cameras_[i], pending.state), image.get());
     Frame frame{std::move(image), nullptr, nullptr, {}};
     if (truth_) FillTruth(static_cast<int>(i), pending, slot, &frame);
     frames.push_back(std::move(frame));
@@ -118,16 +135,24 @@ std::vector<Frame> GlRenderer::Retrieve() {
   return frames;
 }
 
-void GlRenderer::ApplySensor(int camera, Image* image) {
-  const Clock::time_point start = Clock::now();
+void GlRenderer::ApplySensor(int camera, const scene::AppliedControls& controls, Image* image) {
   const scene::CameraSpec& spec = *cameras_[camera];
+  const bool emva = options_.noise && spec.sensor.emva;
+  if (!emva && !controls.commanded) return;
+  const Clock::time_point start = Clock::now();
+  if (!emva) {
+    ScaleBrightness(controls.BrightnessFactor(), image);
+    stats_.cpu_effects_ms += Milliseconds(start, Clock::now());
+    return;
+  }
   if (sensor_models_.size() != cameras_.size()) sensor_models_.resize(cameras_.size());
   std::unique_ptr<SensorModel>& model = sensor_models_[camera];
   if (!model) {
     model = std::make_unique<SensorModel>(*spec.sensor.emva, spec.sensor.seed, spec.name,
                                           image->width(), image->height(), 3);
   }
-  model->ExposeRendered(image->view(), spec.sensor.exposure, image->metadata().frame_index, image);
+  model->ExposeRendered(image->view(), controls.exposure_s, image->metadata().frame_index, image,
+                        controls.GainFactor());
   stats_.cpu_effects_ms += Milliseconds(start, Clock::now());
 }
 
@@ -184,6 +209,10 @@ void GlRenderer::Describe(int camera_index, const Pending& pending, ImageMetadat
   geometry::SetCameraModel(meta, setup.rendered);
   geometry::SetCameraPose(meta, pending.X_WC[i]);
   meta.exposure_samples = pending.exposure_samples[i];
+  const scene::AppliedControls controls = scene_.ControlsOf(camera, pending.state);
+  meta.exposure_s = controls.exposure_s;
+  meta.gain_db = controls.gain_db;
+  meta.focus_m = controls.focus_m;
   meta.has_joints = camera.mount != scene::CameraMount::kWorld;
   meta.joints.clear();
   meta.joint_names.reset();
