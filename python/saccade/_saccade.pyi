@@ -27,6 +27,9 @@ class core:
         camera: str
         time: float
         frame_index: int
+        exposure_s: float
+        gain_db: float
+        focus_m: float
         joints: Optional[npt.NDArray[np.float64]]
         K: Optional[Matrix]
         camera_model: Optional["geometry.CameraModel"]

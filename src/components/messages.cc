@@ -14,6 +14,7 @@ void RegisterMessages() {
   runtime::MessageRegistry& registry = runtime::MessageRegistry::Global();
   registry.Register<JointStateMessage>();
   registry.Register<JointCommand>();
+  registry.Register<CameraControlsMessage>();
   registry.Register<HeadStatusMessage>();
   registry.Register<FacesMessage>();
   registry.Register<CandidatesMessage>();

@@ -4,6 +4,8 @@
 #include <memory>
 
 #include "components/internal_scene.h"
+#include "saccade/components/accommodation_component.h"
+#include "saccade/components/auto_exposure_component.h"
 #include "saccade/components/debug_map.h"
 #include "saccade/components/explore_components.h"
 #include "saccade/components/fixation_component.h"
@@ -22,6 +24,10 @@ void RegisterComponents(runtime::ComponentRegistry& registry) {
   if (registry.Has("sim.cameras")) return;
   registry.Register<SimCameras>("sim.cameras", "renders the scene's cameras (OpenGL/EGL)");
   registry.Register<SimHead>("sim.head", "the head's motors under velocity/acceleration limits");
+  registry.Register<AutoExposureComponent>(
+      "camera.auto_exposure", "holds a camera's brightness at a target: exposure, then gain");
+  registry.Register<AccommodationComponent>("camera.accommodation",
+                                            "focuses both eyes at the distance they verge to");
   registry.Register<UndistortComponent>("vision.undistort", "removes lens distortion");
   registry.Register<MedianComponent>("vision.median", "median filter");
   registry.Register<SharpenComponent>("vision.sharpen", "unsharp-mask sharpening");

@@ -14,7 +14,9 @@
 
 namespace saccade::components {
 
-SimCameras::SimCameras() : joints_(AddInput<JointStateMessage>("joints")) {
+SimCameras::SimCameras()
+    : joints_(AddInput<JointStateMessage>("joints")),
+      controls_(AddInput<CameraControlsMessage>("controls")) {
   options_.cameras = {"left", "right"};
   DeclareParam("scene", &scene_param_, internal::kSceneParamDoc).Path();
   DeclareParam("cameras", &options_.cameras,
@@ -103,6 +105,8 @@ void SimCameras::Step(const runtime::StepContext& context) {
     state.joints = joints->positions;
     state.joint_velocities = joints->velocities;
   }
+  state.camera_controls = camera_controls_;  // commands of earlier steps
+  TakeControls();
   const int64_t frame_index = context.step;
   auto render = [this, state = std::move(state), frame_index] {
     return renderer_->Render(state, frame_index);
@@ -116,6 +120,37 @@ void SimCameras::Step(const runtime::StepContext& context) {
   for (std::size_t i = 0; i < frames.size() && i < outputs_.size(); ++i) {
     outputs_[i]->Emit(runtime::ImageMessage{frames[i].color});
   }
+}
+
+void SimCameras::TakeControls() {
+  const CameraControlsMessage* message = controls_.get();
+  if (message == nullptr || !controls_.fresh()) return;
+  std::map<std::string, scene::CameraControls> next = camera_controls_;
+  for (const CameraCommand& command : message->commands) {
+    std::vector<std::string> names;
+    if (command.camera == "all") {
+      for (const scene::CameraSpec& camera : scene_->cameras()) names.push_back(camera.name);
+    } else if (scene_->FindCamera(command.camera) == nullptr) {
+      std::string known;
+      for (const scene::CameraSpec& camera : scene_->cameras()) {
+        known += (known.empty() ? "" : ", ") + camera.name;
+      }
+      throw InvalidArgument(
+          fmt::format("{}: input 'controls': no camera '{}' in the scene (it has: {}; or \"all\")",
+                      name(), command.camera, known));
+    } else {
+      names.push_back(command.camera);
+    }
+    const scene::CameraControls commanded{command.exposure_s, command.gain_db, command.focus_m};
+    commanded.Validate(fmt::format("{}: input 'controls': camera '{}'", name(), command.camera));
+    for (const std::string& camera : names) {
+      scene::CameraControls& controls = next[camera];
+      if (commanded.exposure_s) controls.exposure_s = commanded.exposure_s;
+      if (commanded.gain_db) controls.gain_db = commanded.gain_db;
+      if (commanded.focus_m) controls.focus_m = commanded.focus_m;
+    }
+  }
+  camera_controls_ = std::move(next);
 }
 
 void SimCameras::Stop() {

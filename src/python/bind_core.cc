@@ -176,6 +176,15 @@ void BindCore(py::module_& m) {
       .def_property_readonly("frame_index",
                              [](const ImageRef& ref) { return ref.image->metadata().frame_index; })
       .def_property_readonly(
+          "exposure_s", [](const ImageRef& ref) { return ref.image->metadata().exposure_s; },
+          "The exposure time the frame was taken with, seconds (0: an instant).")
+      .def_property_readonly(
+          "gain_db", [](const ImageRef& ref) { return ref.image->metadata().gain_db; },
+          "The gain the frame was taken with, dB.")
+      .def_property_readonly(
+          "focus_m", [](const ImageRef& ref) { return ref.image->metadata().focus_m; },
+          "The focus distance the frame was taken with, metres (0: none).")
+      .def_property_readonly(
           "joints",
           [](const ImageRef& ref) -> py::object {
             const ImageMetadata& meta = ref.image->metadata();

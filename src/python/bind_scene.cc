@@ -15,7 +15,7 @@ void BindScene(py::module_& m) {
   py::class_<SceneState>(m, "SceneState", "Time (s), joints (rad) and joint velocities (rad/s).")
       .def(py::init(
                [](double time, const head::JointState& joints, const head::JointState& velocities) {
-                 return SceneState{time, joints, velocities};
+                 return SceneState{time, joints, velocities, {}};
                }),
            "time"_a = 0.0, "joints"_a = head::JointState{},
            "joint_velocities"_a = head::JointState{})

@@ -1,5 +1,6 @@
 #include "saccade/render/camera_chain.h"
 
+#include <algorithm>
 #include <cstring>
 
 #include "saccade/core/error.h"
@@ -49,6 +50,14 @@ CameraChain::CameraChain(const scene::CameraSpec& camera, const geometry::Camera
 FrameOptics CameraChain::FrameDefaults() const {
   FrameOptics frame;
   frame.focus_distance_m = lens_.focus_distance_m;
+  return frame;
+}
+
+FrameOptics CameraChain::FrameOf(double focus_m) const {
+  FrameOptics frame = FrameDefaults();
+  if (focus_m > 0.0) {
+    frame.focus_distance_m = std::max(focus_m, kNearestFocus * lens_.focal_length_m);
+  }
   return frame;
 }
 

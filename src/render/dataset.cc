@@ -154,6 +154,10 @@ json FrameRecord(int64_t index, double time, const std::vector<Frame>& frames,
     // Poses in geometry/json.h's one form, as everywhere else (4x4 nested, row by row).
     entry["X_WC"] = ToJson(*geometry::FindCameraPose(m));
     entry["exposure_samples"] = m.exposure_samples;
+    // The camera controls the frame was taken with (scene/camera_controls.h).
+    entry["exposure_s"] = m.exposure_s;
+    entry["gain_db"] = m.gain_db;
+    entry["focus_m"] = m.focus_m;
     if (m.has_joints) {
       json joints = json::object();
       for (size_t i = 0; i < m.joints.size() && m.joint_names; ++i) {

@@ -95,11 +95,12 @@ SensorModel::SensorModel(const scene::EmvaSensor& params, uint64_t seed, const s
   }
 }
 
-void SensorModel::Expose(const float* photons, int64_t frame_index, uint16_t* raw) const {
+void SensorModel::Expose(const float* photons, int64_t frame_index, uint16_t* raw,
+                         double gain) const {
   const uint64_t key =
       SensorMix(stream_ ^ SensorMix(kFrameStream + static_cast<uint64_t>(frame_index)));
   const double eta = params_.quantum_efficiency;
-  const double K = params_.gain_dn_per_e;
+  const double K = params_.gain_dn_per_e * gain;  // the camera's gain amplifies K
   const double sigma_d = params_.dark_noise_e;
   const double sat = params_.saturation_e;
   const double offset = params_.black_level_dn;
@@ -138,7 +139,8 @@ std::vector<uint16_t> SensorModel::ExposeUniform(double mean_photons, int64_t fr
 }
 
 std::vector<uint16_t> SensorModel::ExposeRendered(const ImageView& rendered, double exposure_s,
-                                                  int64_t frame_index, Image* image8) const {
+                                                  int64_t frame_index, Image* image8,
+                                                  double gain) const {
   const PixelFormat expected = channels_ == 3 ? PixelFormat::kRgb8 : PixelFormat::kGray8;
   if (rendered.width() != width_ || rendered.height() != height_ || rendered.format() != expected) {
     throw InvalidArgument(fmt::format(
@@ -155,7 +157,7 @@ std::vector<uint16_t> SensorModel::ExposeRendered(const ImageView& rendered, dou
     }
   }
   std::vector<uint16_t> raw(values());
-  Expose(photons.data(), frame_index, raw.data());
+  Expose(photons.data(), frame_index, raw.data(), gain);
   if (image8 != nullptr) To8Bit(raw.data(), image8);
   return raw;
 }

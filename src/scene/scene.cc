@@ -208,6 +208,27 @@ geometry::Pose Scene::ObjectPose(const Object& object, const SceneState& state) 
   return object.motion.PoseAt(state.time);
 }
 
+AppliedControls Scene::ControlsOf(const CameraSpec& camera, const SceneState& state) const {
+  const auto found = state.camera_controls.find(camera.name);
+  const double file_focus_m = camera.lens.HasDepthOfField() ? camera.lens.focus_distance_m : 0.0;
+  return ApplyControls(camera.sensor.exposure, file_focus_m,
+                       found == state.camera_controls.end() ? nullptr : &found->second);
+}
+
+void Scene::ValidateControls(const SceneState& state, const std::string& what) const {
+  for (const auto& [name, controls] : state.camera_controls) {
+    if (FindCamera(name) == nullptr) {
+      std::string names;
+      for (const CameraSpec& camera : cameras_) names += (names.empty() ? "" : ", ") + camera.name;
+      throw InvalidArgument(
+          fmt::format("{}: camera controls for '{}', a camera the scene does "
+                      "not have (it has: {})",
+                      what, name, names));
+    }
+    controls.Validate(fmt::format("{}: camera '{}'", what, name));
+  }
+}
+
 const CameraSpec* Scene::FindCamera(const std::string& name) const {
   for (const CameraSpec& camera : cameras_) {
     if (camera.name == name) return &camera;

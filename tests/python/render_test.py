@@ -51,6 +51,8 @@ def test_frames_are_zero_copy_views_of_the_cpp_images(renderer, scene):
     assert color.base.data_address == address and color.sum() > 0
     assert np.asarray(image).ctypes.data == address  # the buffer protocol, no copy either
     assert image.frame_index == 3
+    # The camera controls the frame was taken with: the file's (no exposure: an instant).
+    assert (image.exposure_s, image.gain_db, image.focus_m) == (0.0, 0.0, 0.0)
     assert image.K.shape == (3, 3) and image.X_WC.shape == (4, 4)
 
 

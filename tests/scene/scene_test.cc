@@ -254,7 +254,7 @@ TEST(RobotBody, EyesCannotSeeTheirOwnEyeNorTheHeadAnywhereWithinTheLimits) {
     head::JointState q = head::JointState::Popeye(0, 0, 0, 0);
     for (int joint = 0; joint < 4; ++joint) q[joint] = uniform(robot.head.joint(joint).limits);
     if (trial == 0) q = head::JointState::Popeye(0, 0, 0, 0);
-    SceneState state{0.0, q, {}};
+    SceneState state{0.0, q, {}, {}};
     const int left_eye = robot.head.tree().FindLink("left_eye_link");
     const int right_eye = robot.head.tree().FindLink("right_eye_link");
     for (const RobotPart& part : robot.parts) {

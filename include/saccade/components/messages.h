@@ -12,6 +12,7 @@
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <opencv2/core.hpp>
+#include <optional>
 #include <string>
 #include <tuple>
 #include <vector>
@@ -127,6 +128,22 @@ struct SelectionMessage {
   std::vector<Eigen::Vector3d> suppressed_W;  ///< places inhibition of return suppresses
 };
 
+/// A command of one camera's controls (scene/camera_controls.h): each absent value unchanged.
+struct CameraCommand {
+  std::string camera;                ///< a camera's name, or "all"
+  std::optional<double> exposure_s;  ///< s, in (0, 1]
+  std::optional<double> gain_db;     ///< dB, in [0, 48]
+  std::optional<double> focus_m;     ///< m, > 0
+};
+
+/// Commands of the cameras' exposure, gain and focus (camera.auto_exposure,
+/// camera.accommodation; sim.cameras' `controls` input applies them to the next step's
+/// frames, as a real camera takes a new exposure at the next frame).
+struct CameraControlsMessage {
+  double time = 0.0;                    ///< s, when they were issued
+  std::vector<CameraCommand> commands;  ///< in order: a later value replaces an earlier one
+};
+
 /// One eye's CamShift track of the selected target (vision.camshift).
 struct TrackMessage {
   std::shared_ptr<const Image> image;
@@ -215,6 +232,14 @@ struct JsonCodec<components::InhibitedPlace> : JsonObjectCodec<components::Inhib
 };
 
 template <>
+struct JsonCodec<components::CameraCommand> : JsonObjectCodec<components::CameraCommand> {
+  using T = components::CameraCommand;
+  static constexpr auto kFields =
+      std::make_tuple(JsonField("camera", &T::camera), JsonField("exposure_s", &T::exposure_s),
+                      JsonField("gain_db", &T::gain_db), JsonField("focus_m", &T::focus_m));
+};
+
+template <>
 struct JsonCodec<components::FaceCandidate> : JsonObjectCodec<components::FaceCandidate> {
   using T = components::FaceCandidate;
   static constexpr auto kFields = std::make_tuple(
@@ -246,6 +271,15 @@ struct MessageTraits<components::JointCommand> : FieldMessage<components::JointC
   static constexpr auto kFields = std::make_tuple(
       JsonField("time", &T::time), JsonField("positions", &T::positions),
       JsonField("velocities", &T::velocities), JsonField("target_id", &T::target_id));
+};
+
+template <>
+struct MessageTraits<components::CameraControlsMessage>
+    : FieldMessage<components::CameraControlsMessage> {
+  using T = components::CameraControlsMessage;
+  static constexpr const char* kName = "camera.controls";
+  static constexpr auto kFields =
+      std::make_tuple(JsonField("time", &T::time), JsonField("commands", &T::commands));
 };
 
 template <>

@@ -3,7 +3,15 @@
 //   output per camera of its `cameras` parameter.
 //   inputs:  joints (head.joints, optional): the head's state at this step's time; connect
 //            it from sim.head with delay 1. Without it, the scene's initial joints.
-//   outputs: <camera> (runtime.image) per camera, shared; frame index = step.
+//            controls (camera.controls, optional): exposure, gain and focus commands
+//            (camera.auto_exposure, camera.accommodation). A command received in step t
+//            applies from the frame of step t + 1 on (a real camera's latency: the exposure
+//            under way is not changed; with the usual `delay: 1` connection a command sent in
+//            step t reaches frame t + 2) and holds until another replaces it; "all" commands
+//            every camera of the scene. An unknown camera or a value out of range is an error
+//            naming the component. Without commands, the file's values.
+//   outputs: <camera> (runtime.image) per camera, shared; frame index = step. The metadata
+//            carries the exposure, gain and focus the frame was taken with.
 //   The renderer lives on a thread of its own (its GL context current there). Pipelined
 //   capture (`pipelined`: always, or auto with the real-time clock): each step hands this
 //   step's state to that thread and emits the frames of the previous step's, which rendered
@@ -13,6 +21,7 @@
 //   takes its commands meanwhile).
 // Parameters: declared in the constructor (docs/components.md lists them).
 #include <future>
+#include <map>
 #include <memory>
 #include <optional>
 #include <string>
@@ -52,8 +61,14 @@ class SimCameras : public runtime::Component, public EyeCamerasRole {
   void Configured() override;
 
  private:
+  // Merges this step's commands into camera_controls_ (they apply from the next step).
+  void TakeControls();
+
   std::string scene_param_;
   runtime::Input<JointStateMessage>& joints_;
+  runtime::Input<CameraControlsMessage>& controls_;
+  // The commands in force (scene::SceneState::camera_controls), by camera name.
+  std::map<std::string, scene::CameraControls> camera_controls_;
   std::vector<runtime::Output<runtime::ImageMessage>*> outputs_;
   std::shared_ptr<const scene::Scene> scene_;
   render::RendererOptions options_;

@@ -79,7 +79,12 @@ struct ImageMetadata {
   int64_t frame_index = 0;   ///< 0, 1, 2, ... per camera
   TypedValues typed;         ///< the camera model and pose
   int exposure_samples = 1;  ///< sub-frames the exposure was drawn in (motion blur)
-  bool has_joints = false;   ///< whether the camera rides on a head
+  /// The controls the frame was taken with (scene/camera_controls.h): exposure time, seconds
+  /// (0: an instant), gain, dB, and focus distance, metres (0: none given).
+  double exposure_s = 0.0;
+  double gain_db = 0.0;
+  double focus_m = 0.0;
+  bool has_joints = false;  ///< whether the camera rides on a head
   /// The head's joint values at capture (rad, or m for a prismatic joint), named by
   /// `joint_names` in the same order (shared by every image of the head).
   std::vector<double> joints;

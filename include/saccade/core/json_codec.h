@@ -22,6 +22,7 @@
 #include <cstdint>
 #include <memory>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 #include <tuple>
 #include <type_traits>
@@ -105,6 +106,19 @@ struct JsonCodec<std::vector<T>> {
       out.push_back(JsonCodec<T>::Decode(j[i], {at.object, fmt::format("{}[{}]", at.key, i)}));
     }
     return out;
+  }
+};
+
+/// A value that may be absent: null (or a missing field) for none.
+template <typename T>
+struct JsonCodec<std::optional<T>> {
+  static constexpr bool kOptional = true;
+  static nlohmann::json Encode(const std::optional<T>& v) {
+    return v ? JsonCodec<T>::Encode(*v) : nlohmann::json(nullptr);
+  }
+  static std::optional<T> Decode(const nlohmann::json& j, const JsonWhere& at) {
+    if (j.is_null()) return std::nullopt;
+    return JsonCodec<T>::Decode(j, at);
   }
 };
 

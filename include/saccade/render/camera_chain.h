@@ -49,6 +49,11 @@ class CameraChain {
 
   /// The frame's values from the scene (the lens's focus distance).
   FrameOptics FrameDefaults() const;
+  /// The frame's values with a commanded focus distance (`focus_m` > 0; 0: the scene's). A
+  /// lens does not focus nearer than its focal length: a command nearer focuses at
+  /// kNearestFocus times the focal length.
+  FrameOptics FrameOf(double focus_m) const;
+  static constexpr double kNearestFocus = 1.01;
   /// Vignetting, then depth of field from `depth` (kFloat32, Frame::depth's meaning; needed
   /// when depth_of_field()), on a kRgb8 image in place.
   void ApplyOptics(Image* rgb, const Image* depth, const FrameOptics& frame) const;

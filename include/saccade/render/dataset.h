@@ -56,8 +56,9 @@ class FrameSink {
 };
 
 /// One frame's record, as frames.jsonl holds it: {"frame", "time", "cameras": {name: {width,
-/// height, K, distortion, X_WC, exposure_samples, joints, and with `truth` the objects' boxes
-/// and poses}}}. `files`: each camera's image files too (file, depth, ids).
+/// height, K, distortion, X_WC, exposure_samples, exposure_s, gain_db, focus_m, joints, and
+/// with `truth` the objects' boxes and poses}}}. `files`: each camera's image files too (file,
+/// depth, ids).
 nlohmann::json FrameRecord(int64_t index, double time, const std::vector<Frame>& frames,
                            const TruthRequest& truth, bool scene_has_objects, bool files);
 

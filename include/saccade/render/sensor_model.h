@@ -40,7 +40,9 @@ class SensorModel {
 
   /// One frame: `photons` holds values() mean photon counts (row-major, channels interleaved),
   /// `raw` receives values() DN. Does not throw; deterministic in (seed, camera, frame_index).
-  void Expose(const float* photons, int64_t frame_index, uint16_t* raw) const;
+  /// `gain`: the camera's analogue gain as a factor (>= 1), which multiplies K (the noise in
+  /// electrons stays, the DN per electron grow); 1: the data sheet's K, the same bits as ever.
+  void Expose(const float* photons, int64_t frame_index, uint16_t* raw, double gain = 1.0) const;
 
   /// A uniform exposure of `mean_photons` a pixel (a flat field; 0: a dark field).
   std::vector<uint16_t> ExposeUniform(double mean_photons, int64_t frame_index) const;
@@ -48,9 +50,10 @@ class SensorModel {
   /// A rendered kRgb8 image (channels() 3), its values the radiance proxy: mu_p = value / 255 *
   /// photons_per_second * exposure_s. Returns the raw DN (values()), and, when `image8` is not
   /// null, writes the raw DN scaled to 8 bits (round(y * 255 / (2^bits - 1))) into it
-  /// (`image8` may be `rendered`). Throws InvalidArgument on a size or format mismatch.
+  /// (`image8` may be `rendered`). `gain` as for Expose (a commanded gain, 10^(dB / 20)).
+  /// Throws InvalidArgument on a size or format mismatch.
   std::vector<uint16_t> ExposeRendered(const ImageView& rendered, double exposure_s,
-                                       int64_t frame_index, Image* image8) const;
+                                       int64_t frame_index, Image* image8, double gain = 1.0) const;
 
   /// Raw DN to 8 bits in place of an image of the sensor's size (kRgb8 for 3 channels, kGray8
   /// for 1): round(y * 255 / (2^bits - 1)).

@@ -12,6 +12,7 @@
 #include <Eigen/Geometry>
 #include <cstdint>
 #include <filesystem>
+#include <map>
 #include <memory>
 #include <optional>
 #include <string>
@@ -23,6 +24,7 @@
 #include "saccade/geometry/pose.h"
 #include "saccade/head/head_model.h"
 #include "saccade/head/joint_state.h"
+#include "saccade/scene/camera_controls.h"
 #include "saccade/scene/camera_optics.h"
 #include "saccade/scene/emva_sensor.h"
 
@@ -205,6 +207,10 @@ struct SceneState {
   /// constant rate, which blurs the eye cameras' images (SensorSpec::exposure). Empty or
   /// zero: still.
   head::JointState joint_velocities;
+  /// Commanded exposure, gain and focus by camera name (camera_controls.h); a camera absent
+  /// here, or a control absent from its entry, keeps the file's value. Every name must be a
+  /// camera of the scene and every value in range (Renderer::Submit throws InvalidArgument).
+  std::map<std::string, CameraControls> camera_controls;
 };
 
 /// How Scene::Load reads a file, beyond what the file says.
@@ -244,6 +250,12 @@ class Scene {
   SceneState InitialState() const;
   /// X_WC of a camera in a state (FK for eye-mounted cameras).
   geometry::Pose CameraPose(const CameraSpec& camera, const SceneState& state) const;
+  /// The exposure, gain and focus a camera takes its frame of `state` with: the state's
+  /// commands over the file's values (camera_controls.h). Never throws.
+  AppliedControls ControlsOf(const CameraSpec& camera, const SceneState& state) const;
+  /// Throws InvalidArgument, starting with `what`, when state.camera_controls names a camera
+  /// the scene does not have or holds a value out of range.
+  void ValidateControls(const SceneState& state, const std::string& what) const;
   /// X_WO of an object in a state.
   geometry::Pose ObjectPose(const Object& object, const SceneState& state) const;
   /// The camera named `name`, or nullptr.

@@ -472,6 +472,7 @@ void GlRenderer::Submit(const scene::SceneState& state, int64_t frame_index) {
         in_flight_, pending_[oldest_].frame_index,
         pending_[(oldest_ + 1) % CameraTarget::kSlots].frame_index));
   }
+  scene_.ValidateControls(state, "Renderer::Submit");
   context_.MakeCurrent();
   const Clock::time_point start = Clock::now();
   const int slot = (oldest_ + in_flight_) % CameraTarget::kSlots;
@@ -813,7 +814,7 @@ GlRenderer::ExposurePlan GlRenderer::PlanExposure(int camera,
   // exposure needs for no step between sub-frames to exceed a pixel (1 when nothing moves:
   // one instant), up to the scene's blur_samples.
   if (setup.blur) {
-    const double exposure = spec.sensor.exposure;
+    const double exposure = scene_.ControlsOf(spec, state).exposure_s;  // the commanded one
     const double motion_px =
         ImageMotionPx(camera, StateAfter(state, -0.5 * exposure), StateAfter(state, 0.5 * exposure),
                       &plan.camera_px, &plan.item_px,
@@ -891,7 +892,7 @@ void GlRenderer::DrawTurnStretches(int camera, const scene::SceneState& state,
   const int count = static_cast<int>(plan.sub_states.size()), stretches = plan.stretches;
   const Eigen::Matrix3d K = effects.lens().views[0].intrinsics.Matrix();
   const Eigen::Matrix3d K_inv = K.inverse();
-  const double exposure = spec.sensor.exposure;
+  const double exposure = scene_.ControlsOf(spec, state).exposure_s;
   std::vector<Eigen::Matrix3f> homographies;
   for (int g = 0; g < stretches; ++g) {
     const int first = g * count / stretches, end = (g + 1) * count / stretches;

@@ -311,8 +311,9 @@ class GlRenderer final : public Renderer {
     std::shared_ptr<Image> depth;     // the depth of field's
     const uint8_t* levels = nullptr;  // the late noise's NoiseLevels
     int64_t frame_index = 0;
+    scene::AppliedControls controls;  // the frame's exposure, gain and focus
   };
-  bool HasChainWork(int camera) const;
+  bool HasChainWork(int camera, const ChainJob& job) const;
   void ApplyChains(std::vector<ChainJob>* jobs, std::vector<Frame>* frames);
   void ApplyChain(int camera, const ChainJob& job, Frame* frame);
   // The legacy noise of a camera (the final pass's, bit for bit) on an RGB image in place.
@@ -331,9 +332,11 @@ class GlRenderer final : public Renderer {
   // null: none) and with its noise (null: none; one of them at least).
   const uint8_t* LevelsFor(const NoiseParams& noise);
   // A camera's EMVA 1288 sensor (scene::SensorSpec::emva) on its colour frame, in place: on
-  // the CPU after readback, on every device (render/sensor_model.h); the model made once (its
-  // slot in sensor_models_ made by ApplyChains).
-  void ApplySensor(int camera, Image* image);
+  // the CPU after readback, on every device (render/sensor_model.h); the model made once. With
+  // the frame's commanded exposure and gain (`controls`); without an EMVA sensor (or with the
+  // noise off) a commanded exposure and gain scale the 8-bit values instead
+  // (AppliedControls::BrightnessFactor); nothing commanded: nothing changes.
+  void ApplySensor(int camera, const scene::AppliedControls& controls, Image* image);
   void ConvertRows(int camera, bool lens, const CpuTurn* turn, const uint8_t* pixels,
                    const CpuNoise* noise, Image* image, int first_row, int end_row) const;
 

@@ -2,7 +2,10 @@
 // from its pixel buffer objects into a pooled image, with the frame's metadata.
 #include <fmt/format.h>
 
+#include <algorithm>
+#include <array>
 #include <atomic>
+#include <cmath>
 #include <cstring>
 #include <exception>
 #include <thread>
@@ -14,6 +17,21 @@
 #include "saccade/geometry/image_camera.h"
 
 namespace saccade::render::gl {
+namespace {
+
+// A commanded exposure and gain without an EMVA sensor: every 8-bit value times `factor`,
+// rounded and clipped at 255 (the sensor saturates), through a table.
+void ScaleBrightness(double factor, Image* image) {
+  if (factor == 1.0) return;  // commanded as the file says
+  std::array<uint8_t, 256> table;
+  for (int v = 0; v < 256; ++v) {
+    table[v] = static_cast<uint8_t>(std::min(255.0, std::round(v * factor)));
+  }
+  uint8_t* p = image->data();
+  for (std::size_t i = 0, n = image->size_bytes(); i < n; ++i) p[i] = table[p[i]];
+}
+
+}  // namespace
 
 std::shared_ptr<Image> GlRenderer::NewImage(int camera) {
   const geometry::Intrinsics& K = cameras_[camera]->model.intrinsics();
@@ -115,6 +133,7 @@ std::vector<Frame> GlRenderer::Retrieve() {
       FillTruth(static_cast<int>(i), pending, slot, &frame, dof ? &job.depth : nullptr);
     job.image = image.get();
     job.frame_index = pending.frame_index;
+    job.controls = scene_.ControlsOf(*cameras_[i], pending.state);
     if (setup.late_noise)
       job.levels = LevelsFor(LateNoiseParams(static_cast<int>(i), job.frame_index));
     frames.push_back(std::move(frame));
@@ -127,16 +146,16 @@ std::vector<Frame> GlRenderer::Retrieve() {
   return frames;
 }
 
-bool GlRenderer::HasChainWork(int camera) const {
+bool GlRenderer::HasChainWork(int camera, const ChainJob& job) const {
   const CameraSetup& setup = setups_[camera];
-  return setup.chain != nullptr || setup.late_noise ||
+  return setup.chain != nullptr || setup.late_noise || job.controls.commanded ||
          (options_.noise && cameras_[camera]->sensor.emva.has_value());
 }
 
 void GlRenderer::ApplyChains(std::vector<ChainJob>* jobs, std::vector<Frame>* frames) {
   std::vector<std::size_t> work;
   for (std::size_t i = 0; i < jobs->size(); ++i) {
-    if (HasChainWork(static_cast<int>(i))) work.push_back(i);
+    if (HasChainWork(static_cast<int>(i), (*jobs)[i])) work.push_back(i);
   }
   if (work.empty()) return;
   if (sensor_models_.size() != cameras_.size()) sensor_models_.resize(cameras_.size());
@@ -173,12 +192,11 @@ void GlRenderer::ApplyChain(int camera, const ChainJob& job, Frame* frame) {
   const CameraChain* chain = setup.chain.get();
   Image* image = job.image;
   if (chain != nullptr && chain->optics()) {
-    // The frame's values, resolved once: the scene's (a per-frame command may replace them).
-    const FrameOptics optics = chain->FrameDefaults();
-    chain->ApplyOptics(image, job.depth.get(), optics);
+    // The frame's values, resolved once: the focus distance commanded, else the scene's.
+    chain->ApplyOptics(image, job.depth.get(), chain->FrameOf(job.controls.focus_m));
   }
   if (setup.late_noise) ApplyLateNoise(camera, job.frame_index, job.levels, image);
-  if (options_.noise && cameras_[camera]->sensor.emva) ApplySensor(camera, image);
+  ApplySensor(camera, job.controls, image);
   if (chain != nullptr && chain->color()) frame->raw = chain->ApplyColor(image);
 }
 
@@ -207,14 +225,20 @@ void GlRenderer::ApplyLateNoise(int camera, int64_t frame_index, const uint8_t* 
   }
 }
 
-void GlRenderer::ApplySensor(int camera, Image* image) {
+void GlRenderer::ApplySensor(int camera, const scene::AppliedControls& controls, Image* image) {
   const scene::CameraSpec& spec = *cameras_[camera];
+  const bool emva = options_.noise && spec.sensor.emva;
+  if (!emva) {
+    if (controls.commanded) ScaleBrightness(controls.BrightnessFactor(), image);
+    return;
+  }
   std::unique_ptr<SensorModel>& model = sensor_models_[camera];  // sized by ApplyChains
   if (!model) {
     model = std::make_unique<SensorModel>(*spec.sensor.emva, spec.sensor.seed, spec.name,
                                           image->width(), image->height(), 3);
   }
-  model->ExposeRendered(image->view(), spec.sensor.exposure, image->metadata().frame_index, image);
+  model->ExposeRendered(image->view(), controls.exposure_s, image->metadata().frame_index, image,
+                        controls.GainFactor());
 }
 
 const uint8_t* GlRenderer::LevelsFor(const NoiseParams& noise) {
@@ -270,6 +294,10 @@ void GlRenderer::Describe(int camera_index, const Pending& pending, ImageMetadat
   geometry::SetCameraModel(meta, setup.rendered);
   geometry::SetCameraPose(meta, pending.X_WC[i]);
   meta.exposure_samples = pending.exposure_samples[i];
+  const scene::AppliedControls controls = scene_.ControlsOf(camera, pending.state);
+  meta.exposure_s = controls.exposure_s;
+  meta.gain_db = controls.gain_db;
+  meta.focus_m = controls.focus_m;
   meta.has_joints = camera.mount != scene::CameraMount::kWorld;
   meta.joints.clear();
   meta.joint_names.reset();
