@@ -275,5 +275,31 @@ TEST(CameraChain, DepthOfFieldKeepsTheFocusSharpAndBlursByTheCircleOfConfusion) 
   EXPECT_TRUE(SamePixels(with_depth[1].color->view(), frames[1].color->view()));
 }
 
+// A commanded focus distance (scene::SceneState::camera_controls, as camera.accommodation sends
+// it) replaces the lens's for that frame: both cameras focused at 3 m, the far edge is as sharp
+// as without the lens and the near one blurs by the circle of confusion of 1 m seen from 3 m.
+TEST(CameraChain, ACommandedFocusDistanceMovesTheDepthOfField) {
+  const scene::Scene world = SceneFrom(kDepthOfField);
+  scene::SceneState state = world.InitialState();
+  state.camera_controls["near"].focus_m = 3.0;
+  state.camera_controls["far"].focus_m = 3.0;
+  std::unique_ptr<Renderer> renderer = MakeRenderer(world, {});
+  const std::vector<Frame> frames = renderer->Render(state, 0);
+  RendererOptions sharp_options;
+  sharp_options.optics = false;
+  const std::vector<Frame> sharp = RenderOnce(world, sharp_options);
+  ASSERT_EQ(frames.size(), 2u);
+  EXPECT_DOUBLE_EQ(frames[0].color->metadata().focus_m, 3.0);
+  const int row = 40;
+  EXPECT_NEAR(EdgeWidth(*frames[1].color, row), EdgeWidth(*sharp[1].color, row), 0.1);
+  const scene::CameraSpec& camera = *world.FindCamera("near");
+  const double coc =
+      CircleOfConfusionPx(ToThinLensOptions(camera.lens, 3.0), camera.model.intrinsics(), 1.0);
+  EXPECT_GT(coc, 8.0);
+  EXPECT_NEAR(EdgeWidth(*frames[0].color, row) / 0.687 / coc, 1.0, 0.10);
+  // Without a command the frame says the lens's own focus distance.
+  EXPECT_DOUBLE_EQ(sharp[0].color->metadata().focus_m, 1.0);
+}
+
 }  // namespace
 }  // namespace saccade::render
