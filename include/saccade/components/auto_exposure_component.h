@@ -11,10 +11,12 @@
 // scale, of every `subsample`-th pixel of every `subsample`-th row, weighted by
 // 1 - centre_weight * r^2 with r the distance from the centre over the half-diagonal), in log
 // exposure x gain (L = ln exposure_s + gain_dB * ln(10) / 20):
-//   L_ideal = L_frame + ln(target / max(m, 0.5 / 255))   L_frame: what the frame was taken with
-//   L_new   = L_last + damping * (L_ideal - L_last)       L_last: the last command (L_frame at
-//   first) exposure = clamp(e^L_new, min_exposure_s, max_exposure_s), then gain_dB  = clamp((L_new
-//   - ln exposure) * 20 / ln(10), 0, max_gain_db)
+//   L_ideal  = L_frame + ln(target / max(m, 0.5 / 255))
+//   L_new    = L_last + damping * (L_ideal - L_last)
+//   exposure = clamp(e^L_new, min_exposure_s, max_exposure_s)
+//   gain_dB  = clamp((L_new - ln exposure) * 20 / ln(10), 0, max_gain_db)
+// where L_frame is what the frame was taken with and L_last the last command (L_frame at
+// first).
 // L_ideal comes from the frame's own setting (its metadata), so a frame taken before the last
 // command applied (the camera's latency) estimates the same ideal rather than asking for the
 // step again: the loop does not wind up. The command approaches the ideal by the factor
