@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cstring>
+#include <utility>
 
 #include "saccade/core/error.h"
 
@@ -72,9 +73,11 @@ void CameraChain::ApplyOptics(Image* rgb, const Image* depth, const FrameOptics&
   }
 }
 
-std::shared_ptr<Image> CameraChain::ApplyColor(Image* rgb) const {
+std::shared_ptr<Image> CameraChain::ApplyColor(Image* rgb, Image* mosaic) const {
   if (!color_) return nullptr;
-  ColorImages images = ApplyColorPipeline(rgb->view(), options_);
+  ColorImages images = mosaic != nullptr && options_.cfa != CfaPattern::kNone
+                           ? ApplyColorPipelineToMosaic(std::move(*mosaic), options_)
+                           : ApplyColorPipeline(rgb->view(), options_);
   for (int y = 0; y < rgb->height(); ++y) {
     std::memcpy(rgb->row(y), images.rgb.row(y), 3 * static_cast<std::size_t>(rgb->width()));
   }

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <string>
+#include <utility>
 
 #include "saccade/core/error.h"
 
@@ -369,7 +370,20 @@ ColorImages ApplyColorPipeline(const ImageView& linear_rgb, const ColorOptions& 
     ApplyWhiteBalanceAndTone(out.rgb, options.white_balance, options.tone_curve);
     return out;
   }
-  out.raw = Mosaic(linear_rgb, options.cfa);
+  return ApplyColorPipelineToMosaic(Mosaic(linear_rgb, options.cfa), options);
+}
+
+ColorImages ApplyColorPipelineToMosaic(Image mosaic, const ColorOptions& options) {
+  options.Validate();
+  if (options.cfa == CfaPattern::kNone || PatternOf(mosaic.format()) != options.cfa ||
+      BytesPerPixel(mosaic.format()) != 1) {
+    throw InvalidArgument(fmt::format(
+        "ApplyColorPipelineToMosaic: a {} mosaic with the colour filter '{}', expected {}",
+        ToString(mosaic.format()), ToString(options.cfa),
+        options.cfa == CfaPattern::kNone ? "a filter array" : ToString(BayerFormat(options.cfa))));
+  }
+  ColorImages out;
+  out.raw = std::move(mosaic);
   ApplyWhiteBalanceToMosaic(out.raw, options.white_balance);
   out.rgb = Demosaic(out.raw.view(), options.demosaic);
   ApplyWhiteBalanceAndTone(out.rgb, WhiteBalance{}, options.tone_curve);

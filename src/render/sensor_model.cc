@@ -59,6 +59,13 @@ double SensorPoisson(double lambda, uint64_t bits) {
   return k;
 }
 
+// Whether an image of `format` holds a sensor's values of `channels`: kRgb8 for 3; kGray8 or
+// an 8-bit Bayer mosaic (one photosite a pixel) for 1.
+bool Fits(PixelFormat format, int channels) {
+  if (channels == 3) return format == PixelFormat::kRgb8;
+  return format == PixelFormat::kGray8 || (IsBayer(format) && BytesPerPixel(format) == 1);
+}
+
 uint64_t HashName(uint64_t seed, const std::string& name) {
   uint64_t h = 1469598103934665603ULL;  // FNV-1a
   for (const char c : name) h = (h ^ static_cast<unsigned char>(c)) * 1099511628211ULL;
@@ -142,7 +149,8 @@ std::vector<uint16_t> SensorModel::ExposeRendered(const ImageView& rendered, dou
                                                   int64_t frame_index, Image* image8,
                                                   double gain) const {
   const PixelFormat expected = channels_ == 3 ? PixelFormat::kRgb8 : PixelFormat::kGray8;
-  if (rendered.width() != width_ || rendered.height() != height_ || rendered.format() != expected) {
+  if (rendered.width() != width_ || rendered.height() != height_ ||
+      !Fits(rendered.format(), channels_)) {
     throw InvalidArgument(fmt::format(
         "SensorModel::ExposeRendered: expected a {} x {} {} image, got {} x {} {}", width_, height_,
         ToString(expected), rendered.width(), rendered.height(), ToString(rendered.format())));
@@ -164,7 +172,8 @@ std::vector<uint16_t> SensorModel::ExposeRendered(const ImageView& rendered, dou
 
 void SensorModel::To8Bit(const uint16_t* raw, Image* image8) const {
   const PixelFormat expected = channels_ == 3 ? PixelFormat::kRgb8 : PixelFormat::kGray8;
-  if (image8->width() != width_ || image8->height() != height_ || image8->format() != expected) {
+  if (image8->width() != width_ || image8->height() != height_ ||
+      !Fits(image8->format(), channels_)) {
     throw InvalidArgument(fmt::format(
         "SensorModel::To8Bit: expected a {} x {} {} image, got {} x {} {}", width_, height_,
         ToString(expected), image8->width(), image8->height(), ToString(image8->format())));

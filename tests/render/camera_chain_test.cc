@@ -26,6 +26,7 @@
 #include "saccade/render/dataset.h"
 #include "saccade/render/lens_optics.h"
 #include "saccade/render/renderer.h"
+#include "saccade/render/sensor_model.h"
 #include "saccade/scene/scene.h"
 #include "scratch_dir.h"
 
@@ -112,6 +113,45 @@ TEST(CameraChain, ColourFramesAreTheLibrarysPipelineOfThePlainFrames) {
   cv::demosaicing(mosaic, rgb, cv::COLOR_BayerGR2RGB_EA);
   const ImageView opencv(rgb.data, rgb.cols, rgb.rows, PixelFormat::kRgb8, rgb.step);
   EXPECT_TRUE(SamePixels(linear.color->view(), opencv));
+}
+
+// A Bayer camera with an EMVA sensor exposes its mosaic, a photosite a pixel (one value, not
+// three): the raw mosaic is a 1-channel SensorModel's exposure of the plain frame's mosaic, white
+// balanced, bit for bit, and the image is cv::demosaicing of it.
+TEST(CameraChain, AnEmvaSensorBehindAColourFilterExposesTheMosaic) {
+  const scene::Scene world = SceneFrom(R"(
+background: [0.3, 0.5, 0.9]
+lights: [{type: ambient, intensity: 0.6}, {type: directional, direction: [1, 0.3, -1], intensity: 0.6}]
+ground: {pattern: checker, cell: 0.2, color: [0.9, 0.5, 0.2], color2: [0.1, 0.3, 0.8]}
+cameras:
+  - name: bayer
+    calibration: {width: 160, height: 120, fx: 120, fy: 120}
+    look_at: {eye: [0, 0, 1], target: [2, 0, 0.3]}
+    sensor: {exposure_ms: 8, seed: 5, emva: {preset: imx174},
+             color: {cfa: bggr, white_balance: {red: 1.25, blue: 1.5}}}
+)");
+  RendererOptions plain_options;
+  plain_options.color = false;
+  plain_options.noise = false;
+  const std::vector<Frame> frames = RenderOnce(world);
+  const std::vector<Frame> plain = RenderOnce(world, plain_options);
+  ASSERT_NE(frames[0].raw, nullptr);
+  const scene::CameraSpec& camera = *world.FindCamera("bayer");
+  Image expected = Mosaic(plain[0].color->view(), CfaPattern::kBggr);
+  const SensorModel sensor(*camera.sensor.emva, camera.sensor.seed, camera.name, 160, 120, 1);
+  sensor.ExposeRendered(expected.view(), camera.sensor.exposure, 0, &expected);
+  ApplyWhiteBalanceToMosaic(expected, ToColorOptions(camera.sensor.color).white_balance);
+  EXPECT_TRUE(SamePixels(frames[0].raw->view(), expected.view()));
+  // Not the noiseless mosaic: the sensor's noise is in it.
+  Image noiseless = Mosaic(plain[0].color->view(), CfaPattern::kBggr);
+  ApplyWhiteBalanceToMosaic(noiseless, ToColorOptions(camera.sensor.color).white_balance);
+  EXPECT_FALSE(SamePixels(frames[0].raw->view(), noiseless.view()));
+  const cv::Mat mosaic(120, 160, CV_8UC1, const_cast<uint8_t*>(frames[0].raw->data()),
+                       frames[0].raw->stride());
+  cv::Mat rgb;
+  cv::demosaicing(mosaic, rgb, cv::COLOR_BayerRG2RGB);  // bggr is OpenCV's BayerRG
+  EXPECT_TRUE(SamePixels(frames[0].color->view(),
+                         ImageView(rgb.data, 160, 120, PixelFormat::kRgb8, rgb.step)));
 }
 
 TEST(CameraChain, TheDataSetHoldsTheRawMosaicAndItsPattern) {

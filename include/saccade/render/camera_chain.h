@@ -59,8 +59,9 @@ class CameraChain {
   void ApplyOptics(Image* rgb, const Image* depth, const FrameOptics& frame) const;
   /// The colour half on a kRgb8 image in place (the demosaiced, tone-encoded image); returns
   /// the raw mosaic (kBayer*8, white balanced, with the image's metadata) when there is a
-  /// filter array, else null.
-  std::shared_ptr<Image> ApplyColor(Image* rgb) const;
+  /// filter array, else null. `mosaic` (with a filter array): the sensor's mosaic of `rgb`
+  /// (Mosaic, then exposed by the sensor) to demosaic instead of mosaicing `rgb`; moved from.
+  std::shared_ptr<Image> ApplyColor(Image* rgb, Image* mosaic = nullptr) const;
 
  private:
   scene::LensSpec lens_;

@@ -132,5 +132,9 @@ struct ColorImages {
 /// Demosaic, then the tone curve; without a filter array, white balance and tone on the RGB.
 /// Throws InvalidArgument for another format or invalid options.
 ColorImages ApplyColorPipeline(const ImageView& linear_rgb, const ColorOptions& options);
+/// The same from the sensor's mosaic (kBayer*8 of options.cfa's pattern: Mosaic's, then a
+/// sensor's noise): white balance, Demosaic, tone. Throws InvalidArgument when options.cfa is
+/// kNone, the mosaic's pattern differs, or an option is invalid.
+ColorImages ApplyColorPipelineToMosaic(Image mosaic, const ColorOptions& options);
 
 }  // namespace saccade::render

@@ -47,7 +47,8 @@ class SensorModel {
   /// A uniform exposure of `mean_photons` a pixel (a flat field; 0: a dark field).
   std::vector<uint16_t> ExposeUniform(double mean_photons, int64_t frame_index) const;
 
-  /// A rendered kRgb8 image (channels() 3), its values the radiance proxy: mu_p = value / 255 *
+  /// A rendered kRgb8 image (channels() 3; with 1 channel a kGray8 image or an 8-bit Bayer
+  /// mosaic, a photosite a pixel), its values the radiance proxy: mu_p = value / 255 *
   /// photons_per_second * exposure_s. Returns the raw DN (values()), and, when `image8` is not
   /// null, writes the raw DN scaled to 8 bits (round(y * 255 / (2^bits - 1))) into it
   /// (`image8` may be `rendered`). `gain` as for Expose (a commanded gain, 10^(dB / 20)).
@@ -56,7 +57,7 @@ class SensorModel {
                                        int64_t frame_index, Image* image8, double gain = 1.0) const;
 
   /// Raw DN to 8 bits in place of an image of the sensor's size (kRgb8 for 3 channels, kGray8
-  /// for 1): round(y * 255 / (2^bits - 1)).
+  /// or an 8-bit Bayer mosaic for 1): round(y * 255 / (2^bits - 1)).
   void To8Bit(const uint16_t* raw, Image* image8) const;
 
  private:

@@ -196,6 +196,14 @@ void GlRenderer::ApplyChain(int camera, const ChainJob& job, Frame* frame) {
     chain->ApplyOptics(image, job.depth.get(), chain->FrameOf(job.controls.focus_m));
   }
   if (setup.late_noise) ApplyLateNoise(camera, job.frame_index, job.levels, image);
+  if (chain != nullptr && chain->cfa() && options_.noise && cameras_[camera]->sensor.emva) {
+    // A Bayer sensor's photosites see one colour each: the EMVA sensor exposes the mosaic (a
+    // value a pixel, not three), which demosaicing then spreads as a real camera's does.
+    Image mosaic = Mosaic(image->view(), chain->color_options().cfa);
+    ApplySensor(camera, job.controls, &mosaic);
+    frame->raw = chain->ApplyColor(image, &mosaic);
+    return;
+  }
   ApplySensor(camera, job.controls, image);
   if (chain != nullptr && chain->color()) frame->raw = chain->ApplyColor(image);
 }
@@ -235,7 +243,8 @@ void GlRenderer::ApplySensor(int camera, const scene::AppliedControls& controls,
   std::unique_ptr<SensorModel>& model = sensor_models_[camera];  // sized by ApplyChains
   if (!model) {
     model = std::make_unique<SensorModel>(*spec.sensor.emva, spec.sensor.seed, spec.name,
-                                          image->width(), image->height(), 3);
+                                          image->width(), image->height(),
+                                          IsBayer(image->format()) ? 1 : 3);
   }
   model->ExposeRendered(image->view(), controls.exposure_s, image->metadata().frame_index, image,
                         controls.GainFactor());
