@@ -9,7 +9,7 @@
 //   sigma_y^2   = var(A - B) / 2                  (temporal noise; the fixed pattern cancels)
 // Photon transfer: sigma_y^2 - sigma_y.dark^2 = K (mu_y - mu_y.dark), fitted (least squares,
 // with an intercept) over the points with 0 < mu_y - mu_y.dark <= 70 % of the saturation's;
-// saturation at the largest sigma_y^2: mu_e.sat = (mu_y.sat - mu_y.dark) / K (below the full
+// saturation at the largest sigma_y^2 (averaged over 5 neighbouring exposures): mu_e.sat = (mu_y.sat - mu_y.dark) / K (below the full
 // well: pixels reach it one by one, so the variance peaks before the mean gets there);
 // dark noise sigma_d = sqrt(sigma_y.dark^2 - 1/12) / K (1/12 DN^2: quantisation), from the
 // dark pair of the shortest exposure; eta = R / K with R the slope of mu_y - mu_y.dark against
