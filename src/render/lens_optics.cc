@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <numbers>
 #include <optional>
@@ -30,13 +31,7 @@ void CheckLensPositive(double value, const char* field) {
   }
 }
 
-// How much of a pixel at `distance` (pixels) a disc of radius `radius` covers, anti-aliased
-// over one pixel: 1 inside radius - 0.5, 0 beyond radius + 0.5, linear between.
-float DiscCoverage(float distance, float radius) {
-  return std::clamp(radius + 0.5f - distance, 0.0f, 1.0f);
-}
-
-// The sum of DiscCoverage over the plane: pi (r^2 + 1/12) for r >= 0.5 (the ramp integrated);
+// The sum of DofCoverage over the plane: pi (r^2 + 1/12) for r >= 0.5 (the ramp integrated);
 // below, the disc covers its own pixel only, by r + 0.5.
 float DiscArea(float radius) {
   constexpr float kPi = std::numbers::pi_v<float>;
@@ -52,18 +47,29 @@ struct WindowOffset {
 
 // Tiles of kDofTile x kDofTile pixels bound the circles a pixel's gather can meet.
 constexpr int kDofTile = 16;
+// Pixels of a row gathered at once (one SSE vector of floats each term): a divisor of kDofTile.
+constexpr int kDofLanes = 4;
+using DofVector = float __attribute__((vector_size(kDofLanes * sizeof(float))));
 
-// What the gather reads per pixel: depth (+inf without a surface) and the circle's radius
-// (pixels across, capped); the window's offsets sorted by distance, and per tile the largest
-// radius of any pixel within the window's reach of the tile (so that a pixel's gather stops
-// where no disc, its own or a nearer pixel's, can cover it: the same terms, fewer visits).
+// What the gather reads per pixel, in planes padded by the window's reach (pad_x, pad_y)
+// around the image and kDofLanes more on the right, so that a run of kDofLanes pixels reads
+// every offset without a bounds test: depth (+inf without a surface), the circle's radius
+// (pixels across, capped) and area (DiscArea), whether the pixel is in the image (1 or 0:
+// padding's terms weigh 0) and the colour's three channels. Also the window's offsets sorted
+// by distance, and per tile the largest radius of any pixel within the window's reach of the
+// tile (so that a pixel's gather stops where no disc, its own or a nearer pixel's, can cover
+// it: the same terms, fewer visits).
 struct DofPlanes {
   int width = 0, height = 0;
-  std::vector<float> depth;
-  std::vector<float> radius;
+  int pad_x = 0, pad_y = 0, stride = 0;  // stride: padded plane's row, in values
+  std::vector<float> depth, radius, area, inside, color[3];
   std::vector<WindowOffset> window;
   int tiles_x = 0;
   std::vector<float> reach;  // per tile: the largest radius near it, + 0.5
+  // The index of image pixel (x, y) in the padded planes.
+  std::size_t At(int x, int y) const {
+    return static_cast<std::size_t>(y + pad_y) * stride + static_cast<std::size_t>(x + pad_x);
+  }
 };
 
 // DofPlanes::reach: each tile's largest radius, then the largest over the tiles the window
@@ -75,7 +81,7 @@ void PrepareTileReach(DofPlanes* planes, int reach_x, int reach_y) {
   for (int y = 0; y < planes->height; ++y) {
     for (int x = 0; x < planes->width; ++x) {
       float& m = tile_max[static_cast<std::size_t>(y / kDofTile) * tiles_x + x / kDofTile];
-      m = std::max(m, planes->radius[static_cast<std::size_t>(y) * planes->width + x]);
+      m = std::max(m, planes->radius[planes->At(x, y)]);
     }
   }
   const int tx_reach = (reach_x + kDofTile - 1) / kDofTile;
@@ -95,32 +101,55 @@ void PrepareTileReach(DofPlanes* planes, int reach_x, int reach_y) {
   }
 }
 
-DofPlanes PrepareDof(const ImageView& depth, const ThinLensOptions& lens,
+DofPlanes PrepareDof(const ImageView& rgb, const ImageView& depth, const ThinLensOptions& lens,
                      const geometry::Intrinsics& k, DepthOfFieldSummary* summary) {
   DofPlanes planes;
   planes.width = depth.width();
   planes.height = depth.height();
-  const std::size_t n = static_cast<std::size_t>(planes.width) * planes.height;
-  planes.depth.resize(n);
-  planes.radius.resize(n);
+  std::vector<float> radius(static_cast<std::size_t>(planes.width) * planes.height);
   float max_radius = 0.0f;
+  // CircleOfConfusionPx's terms, in its order, hoisted out of the loop.
+  const double at_infinity = CircleOfConfusion(lens, 0.0);
+  const double pitch = lens.pixel_pitch_m > 0.0 ? lens.pixel_pitch_m : lens.focal_length_m / k.fx();
+  const double s = lens.focus_distance_m;
   for (int y = 0; y < planes.height; ++y) {
     const float* row = reinterpret_cast<const float*>(depth.row(y));
     for (int x = 0; x < planes.width; ++x) {
       const float d = row[x];
       const bool surface = std::isfinite(d) && d > 0.0f;
-      const double coc = CircleOfConfusionPx(lens, k, surface ? d : 0.0);
+      const double coc = (surface ? at_infinity * std::abs(d - s) / d : at_infinity) / pitch;
       summary->max_coc_px = std::max(summary->max_coc_px, coc);
       if (coc > lens.max_coc_px) ++summary->capped_pixels;
-      const std::size_t i = static_cast<std::size_t>(y) * planes.width + x;
-      planes.depth[i] = surface ? d : std::numeric_limits<float>::infinity();
-      planes.radius[i] = static_cast<float>(0.5 * std::min(coc, lens.max_coc_px));
-      max_radius = std::max(max_radius, planes.radius[i]);
+      const auto r = static_cast<float>(0.5 * std::min(coc, lens.max_coc_px));
+      radius[static_cast<std::size_t>(y) * planes.width + x] = r;
+      max_radius = std::max(max_radius, r);
     }
   }
   const double aspect = lens.pixel_pitch_m > 0.0 ? 1.0 : k.fx() / k.fy();  // pitch_y / pitch_x
   const int reach_x = static_cast<int>(std::ceil(max_radius + 0.5f));
   const int reach_y = static_cast<int>(std::ceil((max_radius + 0.5f) / aspect));
+  planes.pad_x = reach_x;
+  planes.pad_y = reach_y;
+  planes.stride = planes.width + 2 * reach_x + kDofLanes;
+  const std::size_t n = static_cast<std::size_t>(planes.stride) * (planes.height + 2 * reach_y);
+  planes.depth.assign(n, std::numeric_limits<float>::infinity());  // padding: never in front
+  planes.radius.assign(n, 0.0f);
+  planes.area.assign(n, DiscArea(0.0f));
+  planes.inside.assign(n, 0.0f);
+  for (std::vector<float>& c : planes.color) c.assign(n, 0.0f);
+  for (int y = 0; y < planes.height; ++y) {
+    const float* row = reinterpret_cast<const float*>(depth.row(y));
+    const uint8_t* c = rgb.row(y);
+    for (int x = 0; x < planes.width; ++x) {
+      const std::size_t i = planes.At(x, y);
+      const float d = row[x];
+      planes.depth[i] = std::isfinite(d) && d > 0.0f ? d : std::numeric_limits<float>::infinity();
+      planes.radius[i] = radius[static_cast<std::size_t>(y) * planes.width + x];
+      planes.area[i] = DiscArea(planes.radius[i]);
+      planes.inside[i] = 1.0f;
+      for (int ch = 0; ch < 3; ++ch) planes.color[ch][i] = c[3 * x + ch];
+    }
+  }
   for (int dy = -reach_y; dy <= reach_y; ++dy) {
     for (int dx = -reach_x; dx <= reach_x; ++dx) {
       const auto distance = static_cast<float>(std::hypot(dx, dy * aspect));
@@ -134,43 +163,64 @@ DofPlanes PrepareDof(const ImageView& depth, const ThinLensOptions& lens,
   return planes;
 }
 
-// One output pixel of ApplyDepthOfField (the header's gather of what is behind, scatter of
-// what is in front).
-void DofPixel(const ImageView& rgb, const DofPlanes& planes, int x, int y, uint8_t* out) {
-  const std::size_t p = static_cast<std::size_t>(y) * planes.width + x;
-  const float depth_p = planes.depth[p], radius_p = planes.radius[p];
-  const float nearer = depth_p * (1.0f - kNearerFraction);
-  float back_weight = 0.0f, front_weight = 0.0f;
-  float back[3] = {0, 0, 0}, front[3] = {0, 0, 0};
-  // No disc reaches p from this far (the window is sorted by distance): neither p's own nor
-  // that of any pixel near p's tile.
-  const float limit = std::max(
-      radius_p + 0.5f,
-      planes.reach[static_cast<std::size_t>(y / kDofTile) * planes.tiles_x + x / kDofTile]);
+DofVector LoadDof(const float* values) {
+  DofVector v;
+  std::memcpy(&v, values, sizeof(v));
+  return v;
+}
+
+// How much of a pixel at `distance` (pixels) a disc of radius `radius` covers, anti-aliased
+// over one pixel: 1 inside radius - 0.5, 0 beyond radius + 0.5, linear between; for kDofLanes
+// discs.
+DofVector DofCoverage(float distance, DofVector radius) {
+  DofVector c = radius + 0.5f - distance;
+  c = c < 0.0f ? DofVector{} : c;
+  return c > 1.0f ? DofVector{} + 1.0f : c;
+}
+
+// kDofLanes output pixels from (x, y) on of one tile's row (the header's gather of what is
+// behind, scatter of what is in front), into out[0 .. count). The tile's reach bounds every
+// pixel's own circle and those near it (the window is sorted by distance): beyond it every
+// term is 0. Each term is the scalar gather's, in its order: the same bits as pixel by pixel.
+void DofRun(const DofPlanes& planes, int x, int y, int count, uint8_t* out) {
+  const std::size_t p = planes.At(x, y);
+  const DofVector radius_p = LoadDof(&planes.radius[p]);
+  const DofVector nearer = LoadDof(&planes.depth[p]) * (1.0f - kNearerFraction);
+  DofVector back_weight{}, front_weight{}, back[3] = {}, front[3] = {};
+  const float limit =
+      planes.reach[static_cast<std::size_t>(y / kDofTile) * planes.tiles_x + x / kDofTile];
+  const auto offset = [&](const WindowOffset& o) {
+    return static_cast<std::ptrdiff_t>(o.dy) * planes.stride + o.dx;
+  };
   for (const WindowOffset& o : planes.window) {
     if (o.distance >= limit) break;
-    const int qx = x + o.dx, qy = y + o.dy;
-    if (qx < 0 || qy < 0 || qx >= planes.width || qy >= planes.height) continue;
-    const std::size_t q = static_cast<std::size_t>(qy) * planes.width + qx;
-    const uint8_t* c = rgb.row(qy) + 3 * qx;
-    if (planes.depth[q] < nearer) {
-      const float coverage = DiscCoverage(o.distance, planes.radius[q]);
-      if (coverage <= 0.0f) continue;
-      const float w = coverage / DiscArea(planes.radius[q]);
-      front_weight += w;
-      for (int ch = 0; ch < 3; ++ch) front[ch] += w * c[ch];
-    } else {
-      const float coverage = DiscCoverage(o.distance, radius_p);
-      if (coverage <= 0.0f) continue;
-      back_weight += coverage;
-      for (int ch = 0; ch < 3; ++ch) back[ch] += coverage * c[ch];
+    const std::size_t q = p + offset(o);
+    const auto in_front = LoadDof(&planes.depth[q]) < nearer;
+    // In front: q's disc over p, weighed by 1 / its area; else p's disc over q (inside only).
+    const DofVector w_front =
+        DofCoverage(o.distance, LoadDof(&planes.radius[q])) / LoadDof(&planes.area[q]);
+    const DofVector w_back = DofCoverage(o.distance, radius_p) * LoadDof(&planes.inside[q]);
+    const DofVector f = in_front ? w_front : DofVector{};
+    const DofVector b = in_front ? DofVector{} : w_back;
+    front_weight += f;
+    back_weight += b;
+    for (int ch = 0; ch < 3; ++ch) {
+      const DofVector c = LoadDof(&planes.color[ch][q]);
+      front[ch] += f * c;
+      back[ch] += b * c;
     }
   }
-  const float alpha = std::min(1.0f, front_weight);
-  for (int ch = 0; ch < 3; ++ch) {
-    float value = back_weight > 0.0f ? back[ch] / back_weight : 0.0f;
-    if (front_weight > 0.0f) value = alpha * front[ch] / front_weight + (1.0f - alpha) * value;
-    out[ch] = static_cast<uint8_t>(std::lround(std::clamp(value, 0.0f, 255.0f)));
+  for (int j = 0; j < count; ++j) {
+    const float alpha = std::min(1.0f, front_weight[j]);
+    for (int ch = 0; ch < 3; ++ch) {
+      float value = back_weight[j] > 0.0f ? back[ch][j] / back_weight[j] : 0.0f;
+      if (front_weight[j] > 0.0f) {
+        value = alpha * front[ch][j] / front_weight[j] + (1.0f - alpha) * value;
+      }
+      // lround of a value in [0, 255]: + 0.5 is exact in double, truncated (no libm call).
+      out[3 * j + ch] =
+          static_cast<uint8_t>(static_cast<double>(std::clamp(value, 0.0f, 255.0f)) + 0.5);
+    }
   }
 }
 
@@ -326,13 +376,15 @@ Image ApplyDepthOfField(const ImageView& rgb, const ImageView& depth, const Thin
   DepthOfFieldSummary local;
   DepthOfFieldSummary* out_summary = summary != nullptr ? summary : &local;
   *out_summary = {};
-  const DofPlanes planes = PrepareDof(depth, lens, intrinsics, out_summary);
+  const DofPlanes planes = PrepareDof(rgb, depth, lens, intrinsics, out_summary);
   Image out(rgb.width(), rgb.height(), PixelFormat::kRgb8);
   if (rgb.metadata() != nullptr) out.metadata() = *rgb.metadata();
   const auto rows = [&](int first, int end) {
     for (int y = first; y < end; ++y) {
       uint8_t* row = out.row(y);
-      for (int x = 0; x < rgb.width(); ++x) DofPixel(rgb, planes, x, y, row + 3 * x);
+      for (int x = 0; x < rgb.width(); x += kDofLanes) {
+        DofRun(planes, x, y, std::min(kDofLanes, rgb.width() - x), row + 3 * x);
+      }
     }
   };
   // Two halves at once where there are two cores (each pixel is computed alone: the same bits).
