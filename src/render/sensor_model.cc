@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <numbers>
 #include <thread>
@@ -75,25 +76,40 @@ const std::vector<double>& GaussianTable() {
 // between kGaussianBins evenly spaced probabilities (its variance within 1e-6 of 1: the
 // quantile is nearly straight over a bin), exact in the two outer bins (the tails, to
 // +-6.3). A table look-up instead of Box-Muller's logarithm and cosine: 5 times as fast.
-double SensorGaussian(uint32_t bits) {
+// `table`: GaussianTable()'s data (looked up once by the caller).
+inline double SensorGaussian(const double* table, uint32_t bits) {
   const uint32_t bin = bits >> (32 - kGaussianBinBits);
-  if (bin == 0 || bin == kGaussianBins - 1) return NormalQuantile(SensorUniform(bits));
-  const double* t = GaussianTable().data() + bin;
-  const double frac = (static_cast<double>(bits & ((1u << (32 - kGaussianBinBits)) - 1)) + 0.5) *
+  if (bin == 0 || bin == kGaussianBins - 1) [[unlikely]] {
+    return NormalQuantile(SensorUniform(bits));
+  }
+  const double* t = table + bin;
+  // The low bits as a fraction of the bin: 2^52 + the bits, by their bit pattern, less 2^52 (an
+  // integer's conversion to double would wait on the register's previous value).
+  const uint64_t low = bits & ((1u << (32 - kGaussianBinBits)) - 1);
+  const double frac = (std::bit_cast<double>(0x4330'0000'0000'0000ULL | low) - 0x1p52 + 0.5) *
                       (1.0 / (1u << (32 - kGaussianBinBits)));
   return t[0] + frac * (t[1] - t[0]);
 }
 
-// x >= 0 rounded half up, as std::round (without a call into libm: the conversion inlines).
-double RoundNonNegative(double x) { return static_cast<double>(static_cast<int64_t>(x + 0.5)); }
+// x >= 0 rounded half up, as std::round, to an integer (without a call into libm).
+int64_t RoundNonNegative(double x) { return static_cast<int64_t>(x + 0.5); }
+
+// x in [0, 2^51) rounded to the nearest whole number, ties to even (std::round differs only at
+// exact ties, which continuous deviates never are), in double arithmetic: without converting to
+// an integer and back, whose conversion to double waits on the register's previous value (a
+// dependency from one value to the next).
+double RoundWhole(double x) {
+  constexpr double kShift = 0x1.8p52;  // adding it leaves no fraction bits (IEEE arithmetic:
+  return (x + kShift) - kShift;        // without -ffast-math the sum is not folded away)
+}
 
 // A Poisson deviate of mean `lambda` from 32 bits: inversion below kExactPoissonMean, the
 // Gaussian approximation (rounded to whole electrons) above.
-double SensorPoisson(double lambda, uint32_t bits) {
+inline double SensorPoisson(const double* table, double lambda, uint32_t bits) {
   if (lambda <= 0.0) return 0.0;
-  if (lambda >= kExactPoissonMean) {
-    const double e = lambda + std::sqrt(lambda) * SensorGaussian(bits);
-    return e > 0.0 ? RoundNonNegative(e) : 0.0;
+  if (lambda >= kExactPoissonMean) [[likely]] {
+    const double e = lambda + std::sqrt(lambda) * SensorGaussian(table, bits);
+    return e > 0.0 ? RoundWhole(e) : 0.0;
   }
   const double u = SensorUniform(bits);
   double p = std::exp(-lambda);
@@ -113,6 +129,24 @@ double SensorPoisson(double lambda, uint32_t bits) {
 bool Fits(PixelFormat format, int channels) {
   if (channels == 3) return format == PixelFormat::kRgb8;
   return format == PixelFormat::kGray8 || (IsBayer(format) && BytesPerPixel(format) == 1);
+}
+
+// part(first, end) over [0, n): in up to four parts on as many threads (up to the cores), each
+// of at least kMinSensorPartValues; in one where that is the whole.
+template <typename Part>
+void ForParts(std::size_t n, const Part& part) {
+  const unsigned threads = std::min<unsigned>(4, std::max(1u, std::thread::hardware_concurrency()));
+  if (n < 2 * kMinSensorPartValues || threads < 2) {
+    part(std::size_t{0}, n);
+    return;
+  }
+  const std::size_t parts = std::min<std::size_t>(threads, n / kMinSensorPartValues);
+  std::vector<std::thread> workers;
+  for (std::size_t p = 1; p < parts; ++p) {
+    workers.emplace_back(part, n * p / parts, n * (p + 1) / parts);
+  }
+  part(std::size_t{0}, n / parts);
+  for (std::thread& t : workers) t.join();
 }
 
 uint64_t HashName(uint64_t seed, const std::string& name) {
@@ -146,10 +180,11 @@ SensorModel::SensorModel(const scene::EmvaSensor& params, uint64_t seed, const s
   const uint64_t dsnu_key = SensorMix(stream_ ^ kDsnuStream);
   for (std::size_t i = 0; i < n; ++i) {
     const auto prnu_bits = static_cast<uint32_t>(SensorMix(prnu_key + i));
-    const double gain = 1.0 + prnu * SensorGaussian(prnu_bits);
+    const double gain = 1.0 + prnu * SensorGaussian(GaussianTable().data(), prnu_bits);
     prnu_[i] = static_cast<float>(std::max(0.0, gain));
     const auto dsnu_bits = static_cast<uint32_t>(SensorMix(dsnu_key + i));
-    dsnu_[i] = static_cast<float>(params_.dsnu_e * SensorGaussian(dsnu_bits));
+    dsnu_[i] =
+        static_cast<float>(params_.dsnu_e * SensorGaussian(GaussianTable().data(), dsnu_bits));
   }
 }
 
@@ -163,32 +198,23 @@ void SensorModel::Expose(const float* photons, int64_t frame_index, uint16_t* ra
   const double sat = params_.saturation_e;
   const double offset = params_.black_level_dn;
   const double max_dn = params_.MaxDn();
-  const auto part = [&](std::size_t first, std::size_t end) {
+  const double* const table = GaussianTable().data();
+  const float* const prnu = prnu_.data();
+  const float* const dsnu = dsnu_.data();
+  const auto part = [=](std::size_t first, std::size_t end) {
     for (std::size_t i = first; i < end; ++i) {
       // One 64-bit hash a value: its upper half draws the shot noise, its lower the dark noise.
       const uint64_t h = SensorMix(key + static_cast<uint64_t>(i));
-      const double lambda = eta * std::max(0.0f, photons[i]) * prnu_[i];
-      double e = SensorPoisson(lambda, static_cast<uint32_t>(h >> 32));
-      e += sigma_d * SensorGaussian(static_cast<uint32_t>(h)) + dsnu_[i];
+      const double lambda = eta * std::max(0.0f, photons[i]) * prnu[i];
+      double e = SensorPoisson(table, lambda, static_cast<uint32_t>(h >> 32));
+      e += sigma_d * SensorGaussian(table, static_cast<uint32_t>(h)) + dsnu[i];
       e = std::min(e, sat);  // the full well
       // round() then clamp to [0, max_dn], as one clamp and a rounding of the non-negative.
       raw[i] = static_cast<uint16_t>(RoundNonNegative(std::clamp(K * e + offset, 0.0, max_dn)));
     }
   };
-  const std::size_t n = values();
   // Each value depends on its index alone: parts give the same bits as one loop.
-  const unsigned threads = std::min<unsigned>(4, std::max(1u, std::thread::hardware_concurrency()));
-  if (n < 2 * kMinSensorPartValues || threads < 2) {
-    part(0, n);
-    return;
-  }
-  const std::size_t parts = std::min<std::size_t>(threads, n / kMinSensorPartValues);
-  std::vector<std::thread> workers;
-  for (std::size_t p = 1; p < parts; ++p) {
-    workers.emplace_back(part, n * p / parts, n * (p + 1) / parts);
-  }
-  part(0, n / parts);
-  for (std::thread& t : workers) t.join();
+  ForParts(values(), part);
 }
 
 std::vector<uint16_t> SensorModel::ExposeUniform(double mean_photons, int64_t frame_index) const {
@@ -209,14 +235,18 @@ std::vector<uint16_t> SensorModel::ExposeRendered(const ImageView& rendered, dou
         ToString(expected), rendered.width(), rendered.height(), ToString(rendered.format())));
   }
   const double scale = params_.photons_per_second * exposure_s / 255.0;
+  float photons_of[256];  // each 8-bit value's photons, as the product per value gave them
+  for (int v = 0; v < 256; ++v) photons_of[v] = static_cast<float>(v * scale);
   std::vector<float> photons(values());
   const std::size_t row_values = static_cast<std::size_t>(width_) * channels_;
-  for (int y = 0; y < height_; ++y) {
-    const uint8_t* row = rendered.row(y);
-    for (std::size_t x = 0; x < row_values; ++x) {
-      photons[y * row_values + x] = static_cast<float>(row[x] * scale);
+  ForParts(static_cast<std::size_t>(height_) * row_values, [&](std::size_t first, std::size_t end) {
+    for (std::size_t y = first / row_values; y * row_values < end; ++y) {
+      const uint8_t* row = rendered.row(static_cast<int>(y));
+      const std::size_t x0 = std::max(first, y * row_values) - y * row_values;
+      const std::size_t x1 = std::min(end, (y + 1) * row_values) - y * row_values;
+      for (std::size_t x = x0; x < x1; ++x) photons[y * row_values + x] = photons_of[row[x]];
     }
-  }
+  });
   std::vector<uint16_t> raw(values());
   Expose(photons.data(), frame_index, raw.data(), gain);
   if (image8 != nullptr) To8Bit(raw.data(), image8);
@@ -232,13 +262,20 @@ void SensorModel::To8Bit(const uint16_t* raw, Image* image8) const {
         ToString(expected), image8->width(), image8->height(), ToString(image8->format())));
   }
   const double scale = 255.0 / params_.MaxDn();
-  const std::size_t row_values = static_cast<std::size_t>(width_) * channels_;
-  for (int y = 0; y < height_; ++y) {
-    uint8_t* row = image8->row(y);
-    for (std::size_t x = 0; x < row_values; ++x) {
-      row[x] = static_cast<uint8_t>(RoundNonNegative(raw[y * row_values + x] * scale));
-    }
+  // Each raw value's 8-bit value, as the product per value gave it.
+  std::vector<uint8_t> to8(static_cast<std::size_t>(params_.MaxDn()) + 1);
+  for (std::size_t v = 0; v < to8.size(); ++v) {
+    to8[v] = static_cast<uint8_t>(RoundNonNegative(static_cast<double>(v) * scale));
   }
+  const std::size_t row_values = static_cast<std::size_t>(width_) * channels_;
+  ForParts(static_cast<std::size_t>(height_) * row_values, [&](std::size_t first, std::size_t end) {
+    for (std::size_t y = first / row_values; y * row_values < end; ++y) {
+      uint8_t* row = image8->row(static_cast<int>(y));
+      const std::size_t x0 = std::max(first, y * row_values) - y * row_values;
+      const std::size_t x1 = std::min(end, (y + 1) * row_values) - y * row_values;
+      for (std::size_t x = x0; x < x1; ++x) row[x] = to8[raw[y * row_values + x]];
+    }
+  });
 }
 
 }  // namespace saccade::render
