@@ -9,11 +9,13 @@
 #   - `saccade bench --scene scenes/bench.yaml --no-effect-table`: the same two cameras with the
 #     bench scene's lens distortion and sensor noise on (and motion blur on, the head still).
 # It prints each round's stereo frames per second and, last, the ratio of the medians
-# (saccade / MuJoCo). FRAMES=N sets the frames timed per run (default 100).
+# (saccade / MuJoCo). FRAMES=N sets the frames timed per run (default 100); SCENE=FILE another
+# scene of saccade's (scenes/bench_realistic.yaml: the same scene through realistic cameras).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 rounds=${1:-3}
 frames=${FRAMES:-100}
+scene=${SCENE:-scenes/bench.yaml}
 peers=${SACCADE_PEERS:-../shared/peers}
 saccade=${SACCADE_BIN:-build/bin/saccade}
 [ -x "$saccade" ] || { echo "mujoco_ratio: $saccade is missing: run scripts/setup.sh first" >&2; exit 1; }
@@ -25,13 +27,13 @@ mujoco=()
 ours=()
 for ((i = 1; i <= rounds; i++)); do
   m=$("$mjbench" "$PEERS_OUT/scene_nomsaa.xml" "$frames" | sed -n 's/.*: \([0-9.]*\) stereo-frames\/s.*/\1/p')
-  s=$("$saccade" bench --scene scenes/bench.yaml --frames "$frames" --no-effect-table --json |
+  s=$("$saccade" bench --scene "$scene" --frames "$frames" --no-effect-table --json |
     python3 -c 'import json, sys; print(round(json.load(sys.stdin)["frames_per_second"], 1))')
   [ -n "$m" ] && [ -n "$s" ] || { echo "mujoco_ratio: a run printed no figure" >&2; exit 1; }
   mujoco+=("$m")
   ours+=("$s")
-  printf 'round %d: MuJoCo %6.1f stereo frames/s   saccade (distortion + noise) %6.1f   ratio %.2f\n' \
-    "$i" "$m" "$s" "$(python3 -c "print($s / $m)")"
+  printf 'round %d: MuJoCo %6.1f stereo frames/s   saccade (%s) %6.1f   ratio %.2f\n' \
+    "$i" "$m" "$(basename "$scene")" "$s" "$(python3 -c "print($s / $m)")"
 done
 python3 - "${mujoco[*]}" "${ours[*]}" <<'EOF'
 import statistics, sys
