@@ -1,7 +1,8 @@
 // sim.cameras' raw mosaic (`raw: true`, issue 45): each camera with a colour filter array gets
 // an output <camera>_raw carrying the Bayer mosaic its colour image was demosaiced from, checked
 // against OpenCV's demosaicing; a scene with no filter array is refused naming the parameter and
-// the cameras. Small images: each test well under a second.
+// the cameras; the demo's and the GUI's latest image of a camera stays its colour image. Small
+// images: each test well under a second.
 #include <gtest/gtest.h>
 
 #include <cstring>
@@ -14,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "saccade/components/demo/loop_outputs.h"
 #include "saccade/components/register.h"
 #include "saccade/components/roles.h"
 #include "saccade/core/error.h"
@@ -90,9 +92,14 @@ TEST(SimCamerasRaw, EachFilteredCameraEmitsTheMosaicItsImageWasDemosaicedFrom) {
       got[name].push_back(m.image);
     });
   }
+  demo::Latest latest;  // what the demo's report and the GUI show of each camera
+  demo::TapLoopOutputs(pipeline, &latest);
   const runtime::RunSummary summary = runtime::RunPipeline(pipeline);
   ASSERT_EQ(summary.errors_total, 0) << summary.FullReport();
   ASSERT_EQ(got["eye"].size(), 2u);
+  // The mosaic carries its camera's name too; the camera's latest image stays the colour one.
+  ASSERT_TRUE(latest.images["eye"]);
+  EXPECT_EQ(latest.images["eye"], got["eye"].back());
   ASSERT_EQ(got["eye_raw"].size(), 2u);
   for (std::size_t i = 0; i < 2; ++i) {
     SCOPED_TRACE(i);
