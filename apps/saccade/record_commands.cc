@@ -196,6 +196,11 @@ class Exporter {
 
   int Run() {
     reader_.ForEachMessage([&](const record::McapMessage& m) {
+      const auto& channel = reader_.channels().at(m.channel_id);
+      if (channel.message_encoding == "json" && channel.topic.ends_with("/frames")) {
+        AddFrameRecord(json::parse(m.data.begin(), m.data.end(), nullptr, false));
+        return true;
+      }
       const auto decoder = decoders_.find(m.channel_id);
       if (decoder == decoders_.end()) return true;
       const std::string& type = decoder->second.first;
@@ -231,7 +236,9 @@ class Exporter {
  private:
   // An image: the camera's (<camera>/image_raw) to <camera>/NNNNNN.png, its depth truth
   // (<camera>/depth/image_raw, 32FC1 metres) to <camera>/depth/ as 16-bit millimetres and its
-  // id truth (<camera>/ids/image_raw, mono16) to <camera>/ids/, as `saccade render` writes them.
+  // id truth (<camera>/ids/image_raw, mono16) to <camera>/ids/ and its raw colour filter mosaic
+  // (<camera>/raw/image_raw, bayer_*8) to <camera>/raw/ as 8-bit grey, as `saccade render`
+  // writes them.
   void AddImage(const std::string& topic, const json& image,
                 const std::vector<std::span<const uint8_t>>& blobs) {
     const int64_t stamp = StampNs(image["header"]);
@@ -239,6 +246,7 @@ class Exporter {
     frame_stamp_ = stamp;
     const std::string truth = topic.ends_with("/depth/image_raw") ? "depth"
                               : topic.ends_with("/ids/image_raw") ? "ids"
+                              : topic.ends_with("/raw/image_raw") ? "raw"
                                                                   : "";
     std::string frame_id = image["header"]["frame_id"];
     std::string camera = frame_id;
@@ -259,6 +267,8 @@ class Exporter {
       cv_type = CV_16UC1;
     else if (encoding == "32FC1" && truth == "depth")
       cv_type = CV_32FC1;
+    else if (truth == "raw" && encoding.starts_with("bayer_") && encoding.ends_with("8"))
+      cv_type = CV_8UC1;
     else {
       if (said_.insert(encoding).second) {
         fmt::print(stderr, "mcap export: {} images not exported (encoding {})\n", camera, encoding);
@@ -292,6 +302,8 @@ class Exporter {
     json& entry = frame_[camera];
     if (!truth.empty()) {
       entry[truth] = file;
+      // The filter's pattern, as frames.jsonl of `saccade render` names it ("rggb", ...).
+      if (truth == "raw") entry["cfa"] = encoding.substr(6, 4);
       return;
     }
     entry["file"] = file;
@@ -308,6 +320,20 @@ class Exporter {
       entry["X_WC"] = PoseJson(pose->second);
     }
     if (!joints_.empty()) entry["joints"] = joints_;
+  }
+  // A frame's record (render --record's /saccade/frames, written after the frame's images at
+  // the same stamp): what the images cannot say, the motion-blur sub-frames and the camera
+  // controls each was taken with, joins the frame's lines.
+  void AddFrameRecord(const json& record) {
+    if (!record.is_object() || !record.contains("cameras") || !record["cameras"].is_object()) {
+      return;
+    }
+    for (const auto& [camera, entry] : record["cameras"].items()) {
+      if (!frame_.contains(camera) || !entry.is_object()) continue;
+      for (const char* key : {"exposure_samples", "exposure_s", "gain_db", "focus_m"}) {
+        if (entry.contains(key)) frame_[camera][key] = entry[key];
+      }
+    }
   }
   void Flush() {
     if (frame_.empty()) return;

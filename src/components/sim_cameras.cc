@@ -21,6 +21,10 @@ SimCameras::SimCameras()
   DeclareParam("scene", &scene_param_, internal::kSceneParamDoc).Path();
   DeclareParam("cameras", &options_.cameras,
                "the scene's cameras to render, one image output each, named as the camera");
+  DeclareParam("raw", &raw_,
+               "also the raw colour filter array mosaic of each camera that has one (the "
+               "scene's sensor: {color: {cfa: ...}}), as the output <camera>_raw (a Bayer "
+               "image, before demosaicing; the colour image's metadata)");
   DeclareParam("distortion", &options_.distortion, "the calibrations' lens distortion");
   DeclareParam("noise", &options_.noise, "sensor noise, seeded per camera and frame");
   DeclareParam("motion_blur", &options_.motion_blur, "blur over each camera's exposure");
@@ -57,6 +61,42 @@ void SimCameras::Configured() {
     }
     outputs_.push_back(&AddOutput<runtime::ImageMessage>(camera));
   }
+  raw_outputs_.assign(options_.cameras.size(), nullptr);
+  if (raw_) AddRawOutputs(path);
+}
+
+void SimCameras::AddRawOutputs(const std::string& path) {
+  std::string without;  // the cameras with no filter array
+  for (std::size_t i = 0; i < options_.cameras.size(); ++i) {
+    const std::string& camera = options_.cameras[i];
+    if (scene_->FindCamera(camera)->sensor.color.cfa == scene::CfaPattern::kNone) {
+      without += (without.empty() ? "" : ", ") + camera;
+      continue;
+    }
+    const std::string name = RawOutputName(camera);
+    if (FindOutput(name) != nullptr) {
+      throw InvalidArgument(
+          fmt::format("parameter 'raw': the raw output of camera '{}', '{}', is also the name "
+                      "of a camera of 'cameras'",
+                      camera, name));
+    }
+    raw_outputs_[i] = &AddOutput<runtime::ImageMessage>(name);
+  }
+  if (std::all_of(raw_outputs_.begin(), raw_outputs_.end(),
+                  [](const auto* output) { return output == nullptr; })) {
+    throw InvalidArgument(fmt::format(
+        "parameter 'raw': no camera of 'cameras' ({}) in scene '{}' has a colour filter array, "
+        "so none has a raw mosaic; give a camera sensor: {{color: {{cfa: rggb}}}} (or bggr, "
+        "gbrg, grbg), or set raw: false",
+        without, path));
+  }
+}
+
+std::string SimCameras::RawMosaicCamera(const std::string& output) const {
+  for (std::size_t i = 0; i < raw_outputs_.size(); ++i) {
+    if (raw_outputs_[i] != nullptr && raw_outputs_[i]->name() == output) return options_.cameras[i];
+  }
+  return "";
 }
 
 SimCameras::~SimCameras() { Stop(); }
@@ -119,6 +159,9 @@ void SimCameras::Step(const runtime::StepContext& context) {
   }
   for (std::size_t i = 0; i < frames.size() && i < outputs_.size(); ++i) {
     outputs_[i]->Emit(runtime::ImageMessage{frames[i].color});
+    if (raw_outputs_[i] != nullptr && frames[i].raw) {
+      raw_outputs_[i]->Emit(runtime::ImageMessage{frames[i].raw});
+    }
   }
 }
 

@@ -54,9 +54,17 @@ nlohmann::json MessageTraits<ImageMessage>::ToJson(const ImageMessage& m) {
   const Image& image = *m.image;
   const ImageMetadata& meta = image.metadata();
   // Metadata only: pixels never go into text (DESIGN.md).
-  return {{"camera", meta.camera},    {"frame_index", meta.frame_index},
-          {"time", meta.time},        {"width", image.width()},
-          {"height", image.height()}, {"format", ToString(image.format())}};
+  // With the camera controls the frame was taken with (ImageMetadata: 0 s an instant, 0 m
+  // none given), as frames.jsonl writes them.
+  return {{"camera", meta.camera},
+          {"frame_index", meta.frame_index},
+          {"time", meta.time},
+          {"width", image.width()},
+          {"height", image.height()},
+          {"format", ToString(image.format())},
+          {"exposure_s", meta.exposure_s},
+          {"gain_db", meta.gain_db},
+          {"focus_m", meta.focus_m}};
 }
 
 ImageMessage MessageTraits<ImageMessage>::FromJson(const nlohmann::json& j) {
@@ -93,10 +101,21 @@ ImageMessage MessageTraits<ImageMessage>::FromJson(const nlohmann::json& j) {
   std::string camera = DecodeField<std::string>(j, kName, "camera");
   const int64_t frame_index = DecodeField<int64_t>(j, kName, "frame_index");
   const double time = DecodeField<double>(j, kName, "time");
+  // The camera controls: optional (absent or null: 0, as ImageMetadata's "none").
+  double controls[3] = {0.0, 0.0, 0.0};
+  const char* const control_keys[3] = {"exposure_s", "gain_db", "focus_m"};
+  for (int i = 0; i < 3; ++i) {
+    const auto it = j.find(control_keys[i]);
+    if (it != j.end() && !it->is_null())
+      controls[i] = DecodeField<double>(j, kName, control_keys[i]);
+  }
   auto image = std::make_shared<Image>(static_cast<int>(width), static_cast<int>(height), format);
   image->metadata().camera = std::move(camera);
   image->metadata().frame_index = frame_index;
   image->metadata().time = time;
+  image->metadata().exposure_s = controls[0];
+  image->metadata().gain_db = controls[1];
+  image->metadata().focus_m = controls[2];
   return {std::move(image)};
 }
 

@@ -4,7 +4,11 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <chrono>
+#include <cstring>
+#include <fstream>
+#include <map>
 #include <optional>
 #include <thread>
 
@@ -15,6 +19,7 @@
 #include "saccade/dds/transport.h"
 #include "saccade/runtime/pipeline.h"
 #include "saccade/runtime/scheduler.h"
+#include "scratch_dir.h"
 
 namespace saccade::dds {
 namespace {
@@ -373,6 +378,69 @@ TEST_F(PipelineTopics, MapOutputPublishesPointCloud2AndItsInhibitedPlaces) {
   // The last step's map: 3 voxels; its one inhibited place.
   EXPECT_EQ(Latest("rt/saccade/map"), std::make_pair(3u, std::string("world")));
   EXPECT_EQ(Latest("rt/saccade/map/inhibited"), std::make_pair(1u, std::string("world")));
+}
+
+// sim.cameras' raw mosaic (`raw: true`) on a topic of its own: sensor_msgs/Image with ROS's Bayer
+// encoding, the mosaic's bytes, beside the demosaiced image on image_raw.
+TEST_F(PipelineTopics, RawMosaicOutputPublishesBayerImages) {
+  constexpr int kDomain = 190;
+  const std::string scene = (saccade::testing_helpers::ScratchDir() / "bayer.yaml").string();
+  std::ofstream(scene) << "lights: [{type: ambient, intensity: 1}]\n"
+                          "ground: {pattern: checker, cell: 0.2, color: [0.9, 0.5, 0.2]}\n"
+                          "cameras:\n"
+                          "  - name: eye\n"
+                          "    calibration: {width: 64, height: 48, fx: 50, fy: 50}\n"
+                          "    look_at: {eye: [0, 0, 1], target: [2, 0, 0]}\n"
+                          "    sensor: {color: {cfa: rggb}}\n";
+  runtime::Pipeline pipeline = runtime::Pipeline::LoadString(
+      "clock: {mode: simulated, step: 0.04, steps: 2}\n"
+      "transport: {domain: 190, namespace: /saccade, clock: \"\"}\n"
+      "components:\n"
+      "  - name: cams\n"
+      "    type: sim.cameras\n"
+      "    params: {scene: " +
+          scene +
+          ", cameras: [eye], raw: true}\n"
+          "    outputs:\n"
+          "      eye: eye/image_raw\n"
+          "      eye_raw: {topic: eye/raw/image_raw, tf: \"\", compressed: \"\"}\n",
+      "raw.yaml");
+  std::map<int64_t, std::shared_ptr<const Image>> sent;  // by stamp, ns
+  for (const auto& c : pipeline.components()) {
+    if (c->name() != "cams") continue;
+    auto* raw = dynamic_cast<runtime::Output<runtime::ImageMessage>*>(c->FindOutput("eye_raw"));
+    ASSERT_NE(raw, nullptr);
+    raw->signal().Connect([&](const runtime::ImageMessage& m) {
+      sent[std::llround(m.image->metadata().time * 1e9)] = m.image;
+    });
+  }
+  const runtime::RunSummary summary = runtime::RunPipeline(pipeline);
+  ASSERT_EQ(summary.errors_total, 0) << summary.FullReport();
+  ASSERT_EQ(sent.size(), 2u);
+
+  // The writer keeps its last images for a reader that comes later (transient local): each one
+  // taken is the mosaic sent at its stamp, the newest the last step's.
+  Raw participant(RawParticipant(kDomain));
+  Raw reader(RawReader(participant.get(), &ref_sensor_msgs_msg_dds__Image__desc,
+                       "rt/saccade/eye/raw/image_raw", 2, /*transient_local=*/true));
+  int64_t newest = -1;
+  ref_sensor_msgs_msg_dds__Image_ got{};
+  for (double wait_s = 10.0; TakeSample(reader.get(), &got, wait_s); wait_s = 0.5) {
+    const int64_t stamp = int64_t{got.header.stamp.sec} * 1'000'000'000 + got.header.stamp.nanosec;
+    ASSERT_TRUE(sent.count(stamp)) << stamp;
+    newest = std::max(newest, stamp);
+    const Image& image = *sent[stamp];
+    EXPECT_STREQ(got.encoding, "bayer_rggb8");
+    EXPECT_STREQ(got.header.frame_id, "eye_optical");
+    EXPECT_EQ(got.width, 64u);
+    EXPECT_EQ(got.height, 48u);
+    EXPECT_EQ(got.step, 64u);
+    ASSERT_EQ(got.data._length, image.size_bytes());
+    EXPECT_EQ(std::memcmp(got.data._buffer, image.data(), image.size_bytes()), 0);
+    dds_sample_free(&got, &ref_sensor_msgs_msg_dds__Image__desc, DDS_FREE_CONTENTS);
+    got = {};
+  }
+  EXPECT_EQ(newest, sent.rbegin()->first);
 }
 
 TEST_F(PipelineTopics, OutputsMustExistAndHaveARosForm) {

@@ -373,6 +373,58 @@ TEST_F(RecordCli, RenderRecordsItsFramesAndExportGivesTheDataSetBackPixelForPixe
   EXPECT_FALSE(fs::exists(Path("set2")));
 }
 
+// A camera with a colour filter array: `render --record` carries its raw mosaic, and `mcap
+// export` gives back `--out`'s raw/ images pixel for pixel with the pattern, and each camera's
+// exposure, gain and focus from the frames' records.
+TEST_F(RecordCli, RenderRecordsTheRawMosaicAndExportGivesItBackWithTheCameraControls) {
+  const std::string scene = Path("bayer.yaml");
+  std::ofstream(scene) << "lights: [{type: ambient, intensity: 1}]\n"
+                          "ground: {pattern: checker, cell: 0.2, color: [0.9, 0.5, 0.2]}\n"
+                          "cameras:\n"
+                          "  - name: eye\n"
+                          "    calibration: {width: 64, height: 48, fx: 50, fy: 50}\n"
+                          "    look_at: {eye: [0, 0, 1], target: [2, 0, 0]}\n"
+                          "    lens: {f_number: 2.8, focal_length_mm: 4, focus_distance: 2.5}\n"
+                          "    sensor: {exposure_ms: 5, blur_samples: 1, read_noise_dn: 1,\n"
+                          "             color: {cfa: gbrg}}\n";
+  const std::string file = Path("raw.mcap");
+  const CommandRun render =
+      Saccade("render --scene " + scene + " --frames 2 --out " + Path("set") + " --record " + file);
+  ASSERT_EQ(render.status, 0) << render.output;
+  const CommandRun exported = Saccade("mcap export " + file + " --out " + Path("exported"));
+  ASSERT_EQ(exported.status, 0) << exported.output;
+  std::ifstream set_index(Path("set") + "/frames.jsonl");
+  std::ifstream exported_index(Path("exported") + "/frames.jsonl");
+  std::vector<json> set, out;
+  for (std::string line; std::getline(set_index, line);) set.push_back(json::parse(line));
+  for (std::string line; std::getline(exported_index, line);) out.push_back(json::parse(line));
+  ASSERT_EQ(set.size(), 2u);
+  ASSERT_EQ(out.size(), 2u);
+  for (std::size_t i = 0; i < set.size(); ++i) {
+    SCOPED_TRACE(i);
+    const json& a = set[i]["cameras"]["eye"];
+    const json& b = out[i]["cameras"]["eye"];
+    EXPECT_EQ(b["cfa"], "gbrg");
+    EXPECT_EQ(a["cfa"], b["cfa"]);
+    EXPECT_EQ(a["exposure_s"], 0.005);
+    EXPECT_EQ(a["focus_m"], 2.5);
+    for (const char* key : {"exposure_samples", "exposure_s", "gain_db", "focus_m"}) {
+      EXPECT_EQ(a[key], b[key]) << key;
+    }
+    const cv::Mat x =
+        cv::imread(Path("set") + "/" + a["raw"].get<std::string>(), cv::IMREAD_UNCHANGED);
+    const cv::Mat y =
+        cv::imread(Path("exported") + "/" + b["raw"].get<std::string>(), cv::IMREAD_UNCHANGED);
+    ASSERT_FALSE(x.empty());
+    ASSERT_EQ(y.type(), CV_8UC1);
+    ASSERT_EQ(x.size(), y.size());
+    EXPECT_EQ(cv::norm(x, y, cv::NORM_INF), 0.0);
+  }
+  const auto topics = MessagesByTopic(file);
+  ASSERT_TRUE(topics.count("/saccade/eye/raw/image_raw"));
+  EXPECT_EQ(topics.at("/saccade/eye/raw/image_raw").size(), 2u);
+}
+
 TEST_F(RecordCli, FilesThatAreNotRecordingsGetAClearError) {
   std::ofstream(Path("text.mcap")) << "not a recording\n";
   const CommandRun info = Saccade("mcap info " + Path("text.mcap"));

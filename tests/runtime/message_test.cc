@@ -56,6 +56,9 @@ TEST(MessageTest, ImageJsonCarriesMetadataNotPixels) {
   image->metadata().camera = "left";
   image->metadata().frame_index = 17;
   image->metadata().time = 0.68;
+  image->metadata().exposure_s = 0.008;
+  image->metadata().gain_db = 6.5;
+  image->metadata().focus_m = 1.25;
   image->data()[0] = 200;
   const nlohmann::json json = MessageTraits<ImageMessage>::ToJson({image});
   EXPECT_EQ(json, (nlohmann::json{{"camera", "left"},
@@ -63,7 +66,10 @@ TEST(MessageTest, ImageJsonCarriesMetadataNotPixels) {
                                   {"time", 0.68},
                                   {"width", 64},
                                   {"height", 48},
-                                  {"format", "rgb8"}}));
+                                  {"format", "rgb8"},
+                                  {"exposure_s", 0.008},
+                                  {"gain_db", 6.5},
+                                  {"focus_m", 1.25}}));
   EXPECT_LT(json.dump().size(), 200u);  // no pixel data
 
   const ImageMessage back = MessageTraits<ImageMessage>::FromJson(json);
@@ -74,8 +80,29 @@ TEST(MessageTest, ImageJsonCarriesMetadataNotPixels) {
   EXPECT_EQ(back.image->metadata().camera, "left");
   EXPECT_EQ(back.image->metadata().frame_index, 17);
   EXPECT_EQ(back.image->metadata().time, 0.68);
+  EXPECT_EQ(back.image->metadata().exposure_s, 0.008);
+  EXPECT_EQ(back.image->metadata().gain_db, 6.5);
+  EXPECT_EQ(back.image->metadata().focus_m, 1.25);
   EXPECT_EQ(back.image->data()[0], 0);  // pixels do not travel
   EXPECT_EQ(MessageTraits<ImageMessage>::ToJson(back), json);
+}
+
+TEST(MessageTest, ImageJsonWithoutCameraControlsDecodesToNone) {
+  // Older senders' JSON has no camera controls: absent or null is ImageMetadata's 0 ("none");
+  // a control of another type is refused naming it.
+  nlohmann::json json = {{"camera", "left"}, {"frame_index", 1},  {"time", 0.04},      {"width", 4},
+                         {"height", 2},      {"format", "gray8"}, {"focus_m", nullptr}};
+  const ImageMessage back = MessageTraits<ImageMessage>::FromJson(json);
+  ASSERT_TRUE(back.image);
+  EXPECT_EQ(back.image->metadata().exposure_s, 0.0);
+  EXPECT_EQ(back.image->metadata().focus_m, 0.0);
+  json["gain_db"] = "loud";
+  try {
+    MessageTraits<ImageMessage>::FromJson(json);
+    ADD_FAILURE() << "a gain of text was accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("gain_db"), std::string::npos) << e.what();
+  }
 }
 
 TEST(MessageTest, BayerImageJsonNamesItsRosEncoding) {

@@ -68,6 +68,13 @@ class EyeCamerasRole {
   /// overlaps rendering with the rest of the loop (sim.cameras' `pipelined`). Rendered cameras
   /// only; real ones capture on their own clock anyway. Call before the run starts.
   virtual void SetPipelined(bool on) { (void)on; }
+  /// The camera whose raw colour filter array mosaic the image output `output` carries
+  /// (sim.cameras' `<camera>_raw`, with `raw: true`); "" for a camera's own image and any
+  /// other output. Recordings put such a mosaic on `<camera>/raw/image_raw`.
+  virtual std::string RawMosaicCamera(const std::string& output) const {
+    (void)output;
+    return "";
+  }
   /// Pairs delivered and frames dropped, for real cameras; nullopt for rendered ones.
   virtual std::optional<CameraPairCounts> pair_counts() const { return std::nullopt; }
   /// A line for people about the sources ("" for rendered cameras).

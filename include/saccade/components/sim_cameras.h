@@ -12,6 +12,12 @@
 //            naming the component. Without commands, the file's values.
 //   outputs: <camera> (runtime.image) per camera, shared; frame index = step. The metadata
 //            carries the exposure, gain and focus the frame was taken with.
+//            <camera>_raw (runtime.image) with `raw: true`, per camera that has a colour filter
+//            array (its scene sensor's color: {cfa: ...}): Frame::raw, the Bayer mosaic
+//            (bayer_rggb8, ...: one 8-bit sample a pixel, white balanced, before demosaicing
+//            and the tone curve) of which <camera> is the demosaiced image, with its metadata;
+//            emitted just after <camera>. A camera without a filter has no mosaic and no raw
+//            output; `raw: true` where none of `cameras` has one is an error naming them.
 //   The renderer lives on a thread of its own (its GL context current there). Pipelined
 //   capture (`pipelined`: always, or auto with the real-time clock): each step hands this
 //   step's state to that thread and emits the frames of the previous step's, which rendered
@@ -54,6 +60,7 @@ class SimCameras : public runtime::Component, public EyeCamerasRole {
   /// included).
   void SetEffects(bool distortion, bool noise, bool motion_blur) override;
   void SetPipelined(bool on) override { pipelined_ = on ? "always" : "never"; }
+  std::string RawMosaicCamera(const std::string& output) const override;
   const render::RendererOptions& options() const { return options_; }
   const render::RendererOptions* rendered() const override { return &options_; }
 
@@ -61,6 +68,10 @@ class SimCameras : public runtime::Component, public EyeCamerasRole {
   void Configured() override;
 
  private:
+  /// The output that carries `camera`'s raw mosaic (`raw`): "<camera>_raw".
+  static std::string RawOutputName(const std::string& camera) { return camera + "_raw"; }
+  // Adds the raw outputs (`raw`); InvalidArgument when no camera has a filter array.
+  void AddRawOutputs(const std::string& path);
   // Merges this step's commands into camera_controls_ (they apply from the next step).
   void TakeControls();
 
@@ -70,6 +81,9 @@ class SimCameras : public runtime::Component, public EyeCamerasRole {
   // The commands in force (scene::SceneState::camera_controls), by camera name.
   std::map<std::string, scene::CameraControls> camera_controls_;
   std::vector<runtime::Output<runtime::ImageMessage>*> outputs_;
+  // Per camera of options_.cameras: its raw mosaic's output, nullptr without one.
+  std::vector<runtime::Output<runtime::ImageMessage>*> raw_outputs_;
+  bool raw_ = false;
   std::shared_ptr<const scene::Scene> scene_;
   render::RendererOptions options_;
   std::unique_ptr<internal::RenderThread> thread_;                    // owns renderer_'s GL context

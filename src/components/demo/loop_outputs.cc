@@ -4,7 +4,10 @@ namespace saccade::components::demo {
 
 void TapLoopOutputs(runtime::Pipeline& pipeline, Latest* latest) {
   Tap<runtime::ImageMessage>(pipeline, [latest](const runtime::ImageMessage& m) {
-    if (m.image) latest->images[m.image->metadata().camera] = m.image;
+    // A raw mosaic (sim.cameras' `raw`) carries its camera's name too: the camera's image is
+    // the demosaiced one.
+    if (m.image && !IsBayer(m.image->format()))
+      latest->images[m.image->metadata().camera] = m.image;
   });
   Tap<FacesMessage>(pipeline, [latest](const FacesMessage& m) {
     if (m.image) latest->faces[m.image->metadata().camera] = m;

@@ -22,7 +22,7 @@ struct FrameRecorder::Impl {
   uint64_t log_time = 0;
   // Per camera: its image, depth and id writers (made on the camera's first frame).
   struct Camera {
-    std::unique_ptr<dds::Writer> image, depth, ids;
+    std::unique_ptr<dds::Writer> image, raw, depth, ids;
   };
   std::map<std::string, Camera> cameras;
   std::unique_ptr<dds::Writer> joints;
@@ -95,6 +95,13 @@ void FrameRecorder::Write(int64_t index, double time, const scene::SceneState& s
     if (!frame.color) continue;
     Impl::Camera& camera = r.CameraOf(frame.color->metadata().camera);
     camera.image->Write(runtime::ImageMessage{frame.color});
+    if (frame.raw) {
+      // The raw mosaic of a camera with a colour filter (bayer_rggb8, ...), beside its image.
+      if (!camera.raw) {
+        camera.raw = r.ImageWriter(frame.color->metadata().camera + "/raw/image_raw", "");
+      }
+      camera.raw->Write(runtime::ImageMessage{frame.raw});
+    }
     if (camera.depth && frame.depth) camera.depth->Write(runtime::ImageMessage{frame.depth});
     if (camera.ids && frame.ids) {
       auto ids =

@@ -112,7 +112,7 @@ void PipelineRecorder::Impl::Tap(runtime::Pipeline& pipeline) {
   const std::string joints_type = runtime::MessageName<components::JointStateMessage>();
   const auto ros_types = dds::SupportedMessageTypes();
   for (const auto& component : pipeline.components()) {
-    const bool cameras = dynamic_cast<components::EyeCamerasRole*>(component.get()) != nullptr;
+    const auto* cameras = dynamic_cast<const components::EyeCamerasRole*>(component.get());
     const bool head = dynamic_cast<components::HeadRole*>(component.get()) != nullptr;
     for (const auto& output : component->outputs()) {
       const std::string& type = output->message_type();
@@ -132,7 +132,14 @@ void PipelineRecorder::Impl::Tap(runtime::Pipeline& pipeline) {
         t.topic = topic;
         t.tf_topic = "";
         t.compressed_format = "";
-        if (cameras && type == image_type) {
+        const std::string mosaic = cameras != nullptr && type == image_type
+                                       ? cameras->RawMosaicCamera(output->name())
+                                       : "";
+        if (!mosaic.empty()) {
+          // A camera's raw mosaic beside its image, as render --record's depth and ids: its
+          // pose is the image's, on /tf once.
+          t.topic = dds::ResolveTopic(mosaic + "/raw/image_raw", options.ns);
+        } else if (cameras != nullptr && type == image_type) {
           t.topic = dds::ResolveTopic(output->name() + "/image_raw", options.ns);
           t.tf_topic = "/tf";
         } else if (head && type == joints_type && output->name() == "joints") {

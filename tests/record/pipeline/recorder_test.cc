@@ -10,19 +10,26 @@
 #include <unistd.h>
 
 #include <array>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "record/run_node.h"
 #include "saccade/components/messages.h"
 #include "saccade/components/register.h"
 #include "saccade/core/error.h"
+#include "saccade/dds/participant.h"
+#include "saccade/dds/topics.h"
 #include "saccade/record/mcap.h"
+#include "saccade/record/player.h"
 #include "saccade/runtime/pipeline.h"
 #include "saccade/runtime/scheduler.h"
 #include "scratch_dir.h"
@@ -237,6 +244,98 @@ TEST(PipelineRecorder, MapsAreRecordedAsPointCloud2WithTheirInhibitedPlaces) {
   EXPECT_EQ(fields, (std::vector<std::string>{"x", "y", "z", "rgb"}));
   EXPECT_EQ(inhibited[2]["value"]["width"], 3);  // a place a step, none forgotten yet
   EXPECT_EQ(inhibited[2]["value"]["point_step"], 20);
+}
+
+// sim.cameras' raw mosaic (`raw: true`) is recorded beside its camera's image, as render
+// --record's depth: `/saccade/<camera>/raw/image_raw`, sensor_msgs/Image with ROS's Bayer
+// encoding and the mosaic's bytes (Foxglove's reader), its camera info, no second pose on /tf;
+// played back (McapPlayer), a DDS reader receives the mosaic again, byte for byte.
+TEST(PipelineRecorder, RawMosaicsAreRecordedWithTheirBayerEncodingAndPlayBack) {
+  setenv("CYCLONEDDS_URI", "file://" SACCADE_SOURCE_DIR "/config/dds/loopback.xml", 0);
+  components::RegisterComponents();
+  const std::string scene = TempFile("bayer.yaml").string();
+  std::ofstream(scene) << "lights: [{type: ambient, intensity: 1}]\n"
+                          "ground: {pattern: checker, cell: 0.2, color: [0.9, 0.5, 0.2]}\n"
+                          "cameras:\n"
+                          "  - name: eye\n"
+                          "    calibration: {width: 64, height: 48, fx: 50, fy: 50}\n"
+                          "    look_at: {eye: [0, 0, 1], target: [2, 0, 0]}\n"
+                          "    sensor: {color: {cfa: rggb}}\n";
+  runtime::Pipeline pipeline = runtime::Pipeline::LoadString(
+      "clock: {mode: simulated, step: 0.04, steps: 3}\n"
+      "components:\n"
+      "  - {name: cameras, type: sim.cameras, params: {scene: " +
+          scene + ", cameras: [eye], raw: true}}\n",
+      "raw.yaml");
+  std::vector<std::shared_ptr<const Image>> raws;
+  auto* raw_output = dynamic_cast<runtime::Output<runtime::ImageMessage>*>(
+      pipeline.components().at(0)->FindOutput("eye_raw"));
+  ASSERT_NE(raw_output, nullptr);
+  raw_output->signal().Connect([&](const runtime::ImageMessage& m) { raws.push_back(m.image); });
+  const fs::path file = TempFile("raw.mcap");
+  {
+    PipelineRecorder recorder(pipeline, file);
+    runtime::RunOptions run;
+    run.after_step = [&](const runtime::StepContext& context) { recorder.AfterStep(context); };
+    const runtime::RunSummary summary = runtime::RunPipeline(pipeline, run);
+    ASSERT_TRUE(summary.errors.empty());
+    recorder.Close();
+  }
+  ASSERT_EQ(raws.size(), 3u);
+
+  int status = 0;
+  const std::string out = Node("decode", file, &status);
+  ASSERT_EQ(status, 0) << out.substr(0, 2000);
+  const json decoded = json::parse(out);
+  std::map<std::string, std::vector<json>> by_topic;
+  for (const json& m : decoded["messages"]) {
+    by_topic[m["topic"].get<std::string>()].push_back(m);
+  }
+  const auto& mosaics = by_topic["/saccade/eye/raw/image_raw"];
+  ASSERT_EQ(mosaics.size(), 3u);
+  for (std::size_t i = 0; i < mosaics.size(); ++i) {
+    const json& v = mosaics[i]["value"];
+    const Image& sent = *raws[i];
+    EXPECT_EQ(StampNs(v["header"]["stamp"]), std::llround(sent.metadata().time * 1e9)) << i;
+    EXPECT_EQ(v["header"]["frame_id"], "eye_optical");
+    EXPECT_EQ(v["encoding"], "bayer_rggb8");
+    EXPECT_EQ(v["width"], 64);
+    EXPECT_EQ(v["height"], 48);
+    EXPECT_EQ(v["step"], 64);
+    EXPECT_EQ(v["data"]["fnv1a"], Fnv1a(sent.data(), sent.size_bytes())) << i;
+  }
+  EXPECT_EQ(by_topic["/saccade/eye/image_raw"].size(), 3u);
+  EXPECT_EQ(by_topic["/saccade/eye/image_raw"][0]["value"]["encoding"], "rgb8");
+  EXPECT_EQ(by_topic["/saccade/eye/raw/camera_info"].size(), 3u);
+  EXPECT_EQ(by_topic["/tf"].size(), 3u);  // the eye's pose once a frame, from its image
+
+  // Played back on DDS: the player's writers keep the last 2 images for later readers.
+  constexpr int kDomain = 226;
+  PlayOptions fast;
+  fast.pace = "fast";
+  McapPlayer player(file, {{"domain", kDomain}}, fast);
+  player.Start();
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+  while (!player.stats().finished && std::chrono::steady_clock::now() < deadline) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  ASSERT_TRUE(player.stats().finished);
+  dds::DomainOptions domain;
+  domain.domain_id = kDomain;
+  dds::TopicOptions topic;
+  topic.topic = "/saccade/eye/raw/image_raw";
+  topic.qos = dds::Qos::Images();
+  topic.qos.durability = dds::Durability::kTransientLocal;
+  auto reader = dds::Reader::Create(dds::Participant::Create(domain), "runtime.image", topic);
+  const auto back = reader->Take<runtime::ImageMessage>(10.0);
+  ASSERT_TRUE(back && back->image);
+  const Image& last = *raws.back();
+  EXPECT_EQ(back->image->format(), PixelFormat::kBayerRggb8);
+  EXPECT_EQ(back->image->metadata().camera, "eye");
+  EXPECT_DOUBLE_EQ(back->image->metadata().time, last.metadata().time);
+  ASSERT_EQ(back->image->size_bytes(), last.size_bytes());
+  EXPECT_EQ(std::memcmp(back->image->data(), last.data(), last.size_bytes()), 0);
+  player.Stop();
 }
 
 TEST(PipelineRecorder, OptionsOutOfRangeAndUnwritableFilesAreRefused) {
