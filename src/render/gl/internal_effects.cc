@@ -567,7 +567,7 @@ void EffectTarget::MakeSourceViews() {
 void EffectTarget::MakeLensRemap(bool lens_on_cpu) {
   const int w = source_width_, h = source_height_;
   const RemapTable table = MakeRemapTable(lens_);
-  if (lens_on_cpu && layers_ == 1 && !truth_) {
+  if (lens_on_cpu && layers_ == 1) {
     cpu_lens_ = std::make_unique<CpuLens>(table, lens_.width, lens_.height, w, h);
     source_buffers_ = std::make_unique<PixelBuffers>(w, h, 4);
   }
@@ -765,7 +765,7 @@ void EffectTarget::BindTruthForDrawing(int view) const {
 
 bool EffectTarget::can_read_source() const {
   if (cpu_lens_) return true;
-  return lens_.kind == geometry::LensMap::Kind::kIdentity && !truth_ && layers_ == 1 &&
+  return lens_.kind == geometry::LensMap::Kind::kIdentity && layers_ == 1 &&
          source_width_ == lens_.width && source_height_ == lens_.height;
 }
 
@@ -866,19 +866,32 @@ void EffectTarget::Finish(EffectPrograms& programs, bool accumulated, const Nois
   glReadBuffer(GL_COLOR_ATTACHMENT0);
   color_buffers_.Read(slot, GL_RGBA, GL_UNSIGNED_BYTE);
 
-  if (truth_) {
-    glBindFramebuffer(GL_FRAMEBUFFER, output_truth_framebuffer_);
-    glUseProgram(programs.GetTruthRemap(identity));
-    BindTexture(kIdsUnit, GL_TEXTURE_2D_ARRAY, truth_ids_);
-    BindTexture(kZUnit, GL_TEXTURE_2D_ARRAY, truth_z_);
-    programs.DrawFullscreen();
-    glBindFramebuffer(GL_READ_FRAMEBUFFER, output_truth_framebuffer_);
-    glReadBuffer(GL_COLOR_ATTACHMENT0);
-    id_buffers_->Read(slot, GL_RED_INTEGER, GL_UNSIGNED_INT);
-    glReadBuffer(GL_COLOR_ATTACHMENT1);
-    depth_buffers_->Read(slot, GL_RED, GL_FLOAT);
-    glReadBuffer(GL_COLOR_ATTACHMENT0);
-  }
+  if (truth_) RemapTruth(programs, slot);
+  glUseProgram(0);
+  glActiveTexture(GL_TEXTURE0);
+  glEnable(GL_DEPTH_TEST);
+}
+
+void EffectTarget::RemapTruth(EffectPrograms& programs, int slot) const {
+  glBindFramebuffer(GL_FRAMEBUFFER, output_truth_framebuffer_);
+  glUseProgram(programs.GetTruthRemap(lens_.kind == geometry::LensMap::Kind::kIdentity));
+  BindTexture(kIdsUnit, GL_TEXTURE_2D_ARRAY, truth_ids_);
+  BindTexture(kZUnit, GL_TEXTURE_2D_ARRAY, truth_z_);
+  programs.DrawFullscreen();
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, output_truth_framebuffer_);
+  glReadBuffer(GL_COLOR_ATTACHMENT0);
+  id_buffers_->Read(slot, GL_RED_INTEGER, GL_UNSIGNED_INT);
+  glReadBuffer(GL_COLOR_ATTACHMENT1);
+  depth_buffers_->Read(slot, GL_RED, GL_FLOAT);
+  glReadBuffer(GL_COLOR_ATTACHMENT0);
+}
+
+void EffectTarget::FinishTruth(EffectPrograms& programs, int slot) const {
+  if (!truth_) return;
+  glDisable(GL_DEPTH_TEST);
+  glViewport(0, 0, lens_.width, lens_.height);
+  if (lens_.kind != geometry::LensMap::Kind::kIdentity) BindTexture(kMapUnit, GL_TEXTURE_2D, map_);
+  RemapTruth(programs, slot);
   glUseProgram(0);
   glActiveTexture(GL_TEXTURE0);
   glEnable(GL_DEPTH_TEST);

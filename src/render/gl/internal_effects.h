@@ -194,8 +194,8 @@ class PixelBuffers {
 class EffectTarget {
  public:
   /// `samples` 0 for no MSAA; `blur`: allocate the accumulation array; `truth`: the id and
-  /// depth arrays and outputs; `lens_on_cpu`: a lens of one source view without truth is
-  /// remapped on the CPU (cpu_lens) when nothing was accumulated. Throws saccade::Error naming
+  /// depth arrays and outputs; `lens_on_cpu`: a lens of one source view is remapped on the
+  /// CPU (cpu_lens) when nothing was accumulated (its truth on the GPU). Throws saccade::Error naming
   /// the sizes when the device refuses.
   EffectTarget(const geometry::LensMap& lens, int samples, bool blur, bool truth,
                bool lens_on_cpu = false);
@@ -248,9 +248,13 @@ class EffectTarget {
   void Finish(EffectPrograms& programs, bool accumulated, const NoiseParams* noise, int slot,
               const TurnSamples* turn = nullptr) const;
 
+  /// With ReadSource instead of Finish: the truth remap and its readback into `slot`, when the
+  /// target has truth (else nothing).
+  void FinishTruth(EffectPrograms& programs, int slot) const;
+
   /// Whether the final pass would only copy the source view (plus noise): an identity lens of
-  /// the camera's size, no truth; or remap it where the CPU does that (cpu_lens). Then
-  /// ReadSource may replace Finish when nothing was accumulated.
+  /// the camera's size; or remap it where the CPU does that (cpu_lens). Then ReadSource, and
+  /// FinishTruth for the truth, may replace Finish when nothing was accumulated.
   bool can_read_source() const;
   /// Starts the readback of the source view into `slot`, the pass skipped: an identity lens's
   /// into color_buffers (Finish's pixels without noise), a lens remapped on the CPU's into
@@ -287,6 +291,8 @@ class EffectTarget {
   // footprint and mesh (and the remap on the CPU where asked); the truth arrays and outputs.
   void MakeSourceViews();
   void MakeLensRemap(bool lens_on_cpu);
+  // The truth's remap pass and readback (the viewport set, the lens's map bound).
+  void RemapTruth(EffectPrograms& programs, int slot) const;
   void MakeTruthTargets();
 
   geometry::LensMap lens_;

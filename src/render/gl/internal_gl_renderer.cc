@@ -1024,6 +1024,7 @@ void GlRenderer::FinishEffects(int camera, int64_t frame_index, int slot, bool a
     if (setup.noise) pending_[slot].cpu_noise[camera] = noise;
     pending_[slot].cpu_lens[camera] = cpu_lens;
     effects.ReadSource(slot);
+    effects.FinishTruth(*effect_programs_, slot);
     return;
   }
   effects.Finish(*effect_programs_, accumulated, setup.noise ? &noise : nullptr, slot, turn);
