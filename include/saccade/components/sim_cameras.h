@@ -52,7 +52,7 @@ class SimCameras : public runtime::Component, public EyeCamerasRole {
   /// Switches the scene's effects (the GUI's toggles); the next Step renders with them
   /// (Renderer::SetEffects). Call from the thread that runs the pipeline (while_waiting
   /// included).
-  void SetEffects(bool distortion, bool noise, bool motion_blur) override;
+  void SetEffects(const render::EffectSwitches& effects) override;
   void SetPipelined(bool on) override { pipelined_ = on ? "always" : "never"; }
   const render::RendererOptions& options() const { return options_; }
   const render::RendererOptions* rendered() const override { return &options_; }
