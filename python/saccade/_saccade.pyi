@@ -205,12 +205,20 @@ class head:
         def axis_errors(self, joints: npt.ArrayLike, p_W: npt.ArrayLike) -> npt.NDArray[np.float64]: ...
 
 class scene:
+    class CameraControls:
+        def __init__(self, exposure_s: Optional[float] = None, gain_db: Optional[float] = None,
+                     focus_m: Optional[float] = None) -> None: ...
+        exposure_s: Optional[float]
+        gain_db: Optional[float]
+        focus_m: Optional[float]
     class SceneState:
         def __init__(self, time: float = 0.0, joints: JointsLike = ...,
-                     joint_velocities: JointsLike = ...) -> None: ...
+                     joint_velocities: JointsLike = ...,
+                     camera_controls: Dict[str, "scene.CameraControls"] = ...) -> None: ...
         time: float
         joints: "head.JointState"
         joint_velocities: "head.JointState"
+        camera_controls: Dict[str, "scene.CameraControls"]
     class Object:
         name: str
         id: int
@@ -246,6 +254,8 @@ class render:
         color: npt.NDArray[np.uint8]
         depth: Optional[npt.NDArray[np.float32]]
         ids: Optional[npt.NDArray[np.uint32]]
+        raw: Optional[npt.NDArray[np.uint8]]
+        raw_format: Optional[str]
         image: "core.Image"
         objects: List["render.ObjectTruth"]
     class RenderStats:
@@ -264,7 +274,8 @@ class render:
     class Renderer:
         def __init__(self, scene: "scene.Scene", cameras: Optional[Sequence[str]] = None,
                      msaa_samples: int = 0, draw_robot: bool = True, distortion: bool = True,
-                     noise: bool = True, motion_blur: bool = True, truth_depth: bool = False,
+                     noise: bool = True, motion_blur: bool = True, optics: bool = True,
+                     color: bool = True, truth_depth: bool = False,
                      truth_ids: bool = False, truth_objects: bool = False,
                      lod_max_error_px: float = 0.25, batch_contexts: int = 0) -> None: ...
         camera_names: List[str]
@@ -274,7 +285,8 @@ class render:
                    out: Optional[npt.NDArray[np.uint8]] = None) -> Any: ...
         def render_batch(self, heads: Sequence["render.BatchHead"],
                          out: Optional[npt.NDArray[np.uint8]] = None) -> npt.NDArray[np.uint8]: ...
-        def set_effects(self, distortion: bool, noise: bool, motion_blur: bool) -> None: ...
+        def set_effects(self, distortion: bool, noise: bool, motion_blur: bool,
+                        optics: bool = True, color: bool = True) -> None: ...
 
 class runtime:
     class Pipeline:

@@ -111,14 +111,9 @@ void SimCameras::Start() {
   }
 }
 
-void SimCameras::SetEffects(bool distortion, bool noise, bool motion_blur) {
-  if (options_.distortion == distortion && options_.noise == noise &&
-      options_.motion_blur == motion_blur) {
-    return;
-  }
-  options_.distortion = distortion;
-  options_.noise = noise;
-  options_.motion_blur = motion_blur;
+void SimCameras::SetEffects(const render::EffectSwitches& effects) {
+  if (render::EffectSwitches::Of(options_) == effects) return;
+  effects.ApplyTo(&options_);
   options_changed_ = true;
 }
 
@@ -134,8 +129,8 @@ void SimCameras::Step(const runtime::StepContext& context) {
   if (options_changed_) {
     // Nothing is in flight now: the frames above were drawn with the old effects and go out
     // with this step's.
-    const bool d = options_.distortion, n = options_.noise, b = options_.motion_blur;
-    internal::Await(thread_->Post([this, d, n, b] { renderer_->SetEffects(d, n, b); }),
+    const render::EffectSwitches effects = render::EffectSwitches::Of(options_);
+    internal::Await(thread_->Post([this, effects] { renderer_->SetEffects(effects); }),
                     while_waiting);
     options_changed_ = false;
   }

@@ -35,6 +35,10 @@ struct StateParts {
   nlohmann::json recording;      ///< {file, megabytes} of the recording, null without one
 };
 
+/// The effects' switches as the protocol writes them (`effects`: distortion, noise, motion_blur,
+/// optics, color).
+nlohmann::json EffectsJson(const render::RendererOptions& options);
+
 /// The state message: the joints with the head's frames (forward kinematics), the target with
 /// each optical axis's error to it, and the poses of `scene`'s moving objects at `parts.time`.
 nlohmann::json StateJson(const StateParts& parts, const scene::Scene& scene);

@@ -43,9 +43,14 @@ Schema LinkPoses() {
 Schema Rgb() { return Named("rgb", Array(Number(), 3)); }
 Schema Rgba() { return Named("rgba", Array(Number(), 4)); }
 Schema Effects() {
-  return Named("effects", Object({Required("distortion", Boolean(), "lens distortion"),
-                                  Required("noise", Boolean(), "sensor noise"),
-                                  Required("motion_blur", Boolean(), "motion blur")}));
+  return Named(
+      "effects",
+      Object({Required("distortion", Boolean(), "lens distortion"),
+              Required("noise", Boolean(), "sensor noise"),
+              Required("motion_blur", Boolean(), "motion blur"),
+              Required("optics", Boolean(), "the lens's vignetting and depth of field"),
+              Required("color", Boolean(),
+                       "the colour filter array, demosaicing, white balance and tone curve")}));
 }
 
 // A command: {"type", "id"} and `fields`; its reply adds `reply`.
@@ -136,7 +141,12 @@ void AddSimulationCommands(std::vector<Message>& out) {
       Command("effects", "the simulated cameras' effects (an error when the cameras are real)",
               {Optional("distortion", Boolean(), "lens distortion (missing: as it is)"),
                Optional("noise", Boolean(), "sensor noise (missing: as it is)"),
-               Optional("motion_blur", Boolean(), "motion blur (missing: as it is)")},
+               Optional("motion_blur", Boolean(), "motion blur (missing: as it is)"),
+               Optional("optics", Boolean(),
+                        "the lens's vignetting and depth of field (missing: as it is)"),
+               Optional("color", Boolean(),
+                        "the sensor's colour filter array, demosaicing, white balance and tone "
+                        "curve (missing: as it is)")},
               {Required("effects", Effects(), "the effects now")});
   out.push_back(std::move(effects));
   out.push_back(Command("pause", "stops the simulation clock", {},
@@ -287,7 +297,10 @@ void AddServerMessages(std::vector<Message>& out) {
        Required("height", Integer(1), "pixels"),
        Required("overlay", Boolean(),
                 "detections (green; rejected red), the CamShift window (yellow) and the target "
-                "(cyan) are drawn into the image")}));
+                "(cyan) are drawn into the image"),
+       Required("exposure_s", Number(0), "the exposure it was taken with (s; 0: an instant)"),
+       Required("gain_db", Number(), "the gain it was taken with (dB)"),
+       Required("focus_m", Number(0), "the focus distance it was taken with (m; 0: none)")}));
 }
 
 Schema Models() {
@@ -320,8 +333,13 @@ Schema Cameras() {
        Required("name", String(), "the camera's name"),
        Required("eye", String({"left", "right", "world"}), "where it is mounted"),
        Required("X_WC", Pose(), "at time 0; eye cameras move with `state.frames`"),
-       Required("near", Number(0), "clip plane (m)"),
-       Required("far", Number(0), "clip plane (m)")}));
+       Required("near", Number(0), "clip plane (m)"), Required("far", Number(0), "clip plane (m)"),
+       Required("optics", Boolean(),
+                "its lens has vignetting or depth of field (what the `effects` switch `optics` "
+                "changes)"),
+       Required("color", Boolean(),
+                "its sensor has a colour filter array, white balance or a tone curve (what the "
+                "`effects` switch `color` changes)")}));
 }
 
 Schema SceneRobot() {
@@ -428,7 +446,9 @@ const std::vector<NamedType>& Types() {
        "rad or m, or rad/s)"},
       {Rgb(), "a linear colour `[r, g, b]`, 0 to 1"},
       {Rgba(), "a linear colour with opacity `[r, g, b, a]`, 0 to 1"},
-      {Effects(), "the simulated cameras' effects: `{distortion, noise, motion_blur}`, booleans"},
+      {Effects(),
+       "the simulated cameras' effects: `{distortion, noise, motion_blur, optics, color}`, "
+       "booleans"},
   };
   return types;
 }

@@ -235,6 +235,9 @@ json CamerasJson(const scene::Scene& scene) {
     camera["X_WC"] = ToJson(c.X_WC);
     camera["near"] = c.clip.near;
     camera["far"] = c.clip.far;
+    // What the `effects` switches optics and color change in its image.
+    camera["optics"] = c.lens.Enabled();
+    camera["color"] = c.sensor.color.Enabled();
     cameras.push_back(camera);
   }
   return cameras;

@@ -362,14 +362,15 @@ json GuiSession::OnEffects(const json& command) {
     throw CommandError("effects: the cameras are not simulated: they have no effects to switch");
   }
   std::lock_guard lock(effects_mutex_);
-  const bool d = command.value("distortion", effects_.distortion);
-  const bool n = command.value("noise", effects_.noise);
-  const bool b = command.value("motion_blur", effects_.motion_blur);
-  effects_.distortion = d;
-  effects_.noise = n;
-  effects_.motion_blur = b;
-  Enqueue([this, d, n, b] { cameras_->SetEffects(d, n, b); });
-  return {{"effects", {{"distortion", d}, {"noise", n}, {"motion_blur", b}}}};
+  render::EffectSwitches effects = render::EffectSwitches::Of(effects_);
+  effects.distortion = command.value("distortion", effects.distortion);
+  effects.noise = command.value("noise", effects.noise);
+  effects.motion_blur = command.value("motion_blur", effects.motion_blur);
+  effects.optics = command.value("optics", effects.optics);
+  effects.color = command.value("color", effects.color);
+  effects.ApplyTo(&effects_);
+  Enqueue([this, effects] { cameras_->SetEffects(effects); });
+  return {{"effects", internal::EffectsJson(effects_)}};
 }
 
 json GuiSession::OnPause(const json&) {
@@ -605,7 +606,10 @@ void GuiSession::EncodeLoop() {
                              {"time", image->metadata().time},
                              {"width", bgr.cols},
                              {"height", bgr.rows},
-                             {"overlay", true}};
+                             {"overlay", true},
+                             {"exposure_s", image->metadata().exposure_s},
+                             {"gain_db", image->metadata().gain_db},
+                             {"focus_m", image->metadata().focus_m}};
         Conform(protocol::CheckFrameHeader(header));
         server_->PublishFrame(camera, header,
                               std::make_shared<const std::string>(jpeg.begin(), jpeg.end()));

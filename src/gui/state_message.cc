@@ -21,6 +21,14 @@ double AxisErrorDeg(const geometry::Pose& X_WC, const Eigen::Vector3d& p_W) {
 
 }  // namespace
 
+json EffectsJson(const render::RendererOptions& o) {
+  return {{"distortion", o.distortion},
+          {"noise", o.noise},
+          {"motion_blur", o.motion_blur},
+          {"optics", o.optics},
+          {"color", o.color}};
+}
+
 json StateJson(const StateParts& parts, const scene::Scene& scene) {
   json state = {{"type", "state"},
                 {"step", parts.step},
@@ -31,9 +39,7 @@ json StateJson(const StateParts& parts, const scene::Scene& scene) {
                 {"manual", !parts.perception}};
   state["effects"] = nullptr;
   if (parts.effects) {
-    const render::RendererOptions& o = *parts.effects;
-    state["effects"] = {
-        {"distortion", o.distortion}, {"noise", o.noise}, {"motion_blur", o.motion_blur}};
+    state["effects"] = EffectsJson(*parts.effects);
   }
   std::optional<std::array<geometry::Pose, 2>> cameras;
   state["joints"] = nullptr;

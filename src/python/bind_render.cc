@@ -106,6 +106,19 @@ void BindFrames(py::module_& m) {
             return f.color ? py::cast(ImageRef{f.color}) : py::none();
           },
           "The colour image's owner, with its metadata.")
+      .def_property_readonly(
+          "raw", [](const Frame& f) { return ImageArray(f.raw); },
+          "The raw mosaic of a camera with a colour filter array: height x width uint8, white "
+          "balanced, before demosaicing and the tone curve (its pattern: raw_format); None "
+          "without a filter, or with color=False.")
+      .def_property_readonly(
+          "raw_format",
+          [](const Frame& f) -> py::object {
+            if (!f.raw) return py::none();
+            return py::str(std::string(ToString(f.raw->format())));
+          },
+          "The mosaic's pattern as its ROS encoding ('bayer_rggb8', 'bayer_bggr8', "
+          "'bayer_gbrg8', 'bayer_grbg8'), or None.")
       .def_readonly("objects", &Frame::objects);
 }
 
@@ -160,8 +173,8 @@ void BindRenderer(py::module_& m) {
                          "without a GPU). Not thread-safe: use it from one thread.")
       .def(py::init([](std::shared_ptr<scene::Scene> scene,
                        const std::optional<std::vector<std::string>>& cameras, int msaa_samples,
-                       bool draw_robot, bool distortion, bool noise, bool motion_blur,
-                       bool truth_depth, bool truth_ids, bool truth_objects,
+                       bool draw_robot, bool distortion, bool noise, bool motion_blur, bool optics,
+                       bool color, bool truth_depth, bool truth_ids, bool truth_objects,
                        double lod_max_error_px, int batch_contexts) {
              RendererOptions options;
              if (cameras) options.cameras = *cameras;
@@ -170,6 +183,8 @@ void BindRenderer(py::module_& m) {
              options.distortion = distortion;
              options.noise = noise;
              options.motion_blur = motion_blur;
+             options.optics = optics;
+             options.color = color;
              options.truth_depth = truth_depth;
              options.truth_ids = truth_ids;
              options.truth_objects = truth_objects;
@@ -188,11 +203,13 @@ void BindRenderer(py::module_& m) {
              return result;
            }),
            "scene"_a, "cameras"_a = py::none(), "msaa_samples"_a = 0, "draw_robot"_a = true,
-           "distortion"_a = true, "noise"_a = true, "motion_blur"_a = true, "truth_depth"_a = false,
-           "truth_ids"_a = false, "truth_objects"_a = false, "lod_max_error_px"_a = 0.25,
-           "batch_contexts"_a = 0,
+           "distortion"_a = true, "noise"_a = true, "motion_blur"_a = true, "optics"_a = true,
+           "color"_a = true, "truth_depth"_a = false, "truth_ids"_a = false,
+           "truth_objects"_a = false, "lod_max_error_px"_a = 0.25, "batch_contexts"_a = 0,
            "Opens a surfaceless EGL context and uploads the scene. `cameras`: names, default "
-           "all. `batch_contexts`: GL contexts that draw a render_batch, each on a thread of its "
+           "all. `optics`: the lenses' vignetting and depth of field; `color`: the sensors' "
+           "colour filter array, white balance, demosaicing and tone curve (Frame.raw). "
+           "`batch_contexts`: GL contexts that draw a render_batch, each on a thread of its "
            "own (1 or 2; 0: 2 on a software rasteriser with 2 cores or more; the images are the "
            "same to the bit). Raises InvalidArgument naming a bad option or an unknown camera.")
       .def_property_readonly("camera_names",
@@ -202,11 +219,12 @@ void BindRenderer(py::module_& m) {
       .def_property_readonly("stats", [](const PyRenderer& r) { return r.renderer->stats(); })
       .def(
           "set_effects",
-          [](PyRenderer& r, bool distortion, bool noise, bool motion_blur) {
+          [](PyRenderer& r, bool distortion, bool noise, bool motion_blur, bool optics,
+             bool color) {
             py::gil_scoped_release release;
-            r.renderer->SetEffects(distortion, noise, motion_blur);
+            r.renderer->SetEffects({distortion, noise, motion_blur, optics, color});
           },
-          "distortion"_a, "noise"_a, "motion_blur"_a,
+          "distortion"_a, "noise"_a, "motion_blur"_a, "optics"_a = true, "color"_a = true,
           "Switches the effects of every camera in place, as the constructor's arguments would: "
           "the next renders are bit for bit those of a Renderer made with them, without a new "
           "context or uploads (say, effects drawn at random per episode).")

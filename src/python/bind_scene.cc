@@ -1,8 +1,12 @@
 // saccade.scene: loading a scene file (scenes/portraits.yaml documents the format) and the
-// state that changes while the description stays (time, joints).
+// state that changes while the description stays (time, joints, commanded camera controls).
 #include <pybind11/eigen.h>
 #include <pybind11/stl.h>
 #include <pybind11/stl/filesystem.h>
+
+#include <map>
+#include <optional>
+#include <string>
 
 #include "python/internal_bindings.h"
 #include "saccade/core/error.h"
@@ -10,18 +14,55 @@
 
 namespace saccade::python {
 
-void BindScene(py::module_& m) {
+namespace {
+
+// The state that changes while the description stays, with the camera controls it commands.
+void BindSceneState(py::module_& m) {
   using namespace scene;
-  py::class_<SceneState>(m, "SceneState", "Time (s), joints (rad) and joint velocities (rad/s).")
-      .def(py::init(
-               [](double time, const head::JointState& joints, const head::JointState& velocities) {
-                 return SceneState{time, joints, velocities, {}};
-               }),
+  py::class_<CameraControls>(m, "CameraControls",
+                             "Commanded exposure (s, in (0, 1]), gain (dB, in [0, 48]) and focus "
+                             "distance (m, > 0) of one camera; None keeps the file's value.")
+      .def(py::init([](std::optional<double> exposure_s, std::optional<double> gain_db,
+                       std::optional<double> focus_m) {
+             return CameraControls{exposure_s, gain_db, focus_m};
+           }),
+           "exposure_s"_a = py::none(), "gain_db"_a = py::none(), "focus_m"_a = py::none())
+      .def_readwrite("exposure_s", &CameraControls::exposure_s)
+      .def_readwrite("gain_db", &CameraControls::gain_db)
+      .def_readwrite("focus_m", &CameraControls::focus_m)
+      .def("__repr__", [](const CameraControls& c) {
+        const auto text = [](const std::optional<double>& v) {
+          return v ? std::string(py::str(py::float_(*v))) : std::string("None");
+        };
+        return "CameraControls(exposure_s=" + text(c.exposure_s) + ", gain_db=" + text(c.gain_db) +
+               ", focus_m=" + text(c.focus_m) + ")";
+      });
+
+  py::class_<SceneState>(m, "SceneState",
+                         "Time (s), joints (rad), joint velocities (rad/s) and commanded camera "
+                         "controls by camera name.")
+      .def(py::init([](double time, const head::JointState& joints,
+                       const head::JointState& velocities,
+                       const std::map<std::string, CameraControls>& controls) {
+             return SceneState{time, joints, velocities, controls};
+           }),
            "time"_a = 0.0, "joints"_a = head::JointState{},
-           "joint_velocities"_a = head::JointState{})
+           "joint_velocities"_a = head::JointState{},
+           "camera_controls"_a = std::map<std::string, CameraControls>{})
       .def_readwrite("time", &SceneState::time)
       .def_readwrite("joints", &SceneState::joints)
-      .def_readwrite("joint_velocities", &SceneState::joint_velocities);
+      .def_readwrite("joint_velocities", &SceneState::joint_velocities)
+      .def_readwrite("camera_controls", &SceneState::camera_controls,
+                     "{camera name: CameraControls}, a copy: assign the whole dict to change it. "
+                     "Rendering raises InvalidArgument for an unknown camera or a value out of "
+                     "range.");
+}
+
+}  // namespace
+
+void BindScene(py::module_& m) {
+  using namespace scene;
+  BindSceneState(m);
 
   py::class_<Object>(m, "Object", "Something drawn in the world.")
       .def_readonly("name", &Object::name)

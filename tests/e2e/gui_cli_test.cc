@@ -315,11 +315,16 @@ TEST_F(GuiCliTest, SwitchesEffectsAndStreamsJpegFrames) {
   Client client(*gui_);
   json error = client.Command({{"type", "effects"}, {"noise", "off"}});
   EXPECT_EQ(error["error"], "effects: field 'noise' must be a boolean, got string");
-  json reply = client.Command({{"type", "effects"}, {"noise", false}});
+  error = client.Command({{"type", "effects"}, {"color", 0}});
+  EXPECT_EQ(error["error"], "effects: field 'color' must be a boolean, got 0");
+  json reply = client.Command({{"type", "effects"}, {"noise", false}, {"color", false}});
   ASSERT_EQ(reply["type"], "reply");
+  EXPECT_EQ(reply["effects"]["color"], false) << reply;
+  EXPECT_EQ(reply["effects"]["optics"], true) << reply;
   EXPECT_EQ(client.Command({{"type", "step"}, {"count", 2}})["type"], "reply");
   const json state = client.State([](const json& s) { return !s["effects"]["noise"].get<bool>(); });
   EXPECT_TRUE(state["effects"]["distortion"].get<bool>());
+  EXPECT_FALSE(state["effects"]["color"].get<bool>());
   // Frames: [4-byte length][JSON header][JPEG].
   while (client.binary().empty()) client.Command({{"type", "step"}});
   const std::string& frame = client.binary().front();

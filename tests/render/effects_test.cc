@@ -1117,7 +1117,7 @@ robot:
     options.motion_blur = (bits & 4) != 0;
     SCOPED_TRACE("distortion " + std::to_string(options.distortion) + ", noise " +
                  std::to_string(options.noise) + ", blur " + std::to_string(options.motion_blur));
-    switched->SetEffects(options.distortion, options.noise, options.motion_blur);
+    switched->SetEffects(EffectSwitches::Of(options));
     ++frame;
     const std::vector<Frame> got = switched->Render(state, frame);
     const std::vector<Frame> made = RenderOnce(world, options, &state, frame);
@@ -1140,11 +1140,65 @@ robot:
 
   // Not while a state is in flight: its pixels were drawn with the effects it was submitted with.
   switched->Submit(state, ++frame);
-  EXPECT_THROW(switched->SetEffects(false, false, false), Error);
+  EXPECT_THROW(switched->SetEffects({false, false, false, true, true}), Error);
   EXPECT_EQ(switched->Retrieve()[0].color->metadata().frame_index, frame);
-  switched->SetEffects(false, false, false);
+  switched->SetEffects({false, false, false, true, true});
   EXPECT_EQ(testing_helpers::DistortionName(switched->Render(state, ++frame)[0].color->metadata()),
             "none");
+}
+
+// The lens's light and the sensor's colour switch as the others: a camera with vignetting,
+// depth of field (which draws depth) and a Bayer filter, and one whose EMVA sensor exposes the
+// mosaic with the colour on and the RGB image without, give after each switch the frames (and
+// the mosaic, or none) of a renderer made with the switches, noise and distortion on.
+TEST(SetEffectsTest, OpticsAndColourSwitchAsARendererMadeWithThem) {
+  const scene::Scene world = SceneFrom(R"(
+background: [0.6, 0.7, 0.8]
+lights: [{type: ambient, intensity: 0.5}, {type: directional, direction: [1, 0, -1]}]
+ground: {pattern: checker, cell: 0.25, color: [0.9, 0.5, 0.2], color2: [0.1, 0.3, 0.8]}
+cameras:
+  - name: real
+    calibration: {width: 96, height: 72, fx: 70, fy: 70,
+                  distortion: {model: radtan, coefficients: [-0.2, 0.05, 0, 0, 0]}}
+    look_at: {eye: [0, 0, 1], target: [2, 0, 0.3]}
+    sensor: {read_noise_dn: 2, gain_dn_per_e: 0.2, seed: 3,
+             color: {cfa: rggb, white_balance: {red: 1.3, blue: 1.6}, tone_curve: srgb}}
+    lens: {vignetting: cos4, f_number: 1.4, focal_length_mm: 6, focus_distance: 1, max_coc_px: 4}
+  - name: emva
+    calibration: {width: 64, height: 48, fx: 50, fy: 50}
+    look_at: {eye: [0, 0, 1], target: [2, 0, 0.3]}
+    sensor: {exposure_ms: 8, seed: 5, emva: {preset: imx174}, color: {cfa: bggr}}
+    lens: {vignetting: cos4}
+)");
+  const scene::SceneState state = world.InitialState();
+  std::unique_ptr<Renderer> switched = MakeRenderer(world);
+  int64_t frame = 0;
+  std::vector<std::vector<uint8_t>> seen;
+  for (const int bits : {0, 1, 3, 2, 0, 3}) {
+    RendererOptions options;
+    options.optics = (bits & 1) != 0;
+    options.color = (bits & 2) != 0;
+    SCOPED_TRACE("optics " + std::to_string(options.optics) + ", color " +
+                 std::to_string(options.color));
+    switched->SetEffects(EffectSwitches::Of(options));
+    ++frame;
+    const std::vector<Frame> got = switched->Render(state, frame);
+    const std::vector<Frame> made = RenderOnce(world, options, &state, frame);
+    ASSERT_EQ(got.size(), 2u);
+    for (int i = 0; i < 2; ++i) {
+      EXPECT_TRUE(SamePixels(*got[i].color, *made[i].color))
+          << i << ": " << Keep(*got[i].color, "switched");
+      ASSERT_EQ(got[i].raw != nullptr, options.color) << i;
+      if (options.color) {
+        EXPECT_TRUE(SamePixels(*got[i].raw, *made[i].raw)) << i;
+      }
+    }
+    const uint8_t* pixels = got[0].color->data();
+    seen.emplace_back(pixels, pixels + got[0].color->size_bytes());
+  }
+  for (int a = 0; a < 4; ++a) {  // the first four are the four combinations
+    for (int b = 0; b < a; ++b) EXPECT_NE(seen[a], seen[b]) << "switches " << b << " and " << a;
+  }
 }
 
 }  // namespace

@@ -42,6 +42,11 @@ const kDragAngleToleranceDeg = 4;  // the mouse lands on whole pixels; the throt
 const kImagePlaneTolerance = 3;   // mean grey difference (of 255), image plane against the view
 const kImageChangeThreshold = 8;   // mean absolute grey difference (of 255) after a 50 deg pan
 const kFixationToleranceDeg = 1.0; // each optical axis to the clicked point
+// The sRGB tone curve lifts the realistic eyes' mid-tones (linear 0.2 encodes as 0.48): with the
+// colour off the image is the linear RGB, darker by far more than this mean grey (of 255).
+const kColourOffDarkening = 10;
+const kFramesAfterSwitch = 3;      // frames shown after a switch before its image is read
+const kRealisticScene = path.join(kRepo, 'scenes', 'portraits_realistic.yaml');
 
 const kChromiumArgs = ['--headless=new', '--no-sandbox', '--disable-background-networking',
   '--disable-component-update', '--disable-sync', '--no-first-run', '--disable-quic',
@@ -131,6 +136,22 @@ async function moveHead(page, joints) {
   assert.equal(reply.type, 'reply', `joints: ${JSON.stringify(reply)}`);
   return waitState(page, (s, j) => Object.entries(j).every(
     ([k, v]) => Math.abs(s.joints.positions[k] - v) < 0.2 * Math.PI / 180), joints);
+}
+
+/** The effect switches' state in the page: disabled, checked and tooltip of each. */
+function effectBoxes(page) {
+  return page.evaluate(() => Object.fromEntries(['distortion', 'noise', 'blur', 'optics', 'color']
+    .map((k) => {
+      const box = document.getElementById(`fx-${k}`);
+      return [k, { disabled: box.disabled, checked: box.checked, title: box.parentElement.title }];
+    })));
+}
+
+/** Waits until the page has shown `count` more frames of `camera` than now. */
+async function waitFrames(page, camera, count) {
+  const shown = await page.evaluate((n) => window.saccadeGui.framesShown[n], camera);
+  await page.waitForFunction(([n, target]) => window.saccadeGui.framesShown[n] >= target,
+    [camera, shown + count], { timeout: kMoveTimeoutMs, polling: 50 });
 }
 
 /** A grey 256 x 192 copy of a camera view's current image, as a plain array. */
@@ -319,6 +340,16 @@ describe('saccade gui (portraits.yaml)', () => {
     console.log(report);
     assert.ok(result.mean < kWorldMeanTolerance, report);
     assert.ok(result.inlierFraction > kWorldInlierFraction, report);
+  });
+
+  test('the optics and colour switches are disabled, saying why, when no camera has them', async () => {
+    await waitReady(page);
+    const boxes = await effectBoxes(page);
+    for (const key of ['optics', 'color']) {
+      assert.ok(boxes[key].disabled, `${key}: ${JSON.stringify(boxes[key])}`);
+      assert.match(boxes[key].title, /^no camera of this scene has /);
+    }
+    for (const key of ['distortion', 'noise', 'blur']) assert.ok(!boxes[key].disabled, key);
   });
 
   test('the page places the world at the poses of the scene and the state, in their one form', async () => {
@@ -784,6 +815,55 @@ describe('saccade gui restarted', () => {
     await waitReady(page);
     assert.ok((await names()).includes('astronaut_near'), 'the page shows the new scene');
     await page.close();
+  });
+});
+
+// Realistic eyes (a Bayer mosaic, sRGB, vignetting, depth of field): the optics and colour
+// switches are offered, and the colour switch changes the streamed camera image.
+describe('saccade gui with realistic cameras (portraits_realistic.yaml)', () => {
+  let browser, server, page;
+
+  before(async () => {
+    browser = await chromium.launch({ executablePath: '/usr/bin/chromium', args: kChromiumArgs });
+    server = await startSaccade(['gui', '--scene', kRealisticScene, '--port', '0']);
+    page = await openPage(browser, server.url.href);
+  });
+
+  after(async () => {
+    await page?.close().catch(() => {});
+    await browser?.close().catch(() => {});
+    await stopSaccade(server);
+  });
+
+  test('switching the colour off shows the linear image, and back on the toned one', async () => {
+    await waitReady(page);
+    const boxes = await effectBoxes(page);
+    for (const key of ['optics', 'color']) {
+      assert.ok(!boxes[key].disabled && boxes[key].checked, `${key}: ${JSON.stringify(boxes[key])}`);
+      assert.match(boxes[key].title, /of left, right$/);
+    }
+    const mean = (xs) => xs.reduce((a, b) => a + b, 0) / xs.length;
+    await waitFrames(page, 'left', 1);
+    // The label says the controls the frame was taken with (the file's 8 ms, 0 dB, 2 m focus).
+    assert.match(await page.textContent('#label-left'), / · 8\.0 ms · 0\.0 dB · focus 2\.00 m$/);
+    const toned = await grabGrey(page, 'left');
+    // The page's switch sends the command; the state says it, the box follows.
+    await page.click('#fx-color');
+    const state = await waitState(page, (s) => s.effects && s.effects.color === false);
+    assert.equal(state.effects.optics, true);
+    await waitFrames(page, 'left', kFramesAfterSwitch);
+    const linear = await grabGrey(page, 'left');
+    console.log(`figures: realistic left eye mean grey ${mean(toned).toFixed(1)} with colour, ` +
+      `${mean(linear).toFixed(1)} without`);
+    assert.ok(mean(linear) < mean(toned) - kColourOffDarkening,
+      `colour off: mean grey ${mean(linear).toFixed(1)}, on: ${mean(toned).toFixed(1)}`);
+    assert.equal((await effectBoxes(page)).color.checked, false);
+    await page.click('#fx-color');
+    await waitState(page, (s) => s.effects && s.effects.color === true);
+    await waitFrames(page, 'left', kFramesAfterSwitch);
+    const again = await grabGrey(page, 'left');
+    assert.ok(mean(again) > mean(linear) + kColourOffDarkening,
+      `colour on again: mean grey ${mean(again).toFixed(1)}, off: ${mean(linear).toFixed(1)}`);
   });
 });
 

@@ -60,8 +60,8 @@ class EyeCamerasRole {
   virtual const render::RendererOptions* rendered() const { return nullptr; }
   /// Switches the rendered effects (the next step renders with them). Throws Error for real
   /// cameras.
-  virtual void SetEffects(bool distortion, bool noise, bool motion_blur) {
-    (void)distortion, (void)noise, (void)motion_blur;
+  virtual void SetEffects(const render::EffectSwitches& effects) {
+    (void)effects;
     throw Error("real cameras have no rendered effects to switch");
   }
   /// Pipelined capture: each step emits the frames rendered during the previous one, which

@@ -58,7 +58,7 @@ class SimCameras : public runtime::Component, public EyeCamerasRole {
   /// Switches the scene's effects (the GUI's toggles); the next Step renders with them
   /// (Renderer::SetEffects). Call from the thread that runs the pipeline (while_waiting
   /// included).
-  void SetEffects(bool distortion, bool noise, bool motion_blur) override;
+  void SetEffects(const render::EffectSwitches& effects) override;
   void SetPipelined(bool on) override { pipelined_ = on ? "always" : "never"; }
   std::string RawMosaicCamera(const std::string& output) const override;
   const render::RendererOptions& options() const { return options_; }

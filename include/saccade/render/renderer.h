@@ -120,6 +120,34 @@ struct RendererOptions {
   bool IsValid(std::string* error) const;
 };
 
+/// The effect switches of RendererOptions that a live renderer can change
+/// (Renderer::SetEffects), each as the option of the same name.
+struct EffectSwitches {
+  bool distortion = true;
+  bool noise = true;
+  bool motion_blur = true;
+  bool optics = true;
+  bool color = true;
+
+  /// The switches of `options`.
+  static EffectSwitches Of(const RendererOptions& options) {
+    return {options.distortion, options.noise, options.motion_blur, options.optics, options.color};
+  }
+  /// Sets them in `options`.
+  void ApplyTo(RendererOptions* options) const {
+    options->distortion = distortion;
+    options->noise = noise;
+    options->motion_blur = motion_blur;
+    options->optics = optics;
+    options->color = color;
+  }
+  bool operator==(const EffectSwitches& other) const {
+    return distortion == other.distortion && noise == other.noise &&
+           motion_blur == other.motion_blur && optics == other.optics && color == other.color;
+  }
+  bool operator!=(const EffectSwitches& other) const { return !(*this == other); }
+};
+
 /// Ground truth of one object (or of the robot's body) in one frame of one camera.
 struct ObjectTruth {
   uint32_t id = 0;
@@ -196,13 +224,13 @@ class Renderer {
   /// Submitted states not yet retrieved (0, 1 or 2). Submit with 2 in flight throws Error.
   virtual int InFlight() const = 0;
 
-  /// Switches the effects for every camera, as RendererOptions' distortion, noise and
-  /// motion_blur would at creation: the next frames are those a renderer made with these
-  /// options gives, bit for bit. Only the cameras' targets are remade; the context, the
+  /// Switches the effects for every camera, as RendererOptions' distortion, noise,
+  /// motion_blur, optics and color would at creation: the next frames are those a renderer made
+  /// with these options gives, bit for bit. Only the cameras' targets are remade; the context, the
   /// uploaded models and textures and the compiled programs are kept (remaking the renderer
   /// instead costs a context and every upload, and churns over a hundred MiB on llvmpipe).
   /// Throws Error while states are in flight (Retrieve them first).
-  virtual void SetEffects(bool distortion, bool noise, bool motion_blur) = 0;
+  virtual void SetEffects(const EffectSwitches& effects) = 0;
 
   /// Batch rendering: draws every head of `heads` through every selected camera into one
   /// framebuffer of tiles and reads them back at once into `out`: heads.size() x cameras x

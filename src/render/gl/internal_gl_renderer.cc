@@ -255,21 +255,22 @@ void GlRenderer::SetChain(std::size_t i, CameraSetup* setup) const {
   setup->truth = truth_ || (setup->chain && setup->chain->depth_of_field());
 }
 
-void GlRenderer::SetEffects(bool distortion, bool noise, bool motion_blur) {
+void GlRenderer::SetEffects(const EffectSwitches& effects) {
   if (in_flight_ > 0) {
     throw Error(fmt::format(
         "Renderer::SetEffects: {} submitted state(s) not yet retrieved; Retrieve them first",
         in_flight_));
   }
-  if (options_.distortion == distortion && options_.noise == noise &&
-      options_.motion_blur == motion_blur) {
-    return;
-  }
+  if (EffectSwitches::Of(options_) == effects) return;
   context_.MakeCurrent();
   const bool previous_distortion = options_.distortion;
-  options_.distortion = distortion;
-  options_.noise = noise;
-  options_.motion_blur = motion_blur;
+  if (effects.color != options_.color) {
+    // A Bayer camera's EMVA sensor exposes the mosaic with the colour on, the RGB image without:
+    // remade at the next frame with the channels it then sees (it is seeded per frame, so the
+    // frames are those of a new renderer's).
+    for (std::unique_ptr<SensorModel>& model : sensor_models_) model.reset();
+  }
+  effects.ApplyTo(&options_);
   BuildCameraSetups(std::move(setups_), previous_distortion);
   glActiveTexture(GL_TEXTURE0);
   CheckGlError("Renderer::SetEffects");

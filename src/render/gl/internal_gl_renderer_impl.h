@@ -159,7 +159,7 @@ class GlRenderer final : public Renderer {
   void Submit(const scene::SceneState& state, int64_t frame_index) override;
   std::vector<Frame> Retrieve() override;
   int InFlight() const override { return in_flight_; }
-  void SetEffects(bool distortion, bool noise, bool motion_blur) override;
+  void SetEffects(const EffectSwitches& effects) override;
   // Batch rendering (internal_batch.cc).
   void RenderBatch(const std::vector<BatchHead>& heads, uint8_t* out,
                    std::size_t out_bytes) override;

@@ -107,7 +107,7 @@ async function start() {
   controls.addEventListener('change', redraw);
   app.controls = controls;
 
-  const controlsPanel = new Controls(document.body, send, (d) => { head.setImageDistance(d); redraw(); });
+  const controlsPanel = new Controls(document.body, send, (d) => { head.setImageDistance(d); redraw(); }, doc);
   // Flow control (docs/gui-protocol.md, frame_window): the server sends at most kFrameWindow
   // frames that the page has not finished with (shown, failed or replaced), so that a page
   // that draws slower than the server renders never lets frames, and the states and replies

@@ -43,7 +43,9 @@ export const table = {
       "fields": [
         {"name":"distortion","required":true,"schema":{"kind":"boolean"}},
         {"name":"noise","required":true,"schema":{"kind":"boolean"}},
-        {"name":"motion_blur","required":true,"schema":{"kind":"boolean"}}
+        {"name":"motion_blur","required":true,"schema":{"kind":"boolean"}},
+        {"name":"optics","required":true,"schema":{"kind":"boolean"}},
+        {"name":"color","required":true,"schema":{"kind":"boolean"}}
       ]
     }
   },
@@ -115,7 +117,9 @@ export const table = {
           {"name":"id","required":true,"schema":{"kind":"integer"}},
           {"name":"distortion","required":false,"schema":{"kind":"boolean"}},
           {"name":"noise","required":false,"schema":{"kind":"boolean"}},
-          {"name":"motion_blur","required":false,"schema":{"kind":"boolean"}}
+          {"name":"motion_blur","required":false,"schema":{"kind":"boolean"}},
+          {"name":"optics","required":false,"schema":{"kind":"boolean"}},
+          {"name":"color","required":false,"schema":{"kind":"boolean"}}
         ]
       },
       "reply": [{"name":"effects","required":true,"schema":{"ref":"effects"}}]
@@ -486,7 +490,10 @@ export const table = {
           {"name":"time","required":true,"schema":{"kind":"number"}},
           {"name":"width","required":true,"schema":{"kind":"integer","min":1.0}},
           {"name":"height","required":true,"schema":{"kind":"integer","min":1.0}},
-          {"name":"overlay","required":true,"schema":{"kind":"boolean"}}
+          {"name":"overlay","required":true,"schema":{"kind":"boolean"}},
+          {"name":"exposure_s","required":true,"schema":{"kind":"number","min":0.0}},
+          {"name":"gain_db","required":true,"schema":{"kind":"number"}},
+          {"name":"focus_m","required":true,"schema":{"kind":"number","min":0.0}}
         ]
       }
     },
@@ -794,7 +801,9 @@ export const table = {
                     },
                     {"name":"X_WC","required":true,"schema":{"ref":"pose"}},
                     {"name":"near","required":true,"schema":{"kind":"number","min":0.0}},
-                    {"name":"far","required":true,"schema":{"kind":"number","min":0.0}}
+                    {"name":"far","required":true,"schema":{"kind":"number","min":0.0}},
+                    {"name":"optics","required":true,"schema":{"kind":"boolean"}},
+                    {"name":"color","required":true,"schema":{"kind":"boolean"}}
                   ]
                 }
               ]

@@ -54,7 +54,7 @@ export class CameraView {
         }
         this.context.drawImage(bitmap, 0, 0);
         this.shown++;
-        this.label.textContent = `${this.name} camera · ${header.width}×${header.height} · frame ${header.frame} · t ${Number(header.time).toFixed(2)} s`;
+        this.label.textContent = `${this.name} camera · ${header.width}×${header.height} · frame ${header.frame} · t ${Number(header.time).toFixed(2)} s${cameraControls(header)}`;
         this.onImage?.(this.name, bitmap);
       } else {
         this.failed++;
@@ -71,6 +71,18 @@ export class CameraView {
   }
 }
 
+/**
+ * The camera controls a frame was taken with (its header's exposure_s, gain_db, focus_m), as the
+ * label's tail: " · 8.0 ms · 0.0 dB · focus 2.00 m"; an instant's exposure and no focus are left out.
+ */
+export function cameraControls(header) {
+  let text = '';
+  if (header.exposure_s > 0) text += ` · ${(header.exposure_s * 1000).toFixed(1)} ms`;
+  text += ` · ${Number(header.gain_db).toFixed(1)} dB`;
+  if (header.focus_m > 0) text += ` · focus ${header.focus_m.toFixed(2)} m`;
+  return text;
+}
+
 /** A line in the page's log (errors in red). */
 export function log(element, text, level = 'info') {
   const line = document.createElement('div');
@@ -80,17 +92,40 @@ export function log(element, text, level = 'info') {
   while (element.childElementCount > 100) element.lastElementChild.remove();
 }
 
+/** What the effect switches that only some cameras have do, for their tooltips. */
+const kCameraEffects = {
+  optics: 'the lens\'s vignetting and depth of field',
+  color: 'the colour filter array, demosaicing, white balance and tone curve',
+};
+
 /**
  * The controls: effects, perception, pause/resume, step, speed, stop, record, and the image plane's
- * distance. `send(type, fields)` sends a command; `onDistance(d)` moves the image planes.
+ * distance. `send(type, fields)` sends a command; `onDistance(d)` moves the image planes; `doc`,
+ * the scene document, says which effects exist (`commands.effects`, each camera's `optics` and
+ * `color`): a switch that would change no image is disabled, its tooltip says why.
  */
 export class Controls {
-  constructor(root, send, onDistance) {
+  constructor(root, send, onDistance, doc) {
     this.root = root;
     const $ = (id) => root.querySelector(`#${id}`);
-    this.effects = { distortion: $('fx-distortion'), noise: $('fx-noise'), motion_blur: $('fx-blur') };
+    this.effects = {
+      distortion: $('fx-distortion'), noise: $('fx-noise'), motion_blur: $('fx-blur'),
+      optics: $('fx-optics'), color: $('fx-color'),
+    };
     for (const [key, box] of Object.entries(this.effects)) {
       box.addEventListener('change', () => send('effects', { [key]: box.checked }));
+      if (doc && !doc.commands.effects) {
+        box.disabled = true;
+        box.parentElement.title = 'the cameras are not simulated';
+      }
+    }
+    for (const [key, what] of Object.entries(kCameraEffects)) {
+      const box = this.effects[key];
+      const cameras = (doc?.cameras ?? []).filter((c) => c[key]).map((c) => c.name);
+      if (box.disabled) continue;
+      box.disabled = cameras.length === 0;
+      box.parentElement.title = cameras.length === 0
+        ? `no camera of this scene has ${what}` : `${what} of ${cameras.join(', ')}`;
     }
     this.perception = $('perception');
     this.perception.addEventListener('change', () => send('perception', { enabled: this.perception.checked }));
