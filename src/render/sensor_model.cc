@@ -149,6 +149,18 @@ void ForParts(std::size_t n, const Part& part) {
   for (std::thread& t : workers) t.join();
 }
 
+// ForParts over the values of `height` rows of `row_values` each: row(y, x0, x1) for the
+// values [x0, x1) of row y that a part holds.
+template <typename Row>
+void ForRowParts(int height, std::size_t row_values, const Row& row) {
+  ForParts(static_cast<std::size_t>(height) * row_values, [&](std::size_t first, std::size_t end) {
+    for (std::size_t y = first / row_values; y * row_values < end; ++y) {
+      row(static_cast<int>(y), std::max(first, y * row_values) - y * row_values,
+          std::min(end, (y + 1) * row_values) - y * row_values);
+    }
+  });
+}
+
 uint64_t HashName(uint64_t seed, const std::string& name) {
   uint64_t h = 1469598103934665603ULL;  // FNV-1a
   for (const char c : name) h = (h ^ static_cast<unsigned char>(c)) * 1099511628211ULL;
@@ -178,13 +190,13 @@ SensorModel::SensorModel(const scene::EmvaSensor& params, uint64_t seed, const s
   const double prnu = params_.prnu_percent / 100.0;
   const uint64_t prnu_key = SensorMix(stream_ ^ kPrnuStream);
   const uint64_t dsnu_key = SensorMix(stream_ ^ kDsnuStream);
+  const double* const table = GaussianTable().data();
   for (std::size_t i = 0; i < n; ++i) {
     const auto prnu_bits = static_cast<uint32_t>(SensorMix(prnu_key + i));
-    const double gain = 1.0 + prnu * SensorGaussian(GaussianTable().data(), prnu_bits);
+    const double gain = 1.0 + prnu * SensorGaussian(table, prnu_bits);
     prnu_[i] = static_cast<float>(std::max(0.0, gain));
     const auto dsnu_bits = static_cast<uint32_t>(SensorMix(dsnu_key + i));
-    dsnu_[i] =
-        static_cast<float>(params_.dsnu_e * SensorGaussian(GaussianTable().data(), dsnu_bits));
+    dsnu_[i] = static_cast<float>(params_.dsnu_e * SensorGaussian(table, dsnu_bits));
   }
 }
 
@@ -239,13 +251,9 @@ std::vector<uint16_t> SensorModel::ExposeRendered(const ImageView& rendered, dou
   for (int v = 0; v < 256; ++v) photons_of[v] = static_cast<float>(v * scale);
   std::vector<float> photons(values());
   const std::size_t row_values = static_cast<std::size_t>(width_) * channels_;
-  ForParts(static_cast<std::size_t>(height_) * row_values, [&](std::size_t first, std::size_t end) {
-    for (std::size_t y = first / row_values; y * row_values < end; ++y) {
-      const uint8_t* row = rendered.row(static_cast<int>(y));
-      const std::size_t x0 = std::max(first, y * row_values) - y * row_values;
-      const std::size_t x1 = std::min(end, (y + 1) * row_values) - y * row_values;
-      for (std::size_t x = x0; x < x1; ++x) photons[y * row_values + x] = photons_of[row[x]];
-    }
+  ForRowParts(height_, row_values, [&](int y, std::size_t x0, std::size_t x1) {
+    const uint8_t* row = rendered.row(y);
+    for (std::size_t x = x0; x < x1; ++x) photons[y * row_values + x] = photons_of[row[x]];
   });
   std::vector<uint16_t> raw(values());
   Expose(photons.data(), frame_index, raw.data(), gain);
@@ -268,13 +276,9 @@ void SensorModel::To8Bit(const uint16_t* raw, Image* image8) const {
     to8[v] = static_cast<uint8_t>(RoundNonNegative(static_cast<double>(v) * scale));
   }
   const std::size_t row_values = static_cast<std::size_t>(width_) * channels_;
-  ForParts(static_cast<std::size_t>(height_) * row_values, [&](std::size_t first, std::size_t end) {
-    for (std::size_t y = first / row_values; y * row_values < end; ++y) {
-      uint8_t* row = image8->row(static_cast<int>(y));
-      const std::size_t x0 = std::max(first, y * row_values) - y * row_values;
-      const std::size_t x1 = std::min(end, (y + 1) * row_values) - y * row_values;
-      for (std::size_t x = x0; x < x1; ++x) row[x] = to8[raw[y * row_values + x]];
-    }
+  ForRowParts(height_, row_values, [&](int y, std::size_t x0, std::size_t x1) {
+    uint8_t* row = image8->row(y);
+    for (std::size_t x = x0; x < x1; ++x) row[x] = to8[raw[y * row_values + x]];
   });
 }
 

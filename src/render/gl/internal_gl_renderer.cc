@@ -264,12 +264,6 @@ void GlRenderer::SetEffects(const EffectSwitches& effects) {
   if (EffectSwitches::Of(options_) == effects) return;
   context_.MakeCurrent();
   const bool previous_distortion = options_.distortion;
-  if (effects.color != options_.color) {
-    // A Bayer camera's EMVA sensor exposes the mosaic with the colour on, the RGB image without:
-    // remade at the next frame with the channels it then sees (it is seeded per frame, so the
-    // frames are those of a new renderer's).
-    for (std::unique_ptr<SensorModel>& model : sensor_models_) model.reset();
-  }
   effects.ApplyTo(&options_);
   BuildCameraSetups(std::move(setups_), previous_distortion);
   glActiveTexture(GL_TEXTURE0);

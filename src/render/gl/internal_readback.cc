@@ -241,10 +241,12 @@ void GlRenderer::ApplySensor(int camera, const scene::AppliedControls& controls,
     return;
   }
   std::unique_ptr<SensorModel>& model = sensor_models_[camera];  // sized by ApplyChains
-  if (!model) {
+  // A Bayer camera's sensor exposes the mosaic (one channel) with the colour on, the RGB image
+  // (three) without it: remade when that changes (seeded per frame: a new renderer's frames).
+  const int channels = IsBayer(image->format()) ? 1 : 3;
+  if (!model || model->channels() != channels) {
     model = std::make_unique<SensorModel>(*spec.sensor.emva, spec.sensor.seed, spec.name,
-                                          image->width(), image->height(),
-                                          IsBayer(image->format()) ? 1 : 3);
+                                          image->width(), image->height(), channels);
   }
   model->ExposeRendered(image->view(), controls.exposure_s, image->metadata().frame_index, image,
                         controls.GainFactor());
