@@ -76,8 +76,10 @@ struct RendererOptions {
   /// Motion blur over the exposure (SensorSpec::exposure, blur_samples).
   bool motion_blur = true;
   /// The lens's photometric effects (scene::LensSpec: vignetting, depth of field), on the CPU
-  /// after readback, before the sensor (render/camera_chain.h). Depth of field draws the
-  /// camera's depth (the ground-truth pass) whether or not truth_depth asks for it.
+  /// after readback, before the sensor (render/camera_chain.h). Depth of field needs the
+  /// camera's depth: the ground-truth pass's when truth is asked for (or on a GPU, with MSAA,
+  /// or a lens of several source views), else the colour pass's own depth buffer, read back
+  /// and remapped on the CPU (render/gl/internal_color_depth.h: no second scene pass).
   bool optics = true;
   /// The sensor's colour (scene::ColorSpec: filter array, white balance, demosaicing, tone
   /// curve), on the CPU after the sensor; Frame::raw carries the mosaic. Off: the plain RGB.

@@ -179,4 +179,30 @@ void CpuLens::RemapRow(const uint8_t* source, int y, uint8_t* rgba_row, bool sim
   }
 }
 
+void CpuLens::RemapDepthRow(const float* source_z, int y, float* z_row) const {
+  const Sample* row = samples_.data() + static_cast<std::size_t>(y) * width_;
+  const std::size_t stride = static_cast<std::size_t>(source_width_);
+  for (int x = 0; x < width_; ++x) {
+    const std::size_t o = row[x].offset / 4;  // the sample's top-left source pixel
+    const uint32_t fx = row[x].weights & 0xFFFFu, fy = row[x].weights >> 16;
+    const float z00 = source_z[o], z10 = source_z[o + 1];
+    const float z01 = source_z[o + stride], z11 = source_z[o + stride + 1];
+    const float low = std::min(std::min(z00, z10), std::min(z01, z11));
+    const float high = std::max(std::max(z00, z10), std::max(z01, z11));
+    if (low > 0.0f && high - low <= 0.02f * low) {
+      const float wx = static_cast<float>(fx) * (1.0f / 256.0f);
+      const float wy = static_cast<float>(fy) * (1.0f / 256.0f);
+      const float top = z00 + (z10 - z00) * wx, bottom = z01 + (z11 - z01) * wx;
+      z_row[x] = top + (bottom - top) * wy;
+    } else {
+      z_row[x] = source_z[o + (fy >= 128 ? stride : 0) + (fx >= 128 ? 1 : 0)];
+    }
+  }
+  for (uint32_t k = row_first_[y]; k < row_first_[y + 1]; ++k) {
+    if (special_first_[k] == special_first_[k + 1]) {
+      z_row[special_pixel_[k] - static_cast<uint32_t>(y) * width_] = 0.0f;
+    }
+  }
+}
+
 }  // namespace saccade::render::gl

@@ -30,6 +30,14 @@ class CpuLens {
   /// portable loop even where the CPU has AVX2 (tests: the two agree to the bit).
   void RemapRow(const uint8_t* source, int y, uint8_t* rgba_row, bool simd = true) const;
 
+  /// Row `y` of the camera's z from the source view's (`source_z`: source-size floats, row 0
+  /// first, 0 where no surface) into `z_row` (width floats), as the truth remap
+  /// (kTruthRemapFragmentSource) without ids: bilinear where the four source pixels around
+  /// the pixel's sample are surfaces within 2 % of each other's depth, the nearest one's
+  /// otherwise (no depth mixed across an edge); a pixel of several samples takes its first,
+  /// one without a ray 0.
+  void RemapDepthRow(const float* source_z, int y, float* z_row) const;
+
   /// Pixels remapped with more than one sample or none (no ray).
   std::size_t special_pixels() const { return special_pixel_.size(); }
 

@@ -510,7 +510,7 @@ void PixelBuffers::Unmap() const {
 // --- EffectTarget -------------------------------------------------------------------------
 
 EffectTarget::EffectTarget(const geometry::LensMap& lens, int samples, bool blur, bool truth,
-                           bool lens_on_cpu)
+                           bool lens_on_cpu, bool color_depth)
     : lens_(lens),
       samples_(samples),
       blur_(blur),
@@ -537,6 +537,16 @@ EffectTarget::EffectTarget(const geometry::LensMap& lens, int samples, bool blur
   glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, output_color_, 0, 0);
   CheckComplete("camera image", lens_.width, lens_.height);
   if (truth_) MakeTruthTargets();
+  if (color_depth) {
+    const bool identity = lens_.kind == geometry::LensMap::Kind::kIdentity &&
+                          source_width_ == lens_.width && source_height_ == lens_.height;
+    if (truth_ || samples_ != 0 || layers_ != 1 || (!identity && cpu_lens_ == nullptr)) {
+      throw Error(
+          "EffectTarget: the colour pass's depth needs one source view without MSAA, the lens "
+          "an identity or remapped on the CPU, and no truth pass");
+    }
+    color_depth_buffers_ = std::make_unique<PixelBuffers>(source_width_, source_height_, 4);
+  }
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
   CheckGlError(fmt::format("Renderer: making the effect targets ({} view(s) of {} x {})", layers_,
                            source_width_, source_height_));
@@ -767,6 +777,11 @@ bool EffectTarget::can_read_source() const {
   if (cpu_lens_) return true;
   return lens_.kind == geometry::LensMap::Kind::kIdentity && layers_ == 1 &&
          source_width_ == lens_.width && source_height_ == lens_.height;
+}
+
+void EffectTarget::ReadColorDepth(int slot) const {
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, draw_framebuffer_);
+  color_depth_buffers_->Read(slot, GL_DEPTH_COMPONENT, GL_FLOAT);
 }
 
 void EffectTarget::ReadSource(int slot) const {

@@ -22,6 +22,10 @@
 // Ground truth, when asked: one more scene pass per view into an R32UI id array and an RG32F
 // depth array (the camera's z and the view's depth; no MSAA: ids are not blended), remapped
 // by the same map into R32UI / R32F images at the camera's size, read back the same way.
+// The depth of field's depth alone (no ground truth asked) on a software rasteriser, for a
+// lens of one source view without MSAA, is the colour pass's own depth buffer read back
+// (color_depth): no second scene pass and no remap pass, Retrieve turns it into the camera's
+// z and remaps it on the CPU (internal_color_depth.h).
 //
 // Everything here needs the renderer's context current.
 
@@ -184,6 +188,8 @@ class PixelBuffers {
   /// Maps the slot's buffer (after its fence), nullptr on failure; Unmap after use.
   const void* Map(int slot) const;
   void Unmap() const;
+  int width() const { return width_; }
+  int height() const { return height_; }
 
  private:
   int width_, height_, bytes_per_pixel_;
@@ -195,10 +201,12 @@ class EffectTarget {
  public:
   /// `samples` 0 for no MSAA; `blur`: allocate the accumulation array; `truth`: the id and
   /// depth arrays and outputs; `lens_on_cpu`: a lens of one source view is remapped on the
-  /// CPU (cpu_lens) when nothing was accumulated (its truth on the GPU). Throws saccade::Error naming
-  /// the sizes when the device refuses.
+  /// CPU (cpu_lens) when nothing was accumulated (its truth on the GPU); `color_depth` (with
+  /// `truth` false, `samples` 0, one source view, and the lens an identity or on the CPU): a
+  /// buffer for the colour pass's depth (ReadColorDepth). Throws saccade::Error naming the
+  /// sizes when the device refuses.
   EffectTarget(const geometry::LensMap& lens, int samples, bool blur, bool truth,
-               bool lens_on_cpu = false);
+               bool lens_on_cpu = false, bool color_depth = false);
   ~EffectTarget();
   EffectTarget(const EffectTarget&) = delete;
   EffectTarget& operator=(const EffectTarget&) = delete;
@@ -209,6 +217,7 @@ class EffectTarget {
 
   const geometry::LensMap& lens() const { return lens_; }
   bool has_truth() const { return truth_; }
+  bool has_color_depth() const { return color_depth_buffers_ != nullptr; }
 
   /// Binds the framebuffer that draws source view `view` and sets the viewport; the caller
   /// clears and draws, then calls FinishView.
@@ -270,6 +279,12 @@ class EffectTarget {
   /// After ReadStretches and the slot's fence: the stretches' RGBA8 pixels, row 0 first.
   const PixelBuffers& stretch_buffers() const { return *stretch_buffers_; }
 
+  /// With has_color_depth: starts the readback of the depth buffer the colour pass left (the
+  /// view just drawn; window depth in [0, 1], 1 where nothing was drawn) into `slot`.
+  void ReadColorDepth(int slot) const;
+  /// After the slot's fence: ReadColorDepth's source-size floats, row 0 first.
+  const PixelBuffers& color_depth_buffers() const { return *color_depth_buffers_; }
+
   /// After the slot's fence: the camera-size RGBA8 pixels, ids (uint32) and depth (float),
   /// row 0 at the top; nullptr on failure. Unmap each after use.
   const PixelBuffers& color_buffers() const { return color_buffers_; }
@@ -319,7 +334,8 @@ class EffectTarget {
   PixelBuffers color_buffers_;
   std::unique_ptr<PixelBuffers> id_buffers_, depth_buffers_;
   std::unique_ptr<CpuLens> cpu_lens_;
-  std::unique_ptr<PixelBuffers> source_buffers_;  // with cpu_lens_
+  std::unique_ptr<PixelBuffers> source_buffers_;       // with cpu_lens_
+  std::unique_ptr<PixelBuffers> color_depth_buffers_;  // with color_depth, source size
   // kMaxTurnStretches layers' worth, made by the first ReadStretches.
   mutable std::unique_ptr<PixelBuffers> stretch_buffers_;
 };

@@ -194,7 +194,7 @@ void GlRenderer::BuildCameraSetups(std::vector<CameraSetup> reuse, bool reuse_di
       setup.blur = options_.motion_blur && camera->sensor.HasBlur();
       if (setup.blur) setup.effects->EnableBlur();
       if ((setup.distorted || setup.noise || setup.blur || setup.truth) &&
-          setup.effects->has_truth() == setup.truth) {
+          (setup.effects->has_truth() || setup.effects->has_color_depth()) == setup.truth) {
         PrebuildFinal(setup);
         targets_.push_back(nullptr);
         setups_.push_back(std::move(setup));
@@ -227,10 +227,21 @@ void GlRenderer::BuildCameraSetups(std::vector<CameraSetup> reuse, bool reuse_di
     }
     if (setup.distorted || setup.noise || setup.blur || setup.truth) {
       if (!effect_programs_) effect_programs_ = std::make_unique<EffectPrograms>();
-      setup.effects =
-          std::make_unique<EffectTarget>(lens, samples_, setup.blur, setup.truth, lens_on_cpu_);
+      // The depth of field's depth alone: the colour pass's, where the CPU remaps the lens
+      // (a software rasteriser) or there is nothing to remap (internal_color_depth.h).
+      const bool identity = lens.kind == geometry::LensMap::Kind::kIdentity &&
+                            lens.views[0].intrinsics.width() == lens.width &&
+                            lens.views[0].intrinsics.height() == lens.height;
+      const bool color_depth = setup.truth && !truth_ && samples_ == 0 && lens.views.size() == 1 &&
+                               (identity || lens_on_cpu_);
+      setup.effects = std::make_unique<EffectTarget>(
+          lens, samples_, setup.blur, setup.truth && !color_depth, lens_on_cpu_, color_depth);
+      if (color_depth) {
+        setup.color_depth = MakeColorDepthMap(setup.views[0].projection, setup.views[0].R_CV,
+                                              lens.views[0].intrinsics);
+      }
       PrebuildFinal(setup);
-      if (setup.truth) effect_programs_->GetTruthRemap(!setup.distorted);
+      if (setup.truth && !color_depth) effect_programs_->GetTruthRemap(!setup.distorted);
       targets_.push_back(nullptr);
     } else {
       targets_.push_back(std::make_unique<CameraTarget>(K.width(), K.height(), samples_, GL_RGBA));
@@ -857,7 +868,7 @@ void GlRenderer::DrawEffects(int camera, const scene::SceneState& state, int64_t
   const bool fused = plan.stretches > 0 && plan.stretches <= effects.turn_stretches();
   bool accumulated = false;  // the final pass reads the accumulation
   if (plan.stretches > 0) {
-    DrawTurnStretches(camera, state, plan, fused ? &turn : nullptr);
+    DrawTurnStretches(camera, state, plan, fused ? &turn : nullptr, slot);
     accumulated = !fused;
   } else if (plan.sub_states.empty()) {
     for (int v = 0; v < static_cast<int>(setup.views.size()); ++v) {
@@ -866,8 +877,9 @@ void GlRenderer::DrawEffects(int camera, const scene::SceneState& state, int64_t
       DrawScene(setup.views[v], near, ViewPose(setup.views[v], X_WC));
       effects.FinishView(v);
     }
+    if (effects.has_color_depth()) effects.ReadColorDepth(slot);
   } else {
-    accumulated = DrawSubFrames(camera, state, plan);
+    accumulated = DrawSubFrames(camera, state, plan, slot);
   }
   if (effects.has_truth()) {
     for (int v = 0; v < static_cast<int>(setup.views.size()); ++v) {
@@ -879,7 +891,7 @@ void GlRenderer::DrawEffects(int camera, const scene::SceneState& state, int64_t
 }
 
 void GlRenderer::DrawTurnStretches(int camera, const scene::SceneState& state,
-                                   const ExposurePlan& plan, TurnSamples* turn) {
+                                   const ExposurePlan& plan, TurnSamples* turn, int slot) {
   const CameraSetup& setup = setups_[camera];
   const EffectTarget& effects = *setup.effects;
   const scene::CameraSpec& spec = *cameras_[camera];
@@ -907,6 +919,7 @@ void GlRenderer::DrawTurnStretches(int camera, const scene::SceneState& state,
     } else {
       effects.FinishView(0);
     }
+    if (g == stretches / 2 && effects.has_color_depth()) effects.ReadColorDepth(slot);
     homographies.clear();
     for (int k = first; k < end; ++k) {
       // A pixel of sub-frame k: its ray in view k, in the world, in the drawn view, its pixel.
@@ -927,8 +940,8 @@ void GlRenderer::DrawTurnStretches(int camera, const scene::SceneState& state,
   UpdatePoses(state);
 }
 
-bool GlRenderer::DrawSubFrames(int camera, const scene::SceneState& state,
-                               const ExposurePlan& plan) {
+bool GlRenderer::DrawSubFrames(int camera, const scene::SceneState& state, const ExposurePlan& plan,
+                               int slot) {
   const CameraSetup& setup = setups_[camera];
   const EffectTarget& effects = *setup.effects;
   const scene::CameraSpec& spec = *cameras_[camera];
@@ -969,6 +982,7 @@ bool GlRenderer::DrawSubFrames(int camera, const scene::SceneState& state,
         DrawScene(setup.views[v], near, ViewPose(setup.views[v], X_WCk));
       }
       effects.FinishView(v);
+      if (i == 0 && effects.has_color_depth()) effects.ReadColorDepth(slot);  // the middle's
       if (region) scissor(*region);
       effects.Accumulate(*effect_programs_, v, weight, i == 0 ? Mode::kReplace : Mode::kAdd);
       glDisable(GL_SCISSOR_TEST);

@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "render/gl/internal_camera_target.h"
+#include "render/gl/internal_color_depth.h"
 #include "render/gl/internal_cpu_turn.h"
 #include "render/gl/internal_effects.h"
 #include "render/gl/internal_egl_context.h"
@@ -207,7 +208,10 @@ class GlRenderer final : public Renderer {
     // whether the legacy noise comes after its optics, on the CPU (`noise` is then false).
     std::unique_ptr<CameraChain> chain;
     bool late_noise = false;
-    bool truth = false;  // the truth pass is drawn: truth asked, or the depth of field's depth
+    // Depth is needed: truth asked, or the depth of field's depth (the truth pass's, or the
+    // colour pass's when the effect target has_color_depth, through color_depth).
+    bool truth = false;
+    ColorDepthMap color_depth;
   };
   // The chain of camera `i` (setup.rendered made), and the noise and truth it implies.
   void SetChain(std::size_t i, CameraSetup* setup) const;
@@ -247,13 +251,16 @@ class GlRenderer final : public Renderer {
   ExposurePlan PlanExposure(int camera, const scene::SceneState& state) const;
   // A turning camera's stretches, each drawn at its middle: into the stretch layers, their
   // sub-frames' homographies added to `turn` (fused into the final pass); or, `turn` null,
-  // into the source view, accumulated through the homographies (TurnBlur).
+  // into the source view, accumulated through the homographies (TurnBlur). The colour
+  // depth, where the target reads it, is the middle stretch's, into `slot`.
   void DrawTurnStretches(int camera, const scene::SceneState& state, const ExposurePlan& plan,
-                         TurnSamples* turn);
+                         TurnSamples* turn, int slot);
   // Every sub-frame drawn and accumulated (with the camera still, only the moving items'
   // regions redrawn after the first, then written back); whether the final pass reads the
-  // accumulation. The poses are `state`'s again after.
-  bool DrawSubFrames(int camera, const scene::SceneState& state, const ExposurePlan& plan);
+  // accumulation. The poses are `state`'s again after. The colour depth, where the target
+  // reads it, is the sub-frame drawn first's (the middle one), into `slot`.
+  bool DrawSubFrames(int camera, const scene::SceneState& state, const ExposurePlan& plan,
+                     int slot);
   // The final pass, or the readback that replaces it where the CPU finishes the image (noise,
   // lens remap, a turn's fetches). `turn`: the stretches' homographies when fused, else null.
   void FinishEffects(int camera, int64_t frame_index, int slot, bool accumulated, TurnSamples* turn,
@@ -300,6 +307,9 @@ class GlRenderer final : public Renderer {
   // (the depth of field's).
   void FillTruth(int camera, const Pending& pending, int slot, Frame* frame,
                  std::shared_ptr<Image>* depth);
+  // The depth of field's depth from the colour pass's depth buffer read back into `slot`
+  // (EffectTarget::ReadColorDepth): the camera's z at its size, 0 where no surface.
+  std::shared_ptr<Image> ColorPassDepth(int camera, int slot, const Image& color);
   // The photometric chain of a frame read back, in place, light first: the lens (vignetting,
   // depth of field from the job's depth), the legacy noise when it comes after them, the EMVA
   // sensor, then the colour (the raw mosaic into frame->raw). ApplyChains runs it for every

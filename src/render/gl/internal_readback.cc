@@ -129,8 +129,11 @@ std::vector<Frame> GlRenderer::Retrieve() {
     Frame frame{image, nullptr, nullptr, {}, nullptr};
     ChainJob& job = jobs[i];
     const bool dof = setup.chain && setup.chain->depth_of_field();
-    if (setup.truth)
+    if (setup.effects && setup.effects->has_color_depth()) {
+      job.depth = ColorPassDepth(static_cast<int>(i), slot, *image);
+    } else if (setup.truth) {
       FillTruth(static_cast<int>(i), pending, slot, &frame, dof ? &job.depth : nullptr);
+    }
     job.image = image.get();
     job.frame_index = pending.frame_index;
     job.controls = scene_.ControlsOf(*cameras_[i], pending.state);

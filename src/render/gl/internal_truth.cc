@@ -1,9 +1,13 @@
 // Ground truth of a frame: depth and instance ids read back, and each object's (and the
-// robot's) pose, pixel count and box in the image.
+// robot's) pose, pixel count and box in the image; the depth of field's depth from the colour
+// pass where that stands for the truth pass (internal_color_depth.h).
 #include <algorithm>
 #include <cstring>
 #include <map>
+#include <thread>
+#include <vector>
 
+#include "render/gl/internal_cpu_lens.h"
 #include "render/gl/internal_gl_renderer_impl.h"
 #include "saccade/core/error.h"
 
@@ -79,6 +83,44 @@ void GlRenderer::FillTruth(int camera, const Pending& pending, int slot, Frame* 
       last->y_max = std::max(last->y_max, y);
     }
   }
+}
+
+std::shared_ptr<Image> GlRenderer::ColorPassDepth(int camera, int slot, const Image& color) {
+  const CameraSetup& setup = setups_[camera];
+  const EffectTarget& effects = *setup.effects;
+  const PixelBuffers& buffers = effects.color_depth_buffers();
+  const auto* window_depth =
+      reinterpret_cast<const float*>(MapOrThrow(buffers, slot, " (colour depth)"));
+  auto depth = std::make_shared<Image>(color.width(), color.height(), PixelFormat::kFloat32);
+  depth->metadata() = color.metadata();
+  const CpuLens* lens = effects.cpu_lens();
+  // An identity lens: the source is the camera, its z the depth; else the source's z, remapped.
+  std::vector<float> source_z;
+  if (lens != nullptr)
+    source_z.resize(static_cast<std::size_t>(buffers.width()) * buffers.height());
+  float* z = lens != nullptr ? source_z.data() : reinterpret_cast<float*>(depth->data());
+  const auto halves = [](int rows, const auto& part) {
+    // Two halves at once where there are two cores: the rasteriser's threads are idle here.
+    static const bool cores = std::thread::hardware_concurrency() >= 2;  // asked once
+    if (!cores || rows < 64) {
+      part(0, rows);
+      return;
+    }
+    std::thread other(part, rows / 2, rows);
+    part(0, rows / 2);
+    other.join();
+  };
+  halves(buffers.height(),
+         [&](int first, int end) { CameraZRows(setup.color_depth, window_depth, first, end, z); });
+  buffers.Unmap();
+  if (lens != nullptr) {
+    halves(depth->height(), [&](int first, int end) {
+      for (int y = first; y < end; ++y) {
+        lens->RemapDepthRow(source_z.data(), y, reinterpret_cast<float*>(depth->row(y)));
+      }
+    });
+  }
+  return depth;
 }
 
 }  // namespace saccade::render::gl
