@@ -8,12 +8,14 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <memory>
 #include <numbers>
 #include <optional>
 #include <string>
 #include <thread>
 #include <vector>
 
+#include "render/internal_lens_optics.h"
 #include "saccade/core/error.h"
 
 namespace saccade::render {
@@ -31,63 +33,113 @@ void CheckLensPositive(double value, const char* field) {
   }
 }
 
-// The sum of DofCoverage over the plane: pi (r^2 + 1/12) for r >= 0.5 (the ramp integrated);
-// below, the disc covers its own pixel only, by r + 0.5.
+// The sum of a disc's coverage (DofRow) over the plane: pi (r^2 + 1/12) for r >= 0.5 (the ramp
+// integrated); below, the disc covers its own pixel only, by r + 0.5.
 float DiscArea(float radius) {
   constexpr float kPi = std::numbers::pi_v<float>;
   return radius < 0.5f ? radius + 0.5f : kPi * (radius * radius + 1.0f / 12.0f);
 }
 
-// One offset of the gather's window, with its distance in pixels across (rows scaled by
-// pitch_y / pitch_x, so that a disc on the sensor is a circle here).
-struct WindowOffset {
-  int dx, dy;
+// One offset of the gather's window: its step in the padded planes (DofPlanes::At) and its
+// distance in pixels across (rows scaled by pitch_y / pitch_x, so that a disc on the sensor is
+// a circle here).
+struct WindowStep {
+  std::ptrdiff_t step;
   float distance;
 };
 
 // Tiles of kDofTile x kDofTile pixels bound the circles a pixel's gather can meet.
 constexpr int kDofTile = 16;
-// Pixels of a row gathered at once (one SSE vector of floats each term): a divisor of kDofTile.
-constexpr int kDofLanes = 4;
-using DofVector = float __attribute__((vector_size(kDofLanes * sizeof(float))));
+// The most pixels of a row gathered at once (DofRow: 8 with AVX2, else 4, one SSE vector):
+// a divisor of kDofTile, so that a run never straddles two tiles.
+constexpr int kDofMaxLanes = 8;
+static_assert(kDofTile % kDofMaxLanes == 0);
 
-// What the gather reads per pixel, in planes padded by the window's reach (pad_x, pad_y)
-// around the image and kDofLanes more on the right, so that a run of kDofLanes pixels reads
-// every offset without a bounds test: depth (+inf without a surface), the circle's radius
-// (pixels across, capped) and area (DiscArea), whether the pixel is in the image (1 or 0:
-// padding's terms weigh 0) and the colour's three channels. Also the window's offsets sorted
-// by distance, and per tile the largest radius of any pixel within the window's reach of the
-// tile (so that a pixel's gather stops where no disc, its own or a nearer pixel's, can cover
-// it: the same terms, fewer visits).
+// What the gather reads per pixel, in planes padded around the image (pad_x, pad_y: at least
+// the window's reach) and kDofMaxLanes more on the right, so that a run of pixels reads every
+// offset without a bounds test: depth (+inf without a surface, NaN in the padding: neither in
+// front of a pixel nor behind it, so its terms weigh 0), the circle's outer edge (radius + 0.5:
+// where the coverage's ramp ends; radius in pixels across, capped), its area (DiscArea) and the
+// colour's three channels. Also the window's offsets sorted by distance, and per tile the
+// largest outer edge of any pixel within the window's reach of the tile (so that a pixel's
+// gather stops where no disc, its own or a nearer pixel's, can cover it: the same terms, fewer
+// visits).
 struct DofPlanes {
   int width = 0, height = 0;
   int pad_x = 0, pad_y = 0, stride = 0;  // stride: padded plane's row, in values
-  std::vector<float> depth, radius, area, inside, color[3];
-  std::vector<WindowOffset> window;
+  // The planes one after the other; not zeroed (PrepareDof writes every value once).
+  std::unique_ptr<float[]> values;
+  float *depth = nullptr, *outer = nullptr, *area = nullptr, *color[3] = {};
+  std::vector<WindowStep> window;
   int tiles_x = 0;
-  std::vector<float> reach;  // per tile: the largest radius near it, + 0.5
+  std::vector<float> reach;  // per tile: the largest outer edge in it, then near it
   // The index of image pixel (x, y) in the padded planes.
   std::size_t At(int x, int y) const {
     return static_cast<std::size_t>(y + pad_y) * stride + static_cast<std::size_t>(x + pad_x);
   }
 };
 
-// DofPlanes::reach: each tile's largest radius, then the largest over the tiles the window
-// reaches from it.
-void PrepareTileReach(DofPlanes* planes, int reach_x, int reach_y) {
-  const int tiles_x = (planes->width + kDofTile - 1) / kDofTile;
-  const int tiles_y = (planes->height + kDofTile - 1) / kDofTile;
-  std::vector<float> tile_max(static_cast<std::size_t>(tiles_x) * tiles_y, 0.0f);
-  for (int y = 0; y < planes->height; ++y) {
-    for (int x = 0; x < planes->width; ++x) {
-      float& m = tile_max[static_cast<std::size_t>(y / kDofTile) * tiles_x + x / kDofTile];
-      m = std::max(m, planes->radius[planes->At(x, y)]);
+// What PrepareDof takes from one part of the rows: the summary's share and the largest radius.
+struct DofPart {
+  double max_coc_px = 0.0;
+  int64_t capped_pixels = 0;
+  float max_radius = 0.0f;
+};
+
+// CircleOfConfusionPx's terms, in its order, hoisted out of the loop.
+struct DofLensTerms {
+  double at_infinity, pitch, focus, max_coc_px;
+};
+
+// Values [first, end) of every plane as the padding's: out of the image.
+void FillDofPadding(DofPlanes* planes, std::size_t first, std::size_t end) {
+  std::fill(planes->depth + first, planes->depth + end, std::numeric_limits<float>::quiet_NaN());
+  std::fill(planes->outer + first, planes->outer + end, 0.5f);
+  std::fill(planes->area + first, planes->area + end, DiscArea(0.0f));
+  for (float* c : planes->color) std::fill(c + first, c + end, 0.0f);
+}
+
+// Image rows [first, end) into the planes, with their padding left and right; each tile's
+// largest outer edge into planes->reach. The circle in double, as CircleOfConfusionPx (the
+// summary is in double; a radius computed in float could round the other way).
+void PrepareDofRows(const ImageView& rgb, const ImageView& depth, const DofLensTerms& terms,
+                    int first, int end, DofPlanes* planes, DofPart* part) {
+  const int w = planes->width;
+  for (int y = first; y < end; ++y) {
+    const std::size_t row_start = planes->At(0, y);
+    FillDofPadding(planes, row_start - planes->pad_x, row_start);
+    FillDofPadding(planes, row_start + w, row_start + w + planes->pad_x + kDofMaxLanes);
+    const float* d_row = reinterpret_cast<const float*>(depth.row(y));
+    const uint8_t* c = rgb.row(y);
+    float* tile = &planes->reach[static_cast<std::size_t>(y / kDofTile) * planes->tiles_x];
+    for (int x = 0; x < w; ++x) {
+      const float d = d_row[x];
+      const bool surface = std::isfinite(d) && d > 0.0f;
+      const double coc =
+          (surface ? terms.at_infinity * std::abs(d - terms.focus) / d : terms.at_infinity) /
+          terms.pitch;
+      part->max_coc_px = std::max(part->max_coc_px, coc);
+      part->capped_pixels += coc > terms.max_coc_px;
+      const auto r = static_cast<float>(0.5 * std::min(coc, terms.max_coc_px));
+      part->max_radius = std::max(part->max_radius, r);
+      const std::size_t i = row_start + x;
+      planes->depth[i] = surface ? d : std::numeric_limits<float>::infinity();
+      planes->outer[i] = r + 0.5f;
+      planes->area[i] = DiscArea(r);
+      for (int ch = 0; ch < 3; ++ch) planes->color[ch][i] = c[3 * x + ch];
+      tile[x / kDofTile] = std::max(tile[x / kDofTile], planes->outer[i]);
     }
   }
+}
+
+// DofPlanes::reach: from each tile's largest outer edge (PrepareDofRows), the largest over the
+// tiles the window reaches from it.
+void PrepareTileReach(DofPlanes* planes, int reach_x, int reach_y) {
+  const int tiles_x = planes->tiles_x;
+  const int tiles_y = (planes->height + kDofTile - 1) / kDofTile;
+  const std::vector<float> tile_max = planes->reach;
   const int tx_reach = (reach_x + kDofTile - 1) / kDofTile;
   const int ty_reach = (reach_y + kDofTile - 1) / kDofTile;
-  planes->tiles_x = tiles_x;
-  planes->reach.assign(tile_max.size(), 0.0f);
   for (int ty = 0; ty < tiles_y; ++ty) {
     for (int tx = 0; tx < tiles_x; ++tx) {
       float m = 0.0f;
@@ -96,8 +148,44 @@ void PrepareTileReach(DofPlanes* planes, int reach_x, int reach_y) {
           m = std::max(m, tile_max[static_cast<std::size_t>(j) * tiles_x + i]);
         }
       }
-      planes->reach[static_cast<std::size_t>(ty) * tiles_x + tx] = m + 0.5f;
+      planes->reach[static_cast<std::size_t>(ty) * tiles_x + tx] = m;
     }
+  }
+}
+
+// The window's offsets within the largest circle, sorted by distance (stable: rows then
+// columns where distances tie, the order of the scalar gather). Offsets a whole image away
+// land in the padding from every pixel: left out (their terms are 0).
+void PrepareWindow(DofPlanes* planes, float max_radius, double aspect) {
+  const int reach_x = static_cast<int>(std::ceil(max_radius + 0.5f));
+  const int reach_y = static_cast<int>(std::ceil((max_radius + 0.5f) / aspect));
+  for (int dy = -reach_y; dy <= reach_y; ++dy) {
+    for (int dx = -reach_x; dx <= reach_x; ++dx) {
+      if (std::abs(dx) >= planes->width || std::abs(dy) >= planes->height) continue;
+      const auto distance = static_cast<float>(std::hypot(dx, dy * aspect));
+      if (distance < max_radius + 0.5f) {
+        planes->window.push_back({static_cast<std::ptrdiff_t>(dy) * planes->stride + dx, distance});
+      }
+    }
+  }
+  std::stable_sort(
+      planes->window.begin(), planes->window.end(),
+      [](const WindowStep& a, const WindowStep& b) { return a.distance < b.distance; });
+  PrepareTileReach(planes, reach_x, reach_y);
+}
+
+// The two halves of the rows at once where there are two cores (each row is computed alone:
+// the same bits); `rows(first, end)`. The halves split at a tile's edge.
+template <typename Rows>
+void SplitDofRows(int height, const Rows& rows) {
+  static const bool cores = std::thread::hardware_concurrency() >= 2;  // asked once
+  if (cores && height >= 2 * kDofTile) {
+    const int half = height / 2 / kDofTile * kDofTile;
+    std::thread other(rows, 1, half, height);
+    rows(0, 0, half);
+    other.join();
+  } else {
+    rows(0, 0, height);
   }
 }
 
@@ -106,123 +194,121 @@ DofPlanes PrepareDof(const ImageView& rgb, const ImageView& depth, const ThinLen
   DofPlanes planes;
   planes.width = depth.width();
   planes.height = depth.height();
-  std::vector<float> radius(static_cast<std::size_t>(planes.width) * planes.height);
-  float max_radius = 0.0f;
-  // CircleOfConfusionPx's terms, in its order, hoisted out of the loop.
-  const double at_infinity = CircleOfConfusion(lens, 0.0);
-  const double pitch = lens.pixel_pitch_m > 0.0 ? lens.pixel_pitch_m : lens.focal_length_m / k.fx();
-  const double s = lens.focus_distance_m;
-  for (int y = 0; y < planes.height; ++y) {
-    const float* row = reinterpret_cast<const float*>(depth.row(y));
-    for (int x = 0; x < planes.width; ++x) {
-      const float d = row[x];
-      const bool surface = std::isfinite(d) && d > 0.0f;
-      const double coc = (surface ? at_infinity * std::abs(d - s) / d : at_infinity) / pitch;
-      summary->max_coc_px = std::max(summary->max_coc_px, coc);
-      if (coc > lens.max_coc_px) ++summary->capped_pixels;
-      const auto r = static_cast<float>(0.5 * std::min(coc, lens.max_coc_px));
-      radius[static_cast<std::size_t>(y) * planes.width + x] = r;
-      max_radius = std::max(max_radius, r);
-    }
-  }
+  // Padded for the capped circle, so that one pass fills the planes (the window, cut at the
+  // largest circle found, reaches no farther); no more than the image's size (PrepareWindow).
   const double aspect = lens.pixel_pitch_m > 0.0 ? 1.0 : k.fx() / k.fy();  // pitch_y / pitch_x
-  const int reach_x = static_cast<int>(std::ceil(max_radius + 0.5f));
-  const int reach_y = static_cast<int>(std::ceil((max_radius + 0.5f) / aspect));
-  planes.pad_x = reach_x;
-  planes.pad_y = reach_y;
-  planes.stride = planes.width + 2 * reach_x + kDofLanes;
-  const std::size_t n = static_cast<std::size_t>(planes.stride) * (planes.height + 2 * reach_y);
-  planes.depth.assign(n, std::numeric_limits<float>::infinity());  // padding: never in front
-  planes.radius.assign(n, 0.0f);
-  planes.area.assign(n, DiscArea(0.0f));
-  planes.inside.assign(n, 0.0f);
-  for (std::vector<float>& c : planes.color) c.assign(n, 0.0f);
-  for (int y = 0; y < planes.height; ++y) {
-    const float* row = reinterpret_cast<const float*>(depth.row(y));
-    const uint8_t* c = rgb.row(y);
-    for (int x = 0; x < planes.width; ++x) {
-      const std::size_t i = planes.At(x, y);
-      const float d = row[x];
-      planes.depth[i] = std::isfinite(d) && d > 0.0f ? d : std::numeric_limits<float>::infinity();
-      planes.radius[i] = radius[static_cast<std::size_t>(y) * planes.width + x];
-      planes.area[i] = DiscArea(planes.radius[i]);
-      planes.inside[i] = 1.0f;
-      for (int ch = 0; ch < 3; ++ch) planes.color[ch][i] = c[3 * x + ch];
-    }
-  }
-  for (int dy = -reach_y; dy <= reach_y; ++dy) {
-    for (int dx = -reach_x; dx <= reach_x; ++dx) {
-      const auto distance = static_cast<float>(std::hypot(dx, dy * aspect));
-      if (distance < max_radius + 0.5f) planes.window.push_back({dx, dy, distance});
-    }
-  }
-  std::stable_sort(
-      planes.window.begin(), planes.window.end(),
-      [](const WindowOffset& a, const WindowOffset& b) { return a.distance < b.distance; });
-  PrepareTileReach(&planes, reach_x, reach_y);
+  const auto cap = static_cast<float>(0.5 * lens.max_coc_px);
+  planes.pad_x = std::min(static_cast<int>(std::ceil(cap + 0.5f)), planes.width);
+  planes.pad_y = std::min(static_cast<int>(std::ceil((cap + 0.5f) / aspect)), planes.height);
+  planes.stride = planes.width + 2 * planes.pad_x + kDofMaxLanes;
+  const std::size_t n =
+      static_cast<std::size_t>(planes.stride) * (planes.height + 2 * planes.pad_y);
+  planes.values = std::make_unique_for_overwrite<float[]>(6 * n);
+  planes.depth = planes.values.get();
+  planes.outer = planes.depth + n;
+  planes.area = planes.outer + n;
+  for (int ch = 0; ch < 3; ++ch) planes.color[ch] = planes.area + (ch + 1) * n;
+  planes.tiles_x = (planes.width + kDofTile - 1) / kDofTile;
+  planes.reach.assign(
+      static_cast<std::size_t>(planes.tiles_x) * ((planes.height + kDofTile - 1) / kDofTile), 0.0f);
+  const DofLensTerms terms{
+      CircleOfConfusion(lens, 0.0),
+      lens.pixel_pitch_m > 0.0 ? lens.pixel_pitch_m : lens.focal_length_m / k.fx(),
+      lens.focus_distance_m, lens.max_coc_px};
+  DofPart parts[2];
+  SplitDofRows(planes.height, [&](int part, int first, int end) {
+    if (first == 0) FillDofPadding(&planes, 0, planes.At(-planes.pad_x, 0));
+    PrepareDofRows(rgb, depth, terms, first, end, &planes, &parts[part]);
+    if (end == planes.height) FillDofPadding(&planes, planes.At(-planes.pad_x, end), n);
+  });
+  summary->max_coc_px = std::max(parts[0].max_coc_px, parts[1].max_coc_px);
+  summary->capped_pixels = parts[0].capped_pixels + parts[1].capped_pixels;
+  PrepareWindow(&planes, std::max(parts[0].max_radius, parts[1].max_radius), aspect);
   return planes;
 }
 
-DofVector LoadDof(const float* values) {
-  DofVector v;
-  std::memcpy(&v, values, sizeof(v));
-  return v;
-}
+// GCC vectors of kLanes floats; Loaded reads them from any float's address.
+template <int kLanes>
+struct DofLanes;
+template <>
+struct DofLanes<4> {
+  using Vector = float __attribute__((vector_size(16)));
+  using Loaded = float __attribute__((vector_size(16), aligned(alignof(float)), may_alias));
+};
+template <>
+struct DofLanes<8> {
+  using Vector = float __attribute__((vector_size(32)));
+  using Loaded = float __attribute__((vector_size(32), aligned(alignof(float)), may_alias));
+};
 
-// How much of a pixel at `distance` (pixels) a disc of radius `radius` covers, anti-aliased
-// over one pixel: 1 inside radius - 0.5, 0 beyond radius + 0.5, linear between; for kDofLanes
-// discs.
-DofVector DofCoverage(float distance, DofVector radius) {
-  DofVector c = radius + 0.5f - distance;
-  c = c < 0.0f ? DofVector{} : c;
-  return c > 1.0f ? DofVector{} + 1.0f : c;
-}
-
-// kDofLanes output pixels from (x, y) on of one tile's row (the header's gather of what is
-// behind, scatter of what is in front), into out[0 .. count). The tile's reach bounds every
-// pixel's own circle and those near it (the window is sorted by distance): beyond it every
-// term is 0. Each term is the scalar gather's, in its order: the same bits as pixel by pixel.
-void DofRun(const DofPlanes& planes, int x, int y, int count, uint8_t* out) {
-  const std::size_t p = planes.At(x, y);
-  const DofVector radius_p = LoadDof(&planes.radius[p]);
-  const DofVector nearer = LoadDof(&planes.depth[p]) * (1.0f - kNearerFraction);
-  DofVector back_weight{}, front_weight{}, back[3] = {}, front[3] = {};
-  const float limit =
-      planes.reach[static_cast<std::size_t>(y / kDofTile) * planes.tiles_x + x / kDofTile];
-  const auto offset = [&](const WindowOffset& o) {
-    return static_cast<std::ptrdiff_t>(o.dy) * planes.stride + o.dx;
-  };
-  for (const WindowOffset& o : planes.window) {
-    if (o.distance >= limit) break;
-    const std::size_t q = p + offset(o);
-    const auto in_front = LoadDof(&planes.depth[q]) < nearer;
-    // In front: q's disc over p, weighed by 1 / its area; else p's disc over q (inside only).
-    const DofVector w_front =
-        DofCoverage(o.distance, LoadDof(&planes.radius[q])) / LoadDof(&planes.area[q]);
-    const DofVector w_back = DofCoverage(o.distance, radius_p) * LoadDof(&planes.inside[q]);
-    const DofVector f = in_front ? w_front : DofVector{};
-    const DofVector b = in_front ? DofVector{} : w_back;
-    front_weight += f;
-    back_weight += b;
-    for (int ch = 0; ch < 3; ++ch) {
-      const DofVector c = LoadDof(&planes.color[ch][q]);
-      front[ch] += f * c;
-      back[ch] += b * c;
-    }
-  }
-  for (int j = 0; j < count; ++j) {
-    const float alpha = std::min(1.0f, front_weight[j]);
-    for (int ch = 0; ch < 3; ++ch) {
-      float value = back_weight[j] > 0.0f ? back[ch][j] / back_weight[j] : 0.0f;
-      if (front_weight[j] > 0.0f) {
-        value = alpha * front[ch][j] / front_weight[j] + (1.0f - alpha) * value;
+// Row y of the image, kLanes output pixels at a time (the header's gather of what is behind,
+// scatter of what is in front), into `out`. The tile's reach bounds every pixel's own circle
+// and those near it (the window is sorted by distance): beyond it every term is 0. Each term
+// is the scalar gather's, in its order: the same bits as pixel by pixel, with 4 lanes or 8.
+// Inlined into DofRowsPortable and DofRowsAvx2, so that each is compiled for its target; the
+// vectors are never passed to a function (their ABI differs with and without AVX).
+template <int kLanes>
+[[gnu::always_inline]] inline void DofRow(const DofPlanes& planes, int y, uint8_t* out) {
+  using Vector = typename DofLanes<kLanes>::Vector;
+  using Loaded = typename DofLanes<kLanes>::Loaded;
+  const float* tile_reach = &planes.reach[static_cast<std::size_t>(y / kDofTile) * planes.tiles_x];
+  for (int x = 0; x < planes.width; x += kLanes) {
+    const std::size_t p = planes.At(x, y);
+    const Vector outer_p = *reinterpret_cast<const Loaded*>(planes.outer + p);
+    const Vector nearer =
+        *reinterpret_cast<const Loaded*>(planes.depth + p) * (1.0f - kNearerFraction);
+    Vector back_weight{}, front_weight{}, back[3] = {}, front[3] = {};
+    const float limit = tile_reach[x / kDofTile];
+    for (const WindowStep& o : planes.window) {
+      if (o.distance >= limit) break;
+      const std::size_t q = p + o.step;
+      const Vector depth_q = *reinterpret_cast<const Loaded*>(planes.depth + q);
+      // DofCoverage of q's disc and of p's: radius + 0.5 - distance, clamped to [0, 1].
+      Vector cover_q = *reinterpret_cast<const Loaded*>(planes.outer + q) - o.distance;
+      cover_q = cover_q < 0.0f ? Vector{} : cover_q;
+      cover_q = cover_q > 1.0f ? Vector{} + 1.0f : cover_q;
+      Vector cover_p = outer_p - o.distance;
+      cover_p = cover_p < 0.0f ? Vector{} : cover_p;
+      cover_p = cover_p > 1.0f ? Vector{} + 1.0f : cover_p;
+      // In front: q's disc over p, weighed by 1 / its area; behind (or at p's depth): p's disc
+      // over q. Padding is neither.
+      const Vector f =
+          depth_q < nearer ? cover_q / *reinterpret_cast<const Loaded*>(planes.area + q) : Vector{};
+      const Vector b = depth_q >= nearer ? cover_p : Vector{};
+      front_weight += f;
+      back_weight += b;
+      for (int ch = 0; ch < 3; ++ch) {
+        const Vector c = *reinterpret_cast<const Loaded*>(planes.color[ch] + q);
+        front[ch] += f * c;
+        back[ch] += b * c;
       }
-      // lround of a value in [0, 255]: + 0.5 is exact in double, truncated (no libm call).
-      out[3 * j + ch] =
-          static_cast<uint8_t>(static_cast<double>(std::clamp(value, 0.0f, 255.0f)) + 0.5);
+    }
+    for (int j = 0; j < std::min(kLanes, planes.width - x); ++j) {
+      const float alpha = std::min(1.0f, front_weight[j]);
+      for (int ch = 0; ch < 3; ++ch) {
+        float value = back_weight[j] > 0.0f ? back[ch][j] / back_weight[j] : 0.0f;
+        if (front_weight[j] > 0.0f) {
+          value = alpha * front[ch][j] / front_weight[j] + (1.0f - alpha) * value;
+        }
+        // lround of a value in [0, 255]: + 0.5 is exact in double, truncated (no libm call).
+        out[3 * (x + j) + ch] =
+            static_cast<uint8_t>(static_cast<double>(std::clamp(value, 0.0f, 255.0f)) + 0.5);
+      }
     }
   }
 }
+
+void DofRowsPortable(const DofPlanes& planes, int first, int end, Image* out) {
+  for (int y = first; y < end; ++y) DofRow<4>(planes, y, out->row(y));
+}
+
+#if defined(__x86_64__)
+// No "fma": a fused multiply-add would round once where the gather rounds twice.
+__attribute__((target("avx2"))) void DofRowsAvx2(const DofPlanes& planes, int first, int end,
+                                                 Image* out) {
+  for (int y = first; y < end; ++y) DofRow<8>(planes, y, out->row(y));
+}
+#endif
 
 }  // namespace
 
@@ -362,6 +448,12 @@ double CircleOfConfusionPx(const ThinLensOptions& lens, const geometry::Intrinsi
 
 Image ApplyDepthOfField(const ImageView& rgb, const ImageView& depth, const ThinLensOptions& lens,
                         const geometry::Intrinsics& intrinsics, DepthOfFieldSummary* summary) {
+  return ApplyDepthOfField(rgb, depth, lens, intrinsics, summary, true);
+}
+
+Image ApplyDepthOfField(const ImageView& rgb, const ImageView& depth, const ThinLensOptions& lens,
+                        const geometry::Intrinsics& intrinsics, DepthOfFieldSummary* summary,
+                        bool simd) {
   lens.Validate();
   if (rgb.format() != PixelFormat::kRgb8 || depth.format() != PixelFormat::kFloat32) {
     throw InvalidArgument(fmt::format(
@@ -379,24 +471,22 @@ Image ApplyDepthOfField(const ImageView& rgb, const ImageView& depth, const Thin
   const DofPlanes planes = PrepareDof(rgb, depth, lens, intrinsics, out_summary);
   Image out(rgb.width(), rgb.height(), PixelFormat::kRgb8);
   if (rgb.metadata() != nullptr) out.metadata() = *rgb.metadata();
-  const auto rows = [&](int first, int end) {
-    for (int y = first; y < end; ++y) {
-      uint8_t* row = out.row(y);
-      for (int x = 0; x < rgb.width(); x += kDofLanes) {
-        DofRun(planes, x, y, std::min(kDofLanes, rgb.width() - x), row + 3 * x);
-      }
+#if defined(__x86_64__)
+  static const bool avx2 = __builtin_cpu_supports("avx2");  // asked once
+  const bool wide = avx2 && simd;
+#else
+  static_cast<void>(simd);
+  constexpr bool wide = false;
+#endif
+  SplitDofRows(rgb.height(), [&](int, int first, int end) {
+#if defined(__x86_64__)
+    if (wide) {
+      DofRowsAvx2(planes, first, end, &out);
+      return;
     }
-  };
-  // Two halves at once where there are two cores (each pixel is computed alone: the same bits).
-  static const bool cores = std::thread::hardware_concurrency() >= 2;  // asked once
-  if (cores && rgb.height() >= 2 * kDofTile) {
-    const int half = rgb.height() / 2;
-    std::thread other(rows, half, rgb.height());
-    rows(0, half);
-    other.join();
-  } else {
-    rows(0, rgb.height());
-  }
+#endif
+    DofRowsPortable(planes, first, end, &out);
+  });
   return out;
 }
 
