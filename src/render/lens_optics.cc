@@ -55,6 +55,20 @@ constexpr int kDofTile = 16;
 constexpr int kDofMaxLanes = 8;
 static_assert(kDofTile % kDofMaxLanes == 0);
 
+// GCC vectors of kLanes floats: Vector, and Loaded to read or write one at any float's address.
+template <int kLanes>
+struct DofLanes;
+template <>
+struct DofLanes<4> {
+  using Vector = float __attribute__((vector_size(16)));
+  using Loaded = float __attribute__((vector_size(16), aligned(alignof(float)), may_alias));
+};
+template <>
+struct DofLanes<8> {
+  using Vector = float __attribute__((vector_size(32)));
+  using Loaded = float __attribute__((vector_size(32), aligned(alignof(float)), may_alias));
+};
+
 // What the gather reads per pixel, in planes padded around the image (pad_x, pad_y: at least
 // the window's reach) and kDofMaxLanes more on the right, so that a run of pixels reads every
 // offset without a bounds test: depth (+inf without a surface, NaN in the padding: neither in
@@ -99,38 +113,105 @@ void FillDofPadding(DofPlanes* planes, std::size_t first, std::size_t end) {
   for (float* c : planes->color) std::fill(c + first, c + end, 0.0f);
 }
 
-// Image rows [first, end) into the planes, with their padding left and right; each tile's
-// largest outer edge into planes->reach. The circle in double, as CircleOfConfusionPx (the
-// summary is in double; a radius computed in float could round the other way).
-void PrepareDofRows(const ImageView& rgb, const ImageView& depth, const DofLensTerms& terms,
-                    int first, int end, DofPlanes* planes, DofPart* part) {
+// Pixel i of the planes from depth d and colour c; the circle in double, as
+// CircleOfConfusionPx (the summary is in double; a radius computed in float could round the
+// other way). The scalar form of PrepareDofRow's vectors, for a row's last pixels.
+void PrepareDofPixel(float d, const uint8_t* c, const DofLensTerms& terms, std::size_t i,
+                     DofPlanes* planes, DofPart* part) {
+  const bool surface = std::isfinite(d) && d > 0.0f;
+  const double coc =
+      (surface ? terms.at_infinity * std::abs(d - terms.focus) / d : terms.at_infinity) /
+      terms.pitch;
+  part->max_coc_px = std::max(part->max_coc_px, coc);
+  part->capped_pixels += coc > terms.max_coc_px;
+  const auto r = static_cast<float>(0.5 * std::min(coc, terms.max_coc_px));
+  part->max_radius = std::max(part->max_radius, r);
+  planes->depth[i] = surface ? d : std::numeric_limits<float>::infinity();
+  planes->outer[i] = r + 0.5f;
+  planes->area[i] = DiscArea(r);
+  for (int ch = 0; ch < 3; ++ch) planes->color[ch][i] = c[ch];
+}
+
+// Image row y into the planes, with its padding left and right, 4 pixels at a time (each
+// value PrepareDofPixel's: the same operations, lane by lane); each tile's largest outer edge
+// into planes->reach. Inlined as DofRow is (4 doubles: one AVX vector, two SSE ones).
+[[gnu::always_inline]] inline void PrepareDofRow(const ImageView& rgb, const ImageView& depth,
+                                                 const DofLensTerms& terms, int y,
+                                                 DofPlanes* planes, DofPart* part) {
+  using Vector = DofLanes<4>::Vector;
+  using Loaded = DofLanes<4>::Loaded;
+  using Doubles = double __attribute__((vector_size(32)));
+  using Bits = uint64_t __attribute__((vector_size(32)));
+  constexpr float kInfinity = std::numeric_limits<float>::infinity();
   const int w = planes->width;
-  for (int y = first; y < end; ++y) {
-    const std::size_t row_start = planes->At(0, y);
-    FillDofPadding(planes, row_start - planes->pad_x, row_start);
-    FillDofPadding(planes, row_start + w, row_start + w + planes->pad_x + kDofMaxLanes);
-    const float* d_row = reinterpret_cast<const float*>(depth.row(y));
-    const uint8_t* c = rgb.row(y);
-    float* tile = &planes->reach[static_cast<std::size_t>(y / kDofTile) * planes->tiles_x];
-    for (int x = 0; x < w; ++x) {
-      const float d = d_row[x];
-      const bool surface = std::isfinite(d) && d > 0.0f;
-      const double coc =
-          (surface ? terms.at_infinity * std::abs(d - terms.focus) / d : terms.at_infinity) /
-          terms.pitch;
-      part->max_coc_px = std::max(part->max_coc_px, coc);
-      part->capped_pixels += coc > terms.max_coc_px;
-      const auto r = static_cast<float>(0.5 * std::min(coc, terms.max_coc_px));
-      part->max_radius = std::max(part->max_radius, r);
-      const std::size_t i = row_start + x;
-      planes->depth[i] = surface ? d : std::numeric_limits<float>::infinity();
-      planes->outer[i] = r + 0.5f;
-      planes->area[i] = DiscArea(r);
-      for (int ch = 0; ch < 3; ++ch) planes->color[ch][i] = c[3 * x + ch];
-      tile[x / kDofTile] = std::max(tile[x / kDofTile], planes->outer[i]);
+  const std::size_t row_start = planes->At(0, y);
+  const float* d_row = reinterpret_cast<const float*>(depth.row(y));
+  const uint8_t* c = rgb.row(y);
+  float* const depth_out = planes->depth + row_start;
+  float* const outer_out = planes->outer + row_start;
+  float* const area_out = planes->area + row_start;
+  float* const color_out[3] = {planes->color[0] + row_start, planes->color[1] + row_start,
+                               planes->color[2] + row_start};
+  Doubles max_coc = Doubles{} + part->max_coc_px;
+  Bits capped{};
+  Vector max_radius = Vector{} + part->max_radius;
+  int x = 0;
+  for (; x + 4 <= w; x += 4) {
+    const Vector d = *reinterpret_cast<const Loaded*>(d_row + x);
+    const Doubles dd = __builtin_convertvector(d, Doubles);
+    // std::abs: the sign bit cleared.
+    const Doubles distance = reinterpret_cast<Doubles>(reinterpret_cast<Bits>(dd - terms.focus) &
+                                                       (Bits{} + ~(uint64_t{1} << 63)));
+    // isfinite(d) && d > 0: d > 0 && d < inf (false for NaN).
+    const Doubles coc =
+        ((dd > 0.0) & (dd < static_cast<double>(kInfinity)) ? terms.at_infinity * distance / dd
+                                                            : Doubles{} + terms.at_infinity) /
+        terms.pitch;
+    max_coc = max_coc < coc ? coc : max_coc;
+    capped -= reinterpret_cast<Bits>(coc > terms.max_coc_px);  // -1 where capped
+    const Vector r = __builtin_convertvector(
+        0.5 * (terms.max_coc_px < coc ? Doubles{} + terms.max_coc_px : coc), Vector);
+    max_radius = max_radius < r ? r : max_radius;
+    *reinterpret_cast<Loaded*>(depth_out + x) =
+        (d > 0.0f) & (d < kInfinity) ? d : Vector{} + kInfinity;
+    *reinterpret_cast<Loaded*>(outer_out + x) = r + 0.5f;
+    // DiscArea.
+    *reinterpret_cast<Loaded*>(area_out + x) =
+        r < 0.5f ? r + 0.5f : std::numbers::pi_v<float> * (r * r + 1.0f / 12.0f);
+    for (int j = 0; j < 4; ++j) {
+      for (int ch = 0; ch < 3; ++ch) color_out[ch][x + j] = c[3 * (x + j) + ch];
     }
   }
+  for (int j = 0; j < 4; ++j) {
+    part->max_coc_px = std::max(part->max_coc_px, max_coc[j]);
+    part->capped_pixels += static_cast<int64_t>(capped[j]);
+    part->max_radius = std::max(part->max_radius, max_radius[j]);
+  }
+  for (; x < w; ++x) PrepareDofPixel(d_row[x], c + 3 * x, terms, row_start + x, planes, part);
+  FillDofPadding(planes, row_start - planes->pad_x, row_start);
+  FillDofPadding(planes, row_start + w, row_start + w + planes->pad_x + kDofMaxLanes);
+  float* tile = &planes->reach[static_cast<std::size_t>(y / kDofTile) * planes->tiles_x];
+  for (int first = 0; first < w; first += kDofTile) {
+    float m = tile[first / kDofTile];
+    for (int x = first; x < std::min(w, first + kDofTile); ++x) m = std::max(m, outer_out[x]);
+    tile[first / kDofTile] = m;
+  }
 }
+
+void PrepareDofRowsPortable(const ImageView& rgb, const ImageView& depth, const DofLensTerms& terms,
+                            int first, int end, DofPlanes* planes, DofPart* part) {
+  for (int y = first; y < end; ++y) PrepareDofRow(rgb, depth, terms, y, planes, part);
+}
+
+#if defined(__x86_64__)
+// No "fma" (DofRowsAvx2).
+__attribute__((target("avx2"))) void PrepareDofRowsAvx2(const ImageView& rgb,
+                                                        const ImageView& depth,
+                                                        const DofLensTerms& terms, int first,
+                                                        int end, DofPlanes* planes, DofPart* part) {
+  for (int y = first; y < end; ++y) PrepareDofRow(rgb, depth, terms, y, planes, part);
+}
+#endif
 
 // DofPlanes::reach: from each tile's largest outer edge (PrepareDofRows), the largest over the
 // tiles the window reaches from it.
@@ -190,7 +271,7 @@ void SplitDofRows(int height, const Rows& rows) {
 }
 
 DofPlanes PrepareDof(const ImageView& rgb, const ImageView& depth, const ThinLensOptions& lens,
-                     const geometry::Intrinsics& k, DepthOfFieldSummary* summary) {
+                     const geometry::Intrinsics& k, bool wide, DepthOfFieldSummary* summary) {
   DofPlanes planes;
   planes.width = depth.width();
   planes.height = depth.height();
@@ -218,7 +299,16 @@ DofPlanes PrepareDof(const ImageView& rgb, const ImageView& depth, const ThinLen
   DofPart parts[2];
   SplitDofRows(planes.height, [&](int part, int first, int end) {
     if (first == 0) FillDofPadding(&planes, 0, planes.At(-planes.pad_x, 0));
-    PrepareDofRows(rgb, depth, terms, first, end, &planes, &parts[part]);
+#if defined(__x86_64__)
+    if (wide) {
+      PrepareDofRowsAvx2(rgb, depth, terms, first, end, &planes, &parts[part]);
+    } else {
+      PrepareDofRowsPortable(rgb, depth, terms, first, end, &planes, &parts[part]);
+    }
+#else
+    static_cast<void>(wide);
+    PrepareDofRowsPortable(rgb, depth, terms, first, end, &planes, &parts[part]);
+#endif
     if (end == planes.height) FillDofPadding(&planes, planes.At(-planes.pad_x, end), n);
   });
   summary->max_coc_px = std::max(parts[0].max_coc_px, parts[1].max_coc_px);
@@ -226,20 +316,6 @@ DofPlanes PrepareDof(const ImageView& rgb, const ImageView& depth, const ThinLen
   PrepareWindow(&planes, std::max(parts[0].max_radius, parts[1].max_radius), aspect);
   return planes;
 }
-
-// GCC vectors of kLanes floats; Loaded reads them from any float's address.
-template <int kLanes>
-struct DofLanes;
-template <>
-struct DofLanes<4> {
-  using Vector = float __attribute__((vector_size(16)));
-  using Loaded = float __attribute__((vector_size(16), aligned(alignof(float)), may_alias));
-};
-template <>
-struct DofLanes<8> {
-  using Vector = float __attribute__((vector_size(32)));
-  using Loaded = float __attribute__((vector_size(32), aligned(alignof(float)), may_alias));
-};
 
 // Row y of the image, kLanes output pixels at a time (the header's gather of what is behind,
 // scatter of what is in front), into `out`. The tile's reach bounds every pixel's own circle
@@ -468,9 +544,6 @@ Image ApplyDepthOfField(const ImageView& rgb, const ImageView& depth, const Thin
   DepthOfFieldSummary local;
   DepthOfFieldSummary* out_summary = summary != nullptr ? summary : &local;
   *out_summary = {};
-  const DofPlanes planes = PrepareDof(rgb, depth, lens, intrinsics, out_summary);
-  Image out(rgb.width(), rgb.height(), PixelFormat::kRgb8);
-  if (rgb.metadata() != nullptr) out.metadata() = *rgb.metadata();
 #if defined(__x86_64__)
   static const bool avx2 = __builtin_cpu_supports("avx2");  // asked once
   const bool wide = avx2 && simd;
@@ -478,6 +551,9 @@ Image ApplyDepthOfField(const ImageView& rgb, const ImageView& depth, const Thin
   static_cast<void>(simd);
   constexpr bool wide = false;
 #endif
+  const DofPlanes planes = PrepareDof(rgb, depth, lens, intrinsics, wide, out_summary);
+  Image out(rgb.width(), rgb.height(), PixelFormat::kRgb8);
+  if (rgb.metadata() != nullptr) out.metadata() = *rgb.metadata();
   SplitDofRows(rgb.height(), [&](int, int first, int end) {
 #if defined(__x86_64__)
     if (wide) {
