@@ -55,18 +55,21 @@ constexpr int kDofTile = 16;
 constexpr int kDofMaxLanes = 8;
 static_assert(kDofTile % kDofMaxLanes == 0);
 
-// GCC vectors of kLanes floats: Vector, and Loaded to read or write one at any float's address.
+// GCC vectors of kLanes floats (Vector; Loaded reads or writes one at any float's address) and
+// of kLanes ints.
 template <int kLanes>
 struct DofLanes;
 template <>
 struct DofLanes<4> {
   using Vector = float __attribute__((vector_size(16)));
   using Loaded = float __attribute__((vector_size(16), aligned(alignof(float)), may_alias));
+  using Ints = int32_t __attribute__((vector_size(16)));
 };
 template <>
 struct DofLanes<8> {
   using Vector = float __attribute__((vector_size(32)));
   using Loaded = float __attribute__((vector_size(32), aligned(alignof(float)), may_alias));
+  using Ints = int32_t __attribute__((vector_size(32)));
 };
 
 // What the gather reads per pixel, in planes padded around the image (pad_x, pad_y: at least
@@ -327,20 +330,24 @@ template <int kLanes>
 [[gnu::always_inline]] inline void DofRow(const DofPlanes& planes, int y, uint8_t* out) {
   using Vector = typename DofLanes<kLanes>::Vector;
   using Loaded = typename DofLanes<kLanes>::Loaded;
+  using Ints = typename DofLanes<kLanes>::Ints;
   const float* tile_reach = &planes.reach[static_cast<std::size_t>(y / kDofTile) * planes.tiles_x];
+  // Locals: the stores below could alias the planes' pointers, which would be reloaded.
+  const float *const depth = planes.depth, *const outer = planes.outer, *const area = planes.area;
+  const float* const color[3] = {planes.color[0], planes.color[1], planes.color[2]};
   for (int x = 0; x < planes.width; x += kLanes) {
     const std::size_t p = planes.At(x, y);
-    const Vector outer_p = *reinterpret_cast<const Loaded*>(planes.outer + p);
-    const Vector nearer =
-        *reinterpret_cast<const Loaded*>(planes.depth + p) * (1.0f - kNearerFraction);
+    const Vector outer_p = *reinterpret_cast<const Loaded*>(outer + p);
+    const Vector nearer = *reinterpret_cast<const Loaded*>(depth + p) * (1.0f - kNearerFraction);
     Vector back_weight{}, front_weight{}, back[3] = {}, front[3] = {};
     const float limit = tile_reach[x / kDofTile];
     for (const WindowStep& o : planes.window) {
       if (o.distance >= limit) break;
       const std::size_t q = p + o.step;
-      const Vector depth_q = *reinterpret_cast<const Loaded*>(planes.depth + q);
-      // DofCoverage of q's disc and of p's: radius + 0.5 - distance, clamped to [0, 1].
-      Vector cover_q = *reinterpret_cast<const Loaded*>(planes.outer + q) - o.distance;
+      const Vector depth_q = *reinterpret_cast<const Loaded*>(depth + q);
+      // How much of p each disc covers, anti-aliased over one pixel: radius + 0.5 - distance,
+      // clamped to [0, 1]; q's disc and p's.
+      Vector cover_q = *reinterpret_cast<const Loaded*>(outer + q) - o.distance;
       cover_q = cover_q < 0.0f ? Vector{} : cover_q;
       cover_q = cover_q > 1.0f ? Vector{} + 1.0f : cover_q;
       Vector cover_p = outer_p - o.distance;
@@ -349,27 +356,36 @@ template <int kLanes>
       // In front: q's disc over p, weighed by 1 / its area; behind (or at p's depth): p's disc
       // over q. Padding is neither.
       const Vector f =
-          depth_q < nearer ? cover_q / *reinterpret_cast<const Loaded*>(planes.area + q) : Vector{};
+          depth_q < nearer ? cover_q / *reinterpret_cast<const Loaded*>(area + q) : Vector{};
       const Vector b = depth_q >= nearer ? cover_p : Vector{};
       front_weight += f;
       back_weight += b;
+#pragma GCC unroll 3
       for (int ch = 0; ch < 3; ++ch) {
-        const Vector c = *reinterpret_cast<const Loaded*>(planes.color[ch] + q);
+        const Vector c = *reinterpret_cast<const Loaded*>(color[ch] + q);
         front[ch] += f * c;
         back[ch] += b * c;
       }
     }
+    // The average behind, and over it what is in front with the opacity its weights sum to
+    // (at most 1); lane by lane the scalar gather's operations (std::min, std::clamp as their
+    // comparisons), the lanes without a weight's division discarded.
+    const Vector alpha = front_weight < 1.0f ? front_weight : Vector{} + 1.0f;
+    Ints rounded[3];
+#pragma GCC unroll 3
+    for (int ch = 0; ch < 3; ++ch) {
+      Vector value = back_weight > 0.0f ? back[ch] / back_weight : Vector{};
+      value =
+          front_weight > 0.0f ? alpha * front[ch] / front_weight + (1.0f - alpha) * value : value;
+      value = value < 0.0f ? Vector{} : value;
+      value = value > 255.0f ? Vector{} + 255.0f : value;
+      // lround of a value in [0, 255]: its integer part, + 1 where the fraction (exact: the
+      // difference of two floats within a factor of 2, or the value below 1) is >= 0.5.
+      const Ints whole = __builtin_convertvector(value, Ints);
+      rounded[ch] = whole - (value - __builtin_convertvector(whole, Vector) >= 0.5f);
+    }
     for (int j = 0; j < std::min(kLanes, planes.width - x); ++j) {
-      const float alpha = std::min(1.0f, front_weight[j]);
-      for (int ch = 0; ch < 3; ++ch) {
-        float value = back_weight[j] > 0.0f ? back[ch][j] / back_weight[j] : 0.0f;
-        if (front_weight[j] > 0.0f) {
-          value = alpha * front[ch][j] / front_weight[j] + (1.0f - alpha) * value;
-        }
-        // lround of a value in [0, 255]: + 0.5 is exact in double, truncated (no libm call).
-        out[3 * (x + j) + ch] =
-            static_cast<uint8_t>(static_cast<double>(std::clamp(value, 0.0f, 255.0f)) + 0.5);
-      }
+      for (int ch = 0; ch < 3; ++ch) out[3 * (x + j) + ch] = static_cast<uint8_t>(rounded[ch][j]);
     }
   }
 }
