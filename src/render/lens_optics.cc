@@ -145,6 +145,9 @@ void PrepareDofPixel(float d, const uint8_t* c, const DofLensTerms& terms, std::
   using Loaded = DofLanes<4>::Loaded;
   using Doubles = double __attribute__((vector_size(32)));
   using Bits = uint64_t __attribute__((vector_size(32)));
+  using Ints = DofLanes<4>::Ints;
+  using Bytes = uint8_t __attribute__((vector_size(16)));
+  using LoadedBytes = uint8_t __attribute__((vector_size(16), aligned(1), may_alias));
   constexpr float kInfinity = std::numeric_limits<float>::infinity();
   const int w = planes->width;
   const std::size_t row_start = planes->At(0, y);
@@ -158,47 +161,66 @@ void PrepareDofPixel(float d, const uint8_t* c, const DofLensTerms& terms, std::
   Doubles max_coc = Doubles{} + part->max_coc_px;
   Bits capped{};
   Vector max_radius = Vector{} + part->max_radius;
-  int x = 0;
-  for (; x + 4 <= w; x += 4) {
-    const Vector d = *reinterpret_cast<const Loaded*>(d_row + x);
-    const Doubles dd = __builtin_convertvector(d, Doubles);
-    // std::abs: the sign bit cleared.
-    const Doubles distance = reinterpret_cast<Doubles>(reinterpret_cast<Bits>(dd - terms.focus) &
-                                                       (Bits{} + ~(uint64_t{1} << 63)));
-    // isfinite(d) && d > 0: d > 0 && d < inf (false for NaN).
-    const Doubles coc =
-        ((dd > 0.0) & (dd < static_cast<double>(kInfinity)) ? terms.at_infinity * distance / dd
-                                                            : Doubles{} + terms.at_infinity) /
-        terms.pitch;
-    max_coc = max_coc < coc ? coc : max_coc;
-    capped -= reinterpret_cast<Bits>(coc > terms.max_coc_px);  // -1 where capped
-    const Vector r = __builtin_convertvector(
-        0.5 * (terms.max_coc_px < coc ? Doubles{} + terms.max_coc_px : coc), Vector);
-    max_radius = max_radius < r ? r : max_radius;
-    *reinterpret_cast<Loaded*>(depth_out + x) =
-        (d > 0.0f) & (d < kInfinity) ? d : Vector{} + kInfinity;
-    *reinterpret_cast<Loaded*>(outer_out + x) = r + 0.5f;
-    // DiscArea.
-    *reinterpret_cast<Loaded*>(area_out + x) =
-        r < 0.5f ? r + 0.5f : std::numbers::pi_v<float> * (r * r + 1.0f / 12.0f);
-    for (int j = 0; j < 4; ++j) {
-      for (int ch = 0; ch < 3; ++ch) color_out[ch][x + j] = c[3 * (x + j) + ch];
+  float* const tile = &planes->reach[static_cast<std::size_t>(y / kDofTile) * planes->tiles_x];
+  for (int first = 0; first < w; first += kDofTile) {
+    const int end = std::min(w, first + kDofTile);
+    Vector tile_outer = Vector{} + tile[first / kDofTile];
+    int x = first;
+    for (; x + 4 <= end && x + 6 <= w; x += 4) {
+      const Vector d = *reinterpret_cast<const Loaded*>(d_row + x);
+      const Doubles dd = __builtin_convertvector(d, Doubles);
+      // std::abs: the sign bit cleared.
+      const Doubles distance = reinterpret_cast<Doubles>(reinterpret_cast<Bits>(dd - terms.focus) &
+                                                         (Bits{} + ~(uint64_t{1} << 63)));
+      // isfinite(d) && d > 0: d > 0 && d < inf (false for NaN).
+      const Doubles coc =
+          ((dd > 0.0) & (dd < static_cast<double>(kInfinity)) ? terms.at_infinity * distance / dd
+                                                              : Doubles{} + terms.at_infinity) /
+          terms.pitch;
+      max_coc = max_coc < coc ? coc : max_coc;
+      capped -= reinterpret_cast<Bits>(coc > terms.max_coc_px);  // -1 where capped
+      const Vector r = __builtin_convertvector(
+          0.5 * (terms.max_coc_px < coc ? Doubles{} + terms.max_coc_px : coc), Vector);
+      max_radius = max_radius < r ? r : max_radius;
+      *reinterpret_cast<Loaded*>(depth_out + x) =
+          (d > 0.0f) & (d < kInfinity) ? d : Vector{} + kInfinity;
+      const Vector outer = r + 0.5f;
+      *reinterpret_cast<Loaded*>(outer_out + x) = outer;
+      tile_outer = tile_outer < outer ? outer : tile_outer;
+      // DiscArea.
+      *reinterpret_cast<Loaded*>(area_out + x) =
+          r < 0.5f ? r + 0.5f : std::numbers::pi_v<float> * (r * r + 1.0f / 12.0f);
+      // The 4 pixels' 12 bytes (read as 16: the loop stops 2 pixels before the row's end),
+      // each channel's 4 widened to ints, then floats.
+      const Bytes rgb4 = *reinterpret_cast<const LoadedBytes*>(c + 3 * x);
+      constexpr Bytes kZero{};
+      *reinterpret_cast<Loaded*>(color_out[0] + x) = __builtin_convertvector(
+          reinterpret_cast<Ints>(__builtin_shufflevector(rgb4, kZero, 0, 16, 16, 16, 3, 16, 16, 16,
+                                                         6, 16, 16, 16, 9, 16, 16, 16)),
+          Vector);
+      *reinterpret_cast<Loaded*>(color_out[1] + x) = __builtin_convertvector(
+          reinterpret_cast<Ints>(__builtin_shufflevector(rgb4, kZero, 1, 16, 16, 16, 4, 16, 16, 16,
+                                                         7, 16, 16, 16, 10, 16, 16, 16)),
+          Vector);
+      *reinterpret_cast<Loaded*>(color_out[2] + x) = __builtin_convertvector(
+          reinterpret_cast<Ints>(__builtin_shufflevector(rgb4, kZero, 2, 16, 16, 16, 5, 16, 16, 16,
+                                                         8, 16, 16, 16, 11, 16, 16, 16)),
+          Vector);
     }
+    float m = std::max({tile_outer[0], tile_outer[1], tile_outer[2], tile_outer[3]});
+    for (; x < end; ++x) {  // the row's last pixels, from the 3rd last
+      PrepareDofPixel(d_row[x], c + 3 * x, terms, row_start + x, planes, part);
+      m = std::max(m, outer_out[x]);
+    }
+    tile[first / kDofTile] = m;
   }
   for (int j = 0; j < 4; ++j) {
     part->max_coc_px = std::max(part->max_coc_px, max_coc[j]);
     part->capped_pixels += static_cast<int64_t>(capped[j]);
     part->max_radius = std::max(part->max_radius, max_radius[j]);
   }
-  for (; x < w; ++x) PrepareDofPixel(d_row[x], c + 3 * x, terms, row_start + x, planes, part);
   FillDofPadding(planes, row_start - planes->pad_x, row_start);
   FillDofPadding(planes, row_start + w, row_start + w + planes->pad_x + kDofMaxLanes);
-  float* tile = &planes->reach[static_cast<std::size_t>(y / kDofTile) * planes->tiles_x];
-  for (int first = 0; first < w; first += kDofTile) {
-    float m = tile[first / kDofTile];
-    for (int x = first; x < std::min(w, first + kDofTile); ++x) m = std::max(m, outer_out[x]);
-    tile[first / kDofTile] = m;
-  }
 }
 
 void PrepareDofRowsPortable(const ImageView& rgb, const ImageView& depth, const DofLensTerms& terms,
