@@ -118,9 +118,11 @@ void FillDofPadding(DofPlanes* planes, std::size_t first, std::size_t end) {
 
 // Pixel i of the planes from depth d and colour c; the circle in double, as
 // CircleOfConfusionPx (the summary is in double; a radius computed in float could round the
-// other way). The scalar form of PrepareDofRow's vectors, for a row's last pixels.
-void PrepareDofPixel(float d, const uint8_t* c, const DofLensTerms& terms, std::size_t i,
-                     DofPlanes* planes, DofPart* part) {
+// other way). The scalar form of PrepareDofRow's vectors, for a row's last pixels; inlined (a
+// call from AVX code to SSE code costs more than the pixel).
+[[gnu::always_inline]] inline void PrepareDofPixel(float d, const uint8_t* c,
+                                                   const DofLensTerms& terms, std::size_t i,
+                                                   DofPlanes* planes, DofPart* part) {
   const bool surface = std::isfinite(d) && d > 0.0f;
   const double coc =
       (surface ? terms.at_infinity * std::abs(d - terms.focus) / d : terms.at_infinity) /
@@ -342,6 +344,16 @@ DofPlanes PrepareDof(const ImageView& rgb, const ImageView& depth, const ThinLen
   return planes;
 }
 
+// Whether any lane of a comparison's mask is true (GCC reduces it with vector ORs).
+template <typename Ints>
+[[gnu::always_inline]] inline bool AnyLane(const Ints& mask) {
+  uint64_t words[sizeof(Ints) / sizeof(uint64_t)];
+  std::memcpy(words, &mask, sizeof(mask));
+  uint64_t any = 0;
+  for (const uint64_t word : words) any |= word;
+  return any != 0;
+}
+
 // Row y of the image, kLanes output pixels at a time (the header's gather of what is behind,
 // scatter of what is in front), into `out`. The tile's reach bounds every pixel's own circle
 // and those near it (the window is sorted by distance): beyond it every term is 0. Each term
@@ -376,17 +388,23 @@ template <int kLanes>
       cover_p = cover_p < 0.0f ? Vector{} : cover_p;
       cover_p = cover_p > 1.0f ? Vector{} + 1.0f : cover_p;
       // In front: q's disc over p, weighed by 1 / its area; behind (or at p's depth): p's disc
-      // over q. Padding is neither.
-      const Vector f =
-          depth_q < nearer ? cover_q / *reinterpret_cast<const Loaded*>(area + q) : Vector{};
-      const Vector b = depth_q >= nearer ? cover_p : Vector{};
-      front_weight += f;
-      back_weight += b;
+      // over q. Padding is neither. A side no lane is on is skipped: its terms are +0, which
+      // leave the sums (+0 or more) as they are.
+      const Ints in_front = depth_q < nearer, behind = depth_q >= nearer;
+      if (AnyLane(in_front)) {
+        const Vector f = in_front ? cover_q / *reinterpret_cast<const Loaded*>(area + q) : Vector{};
+        front_weight += f;
 #pragma GCC unroll 3
-      for (int ch = 0; ch < 3; ++ch) {
-        const Vector c = *reinterpret_cast<const Loaded*>(color[ch] + q);
-        front[ch] += f * c;
-        back[ch] += b * c;
+        for (int ch = 0; ch < 3; ++ch) {
+          front[ch] += f * *reinterpret_cast<const Loaded*>(color[ch] + q);
+        }
+      }
+      if (AnyLane(behind)) {
+        const Vector b = behind ? cover_p : Vector{};
+        back_weight += b;
+#pragma GCC unroll 3
+        for (int ch = 0; ch < 3; ++ch)
+          back[ch] += b * *reinterpret_cast<const Loaded*>(color[ch] + q);
       }
     }
     // The average behind, and over it what is in front with the opacity its weights sum to
