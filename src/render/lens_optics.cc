@@ -4,6 +4,7 @@
 
 #include <Eigen/Core>
 #include <algorithm>
+#include <atomic>
 #include <cctype>
 #include <cmath>
 #include <cstring>
@@ -282,19 +283,27 @@ void PrepareWindow(DofPlanes* planes, float max_radius, double aspect) {
   PrepareTileReach(planes, reach_x, reach_y);
 }
 
-// The two halves of the rows at once where there are two cores (each row is computed alone:
-// the same bits); `rows(first, end)`. The halves split at a tile's edge.
+// The rows on two threads where there are two cores (each row is computed alone: the same
+// bits), `rows(part, first, end)` on thread `part` (0 or 1). Each thread claims a tile's rows
+// at a time until none are left: the halves of an image cost differently (a blurred
+// foreground below a sharp background) and a core may be busy with other work; claims at a
+// tile's edge keep each tile to one thread.
 template <typename Rows>
-void SplitDofRows(int height, const Rows& rows) {
+void ShareDofRows(int height, const Rows& rows) {
   static const bool cores = std::thread::hardware_concurrency() >= 2;  // asked once
-  if (cores && height >= 2 * kDofTile) {
-    const int half = height / 2 / kDofTile * kDofTile;
-    std::thread other(rows, 1, half, height);
-    rows(0, 0, half);
-    other.join();
-  } else {
+  if (!cores || height < 2 * kDofTile) {
     rows(0, 0, height);
+    return;
   }
+  std::atomic<int> next{0};
+  const auto claim = [&](int part) {
+    for (int first; (first = next.fetch_add(kDofTile)) < height;) {
+      rows(part, first, std::min(height, first + kDofTile));
+    }
+  };
+  std::thread other(claim, 1);
+  claim(0);
+  other.join();
 }
 
 DofPlanes PrepareDof(const ImageView& rgb, const ImageView& depth, const ThinLensOptions& lens,
@@ -324,7 +333,7 @@ DofPlanes PrepareDof(const ImageView& rgb, const ImageView& depth, const ThinLen
       lens.pixel_pitch_m > 0.0 ? lens.pixel_pitch_m : lens.focal_length_m / k.fx(),
       lens.focus_distance_m, lens.max_coc_px};
   DofPart parts[2];
-  SplitDofRows(planes.height, [&](int part, int first, int end) {
+  ShareDofRows(planes.height, [&](int part, int first, int end) {
     if (first == 0) FillDofPadding(&planes, 0, planes.At(-planes.pad_x, 0));
 #if defined(__x86_64__)
     if (wide) {
@@ -610,7 +619,7 @@ Image ApplyDepthOfField(const ImageView& rgb, const ImageView& depth, const Thin
   const DofPlanes planes = PrepareDof(rgb, depth, lens, intrinsics, wide, out_summary);
   Image out(rgb.width(), rgb.height(), PixelFormat::kRgb8);
   if (rgb.metadata() != nullptr) out.metadata() = *rgb.metadata();
-  SplitDofRows(rgb.height(), [&](int, int first, int end) {
+  ShareDofRows(rgb.height(), [&](int, int first, int end) {
 #if defined(__x86_64__)
     if (wide) {
       DofRowsAvx2(planes, first, end, &out);
