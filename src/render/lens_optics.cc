@@ -5,6 +5,7 @@
 #include <Eigen/Core>
 #include <algorithm>
 #include <atomic>
+#include <bit>
 #include <cctype>
 #include <cmath>
 #include <cstring>
@@ -56,21 +57,27 @@ constexpr int kDofTile = 16;
 constexpr int kDofMaxLanes = 8;
 static_assert(kDofTile % kDofMaxLanes == 0);
 
-// GCC vectors of kLanes floats (Vector; Loaded reads or writes one at any float's address) and
-// of kLanes ints.
+// GCC vectors of kLanes floats (Vector; Loaded reads or writes one at any float's address), of
+// kLanes ints and of their bytes.
 template <int kLanes>
 struct DofLanes;
+// The byte shuffles between colours and ints read an int's low byte first.
+static_assert(std::endian::native == std::endian::little);
 template <>
 struct DofLanes<4> {
   using Vector = float __attribute__((vector_size(16)));
   using Loaded = float __attribute__((vector_size(16), aligned(alignof(float)), may_alias));
   using Ints = int32_t __attribute__((vector_size(16)));
+  using Bytes = uint8_t __attribute__((vector_size(16)));
+  using LoadedBytes = uint8_t __attribute__((vector_size(16), aligned(1), may_alias));
 };
 template <>
 struct DofLanes<8> {
   using Vector = float __attribute__((vector_size(32)));
   using Loaded = float __attribute__((vector_size(32), aligned(alignof(float)), may_alias));
   using Ints = int32_t __attribute__((vector_size(32)));
+  using Bytes = uint8_t __attribute__((vector_size(32)));
+  using LoadedBytes = uint8_t __attribute__((vector_size(32), aligned(1), may_alias));
 };
 
 // What the gather reads per pixel, in planes padded around the image (pad_x, pad_y: at least
@@ -374,6 +381,8 @@ template <int kLanes>
   using Vector = typename DofLanes<kLanes>::Vector;
   using Loaded = typename DofLanes<kLanes>::Loaded;
   using Ints = typename DofLanes<kLanes>::Ints;
+  using Bytes = typename DofLanes<kLanes>::Bytes;
+  using LoadedBytes = typename DofLanes<kLanes>::LoadedBytes;
   const float* tile_reach = &planes.reach[static_cast<std::size_t>(y / kDofTile) * planes.tiles_x];
   // Locals: the stores below could alias the planes' pointers, which would be reloaded.
   const float *const depth = planes.depth, *const outer = planes.outer, *const area = planes.area;
@@ -433,8 +442,24 @@ template <int kLanes>
       const Ints whole = __builtin_convertvector(value, Ints);
       rounded[ch] = whole - (value - __builtin_convertvector(whole, Vector) >= 0.5f);
     }
-    for (int j = 0; j < std::min(kLanes, planes.width - x); ++j) {
-      for (int ch = 0; ch < 3; ++ch) out[3 * (x + j) + ch] = static_cast<uint8_t>(rounded[ch][j]);
+    // Each lane's RGB in its int's low 3 bytes, packed to the front of the vector; stored whole
+    // where the row has room (the bytes past the run's are the next run's, written after).
+    const Ints rgb = rounded[0] | rounded[1] << 8 | rounded[2] << 16;
+    const Bytes bytes = reinterpret_cast<Bytes>(rgb);
+    uint8_t* const run_out = out + 3 * x;
+    if (3 * x + static_cast<int>(sizeof(Bytes)) <= 3 * planes.width) {
+      if constexpr (kLanes == 8) {
+        *reinterpret_cast<LoadedBytes*>(run_out) = __builtin_shufflevector(
+            bytes, bytes, 0, 1, 2, 4, 5, 6, 8, 9, 10, 12, 13, 14, 16, 17, 18, 20, 21, 22, 24, 25,
+            26, 28, 29, 30, 3, 7, 11, 15, 19, 23, 27, 31);
+      } else {
+        *reinterpret_cast<LoadedBytes*>(run_out) = __builtin_shufflevector(
+            bytes, bytes, 0, 1, 2, 4, 5, 6, 8, 9, 10, 12, 13, 14, 3, 7, 11, 15);
+      }
+    } else {
+      for (int j = 0; j < std::min(kLanes, planes.width - x); ++j) {
+        for (int ch = 0; ch < 3; ++ch) run_out[3 * j + ch] = static_cast<uint8_t>(rounded[ch][j]);
+      }
     }
   }
 }
