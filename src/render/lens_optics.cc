@@ -145,19 +145,54 @@ void FillDofPadding(DofPlanes* planes, std::size_t first, std::size_t end) {
   for (int ch = 0; ch < 3; ++ch) planes->color[ch][i] = c[ch];
 }
 
+// Pixels x .. x + 3 of an RGB row (`rgb` at pixel x) into the colour planes' values x ..
+// x + 3. kShuffleBytes: the bytes sorted by one shuffle (pshufb with AVX2; plain SSE2 has none,
+// and the compiler's stand-in costs more than converting byte by byte).
+template <bool kShuffleBytes>
+[[gnu::always_inline]] inline void PrepareDofColors(const uint8_t* rgb, int x,
+                                                    float* const color_out[3]) {
+  using Vector = DofLanes<4>::Vector;
+  using Loaded = DofLanes<4>::Loaded;
+  using Ints = DofLanes<4>::Ints;
+  using Bytes = uint8_t __attribute__((vector_size(16)));
+  using LoadedBytes = uint8_t __attribute__((vector_size(16), aligned(1), may_alias));
+  if constexpr (kShuffleBytes) {
+    // The 4 pixels' 12 bytes (read as 16: the caller leaves 2 more pixels in the row),
+    // each channel's 4 widened to ints, then floats.
+    const Bytes rgb4 = *reinterpret_cast<const LoadedBytes*>(rgb);
+    constexpr Bytes kZero{};
+    *reinterpret_cast<Loaded*>(color_out[0] + x) = __builtin_convertvector(
+        reinterpret_cast<Ints>(__builtin_shufflevector(rgb4, kZero, 0, 16, 16, 16, 3, 16, 16, 16, 6,
+                                                       16, 16, 16, 9, 16, 16, 16)),
+        Vector);
+    *reinterpret_cast<Loaded*>(color_out[1] + x) = __builtin_convertvector(
+        reinterpret_cast<Ints>(__builtin_shufflevector(rgb4, kZero, 1, 16, 16, 16, 4, 16, 16, 16, 7,
+                                                       16, 16, 16, 10, 16, 16, 16)),
+        Vector);
+    *reinterpret_cast<Loaded*>(color_out[2] + x) = __builtin_convertvector(
+        reinterpret_cast<Ints>(__builtin_shufflevector(rgb4, kZero, 2, 16, 16, 16, 5, 16, 16, 16, 8,
+                                                       16, 16, 16, 11, 16, 16, 16)),
+        Vector);
+  } else {
+    for (int j = 0; j < 4; ++j) {
+      for (int ch = 0; ch < 3; ++ch) color_out[ch][x + j] = rgb[3 * j + ch];
+    }
+  }
+}
+
 // Image row y into the planes, with its padding left and right, 4 pixels at a time (each
 // value PrepareDofPixel's: the same operations, lane by lane); each tile's largest outer edge
-// into planes->reach. Inlined as DofRow is (4 doubles: one AVX vector, two SSE ones).
+// into planes->reach. Inlined as DofRow is. kShuffleBytes: PrepareDofColors'.
+template <bool kShuffleBytes>
 [[gnu::always_inline]] inline void PrepareDofRow(const ImageView& rgb, const ImageView& depth,
                                                  const DofLensTerms& terms, int y,
                                                  DofPlanes* planes, DofPart* part) {
   using Vector = DofLanes<4>::Vector;
   using Loaded = DofLanes<4>::Loaded;
-  using Doubles = double __attribute__((vector_size(32)));
-  using Bits = uint64_t __attribute__((vector_size(32)));
-  using Ints = DofLanes<4>::Ints;
-  using Bytes = uint8_t __attribute__((vector_size(16)));
-  using LoadedBytes = uint8_t __attribute__((vector_size(16), aligned(1), may_alias));
+  using Halves = float __attribute__((vector_size(8)));
+  using LoadedHalf = float __attribute__((vector_size(8), aligned(alignof(float)), may_alias));
+  using Doubles = double __attribute__((vector_size(16)));
+  using Bits = uint64_t __attribute__((vector_size(16)));
   constexpr float kInfinity = std::numeric_limits<float>::infinity();
   const int w = planes->width;
   const std::size_t row_start = planes->At(0, y);
@@ -178,19 +213,27 @@ void FillDofPadding(DofPlanes* planes, std::size_t first, std::size_t end) {
     int x = first;
     for (; x + 4 <= end && x + 6 <= w; x += 4) {
       const Vector d = *reinterpret_cast<const Loaded*>(d_row + x);
-      const Doubles dd = __builtin_convertvector(d, Doubles);
-      // std::abs: the sign bit cleared.
-      const Doubles distance = reinterpret_cast<Doubles>(reinterpret_cast<Bits>(dd - terms.focus) &
-                                                         (Bits{} + ~(uint64_t{1} << 63)));
-      // isfinite(d) && d > 0: d > 0 && d < inf (false for NaN).
-      const Doubles coc =
-          ((dd > 0.0) & (dd < static_cast<double>(kInfinity)) ? terms.at_infinity * distance / dd
-                                                              : Doubles{} + terms.at_infinity) /
-          terms.pitch;
-      max_coc = max_coc < coc ? coc : max_coc;
-      capped -= reinterpret_cast<Bits>(coc > terms.max_coc_px);  // -1 where capped
-      const Vector r = __builtin_convertvector(
-          0.5 * (terms.max_coc_px < coc ? Doubles{} + terms.max_coc_px : coc), Vector);
+      // Two doubles at a time (one SSE vector: wider ones are split by the compiler, badly
+      // without AVX).
+      Halves radius[2];
+#pragma GCC unroll 2
+      for (int h = 0; h < 2; ++h) {
+        const Doubles dd = __builtin_convertvector(
+            *reinterpret_cast<const LoadedHalf*>(d_row + x + 2 * h), Doubles);
+        // std::abs: the sign bit cleared.
+        const Doubles distance = reinterpret_cast<Doubles>(
+            reinterpret_cast<Bits>(dd - terms.focus) & (Bits{} + ~(uint64_t{1} << 63)));
+        // isfinite(d) && d > 0: d > 0 && d < inf (false for NaN).
+        const Doubles coc =
+            ((dd > 0.0) & (dd < static_cast<double>(kInfinity)) ? terms.at_infinity * distance / dd
+                                                                : Doubles{} + terms.at_infinity) /
+            terms.pitch;
+        max_coc = max_coc < coc ? coc : max_coc;
+        capped -= reinterpret_cast<Bits>(coc > terms.max_coc_px);  // -1 where capped
+        radius[h] = __builtin_convertvector(
+            0.5 * (terms.max_coc_px < coc ? Doubles{} + terms.max_coc_px : coc), Halves);
+      }
+      const Vector r = __builtin_shufflevector(radius[0], radius[1], 0, 1, 2, 3);
       max_radius = max_radius < r ? r : max_radius;
       *reinterpret_cast<Loaded*>(depth_out + x) =
           (d > 0.0f) & (d < kInfinity) ? d : Vector{} + kInfinity;
@@ -200,22 +243,7 @@ void FillDofPadding(DofPlanes* planes, std::size_t first, std::size_t end) {
       // DiscArea.
       *reinterpret_cast<Loaded*>(area_out + x) =
           r < 0.5f ? r + 0.5f : std::numbers::pi_v<float> * (r * r + 1.0f / 12.0f);
-      // The 4 pixels' 12 bytes (read as 16: the loop stops 2 pixels before the row's end),
-      // each channel's 4 widened to ints, then floats.
-      const Bytes rgb4 = *reinterpret_cast<const LoadedBytes*>(c + 3 * x);
-      constexpr Bytes kZero{};
-      *reinterpret_cast<Loaded*>(color_out[0] + x) = __builtin_convertvector(
-          reinterpret_cast<Ints>(__builtin_shufflevector(rgb4, kZero, 0, 16, 16, 16, 3, 16, 16, 16,
-                                                         6, 16, 16, 16, 9, 16, 16, 16)),
-          Vector);
-      *reinterpret_cast<Loaded*>(color_out[1] + x) = __builtin_convertvector(
-          reinterpret_cast<Ints>(__builtin_shufflevector(rgb4, kZero, 1, 16, 16, 16, 4, 16, 16, 16,
-                                                         7, 16, 16, 16, 10, 16, 16, 16)),
-          Vector);
-      *reinterpret_cast<Loaded*>(color_out[2] + x) = __builtin_convertvector(
-          reinterpret_cast<Ints>(__builtin_shufflevector(rgb4, kZero, 2, 16, 16, 16, 5, 16, 16, 16,
-                                                         8, 16, 16, 16, 11, 16, 16, 16)),
-          Vector);
+      PrepareDofColors<kShuffleBytes>(c + 3 * x, x, color_out);
     }
     float m = std::max({tile_outer[0], tile_outer[1], tile_outer[2], tile_outer[3]});
     for (; x < end; ++x) {  // the row's last pixels, from the 3rd last
@@ -224,18 +252,18 @@ void FillDofPadding(DofPlanes* planes, std::size_t first, std::size_t end) {
     }
     tile[first / kDofTile] = m;
   }
-  for (int j = 0; j < 4; ++j) {
+  for (int j = 0; j < 2; ++j) {
     part->max_coc_px = std::max(part->max_coc_px, max_coc[j]);
     part->capped_pixels += static_cast<int64_t>(capped[j]);
-    part->max_radius = std::max(part->max_radius, max_radius[j]);
   }
+  for (int j = 0; j < 4; ++j) part->max_radius = std::max(part->max_radius, max_radius[j]);
   FillDofPadding(planes, row_start - planes->pad_x, row_start);
   FillDofPadding(planes, row_start + w, row_start + w + planes->pad_x + kDofMaxLanes);
 }
 
 void PrepareDofRowsPortable(const ImageView& rgb, const ImageView& depth, const DofLensTerms& terms,
                             int first, int end, DofPlanes* planes, DofPart* part) {
-  for (int y = first; y < end; ++y) PrepareDofRow(rgb, depth, terms, y, planes, part);
+  for (int y = first; y < end; ++y) PrepareDofRow<false>(rgb, depth, terms, y, planes, part);
 }
 
 #if defined(__x86_64__)
@@ -244,7 +272,7 @@ __attribute__((target("avx2"))) void PrepareDofRowsAvx2(const ImageView& rgb,
                                                         const ImageView& depth,
                                                         const DofLensTerms& terms, int first,
                                                         int end, DofPlanes* planes, DofPart* part) {
-  for (int y = first; y < end; ++y) PrepareDofRow(rgb, depth, terms, y, planes, part);
+  for (int y = first; y < end; ++y) PrepareDofRow<true>(rgb, depth, terms, y, planes, part);
 }
 #endif
 
