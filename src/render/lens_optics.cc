@@ -246,7 +246,8 @@ template <bool kShuffleBytes>
       PrepareDofColors<kShuffleBytes>(c + 3 * x, x, color_out);
     }
     float m = std::max({tile_outer[0], tile_outer[1], tile_outer[2], tile_outer[3]});
-    for (; x < end; ++x) {  // the row's last pixels, from the 3rd last
+    // The row's last 2 to 5 pixels (PrepareDofColors reads 2 pixels past its 4).
+    for (; x < end; ++x) {
       PrepareDofPixel(d_row[x], c + 3 * x, terms, row_start + x, planes, part);
       m = std::max(m, outer_out[x]);
     }
