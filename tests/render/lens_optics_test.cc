@@ -14,6 +14,7 @@
 #include <limits>
 #include <opencv2/calib3d.hpp>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "render/internal_lens_optics.h"
@@ -371,48 +372,50 @@ Image DepthOfFieldByDefinition(const Image& rgb, const Image& depth, const ThinL
 }
 
 // Tiles, a window cut at each tile's reach, eight pixels at a time (four without AVX2), two
-// threads, padding for the image's edges: none of it changes a value. A width that is not a
-// multiple of eight, a height that two threads split, depths from 0.4 m to 6 m and holes (no
-// surface) scattered by a hash, circles up to the cap. The summary is CircleOfConfusionPx's.
+// threads, padding for the image's edges: none of it changes a value. Widths that are not
+// multiples of eight (each leaving a different number of pixels to a row's scalar end), a
+// height that two threads split and one that they do not, depths from 0.4 m to 6 m and holes
+// (no surface) scattered by a hash, circles up to the cap. The summary is CircleOfConfusionPx's.
 TEST(DepthOfField, EqualsTheGatherPixelByPixelBitForBit) {
-  const int w = 45, h = 37;
-  Image rgb(w, h, PixelFormat::kRgb8);
-  Image depth(w, h, PixelFormat::kFloat32);
-  uint32_t state = 12345;
-  const auto next = [&] { return state = state * 1664525u + 1013904223u; };
-  for (int y = 0; y < h; ++y) {
-    for (int x = 0; x < w; ++x) {
-      for (int ch = 0; ch < 3; ++ch) rgb.row(y)[3 * x + ch] = static_cast<uint8_t>(next() >> 24);
-      const uint32_t r = next() >> 8;
-      reinterpret_cast<float*>(depth.row(y))[x] =
-          r % 17 == 0 ? 0.0f : static_cast<float>((x < w / 2 ? 0.4 : 1.0) + (r % 5000) * 1e-3);
-    }
-  }
-  ThinLensOptions lens = Lens();
-  lens.max_coc_px = 9.0;
-  const geometry::Intrinsics k(w, h, 1000.0, 900.0, 22.0, 10.0);
-  double max_coc_px = 0.0;
-  int64_t capped = 0;
-  for (int y = 0; y < h; ++y) {
-    for (int x = 0; x < w; ++x) {
-      const float d = reinterpret_cast<const float*>(depth.row(y))[x];
-      const double coc = CircleOfConfusionPx(lens, k, d > 0.0f ? d : 0.0);
-      max_coc_px = std::max(max_coc_px, coc);
-      capped += coc > lens.max_coc_px;
-    }
-  }
-  ASSERT_GT(capped, 0);
-  const Image reference = DepthOfFieldByDefinition(rgb, depth, lens, k);
-  for (const bool simd : {true, false}) {
-    DepthOfFieldSummary summary;
-    const Image fast = ApplyDepthOfField(rgb.view(), depth.view(), lens, k, &summary, simd);
-    int differing = 0;
+  for (const auto& [w, h] : {std::pair{45, 37}, std::pair{46, 20}}) {
+    Image rgb(w, h, PixelFormat::kRgb8);
+    Image depth(w, h, PixelFormat::kFloat32);
+    uint32_t state = 12345;
+    const auto next = [&] { return state = state * 1664525u + 1013904223u; };
     for (int y = 0; y < h; ++y) {
-      for (int i = 0; i < 3 * w; ++i) differing += fast.row(y)[i] != reference.row(y)[i];
+      for (int x = 0; x < w; ++x) {
+        for (int ch = 0; ch < 3; ++ch) rgb.row(y)[3 * x + ch] = static_cast<uint8_t>(next() >> 24);
+        const uint32_t r = next() >> 8;
+        reinterpret_cast<float*>(depth.row(y))[x] =
+            r % 17 == 0 ? 0.0f : static_cast<float>((x < w / 2 ? 0.4 : 1.0) + (r % 5000) * 1e-3);
+      }
     }
-    EXPECT_EQ(differing, 0) << "simd " << simd;
-    EXPECT_EQ(summary.max_coc_px, max_coc_px) << "simd " << simd;
-    EXPECT_EQ(summary.capped_pixels, capped) << "simd " << simd;
+    ThinLensOptions lens = Lens();
+    lens.max_coc_px = 9.0;
+    const geometry::Intrinsics k(w, h, 1000.0, 900.0, 22.0, 10.0);
+    double max_coc_px = 0.0;
+    int64_t capped = 0;
+    for (int y = 0; y < h; ++y) {
+      for (int x = 0; x < w; ++x) {
+        const float d = reinterpret_cast<const float*>(depth.row(y))[x];
+        const double coc = CircleOfConfusionPx(lens, k, d > 0.0f ? d : 0.0);
+        max_coc_px = std::max(max_coc_px, coc);
+        capped += coc > lens.max_coc_px;
+      }
+    }
+    ASSERT_GT(capped, 0);
+    const Image reference = DepthOfFieldByDefinition(rgb, depth, lens, k);
+    for (const bool simd : {true, false}) {
+      DepthOfFieldSummary summary;
+      const Image fast = ApplyDepthOfField(rgb.view(), depth.view(), lens, k, &summary, simd);
+      int differing = 0;
+      for (int y = 0; y < h; ++y) {
+        for (int i = 0; i < 3 * w; ++i) differing += fast.row(y)[i] != reference.row(y)[i];
+      }
+      EXPECT_EQ(differing, 0) << w << " x " << h << ", simd " << simd;
+      EXPECT_EQ(summary.max_coc_px, max_coc_px) << w << " x " << h << ", simd " << simd;
+      EXPECT_EQ(summary.capped_pixels, capped) << w << " x " << h << ", simd " << simd;
+    }
   }
 }
 
