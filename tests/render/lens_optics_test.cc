@@ -374,10 +374,19 @@ Image DepthOfFieldByDefinition(const Image& rgb, const Image& depth, const ThinL
 // Tiles, a window cut at each tile's reach, eight pixels at a time (four without AVX2), two
 // threads, padding for the image's edges: none of it changes a value. Widths that are not
 // multiples of eight (each leaving a different number of pixels to a row's scalar end), a
-// height that two threads split and one that they do not, depths from 0.4 m to 6 m and holes
-// (no surface) scattered by a hash, circles up to the cap. The summary is CircleOfConfusionPx's.
+// height that two threads split and ones that they do not, depths from 0.4 m to 6 m and holes
+// (no surface) scattered by a hash, circles up to the cap or wider than the image. The summary
+// is CircleOfConfusionPx's.
 TEST(DepthOfField, EqualsTheGatherPixelByPixelBitForBit) {
-  for (const auto& [w, h] : {std::pair{45, 37}, std::pair{46, 20}}) {
+  struct Case {
+    int w, h;
+    double max_coc_px;
+    bool some_capped;
+  };
+  // The last: circles wider than the image is tall (its padding and its window cut at the
+  // image's size; without the cut the gather reads past the planes and differs).
+  for (const auto& [w, h, max_coc, some_capped] :
+       {Case{45, 37, 9.0, true}, Case{46, 20, 9.0, true}, Case{12, 5, 40.0, false}}) {
     Image rgb(w, h, PixelFormat::kRgb8);
     Image depth(w, h, PixelFormat::kFloat32);
     uint32_t state = 12345;
@@ -391,7 +400,7 @@ TEST(DepthOfField, EqualsTheGatherPixelByPixelBitForBit) {
       }
     }
     ThinLensOptions lens = Lens();
-    lens.max_coc_px = 9.0;
+    lens.max_coc_px = max_coc;
     const geometry::Intrinsics k(w, h, 1000.0, 900.0, 22.0, 10.0);
     double max_coc_px = 0.0;
     int64_t capped = 0;
@@ -403,7 +412,7 @@ TEST(DepthOfField, EqualsTheGatherPixelByPixelBitForBit) {
         capped += coc > lens.max_coc_px;
       }
     }
-    ASSERT_GT(capped, 0);
+    EXPECT_EQ(capped > 0, some_capped) << w << " x " << h;
     const Image reference = DepthOfFieldByDefinition(rgb, depth, lens, k);
     for (const bool simd : {true, false}) {
       DepthOfFieldSummary summary;
