@@ -298,15 +298,20 @@ void PrepareTileReach(DofPlanes* planes, int reach_x, int reach_y) {
   }
 }
 
+// The reach of a circle of outer edge `edge` (pixels across) across and down, each no more
+// than `limit` (in double: a huge circle's reach overflows an int).
+int DofReach(float edge, double aspect, int limit) {
+  return static_cast<int>(std::min(std::ceil(edge / aspect), static_cast<double>(limit)));
+}
+
 // The window's offsets within the largest circle, sorted by distance (stable: rows then
 // columns where distances tie, the order of the scalar gather). Offsets a whole image away
 // land in the padding from every pixel: left out (their terms are 0).
 void PrepareWindow(DofPlanes* planes, float max_radius, double aspect) {
-  const int reach_x = static_cast<int>(std::ceil(max_radius + 0.5f));
-  const int reach_y = static_cast<int>(std::ceil((max_radius + 0.5f) / aspect));
+  const int reach_x = DofReach(max_radius + 0.5f, 1.0, planes->width - 1);
+  const int reach_y = DofReach(max_radius + 0.5f, aspect, planes->height - 1);
   for (int dy = -reach_y; dy <= reach_y; ++dy) {
     for (int dx = -reach_x; dx <= reach_x; ++dx) {
-      if (std::abs(dx) >= planes->width || std::abs(dy) >= planes->height) continue;
       const auto distance = static_cast<float>(std::hypot(dx, dy * aspect));
       if (distance < max_radius + 0.5f) {
         planes->window.push_back({static_cast<std::ptrdiff_t>(dy) * planes->stride + dx, distance});
@@ -347,12 +352,14 @@ DofPlanes PrepareDof(const ImageView& rgb, const ImageView& depth, const ThinLen
   DofPlanes planes;
   planes.width = depth.width();
   planes.height = depth.height();
-  // Padded for the capped circle, so that one pass fills the planes (the window, cut at the
-  // largest circle found, reaches no farther); no more than the image's size (PrepareWindow).
+  // Padded for the capped circle, so that one pass fills the planes: the window, cut at the
+  // largest circle found (a radius <= cap, rounded the same way), reaches no farther, nor past
+  // the image's size (PrepareWindow).
   const double aspect = lens.pixel_pitch_m > 0.0 ? 1.0 : k.fx() / k.fy();  // pitch_y / pitch_x
-  const auto cap = static_cast<float>(0.5 * lens.max_coc_px);
-  planes.pad_x = std::min(static_cast<int>(std::ceil(cap + 0.5f)), planes.width);
-  planes.pad_y = std::min(static_cast<int>(std::ceil((cap + 0.5f) / aspect)), planes.height);
+  const auto cap = static_cast<float>(
+      std::min(0.5 * lens.max_coc_px, static_cast<double>(std::numeric_limits<float>::max())));
+  planes.pad_x = DofReach(cap + 0.5f, 1.0, planes.width);
+  planes.pad_y = DofReach(cap + 0.5f, aspect, planes.height);
   planes.stride = planes.width + 2 * planes.pad_x + kDofMaxLanes;
   const std::size_t n =
       static_cast<std::size_t>(planes.stride) * (planes.height + 2 * planes.pad_y);

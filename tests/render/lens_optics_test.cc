@@ -428,5 +428,32 @@ TEST(DepthOfField, EqualsTheGatherPixelByPixelBitForBit) {
   }
 }
 
+// A cap far above any image (valid: finite, >= 1) and surfaces a few microns away: circles of
+// millions of pixels, which pad and window no farther than the image's size (neither runs
+// for hours nor overflows), and the whole image averaged: still the gather's bits.
+TEST(DepthOfField, CirclesFarWiderThanTheImageCostNoMoreThanIt) {
+  const int w = 12, h = 5;
+  Image rgb(w, h, PixelFormat::kRgb8);
+  Image depth(w, h, PixelFormat::kFloat32);
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      for (int ch = 0; ch < 3; ++ch) rgb.row(y)[3 * x + ch] = static_cast<uint8_t>(20 * x + ch);
+      reinterpret_cast<float*>(depth.row(y))[x] = 1e-5f * static_cast<float>(1 + (x + y) % 3);
+    }
+  }
+  ThinLensOptions lens = Lens();
+  lens.max_coc_px = 1e30;
+  const geometry::Intrinsics k(w, h, 1000.0, 900.0, 5.5, 2.0);
+  DepthOfFieldSummary summary;
+  const Image fast = ApplyDepthOfField(rgb.view(), depth.view(), lens, k, &summary);
+  EXPECT_GT(summary.max_coc_px, 1e6);
+  const Image reference = DepthOfFieldByDefinition(rgb, depth, lens, k);
+  int differing = 0;
+  for (int y = 0; y < h; ++y) {
+    for (int i = 0; i < 3 * w; ++i) differing += fast.row(y)[i] != reference.row(y)[i];
+  }
+  EXPECT_EQ(differing, 0);
+}
+
 }  // namespace
 }  // namespace saccade::render
