@@ -4,16 +4,20 @@
 
 #include <Eigen/Core>
 #include <algorithm>
+#include <atomic>
+#include <bit>
 #include <cctype>
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <memory>
 #include <numbers>
 #include <optional>
 #include <string>
 #include <thread>
 #include <vector>
 
+#include "render/internal_lens_optics.h"
 #include "saccade/core/error.h"
 
 namespace saccade::render {
@@ -31,63 +35,256 @@ void CheckLensPositive(double value, const char* field) {
   }
 }
 
-// The sum of DofCoverage over the plane: pi (r^2 + 1/12) for r >= 0.5 (the ramp integrated);
-// below, the disc covers its own pixel only, by r + 0.5.
+// The sum of a disc's coverage (DofRow) over the plane: pi (r^2 + 1/12) for r >= 0.5 (the ramp
+// integrated); below, the disc covers its own pixel only, by r + 0.5.
 float DiscArea(float radius) {
   constexpr float kPi = std::numbers::pi_v<float>;
   return radius < 0.5f ? radius + 0.5f : kPi * (radius * radius + 1.0f / 12.0f);
 }
 
-// One offset of the gather's window, with its distance in pixels across (rows scaled by
-// pitch_y / pitch_x, so that a disc on the sensor is a circle here).
-struct WindowOffset {
-  int dx, dy;
+// One offset of the gather's window: its step in the padded planes (DofPlanes::At) and its
+// distance in pixels across (rows scaled by pitch_y / pitch_x, so that a disc on the sensor is
+// a circle here).
+struct WindowStep {
+  std::ptrdiff_t step;
   float distance;
 };
 
 // Tiles of kDofTile x kDofTile pixels bound the circles a pixel's gather can meet.
 constexpr int kDofTile = 16;
-// Pixels of a row gathered at once (one SSE vector of floats each term): a divisor of kDofTile.
-constexpr int kDofLanes = 4;
-using DofVector = float __attribute__((vector_size(kDofLanes * sizeof(float))));
+// The most pixels of a row gathered at once (DofRow: 8 with AVX2, else 4, one SSE vector):
+// a divisor of kDofTile, so that a run never straddles two tiles.
+constexpr int kDofMaxLanes = 8;
+static_assert(kDofTile % kDofMaxLanes == 0);
 
-// What the gather reads per pixel, in planes padded by the window's reach (pad_x, pad_y)
-// around the image and kDofLanes more on the right, so that a run of kDofLanes pixels reads
-// every offset without a bounds test: depth (+inf without a surface), the circle's radius
-// (pixels across, capped) and area (DiscArea), whether the pixel is in the image (1 or 0:
-// padding's terms weigh 0) and the colour's three channels. Also the window's offsets sorted
-// by distance, and per tile the largest radius of any pixel within the window's reach of the
-// tile (so that a pixel's gather stops where no disc, its own or a nearer pixel's, can cover
-// it: the same terms, fewer visits).
+// GCC vectors of kLanes floats (Vector; Loaded reads or writes one at any float's address), of
+// kLanes ints and of their bytes.
+template <int kLanes>
+struct DofLanes;
+// The byte shuffles between colours and ints read an int's low byte first.
+static_assert(std::endian::native == std::endian::little);
+template <>
+struct DofLanes<4> {
+  using Vector = float __attribute__((vector_size(16)));
+  using Loaded = float __attribute__((vector_size(16), aligned(alignof(float)), may_alias));
+  using Ints = int32_t __attribute__((vector_size(16)));
+  using Bytes = uint8_t __attribute__((vector_size(16)));
+  using LoadedBytes = uint8_t __attribute__((vector_size(16), aligned(1), may_alias));
+};
+template <>
+struct DofLanes<8> {
+  using Vector = float __attribute__((vector_size(32)));
+  using Loaded = float __attribute__((vector_size(32), aligned(alignof(float)), may_alias));
+  using Ints = int32_t __attribute__((vector_size(32)));
+  using Bytes = uint8_t __attribute__((vector_size(32)));
+  using LoadedBytes = uint8_t __attribute__((vector_size(32), aligned(1), may_alias));
+};
+
+// What the gather reads per pixel, in planes padded around the image (pad_x, pad_y: at least
+// the window's reach) and kDofMaxLanes more on the right, so that a run of pixels reads every
+// offset without a bounds test: depth (+inf without a surface, NaN in the padding: neither in
+// front of a pixel nor behind it, so its terms weigh 0), the circle's outer edge (radius + 0.5:
+// where the coverage's ramp ends; radius in pixels across, capped), its area (DiscArea) and the
+// colour's three channels. Also the window's offsets sorted by distance, and per tile the
+// largest outer edge of any pixel within the window's reach of the tile (so that a pixel's
+// gather stops where no disc, its own or a nearer pixel's, can cover it: the same terms, fewer
+// visits).
 struct DofPlanes {
   int width = 0, height = 0;
   int pad_x = 0, pad_y = 0, stride = 0;  // stride: padded plane's row, in values
-  std::vector<float> depth, radius, area, inside, color[3];
-  std::vector<WindowOffset> window;
+  // The planes one after the other; not zeroed (PrepareDof writes every value once).
+  std::unique_ptr<float[]> values;
+  float *depth = nullptr, *outer = nullptr, *area = nullptr, *color[3] = {};
+  std::vector<WindowStep> window;
   int tiles_x = 0;
-  std::vector<float> reach;  // per tile: the largest radius near it, + 0.5
+  std::vector<float> reach;  // per tile: the largest outer edge in it, then near it
   // The index of image pixel (x, y) in the padded planes.
   std::size_t At(int x, int y) const {
     return static_cast<std::size_t>(y + pad_y) * stride + static_cast<std::size_t>(x + pad_x);
   }
 };
 
-// DofPlanes::reach: each tile's largest radius, then the largest over the tiles the window
-// reaches from it.
-void PrepareTileReach(DofPlanes* planes, int reach_x, int reach_y) {
-  const int tiles_x = (planes->width + kDofTile - 1) / kDofTile;
-  const int tiles_y = (planes->height + kDofTile - 1) / kDofTile;
-  std::vector<float> tile_max(static_cast<std::size_t>(tiles_x) * tiles_y, 0.0f);
-  for (int y = 0; y < planes->height; ++y) {
-    for (int x = 0; x < planes->width; ++x) {
-      float& m = tile_max[static_cast<std::size_t>(y / kDofTile) * tiles_x + x / kDofTile];
-      m = std::max(m, planes->radius[planes->At(x, y)]);
+// What PrepareDof takes from one part of the rows: the summary's share and the largest radius.
+struct DofPart {
+  double max_coc_px = 0.0;
+  int64_t capped_pixels = 0;
+  float max_radius = 0.0f;
+};
+
+// CircleOfConfusionPx's terms, in its order, hoisted out of the loop.
+struct DofLensTerms {
+  double at_infinity, pitch, focus, max_coc_px;
+};
+
+// Values [first, end) of every plane as the padding's: out of the image.
+void FillDofPadding(DofPlanes* planes, std::size_t first, std::size_t end) {
+  std::fill(planes->depth + first, planes->depth + end, std::numeric_limits<float>::quiet_NaN());
+  std::fill(planes->outer + first, planes->outer + end, 0.5f);
+  std::fill(planes->area + first, planes->area + end, DiscArea(0.0f));
+  for (float* c : planes->color) std::fill(c + first, c + end, 0.0f);
+}
+
+// Pixel i of the planes from depth d and colour c; the circle in double, as
+// CircleOfConfusionPx (the summary is in double; a radius computed in float could round the
+// other way). The scalar form of PrepareDofRow's vectors, for a row's last pixels; inlined (a
+// call from AVX code to SSE code costs more than the pixel).
+[[gnu::always_inline]] inline void PrepareDofPixel(float d, const uint8_t* c,
+                                                   const DofLensTerms& terms, std::size_t i,
+                                                   DofPlanes* planes, DofPart* part) {
+  const bool surface = std::isfinite(d) && d > 0.0f;
+  const double coc =
+      (surface ? terms.at_infinity * std::abs(d - terms.focus) / d : terms.at_infinity) /
+      terms.pitch;
+  part->max_coc_px = std::max(part->max_coc_px, coc);
+  part->capped_pixels += coc > terms.max_coc_px;
+  const auto r = static_cast<float>(0.5 * std::min(coc, terms.max_coc_px));
+  part->max_radius = std::max(part->max_radius, r);
+  planes->depth[i] = surface ? d : std::numeric_limits<float>::infinity();
+  planes->outer[i] = r + 0.5f;
+  planes->area[i] = DiscArea(r);
+  for (int ch = 0; ch < 3; ++ch) planes->color[ch][i] = c[ch];
+}
+
+// Pixels x .. x + 3 of an RGB row (`rgb` at pixel x) into the colour planes' values x ..
+// x + 3. kShuffleBytes: the bytes sorted by one shuffle (pshufb with AVX2; plain SSE2 has none,
+// and the compiler's stand-in costs more than converting byte by byte).
+template <bool kShuffleBytes>
+[[gnu::always_inline]] inline void PrepareDofColors(const uint8_t* rgb, int x,
+                                                    float* const color_out[3]) {
+  using Vector = DofLanes<4>::Vector;
+  using Loaded = DofLanes<4>::Loaded;
+  using Ints = DofLanes<4>::Ints;
+  using Bytes = uint8_t __attribute__((vector_size(16)));
+  using LoadedBytes = uint8_t __attribute__((vector_size(16), aligned(1), may_alias));
+  if constexpr (kShuffleBytes) {
+    // The 4 pixels' 12 bytes (read as 16: the caller leaves 2 more pixels in the row),
+    // each channel's 4 widened to ints, then floats.
+    const Bytes rgb4 = *reinterpret_cast<const LoadedBytes*>(rgb);
+    constexpr Bytes kZero{};
+    *reinterpret_cast<Loaded*>(color_out[0] + x) = __builtin_convertvector(
+        reinterpret_cast<Ints>(__builtin_shufflevector(rgb4, kZero, 0, 16, 16, 16, 3, 16, 16, 16, 6,
+                                                       16, 16, 16, 9, 16, 16, 16)),
+        Vector);
+    *reinterpret_cast<Loaded*>(color_out[1] + x) = __builtin_convertvector(
+        reinterpret_cast<Ints>(__builtin_shufflevector(rgb4, kZero, 1, 16, 16, 16, 4, 16, 16, 16, 7,
+                                                       16, 16, 16, 10, 16, 16, 16)),
+        Vector);
+    *reinterpret_cast<Loaded*>(color_out[2] + x) = __builtin_convertvector(
+        reinterpret_cast<Ints>(__builtin_shufflevector(rgb4, kZero, 2, 16, 16, 16, 5, 16, 16, 16, 8,
+                                                       16, 16, 16, 11, 16, 16, 16)),
+        Vector);
+  } else {
+    for (int j = 0; j < 4; ++j) {
+      for (int ch = 0; ch < 3; ++ch) color_out[ch][x + j] = rgb[3 * j + ch];
     }
   }
+}
+
+// Image row y into the planes, with its padding left and right, 4 pixels at a time (each
+// value PrepareDofPixel's: the same operations, lane by lane); each tile's largest outer edge
+// into planes->reach. Inlined as DofRow is. kShuffleBytes: PrepareDofColors'.
+template <bool kShuffleBytes>
+[[gnu::always_inline]] inline void PrepareDofRow(const ImageView& rgb, const ImageView& depth,
+                                                 const DofLensTerms& terms, int y,
+                                                 DofPlanes* planes, DofPart* part) {
+  using Vector = DofLanes<4>::Vector;
+  using Loaded = DofLanes<4>::Loaded;
+  using Halves = float __attribute__((vector_size(8)));
+  using LoadedHalf = float __attribute__((vector_size(8), aligned(alignof(float)), may_alias));
+  using Doubles = double __attribute__((vector_size(16)));
+  using Bits = uint64_t __attribute__((vector_size(16)));
+  constexpr float kInfinity = std::numeric_limits<float>::infinity();
+  const int w = planes->width;
+  const std::size_t row_start = planes->At(0, y);
+  const float* d_row = reinterpret_cast<const float*>(depth.row(y));
+  const uint8_t* c = rgb.row(y);
+  float* const depth_out = planes->depth + row_start;
+  float* const outer_out = planes->outer + row_start;
+  float* const area_out = planes->area + row_start;
+  float* const color_out[3] = {planes->color[0] + row_start, planes->color[1] + row_start,
+                               planes->color[2] + row_start};
+  Doubles max_coc = Doubles{} + part->max_coc_px;
+  Bits capped{};
+  Vector max_radius = Vector{} + part->max_radius;
+  float* const tile = &planes->reach[static_cast<std::size_t>(y / kDofTile) * planes->tiles_x];
+  for (int first = 0; first < w; first += kDofTile) {
+    const int end = std::min(w, first + kDofTile);
+    Vector tile_outer = Vector{} + tile[first / kDofTile];
+    int x = first;
+    for (; x + 4 <= end && x + 6 <= w; x += 4) {
+      const Vector d = *reinterpret_cast<const Loaded*>(d_row + x);
+      // Two doubles at a time (one SSE vector: wider ones are split by the compiler, badly
+      // without AVX).
+      Halves radius[2];
+#pragma GCC unroll 2
+      for (int h = 0; h < 2; ++h) {
+        const Doubles dd = __builtin_convertvector(
+            *reinterpret_cast<const LoadedHalf*>(d_row + x + 2 * h), Doubles);
+        // std::abs: the sign bit cleared.
+        const Doubles distance = reinterpret_cast<Doubles>(
+            reinterpret_cast<Bits>(dd - terms.focus) & (Bits{} + ~(uint64_t{1} << 63)));
+        // isfinite(d) && d > 0: d > 0 && d < inf (false for NaN).
+        const Doubles coc =
+            ((dd > 0.0) & (dd < static_cast<double>(kInfinity)) ? terms.at_infinity * distance / dd
+                                                                : Doubles{} + terms.at_infinity) /
+            terms.pitch;
+        max_coc = max_coc < coc ? coc : max_coc;
+        capped -= reinterpret_cast<Bits>(coc > terms.max_coc_px);  // -1 where capped
+        radius[h] = __builtin_convertvector(
+            0.5 * (terms.max_coc_px < coc ? Doubles{} + terms.max_coc_px : coc), Halves);
+      }
+      const Vector r = __builtin_shufflevector(radius[0], radius[1], 0, 1, 2, 3);
+      max_radius = max_radius < r ? r : max_radius;
+      *reinterpret_cast<Loaded*>(depth_out + x) =
+          (d > 0.0f) & (d < kInfinity) ? d : Vector{} + kInfinity;
+      const Vector outer = r + 0.5f;
+      *reinterpret_cast<Loaded*>(outer_out + x) = outer;
+      tile_outer = tile_outer < outer ? outer : tile_outer;
+      // DiscArea.
+      *reinterpret_cast<Loaded*>(area_out + x) =
+          r < 0.5f ? r + 0.5f : std::numbers::pi_v<float> * (r * r + 1.0f / 12.0f);
+      PrepareDofColors<kShuffleBytes>(c + 3 * x, x, color_out);
+    }
+    float m = std::max({tile_outer[0], tile_outer[1], tile_outer[2], tile_outer[3]});
+    // The row's last 2 to 5 pixels (PrepareDofColors reads 2 pixels past its 4).
+    for (; x < end; ++x) {
+      PrepareDofPixel(d_row[x], c + 3 * x, terms, row_start + x, planes, part);
+      m = std::max(m, outer_out[x]);
+    }
+    tile[first / kDofTile] = m;
+  }
+  for (int j = 0; j < 2; ++j) {
+    part->max_coc_px = std::max(part->max_coc_px, max_coc[j]);
+    part->capped_pixels += static_cast<int64_t>(capped[j]);
+  }
+  for (int j = 0; j < 4; ++j) part->max_radius = std::max(part->max_radius, max_radius[j]);
+  FillDofPadding(planes, row_start - planes->pad_x, row_start);
+  FillDofPadding(planes, row_start + w, row_start + w + planes->pad_x + kDofMaxLanes);
+}
+
+void PrepareDofRowsPortable(const ImageView& rgb, const ImageView& depth, const DofLensTerms& terms,
+                            int first, int end, DofPlanes* planes, DofPart* part) {
+  for (int y = first; y < end; ++y) PrepareDofRow<false>(rgb, depth, terms, y, planes, part);
+}
+
+#if defined(__x86_64__)
+// No "fma" (DofRowsAvx2).
+__attribute__((target("avx2"))) void PrepareDofRowsAvx2(const ImageView& rgb,
+                                                        const ImageView& depth,
+                                                        const DofLensTerms& terms, int first,
+                                                        int end, DofPlanes* planes, DofPart* part) {
+  for (int y = first; y < end; ++y) PrepareDofRow<true>(rgb, depth, terms, y, planes, part);
+}
+#endif
+
+// DofPlanes::reach: from each tile's largest outer edge (PrepareDofRows), the largest over the
+// tiles the window reaches from it.
+void PrepareTileReach(DofPlanes* planes, int reach_x, int reach_y) {
+  const int tiles_x = planes->tiles_x;
+  const int tiles_y = (planes->height + kDofTile - 1) / kDofTile;
+  const std::vector<float> tile_max = planes->reach;
   const int tx_reach = (reach_x + kDofTile - 1) / kDofTile;
   const int ty_reach = (reach_y + kDofTile - 1) / kDofTile;
-  planes->tiles_x = tiles_x;
-  planes->reach.assign(tile_max.size(), 0.0f);
   for (int ty = 0; ty < tiles_y; ++ty) {
     for (int tx = 0; tx < tiles_x; ++tx) {
       float m = 0.0f;
@@ -96,133 +293,224 @@ void PrepareTileReach(DofPlanes* planes, int reach_x, int reach_y) {
           m = std::max(m, tile_max[static_cast<std::size_t>(j) * tiles_x + i]);
         }
       }
-      planes->reach[static_cast<std::size_t>(ty) * tiles_x + tx] = m + 0.5f;
+      planes->reach[static_cast<std::size_t>(ty) * tiles_x + tx] = m;
     }
   }
 }
 
-DofPlanes PrepareDof(const ImageView& rgb, const ImageView& depth, const ThinLensOptions& lens,
-                     const geometry::Intrinsics& k, DepthOfFieldSummary* summary) {
-  DofPlanes planes;
-  planes.width = depth.width();
-  planes.height = depth.height();
-  std::vector<float> radius(static_cast<std::size_t>(planes.width) * planes.height);
-  float max_radius = 0.0f;
-  // CircleOfConfusionPx's terms, in its order, hoisted out of the loop.
-  const double at_infinity = CircleOfConfusion(lens, 0.0);
-  const double pitch = lens.pixel_pitch_m > 0.0 ? lens.pixel_pitch_m : lens.focal_length_m / k.fx();
-  const double s = lens.focus_distance_m;
-  for (int y = 0; y < planes.height; ++y) {
-    const float* row = reinterpret_cast<const float*>(depth.row(y));
-    for (int x = 0; x < planes.width; ++x) {
-      const float d = row[x];
-      const bool surface = std::isfinite(d) && d > 0.0f;
-      const double coc = (surface ? at_infinity * std::abs(d - s) / d : at_infinity) / pitch;
-      summary->max_coc_px = std::max(summary->max_coc_px, coc);
-      if (coc > lens.max_coc_px) ++summary->capped_pixels;
-      const auto r = static_cast<float>(0.5 * std::min(coc, lens.max_coc_px));
-      radius[static_cast<std::size_t>(y) * planes.width + x] = r;
-      max_radius = std::max(max_radius, r);
-    }
-  }
-  const double aspect = lens.pixel_pitch_m > 0.0 ? 1.0 : k.fx() / k.fy();  // pitch_y / pitch_x
-  const int reach_x = static_cast<int>(std::ceil(max_radius + 0.5f));
-  const int reach_y = static_cast<int>(std::ceil((max_radius + 0.5f) / aspect));
-  planes.pad_x = reach_x;
-  planes.pad_y = reach_y;
-  planes.stride = planes.width + 2 * reach_x + kDofLanes;
-  const std::size_t n = static_cast<std::size_t>(planes.stride) * (planes.height + 2 * reach_y);
-  planes.depth.assign(n, std::numeric_limits<float>::infinity());  // padding: never in front
-  planes.radius.assign(n, 0.0f);
-  planes.area.assign(n, DiscArea(0.0f));
-  planes.inside.assign(n, 0.0f);
-  for (std::vector<float>& c : planes.color) c.assign(n, 0.0f);
-  for (int y = 0; y < planes.height; ++y) {
-    const float* row = reinterpret_cast<const float*>(depth.row(y));
-    const uint8_t* c = rgb.row(y);
-    for (int x = 0; x < planes.width; ++x) {
-      const std::size_t i = planes.At(x, y);
-      const float d = row[x];
-      planes.depth[i] = std::isfinite(d) && d > 0.0f ? d : std::numeric_limits<float>::infinity();
-      planes.radius[i] = radius[static_cast<std::size_t>(y) * planes.width + x];
-      planes.area[i] = DiscArea(planes.radius[i]);
-      planes.inside[i] = 1.0f;
-      for (int ch = 0; ch < 3; ++ch) planes.color[ch][i] = c[3 * x + ch];
-    }
-  }
+// The reach of a circle of outer edge `edge` (pixels across) across and down, each no more
+// than `limit` (in double: a huge circle's reach overflows an int).
+int DofReach(float edge, double aspect, int limit) {
+  return static_cast<int>(std::min(std::ceil(edge / aspect), static_cast<double>(limit)));
+}
+
+// The window's offsets within the largest circle, sorted by distance (stable: rows then
+// columns where distances tie, the order of the scalar gather). Offsets a whole image away
+// land in the padding from every pixel: left out (their terms are 0).
+void PrepareWindow(DofPlanes* planes, float max_radius, double aspect) {
+  const int reach_x = DofReach(max_radius + 0.5f, 1.0, planes->width - 1);
+  const int reach_y = DofReach(max_radius + 0.5f, aspect, planes->height - 1);
   for (int dy = -reach_y; dy <= reach_y; ++dy) {
     for (int dx = -reach_x; dx <= reach_x; ++dx) {
       const auto distance = static_cast<float>(std::hypot(dx, dy * aspect));
-      if (distance < max_radius + 0.5f) planes.window.push_back({dx, dy, distance});
+      if (distance < max_radius + 0.5f) {
+        planes->window.push_back({static_cast<std::ptrdiff_t>(dy) * planes->stride + dx, distance});
+      }
     }
   }
   std::stable_sort(
-      planes.window.begin(), planes.window.end(),
-      [](const WindowOffset& a, const WindowOffset& b) { return a.distance < b.distance; });
-  PrepareTileReach(&planes, reach_x, reach_y);
+      planes->window.begin(), planes->window.end(),
+      [](const WindowStep& a, const WindowStep& b) { return a.distance < b.distance; });
+  PrepareTileReach(planes, reach_x, reach_y);
+}
+
+// The rows on two threads where there are two cores (each row is computed alone: the same
+// bits), `rows(part, first, end)` on thread `part` (0 or 1). Each thread claims a tile's rows
+// at a time until none are left: the halves of an image cost differently (a blurred
+// foreground below a sharp background) and a core may be busy with other work; claims at a
+// tile's edge keep each tile to one thread.
+template <typename Rows>
+void ShareDofRows(int height, const Rows& rows) {
+  static const bool cores = std::thread::hardware_concurrency() >= 2;  // asked once
+  if (!cores || height < 2 * kDofTile) {
+    rows(0, 0, height);
+    return;
+  }
+  std::atomic<int> next{0};
+  const auto claim = [&](int part) {
+    for (int first; (first = next.fetch_add(kDofTile)) < height;) {
+      rows(part, first, std::min(height, first + kDofTile));
+    }
+  };
+  std::thread other(claim, 1);
+  claim(0);
+  other.join();
+}
+
+DofPlanes PrepareDof(const ImageView& rgb, const ImageView& depth, const ThinLensOptions& lens,
+                     const geometry::Intrinsics& k, bool wide, DepthOfFieldSummary* summary) {
+  DofPlanes planes;
+  planes.width = depth.width();
+  planes.height = depth.height();
+  // Padded for the capped circle, so that one pass fills the planes: the window, cut at the
+  // largest circle found (a radius <= cap, rounded the same way), reaches no farther, nor past
+  // the image's size (PrepareWindow).
+  const double aspect = lens.pixel_pitch_m > 0.0 ? 1.0 : k.fx() / k.fy();  // pitch_y / pitch_x
+  const auto cap = static_cast<float>(
+      std::min(0.5 * lens.max_coc_px, static_cast<double>(std::numeric_limits<float>::max())));
+  planes.pad_x = DofReach(cap + 0.5f, 1.0, planes.width);
+  planes.pad_y = DofReach(cap + 0.5f, aspect, planes.height);
+  planes.stride = planes.width + 2 * planes.pad_x + kDofMaxLanes;
+  const std::size_t n =
+      static_cast<std::size_t>(planes.stride) * (planes.height + 2 * planes.pad_y);
+  planes.values = std::make_unique_for_overwrite<float[]>(6 * n);
+  planes.depth = planes.values.get();
+  planes.outer = planes.depth + n;
+  planes.area = planes.outer + n;
+  for (int ch = 0; ch < 3; ++ch) planes.color[ch] = planes.area + (ch + 1) * n;
+  planes.tiles_x = (planes.width + kDofTile - 1) / kDofTile;
+  planes.reach.assign(
+      static_cast<std::size_t>(planes.tiles_x) * ((planes.height + kDofTile - 1) / kDofTile), 0.0f);
+  const DofLensTerms terms{
+      CircleOfConfusion(lens, 0.0),
+      lens.pixel_pitch_m > 0.0 ? lens.pixel_pitch_m : lens.focal_length_m / k.fx(),
+      lens.focus_distance_m, lens.max_coc_px};
+  DofPart parts[2];
+  ShareDofRows(planes.height, [&](int part, int first, int end) {
+    if (first == 0) FillDofPadding(&planes, 0, planes.At(-planes.pad_x, 0));
+#if defined(__x86_64__)
+    if (wide) {
+      PrepareDofRowsAvx2(rgb, depth, terms, first, end, &planes, &parts[part]);
+    } else {
+      PrepareDofRowsPortable(rgb, depth, terms, first, end, &planes, &parts[part]);
+    }
+#else
+    static_cast<void>(wide);
+    PrepareDofRowsPortable(rgb, depth, terms, first, end, &planes, &parts[part]);
+#endif
+    if (end == planes.height) FillDofPadding(&planes, planes.At(-planes.pad_x, end), n);
+  });
+  summary->max_coc_px = std::max(parts[0].max_coc_px, parts[1].max_coc_px);
+  summary->capped_pixels = parts[0].capped_pixels + parts[1].capped_pixels;
+  PrepareWindow(&planes, std::max(parts[0].max_radius, parts[1].max_radius), aspect);
   return planes;
 }
 
-DofVector LoadDof(const float* values) {
-  DofVector v;
-  std::memcpy(&v, values, sizeof(v));
-  return v;
+// Whether any lane of a comparison's mask is true (GCC reduces it with vector ORs).
+template <typename Ints>
+[[gnu::always_inline]] inline bool AnyLane(const Ints& mask) {
+  uint64_t words[sizeof(Ints) / sizeof(uint64_t)];
+  std::memcpy(words, &mask, sizeof(mask));
+  uint64_t any = 0;
+  for (const uint64_t word : words) any |= word;
+  return any != 0;
 }
 
-// How much of a pixel at `distance` (pixels) a disc of radius `radius` covers, anti-aliased
-// over one pixel: 1 inside radius - 0.5, 0 beyond radius + 0.5, linear between; for kDofLanes
-// discs.
-DofVector DofCoverage(float distance, DofVector radius) {
-  DofVector c = radius + 0.5f - distance;
-  c = c < 0.0f ? DofVector{} : c;
-  return c > 1.0f ? DofVector{} + 1.0f : c;
-}
-
-// kDofLanes output pixels from (x, y) on of one tile's row (the header's gather of what is
-// behind, scatter of what is in front), into out[0 .. count). The tile's reach bounds every
-// pixel's own circle and those near it (the window is sorted by distance): beyond it every
-// term is 0. Each term is the scalar gather's, in its order: the same bits as pixel by pixel.
-void DofRun(const DofPlanes& planes, int x, int y, int count, uint8_t* out) {
-  const std::size_t p = planes.At(x, y);
-  const DofVector radius_p = LoadDof(&planes.radius[p]);
-  const DofVector nearer = LoadDof(&planes.depth[p]) * (1.0f - kNearerFraction);
-  DofVector back_weight{}, front_weight{}, back[3] = {}, front[3] = {};
-  const float limit =
-      planes.reach[static_cast<std::size_t>(y / kDofTile) * planes.tiles_x + x / kDofTile];
-  const auto offset = [&](const WindowOffset& o) {
-    return static_cast<std::ptrdiff_t>(o.dy) * planes.stride + o.dx;
-  };
-  for (const WindowOffset& o : planes.window) {
-    if (o.distance >= limit) break;
-    const std::size_t q = p + offset(o);
-    const auto in_front = LoadDof(&planes.depth[q]) < nearer;
-    // In front: q's disc over p, weighed by 1 / its area; else p's disc over q (inside only).
-    const DofVector w_front =
-        DofCoverage(o.distance, LoadDof(&planes.radius[q])) / LoadDof(&planes.area[q]);
-    const DofVector w_back = DofCoverage(o.distance, radius_p) * LoadDof(&planes.inside[q]);
-    const DofVector f = in_front ? w_front : DofVector{};
-    const DofVector b = in_front ? DofVector{} : w_back;
-    front_weight += f;
-    back_weight += b;
-    for (int ch = 0; ch < 3; ++ch) {
-      const DofVector c = LoadDof(&planes.color[ch][q]);
-      front[ch] += f * c;
-      back[ch] += b * c;
-    }
-  }
-  for (int j = 0; j < count; ++j) {
-    const float alpha = std::min(1.0f, front_weight[j]);
-    for (int ch = 0; ch < 3; ++ch) {
-      float value = back_weight[j] > 0.0f ? back[ch][j] / back_weight[j] : 0.0f;
-      if (front_weight[j] > 0.0f) {
-        value = alpha * front[ch][j] / front_weight[j] + (1.0f - alpha) * value;
+// Row y of the image, kLanes output pixels at a time (the header's gather of what is behind,
+// scatter of what is in front), into `out`. The tile's reach bounds every pixel's own circle
+// and those near it (the window is sorted by distance): beyond it every term is 0. Each term
+// is the scalar gather's, in its order: the same bits as pixel by pixel, with 4 lanes or 8.
+// Inlined into DofRowsPortable and DofRowsAvx2, so that each is compiled for its target; the
+// vectors are never passed to a function (their ABI differs with and without AVX).
+template <int kLanes>
+[[gnu::always_inline]] inline void DofRow(const DofPlanes& planes, int y, uint8_t* out) {
+  using Vector = typename DofLanes<kLanes>::Vector;
+  using Loaded = typename DofLanes<kLanes>::Loaded;
+  using Ints = typename DofLanes<kLanes>::Ints;
+  using Bytes = typename DofLanes<kLanes>::Bytes;
+  using LoadedBytes = typename DofLanes<kLanes>::LoadedBytes;
+  const float* tile_reach = &planes.reach[static_cast<std::size_t>(y / kDofTile) * planes.tiles_x];
+  // Locals: the stores below could alias the planes' pointers, which would be reloaded.
+  const float *const depth = planes.depth, *const outer = planes.outer, *const area = planes.area;
+  const float* const color[3] = {planes.color[0], planes.color[1], planes.color[2]};
+  for (int x = 0; x < planes.width; x += kLanes) {
+    const std::size_t p = planes.At(x, y);
+    const Vector outer_p = *reinterpret_cast<const Loaded*>(outer + p);
+    const Vector nearer = *reinterpret_cast<const Loaded*>(depth + p) * (1.0f - kNearerFraction);
+    Vector back_weight{}, front_weight{}, back[3] = {}, front[3] = {};
+    const float limit = tile_reach[x / kDofTile];
+    for (const WindowStep& o : planes.window) {
+      if (o.distance >= limit) break;
+      const std::size_t q = p + o.step;
+      const Vector depth_q = *reinterpret_cast<const Loaded*>(depth + q);
+      // How much of p each disc covers, anti-aliased over one pixel: radius + 0.5 - distance,
+      // clamped to [0, 1]; q's disc and p's.
+      Vector cover_q = *reinterpret_cast<const Loaded*>(outer + q) - o.distance;
+      cover_q = cover_q < 0.0f ? Vector{} : cover_q;
+      cover_q = cover_q > 1.0f ? Vector{} + 1.0f : cover_q;
+      Vector cover_p = outer_p - o.distance;
+      cover_p = cover_p < 0.0f ? Vector{} : cover_p;
+      cover_p = cover_p > 1.0f ? Vector{} + 1.0f : cover_p;
+      // In front: q's disc over p, weighed by 1 / its area; behind (or at p's depth): p's disc
+      // over q. Padding is neither. A side no lane is on is skipped: its terms are +0, which
+      // leave the sums (+0 or more) as they are.
+      const Ints in_front = depth_q < nearer, behind = depth_q >= nearer;
+      if (AnyLane(in_front)) {
+        const Vector f = in_front ? cover_q / *reinterpret_cast<const Loaded*>(area + q) : Vector{};
+        front_weight += f;
+#pragma GCC unroll 3
+        for (int ch = 0; ch < 3; ++ch) {
+          front[ch] += f * *reinterpret_cast<const Loaded*>(color[ch] + q);
+        }
       }
-      // lround of a value in [0, 255]: + 0.5 is exact in double, truncated (no libm call).
-      out[3 * j + ch] =
-          static_cast<uint8_t>(static_cast<double>(std::clamp(value, 0.0f, 255.0f)) + 0.5);
+      if (AnyLane(behind)) {
+        const Vector b = behind ? cover_p : Vector{};
+        back_weight += b;
+#pragma GCC unroll 3
+        for (int ch = 0; ch < 3; ++ch)
+          back[ch] += b * *reinterpret_cast<const Loaded*>(color[ch] + q);
+      }
+    }
+    // The average behind, and over it what is in front with the opacity its weights sum to
+    // (at most 1); lane by lane the scalar gather's operations (std::min, std::clamp as their
+    // comparisons), the lanes without a weight's division discarded.
+    const Vector alpha = front_weight < 1.0f ? front_weight : Vector{} + 1.0f;
+    Ints rounded[3];
+#pragma GCC unroll 3
+    for (int ch = 0; ch < 3; ++ch) {
+      Vector value = back_weight > 0.0f ? back[ch] / back_weight : Vector{};
+      value =
+          front_weight > 0.0f ? alpha * front[ch] / front_weight + (1.0f - alpha) * value : value;
+      value = value < 0.0f ? Vector{} : value;
+      value = value > 255.0f ? Vector{} + 255.0f : value;
+      // lround of a value in [0, 255]: its integer part, + 1 where the fraction (exact: the
+      // difference of two floats within a factor of 2, or the value below 1) is >= 0.5.
+      const Ints whole = __builtin_convertvector(value, Ints);
+      rounded[ch] = whole - (value - __builtin_convertvector(whole, Vector) >= 0.5f);
+    }
+    // Each lane's RGB in its int's low 3 bytes, packed to the front of the vector; stored whole
+    // where the row has room (the bytes past the run's are the next run's, written after).
+    const Ints rgb = rounded[0] | rounded[1] << 8 | rounded[2] << 16;
+    const Bytes bytes = reinterpret_cast<Bytes>(rgb);
+    uint8_t* const run_out = out + 3 * x;
+    if (3 * x + static_cast<int>(sizeof(Bytes)) <= 3 * planes.width) {
+      if constexpr (kLanes == 8) {
+        *reinterpret_cast<LoadedBytes*>(run_out) = __builtin_shufflevector(
+            bytes, bytes, 0, 1, 2, 4, 5, 6, 8, 9, 10, 12, 13, 14, 16, 17, 18, 20, 21, 22, 24, 25,
+            26, 28, 29, 30, 3, 7, 11, 15, 19, 23, 27, 31);
+      } else {
+        *reinterpret_cast<LoadedBytes*>(run_out) = __builtin_shufflevector(
+            bytes, bytes, 0, 1, 2, 4, 5, 6, 8, 9, 10, 12, 13, 14, 3, 7, 11, 15);
+      }
+    } else {
+      for (int j = 0; j < std::min(kLanes, planes.width - x); ++j) {
+        for (int ch = 0; ch < 3; ++ch) run_out[3 * j + ch] = static_cast<uint8_t>(rounded[ch][j]);
+      }
     }
   }
 }
+
+void DofRowsPortable(const DofPlanes& planes, int first, int end, Image* out) {
+  for (int y = first; y < end; ++y) DofRow<4>(planes, y, out->row(y));
+}
+
+#if defined(__x86_64__)
+// No "fma": a fused multiply-add would round once where the gather rounds twice.
+__attribute__((target("avx2"))) void DofRowsAvx2(const DofPlanes& planes, int first, int end,
+                                                 Image* out) {
+  for (int y = first; y < end; ++y) DofRow<8>(planes, y, out->row(y));
+}
+#endif
 
 }  // namespace
 
@@ -362,6 +650,12 @@ double CircleOfConfusionPx(const ThinLensOptions& lens, const geometry::Intrinsi
 
 Image ApplyDepthOfField(const ImageView& rgb, const ImageView& depth, const ThinLensOptions& lens,
                         const geometry::Intrinsics& intrinsics, DepthOfFieldSummary* summary) {
+  return ApplyDepthOfField(rgb, depth, lens, intrinsics, summary, true);
+}
+
+Image ApplyDepthOfField(const ImageView& rgb, const ImageView& depth, const ThinLensOptions& lens,
+                        const geometry::Intrinsics& intrinsics, DepthOfFieldSummary* summary,
+                        bool simd) {
   lens.Validate();
   if (rgb.format() != PixelFormat::kRgb8 || depth.format() != PixelFormat::kFloat32) {
     throw InvalidArgument(fmt::format(
@@ -376,27 +670,25 @@ Image ApplyDepthOfField(const ImageView& rgb, const ImageView& depth, const Thin
   DepthOfFieldSummary local;
   DepthOfFieldSummary* out_summary = summary != nullptr ? summary : &local;
   *out_summary = {};
-  const DofPlanes planes = PrepareDof(rgb, depth, lens, intrinsics, out_summary);
+#if defined(__x86_64__)
+  static const bool avx2 = __builtin_cpu_supports("avx2");  // asked once
+  const bool wide = avx2 && simd;
+#else
+  static_cast<void>(simd);
+  constexpr bool wide = false;
+#endif
+  const DofPlanes planes = PrepareDof(rgb, depth, lens, intrinsics, wide, out_summary);
   Image out(rgb.width(), rgb.height(), PixelFormat::kRgb8);
   if (rgb.metadata() != nullptr) out.metadata() = *rgb.metadata();
-  const auto rows = [&](int first, int end) {
-    for (int y = first; y < end; ++y) {
-      uint8_t* row = out.row(y);
-      for (int x = 0; x < rgb.width(); x += kDofLanes) {
-        DofRun(planes, x, y, std::min(kDofLanes, rgb.width() - x), row + 3 * x);
-      }
+  ShareDofRows(rgb.height(), [&](int, int first, int end) {
+#if defined(__x86_64__)
+    if (wide) {
+      DofRowsAvx2(planes, first, end, &out);
+      return;
     }
-  };
-  // Two halves at once where there are two cores (each pixel is computed alone: the same bits).
-  static const bool cores = std::thread::hardware_concurrency() >= 2;  // asked once
-  if (cores && rgb.height() >= 2 * kDofTile) {
-    const int half = rgb.height() / 2;
-    std::thread other(rows, half, rgb.height());
-    rows(0, half);
-    other.join();
-  } else {
-    rows(0, rgb.height());
-  }
+#endif
+    DofRowsPortable(planes, first, end, &out);
+  });
   return out;
 }
 

@@ -14,8 +14,10 @@
 #include <limits>
 #include <opencv2/calib3d.hpp>
 #include <string>
+#include <utility>
 #include <vector>
 
+#include "render/internal_lens_optics.h"
 #include "saccade/core/error.h"
 #include "saccade/geometry/distortion.h"
 
@@ -369,27 +371,82 @@ Image DepthOfFieldByDefinition(const Image& rgb, const Image& depth, const ThinL
   return out;
 }
 
-// Tiles, a window cut at each tile's reach, eight pixels at a time, padding for the image's
-// edges: none of it changes a value. A width that is not a multiple of eight, depths from
-// 0.4 m to 6 m and holes (no surface) scattered by a hash, circles up to the cap.
+// Tiles, a window cut at each tile's reach, eight pixels at a time (four without AVX2), two
+// threads, padding for the image's edges: none of it changes a value. Widths that are not
+// multiples of eight (each leaving a different number of pixels to a row's scalar end), a
+// height that two threads split and ones that they do not, depths from 0.4 m to 6 m and holes
+// (no surface) scattered by a hash, circles up to the cap or wider than the image. The summary
+// is CircleOfConfusionPx's.
 TEST(DepthOfField, EqualsTheGatherPixelByPixelBitForBit) {
-  const int w = 45, h = 21;
+  struct Case {
+    int w, h;
+    double max_coc_px;
+    bool some_capped;
+  };
+  // The last: circles wider than the image is tall (its padding and its window cut at the
+  // image's size; without the cut the gather reads past the planes and differs).
+  for (const auto& [w, h, max_coc, some_capped] :
+       {Case{45, 37, 9.0, true}, Case{46, 20, 9.0, true}, Case{12, 5, 40.0, false}}) {
+    Image rgb(w, h, PixelFormat::kRgb8);
+    Image depth(w, h, PixelFormat::kFloat32);
+    uint32_t state = 12345;
+    const auto next = [&] { return state = state * 1664525u + 1013904223u; };
+    for (int y = 0; y < h; ++y) {
+      for (int x = 0; x < w; ++x) {
+        for (int ch = 0; ch < 3; ++ch) rgb.row(y)[3 * x + ch] = static_cast<uint8_t>(next() >> 24);
+        const uint32_t r = next() >> 8;
+        reinterpret_cast<float*>(depth.row(y))[x] =
+            r % 17 == 0 ? 0.0f : static_cast<float>((x < w / 2 ? 0.4 : 1.0) + (r % 5000) * 1e-3);
+      }
+    }
+    ThinLensOptions lens = Lens();
+    lens.max_coc_px = max_coc;
+    const geometry::Intrinsics k(w, h, 1000.0, 900.0, 22.0, 10.0);
+    double max_coc_px = 0.0;
+    int64_t capped = 0;
+    for (int y = 0; y < h; ++y) {
+      for (int x = 0; x < w; ++x) {
+        const float d = reinterpret_cast<const float*>(depth.row(y))[x];
+        const double coc = CircleOfConfusionPx(lens, k, d > 0.0f ? d : 0.0);
+        max_coc_px = std::max(max_coc_px, coc);
+        capped += coc > lens.max_coc_px;
+      }
+    }
+    EXPECT_EQ(capped > 0, some_capped) << w << " x " << h;
+    const Image reference = DepthOfFieldByDefinition(rgb, depth, lens, k);
+    for (const bool simd : {true, false}) {
+      DepthOfFieldSummary summary;
+      const Image fast = ApplyDepthOfField(rgb.view(), depth.view(), lens, k, &summary, simd);
+      int differing = 0;
+      for (int y = 0; y < h; ++y) {
+        for (int i = 0; i < 3 * w; ++i) differing += fast.row(y)[i] != reference.row(y)[i];
+      }
+      EXPECT_EQ(differing, 0) << w << " x " << h << ", simd " << simd;
+      EXPECT_EQ(summary.max_coc_px, max_coc_px) << w << " x " << h << ", simd " << simd;
+      EXPECT_EQ(summary.capped_pixels, capped) << w << " x " << h << ", simd " << simd;
+    }
+  }
+}
+
+// A cap far above any image (valid: finite, >= 1) and surfaces a few microns away: circles of
+// millions of pixels, which pad and window no farther than the image's size (neither runs
+// for hours nor overflows), and the whole image averaged: still the gather's bits.
+TEST(DepthOfField, CirclesFarWiderThanTheImageCostNoMoreThanIt) {
+  const int w = 12, h = 5;
   Image rgb(w, h, PixelFormat::kRgb8);
   Image depth(w, h, PixelFormat::kFloat32);
-  uint32_t state = 12345;
-  const auto next = [&] { return state = state * 1664525u + 1013904223u; };
   for (int y = 0; y < h; ++y) {
     for (int x = 0; x < w; ++x) {
-      for (int ch = 0; ch < 3; ++ch) rgb.row(y)[3 * x + ch] = static_cast<uint8_t>(next() >> 24);
-      const uint32_t r = next() >> 8;
-      reinterpret_cast<float*>(depth.row(y))[x] =
-          r % 17 == 0 ? 0.0f : static_cast<float>((x < w / 2 ? 0.4 : 1.0) + (r % 5000) * 1e-3);
+      for (int ch = 0; ch < 3; ++ch) rgb.row(y)[3 * x + ch] = static_cast<uint8_t>(20 * x + ch);
+      reinterpret_cast<float*>(depth.row(y))[x] = 1e-5f * static_cast<float>(1 + (x + y) % 3);
     }
   }
   ThinLensOptions lens = Lens();
-  lens.max_coc_px = 9.0;
-  const geometry::Intrinsics k(w, h, 1000.0, 900.0, 22.0, 10.0);
-  const Image fast = ApplyDepthOfField(rgb.view(), depth.view(), lens, k);
+  lens.max_coc_px = 1e30;
+  const geometry::Intrinsics k(w, h, 1000.0, 900.0, 5.5, 2.0);
+  DepthOfFieldSummary summary;
+  const Image fast = ApplyDepthOfField(rgb.view(), depth.view(), lens, k, &summary);
+  EXPECT_GT(summary.max_coc_px, 1e6);
   const Image reference = DepthOfFieldByDefinition(rgb, depth, lens, k);
   int differing = 0;
   for (int y = 0; y < h; ++y) {
