@@ -2,7 +2,7 @@
 // The depth of field's depth from the colour pass's own depth buffer (EffectTarget::
 // ReadColorDepth), for a camera whose only need of depth is its depth of field, on a software
 // rasteriser: the truth pass draws the scene a second time and its remap pass fetches nine
-// texels a pixel, together 60 to 80 ms a stereo frame of the bench scene on llvmpipe, while
+// texels a pixel, together about 80 ms a stereo frame of the bench scene on llvmpipe, while
 // the colour pass has already rasterised the depth. Here the window depth becomes the
 // camera's z on the CPU (the projection's inverse along each pixel's ray) and is remapped
 // through the lens as the truth's is (CpuLens::RemapDepthRow). The colour pass's depth is

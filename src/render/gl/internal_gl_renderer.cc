@@ -232,8 +232,9 @@ void GlRenderer::BuildCameraSetups(std::vector<CameraSetup> reuse, bool reuse_di
       const bool identity = lens.kind == geometry::LensMap::Kind::kIdentity &&
                             lens.views[0].intrinsics.width() == lens.width &&
                             lens.views[0].intrinsics.height() == lens.height;
+      const bool cpu_remap = lens.kind != geometry::LensMap::Kind::kIdentity && lens_on_cpu_;
       const bool color_depth = setup.truth && !truth_ && samples_ == 0 && lens.views.size() == 1 &&
-                               (identity || lens_on_cpu_);
+                               (identity || cpu_remap);
       setup.effects = std::make_unique<EffectTarget>(
           lens, samples_, setup.blur, setup.truth && !color_depth, lens_on_cpu_, color_depth);
       if (color_depth) {
