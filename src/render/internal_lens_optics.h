@@ -1,6 +1,7 @@
 #pragma once
-// ApplyDepthOfField with the choice of its kernel (lens_optics.cc), for tests: where the CPU has
-// AVX2 the gather runs 8 pixels of a row at once, elsewhere 4; both give the same bits.
+// ApplyDepthOfField and ApplyVignetting with the choice of their kernels (lens_optics.cc), for
+// tests: where the CPU has AVX2 they run 8 pixels of a row at once, elsewhere 4 or 1; both give
+// the same bits.
 
 #include "saccade/render/lens_optics.h"
 
@@ -11,5 +12,9 @@ namespace saccade::render {
 Image ApplyDepthOfField(const ImageView& rgb, const ImageView& depth, const ThinLensOptions& lens,
                         const geometry::Intrinsics& intrinsics, DepthOfFieldSummary* summary,
                         bool simd);
+
+/// ApplyVignetting (render/lens_optics.h); `simd` false: the portable loop even where the CPU
+/// has AVX2 (8 pixels at a time; tests: the two agree to the bit).
+void ApplyVignetting(Image& rgb, const Image& factors, bool simd);
 
 }  // namespace saccade::render

@@ -78,6 +78,39 @@ TEST(Vignetting, Cos4FollowsTheRayAngleAtTheCornersAsOpenCVUndistortsThem) {
   EXPECT_EQ(image.row(65)[3 * 70], 200);
 }
 
+// The AVX2 row (8 pixels at a time) and the portable loop give the same bytes, on a width that
+// leaves pixels to the loop's end, with factors above 1 (clipped at 255) and exact halves
+// (125 x 0.5 = 62.5 rounds away from zero, to 63), each value the formula's rounding.
+TEST(Vignetting, TheVectorRowEqualsThePortableLoopBitForBit) {
+  const int width = 203, height = 7;
+  Image image(width, height, PixelFormat::kRgb8);
+  Image factors(width, height, PixelFormat::kFloat32);
+  uint32_t state = 12345;
+  const auto next = [&] { return state = state * 1664525u + 1013904223u; };
+  for (int y = 0; y < height; ++y) {
+    float* f = reinterpret_cast<float*>(factors.row(y));
+    for (int x = 0; x < width; ++x) {
+      f[x] = x % 17 == 0 ? 0.5f : static_cast<float>(next() >> 8) / (1u << 24) * 1.6f;
+      for (int ch = 0; ch < 3; ++ch) image.row(y)[3 * x + ch] = static_cast<uint8_t>(next() >> 24);
+    }
+  }
+  image.row(0)[0] = 125;  // x 0.5 = 62.5
+  Image vectors = image, portable = image;
+  ApplyVignetting(vectors, factors, true);
+  ApplyVignetting(portable, factors, false);
+  int differing = 0;
+  for (int y = 0; y < height; ++y) {
+    const float* f = reinterpret_cast<const float*>(factors.row(y));
+    for (int i = 0; i < 3 * width; ++i) {
+      differing += vectors.row(y)[i] != portable.row(y)[i];
+      const double expected = std::min(255.0, static_cast<double>(image.row(y)[i] * f[i / 3]));
+      ASSERT_EQ(portable.row(y)[i], std::lround(expected)) << "row " << y << " value " << i;
+    }
+  }
+  EXPECT_EQ(differing, 0);
+  EXPECT_EQ(vectors.row(0)[0], 63);
+}
+
 TEST(Vignetting, PolynomialIsOneAtThePrincipalPointAndItsSumAtTheFarthestCorner) {
   // Principal point off centre: the farthest corner is the bottom right.
   const geometry::Intrinsics k(101, 81, 90.0, 90.0, 30.0, 20.0);
