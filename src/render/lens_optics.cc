@@ -62,7 +62,8 @@ constexpr int kDofMaxLanes = 8;
 static_assert(kDofTile % kDofMaxLanes == 0);
 
 // GCC vectors of kLanes floats (Vector; Loaded reads or writes one at any float's address), of
-// kLanes ints and of their bytes.
+// kLanes ints and of their bytes. One specialisation per width: GCC drops a vector_size that
+// depends on a template parameter (the type becomes a plain scalar).
 template <int kLanes>
 struct DofLanes;
 // The byte shuffles between colours and ints read an int's low byte first.

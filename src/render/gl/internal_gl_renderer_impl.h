@@ -212,6 +212,7 @@ class GlRenderer final : public Renderer {
     // colour pass's when the effect target has_color_depth, through color_depth).
     bool truth = false;
     ColorDepthMap color_depth;
+    std::vector<float> color_depth_source_z;  // ColorPassDepth's source-size buffer
   };
   // The chain of camera `i` (setup.rendered made), and the noise and truth it implies.
   void SetChain(std::size_t i, CameraSetup* setup) const;

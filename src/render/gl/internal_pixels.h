@@ -2,6 +2,7 @@
 // Pixel conversion of the readback.
 #include <cstddef>
 #include <cstdint>
+#include <thread>
 #include <vector>
 
 namespace saccade::render::gl {
@@ -9,6 +10,22 @@ namespace saccade::render::gl {
 /// Images of at least this many pixels get their CPU noise in two halves on two threads
 /// (Retrieve); smaller ones in one piece, where a thread costs more than it saves.
 constexpr std::size_t kMinSplitNoisePixels = 256 * 256;
+
+/// part(first_row, end_row) over rows [0, rows) of an image of `pixels` pixels: in two halves
+/// at once where there are two cores and at least kMinSplitNoisePixels pixels (Retrieve runs
+/// after the frame's fence, when a software rasteriser's threads are idle), else in one piece.
+/// The same result either way where each row is computed alone.
+template <class Part>
+void InTwoHalves(int rows, std::size_t pixels, const Part& part) {
+  static const bool cores = std::thread::hardware_concurrency() >= 2;  // asked once
+  if (!cores || pixels < kMinSplitNoisePixels) {
+    part(0, rows);
+    return;
+  }
+  std::thread other(part, rows / 2, rows);
+  part(0, rows / 2);
+  other.join();
+}
 
 /// RGBA rows to tightly packed RGB (alpha dropped); SSSE3 where the CPU has it.
 void RgbaToRgb(const uint8_t* rgba, uint8_t* rgb, std::size_t pixels);

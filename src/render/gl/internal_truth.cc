@@ -4,11 +4,11 @@
 #include <algorithm>
 #include <cstring>
 #include <map>
-#include <thread>
 #include <vector>
 
 #include "render/gl/internal_cpu_lens.h"
 #include "render/gl/internal_gl_renderer_impl.h"
+#include "render/gl/internal_pixels.h"
 #include "saccade/core/error.h"
 
 namespace saccade::render::gl {
@@ -86,7 +86,7 @@ void GlRenderer::FillTruth(int camera, const Pending& pending, int slot, Frame* 
 }
 
 std::shared_ptr<Image> GlRenderer::ColorPassDepth(int camera, int slot, const Image& color) {
-  const CameraSetup& setup = setups_[camera];
+  CameraSetup& setup = setups_[camera];
   const EffectTarget& effects = *setup.effects;
   const PixelBuffers& buffers = effects.color_depth_buffers();
   const auto* window_depth =
@@ -94,29 +94,20 @@ std::shared_ptr<Image> GlRenderer::ColorPassDepth(int camera, int slot, const Im
   auto depth = std::make_shared<Image>(color.width(), color.height(), PixelFormat::kFloat32);
   depth->metadata() = color.metadata();
   const CpuLens* lens = effects.cpu_lens();
-  // An identity lens: the source is the camera, its z the depth; else the source's z, remapped.
-  std::vector<float> source_z;
-  if (lens != nullptr)
-    source_z.resize(static_cast<std::size_t>(buffers.width()) * buffers.height());
-  float* z = lens != nullptr ? source_z.data() : reinterpret_cast<float*>(depth->data());
-  const auto halves = [](int rows, const auto& part) {
-    // Two halves at once where there are two cores: the rasteriser's threads are idle here.
-    static const bool cores = std::thread::hardware_concurrency() >= 2;  // asked once
-    if (!cores || rows < 64) {
-      part(0, rows);
-      return;
-    }
-    std::thread other(part, rows / 2, rows);
-    part(0, rows / 2);
-    other.join();
-  };
-  halves(buffers.height(),
-         [&](int first, int end) { CameraZRows(setup.color_depth, window_depth, first, end, z); });
+  // An identity lens: the source is the camera, its z the depth; else the source's z (into the
+  // setup's buffer, kept from frame to frame), remapped.
+  const std::size_t source_pixels = static_cast<std::size_t>(buffers.width()) * buffers.height();
+  if (lens != nullptr) setup.color_depth_source_z.resize(source_pixels);
+  float* z =
+      lens != nullptr ? setup.color_depth_source_z.data() : reinterpret_cast<float*>(depth->data());
+  InTwoHalves(buffers.height(), source_pixels, [&](int first, int end) {
+    CameraZRows(setup.color_depth, window_depth, first, end, z);
+  });
   buffers.Unmap();
   if (lens != nullptr) {
-    halves(depth->height(), [&](int first, int end) {
+    InTwoHalves(depth->height(), source_pixels, [&](int first, int end) {
       for (int y = first; y < end; ++y) {
-        lens->RemapDepthRow(source_z.data(), y, reinterpret_cast<float*>(depth->row(y)));
+        lens->RemapDepthRow(z, y, reinterpret_cast<float*>(depth->row(y)));
       }
     });
   }
