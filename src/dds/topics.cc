@@ -46,6 +46,11 @@ dds_qos_t* MakeQos(const Qos& qos) {
   dds_qset_durability(q, qos.durability == Durability::kVolatile ? DDS_DURABILITY_VOLATILE
                                                                  : DDS_DURABILITY_TRANSIENT_LOCAL);
   dds_qset_history(q, DDS_HISTORY_KEEP_LAST, qos.depth);
+  // A transient-local writer keeps for readers that come later what its durability service's
+  // history says, not its own history (Cyclone's default: the last 1): the same depth, as
+  // rmw_cyclonedds sets it.
+  dds_qset_durability_service(q, 0, DDS_HISTORY_KEEP_LAST, qos.depth, DDS_LENGTH_UNLIMITED,
+                              DDS_LENGTH_UNLIMITED, DDS_LENGTH_UNLIMITED);
   const dds_data_representation_id_t xcdr1 = DDS_DATA_REPRESENTATION_XCDR1;
   dds_qset_data_representation(q, 1, &xcdr1);
   return q;

@@ -418,12 +418,14 @@ TEST_F(PipelineTopics, RawMosaicOutputPublishesBayerImages) {
   ASSERT_EQ(summary.errors_total, 0) << summary.FullReport();
   ASSERT_EQ(sent.size(), 2u);
 
-  // The writer keeps its last images for a reader that comes later (transient local): each one
-  // taken is the mosaic sent at its stamp, the newest the last step's.
+  // The writer keeps its last 2 images for a reader that comes later (transient local; Cyclone
+  // kept 1 until the durability service's history was set): each one taken is the mosaic sent
+  // at its stamp, the newest the last step's.
   Raw participant(RawParticipant(kDomain));
   Raw reader(RawReader(participant.get(), &ref_sensor_msgs_msg_dds__Image__desc,
                        "rt/saccade/eye/raw/image_raw", 2, /*transient_local=*/true));
   int64_t newest = -1;
+  int taken = 0;
   ref_sensor_msgs_msg_dds__Image_ got{};
   for (double wait_s = 10.0; TakeSample(reader.get(), &got, wait_s); wait_s = 0.5) {
     const int64_t stamp = int64_t{got.header.stamp.sec} * 1'000'000'000 + got.header.stamp.nanosec;
@@ -439,7 +441,9 @@ TEST_F(PipelineTopics, RawMosaicOutputPublishesBayerImages) {
     EXPECT_EQ(std::memcmp(got.data._buffer, image.data(), image.size_bytes()), 0);
     dds_sample_free(&got, &ref_sensor_msgs_msg_dds__Image__desc, DDS_FREE_CONTENTS);
     got = {};
+    ++taken;
   }
+  EXPECT_EQ(taken, 2) << "a late reader gets both images the writer keeps";
   EXPECT_EQ(newest, sent.rbegin()->first);
 }
 

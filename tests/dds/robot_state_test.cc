@@ -96,9 +96,9 @@ class RobotState : public ::testing::Test {
          TakeSample(tf.get(), &message, messages == 0 ? 10.0 : 0.5);) {
       ++messages;
       ASSERT_EQ(static_cast<int>(message.transforms._length), tree.num_joints() + 1);
-      // Stamped with the joints' time: the end of the last of the 5 steps of 0.04 s.
+      // Stamped with the joints' time, oldest first: the end of each of the 5 steps of 0.04 s.
       EXPECT_EQ(message.transforms._buffer[0].header.stamp.sec, 0);
-      EXPECT_EQ(message.transforms._buffer[0].header.stamp.nanosec, 200000000u);
+      EXPECT_EQ(message.transforms._buffer[0].header.stamp.nanosec, 40000000u * messages);
       std::map<std::string, geometry::Pose> world;  // parents come first (tree order)
       world["world"] = geometry::Pose::Identity();
       for (uint32_t i = 0; i < message.transforms._length; ++i) {
@@ -118,8 +118,8 @@ class RobotState : public ::testing::Test {
       dds_sample_free(&message, &ref_tf2_msgs_msg_dds__TFMessage__desc, DDS_FREE_CONTENTS);
       message = {};
     }
-    // Cyclone keeps the newest for a late joiner (durability service: keep last 1).
-    EXPECT_GE(messages, 1);
+    // The writer keeps its last 100 (tf's depth, transient local): a late joiner gets all 5.
+    EXPECT_EQ(messages, 5);
   }
 };
 
