@@ -23,6 +23,7 @@
 #include "saccade/dds/topic_names.h"
 #include "saccade/dds/topics.h"
 #include "saccade/record/mcap.h"
+#include "saccade/render/dataset.h"
 
 namespace saccade::record {
 
@@ -38,6 +39,7 @@ struct PipelineRecorder::Impl {
   struct Source {
     std::unique_ptr<dds::Writer> ros;
     std::string json_topic;
+    bool camera_image = false;  // an eye camera's image (not its mosaic): in the step's frame
   };
   // A message sent during the step, kept until the writing thread takes it.
   struct Pending {
@@ -57,6 +59,7 @@ struct PipelineRecorder::Impl {
   std::vector<std::unique_ptr<Source>> sources;
   std::vector<std::pair<runtime::OutputBase*, runtime::ConnectionId>> connections;
   std::map<std::string, std::unique_ptr<Source>> extra;  // AddJson's, by topic
+  Source frames;  // each step's frame record, as render --record's (/saccade/frames)
 
   std::mutex step_mutex;  // guards `step` (outputs emit from any thread)
   std::vector<Pending> step;
@@ -99,6 +102,10 @@ struct PipelineRecorder::Impl {
     std::lock_guard lock(step_mutex);
     step.push_back(std::move(p));
   }
+  // The step's frame record (render/dataset.h's FrameRecord, without files or truth) from the
+  // metadata of its camera images, appended after them: what sensor_msgs/Image cannot say,
+  // the motion-blur sub-frames and the camera controls (exposure, gain, focus) of each image.
+  void AddFrameRecord(std::vector<Pending>* messages);
   void WriteLoop();
   void WriteStep(Step& s);
   void RethrowFailure() {
@@ -142,6 +149,7 @@ void PipelineRecorder::Impl::Tap(runtime::Pipeline& pipeline) {
         } else if (cameras != nullptr && type == image_type) {
           t.topic = dds::ResolveTopic(output->name() + "/image_raw", options.ns);
           t.tf_topic = "/tf";
+          raw->camera_image = true;
         } else if (head && type == joints_type && output->name() == "joints") {
           t.topic = dds::ResolveTopic("joint_states", options.ns);
           t.targets_topic = dds::ResolveTopic("joint_targets", options.ns);
@@ -178,6 +186,20 @@ runtime::ConnectionId PipelineRecorder::Impl::ConnectRos(runtime::OutputBase& ou
   SACCADE_ASSERT(id.has_value(),
                  "record: a ROS 2 type the recorder cannot keep: " + output.message_type());
   return *id;
+}
+
+void PipelineRecorder::Impl::AddFrameRecord(std::vector<Pending>* messages) {
+  std::vector<render::Frame> images;
+  for (const Pending& p : *messages) {
+    if (!p.source->camera_image) continue;
+    const auto& m = *static_cast<const runtime::ImageMessage*>(p.message.get());
+    if (m.image) images.push_back(render::Frame{m.image, nullptr, nullptr, {}, nullptr});
+  }
+  if (images.empty()) return;
+  const ImageMetadata& first = images.front().color->metadata();
+  const nlohmann::json record =
+      render::FrameRecord(first.frame_index, first.time, images, {}, false, false);
+  messages->push_back({&frames, nullptr, record.dump(), internal::Nanoseconds(first.time)});
 }
 
 void PipelineRecorder::Impl::WriteStep(Step& s) {
@@ -221,6 +243,7 @@ PipelineRecorder::PipelineRecorder(runtime::Pipeline& pipeline, const std::files
                                    RecorderOptions options)
     : impl_(std::make_unique<Impl>(path, std::move(options))) {
   impl_->writer.AddMetadata("saccade", impl_->options.metadata);
+  impl_->frames.json_topic = dds::ResolveTopic("frames", impl_->options.ns);
   impl_->Tap(pipeline);
   impl_->thread = std::thread([this] {
     pthread_setname_np(pthread_self(), "mcap-writer");  // in top and perf
@@ -255,6 +278,7 @@ void PipelineRecorder::AfterStep(const runtime::StepContext& context) {
     std::lock_guard lock(impl_->step_mutex);
     s.messages.swap(impl_->step);
   }
+  impl_->AddFrameRecord(&s.messages);
   std::unique_lock lock(impl_->queue_mutex);
   impl_->queue_changed.wait(lock, [&] { return impl_->queue.size() < kMaxQueuedSteps; });
   impl_->queue.push_back(std::move(s));

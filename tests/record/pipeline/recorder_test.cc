@@ -260,7 +260,8 @@ TEST(PipelineRecorder, RawMosaicsAreRecordedWithTheirBayerEncodingAndPlayBack) {
                           "  - name: eye\n"
                           "    calibration: {width: 64, height: 48, fx: 50, fy: 50}\n"
                           "    look_at: {eye: [0, 0, 1], target: [2, 0, 0]}\n"
-                          "    sensor: {color: {cfa: rggb}}\n";
+                          "    sensor: {exposure_ms: 6, color: {cfa: rggb}}\n"
+                          "    lens: {f_number: 2.8, focal_length_mm: 6, focus_distance: 1.5}\n";
   runtime::Pipeline pipeline = runtime::Pipeline::LoadString(
       "clock: {mode: simulated, step: 0.04, steps: 3}\n"
       "components:\n"
@@ -308,6 +309,22 @@ TEST(PipelineRecorder, RawMosaicsAreRecordedWithTheirBayerEncodingAndPlayBack) {
   EXPECT_EQ(by_topic["/saccade/eye/image_raw"][0]["value"]["encoding"], "rgb8");
   EXPECT_EQ(by_topic["/saccade/eye/raw/camera_info"].size(), 3u);
   EXPECT_EQ(by_topic["/tf"].size(), 3u);  // the eye's pose once a frame, from its image
+  // Each step's frame record (/saccade/frames, JSON, as render --record's): what an Image
+  // cannot carry, the camera controls each image was taken with, from its metadata.
+  const auto& records = by_topic["/saccade/frames"];
+  ASSERT_EQ(records.size(), 3u);
+  for (std::size_t i = 0; i < records.size(); ++i) {
+    const ImageMetadata& m = raws[i]->metadata();
+    const json& eye = records[i]["value"]["cameras"]["eye"];
+    EXPECT_EQ(records[i]["value"]["frame"], m.frame_index) << i;
+    EXPECT_EQ(records[i]["value"]["time"], m.time) << i;
+    EXPECT_EQ(eye["exposure_s"], 0.006) << i;
+    EXPECT_EQ(eye["exposure_s"], m.exposure_s) << i;
+    EXPECT_EQ(eye["gain_db"], m.gain_db) << i;
+    EXPECT_EQ(eye["focus_m"], 1.5) << i;
+    EXPECT_EQ(eye["exposure_samples"], m.exposure_samples) << i;
+    EXPECT_EQ(eye["width"], 64) << i;
+  }
 
   // Played back on DDS: the player's writers keep the last 2 images for later readers.
   constexpr int kDomain = 226;
