@@ -7,6 +7,19 @@
 #include "saccade/core/error.h"
 
 namespace saccade::render {
+namespace {
+
+// `pixels`, an image of `image`'s size and format, become `image`'s pixels; `image` keeps its
+// metadata (a move of the buffer where the chain's result had been copied row by row).
+void TakePixels(Image* image, Image pixels) {
+  SACCADE_ASSERT(pixels.width() == image->width() && pixels.height() == image->height() &&
+                     pixels.format() == image->format(),
+                 "CameraChain: a result of another size or format than its image");
+  pixels.metadata() = std::move(image->metadata());
+  *image = std::move(pixels);
+}
+
+}  // namespace
 
 ColorOptions ToColorOptions(const scene::ColorSpec& color) {
   ColorOptions options;
@@ -66,11 +79,9 @@ void CameraChain::ApplyOptics(Image* rgb, const Image* depth, const FrameOptics&
   if (vignetting_) ApplyVignetting(*rgb, factors_);
   if (!depth_of_field_) return;
   if (depth == nullptr) throw Error("CameraChain::ApplyOptics: depth of field without a depth");
-  const Image blurred = ApplyDepthOfField(
-      rgb->view(), depth->view(), ToThinLensOptions(lens_, frame.focus_distance_m), intrinsics_);
-  for (int y = 0; y < rgb->height(); ++y) {
-    std::memcpy(rgb->row(y), blurred.row(y), 3 * static_cast<std::size_t>(rgb->width()));
-  }
+  Image blurred = ApplyDepthOfField(rgb->view(), depth->view(),
+                                    ToThinLensOptions(lens_, frame.focus_distance_m), intrinsics_);
+  TakePixels(rgb, std::move(blurred));
 }
 
 std::shared_ptr<Image> CameraChain::ApplyColor(Image* rgb, Image* mosaic) const {
@@ -78,9 +89,7 @@ std::shared_ptr<Image> CameraChain::ApplyColor(Image* rgb, Image* mosaic) const 
   ColorImages images = mosaic != nullptr && options_.cfa != CfaPattern::kNone
                            ? ApplyColorPipelineToMosaic(std::move(*mosaic), options_)
                            : ApplyColorPipeline(rgb->view(), options_);
-  for (int y = 0; y < rgb->height(); ++y) {
-    std::memcpy(rgb->row(y), images.rgb.row(y), 3 * static_cast<std::size_t>(rgb->width()));
-  }
+  TakePixels(rgb, std::move(images.rgb));
   if (options_.cfa == CfaPattern::kNone) return nullptr;
   images.raw.metadata() = rgb->metadata();
   return std::make_shared<Image>(std::move(images.raw));

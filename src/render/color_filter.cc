@@ -44,49 +44,56 @@ void CheckWhiteBalanceGain(double gain, const char* field) {
   }
 }
 
-// A mosaic's 8-bit samples with their colours, read with the pattern's cell.
-struct MosaicReader {
-  const ImageView& in;
-  std::array<int, 4> cell;
-  int Channel(int x, int y) const { return cell[(y & 1) * 2 + (x & 1)]; }
-  int At(int x, int y) const { return in.row(y)[x]; }
+// The three rows around an interior row y of a mosaic and the colours of its pixels, by the
+// parity of x: own[q] at (x, y), across[q] at (x +- 1, y), below[q] at (x, y +- 1).
+struct MosaicRows {
+  const uint8_t* up;
+  const uint8_t* mid;
+  const uint8_t* down;
+  int own[2], across[2], below[2];
+
+  MosaicRows(const ImageView& in, const std::array<int, 4>& cell, int y)
+      : up(in.row(y - 1)), mid(in.row(y)), down(in.row(y + 1)) {
+    for (int q = 0; q < 2; ++q) {
+      own[q] = cell[(y & 1) * 2 + q];
+      across[q] = cell[(y & 1) * 2 + (q ^ 1)];
+      below[q] = cell[((y + 1) & 1) * 2 + q];
+    }
+  }
 };
 
-// One interior pixel of cv::demosaicing's bilinear code (demosaicing.cpp, Bayer2RGB_): the
+// One interior pixel x of cv::demosaicing's bilinear code (demosaicing.cpp, Bayer2RGB_): the
 // pixel's own colour as it is, a missing colour of two neighbours (a + b + 1) >> 1, of four
-// (a + b + c + d + 2) >> 2.
-void BilinearPixel(const MosaicReader& m, int x, int y, uint8_t* rgb) {
-  const int own = m.Channel(x, y);
-  rgb[own] = static_cast<uint8_t>(m.At(x, y));
+// (a + b + c + d + 2) >> 2. `m`'s row pointers read the neighbours directly.
+inline void BilinearPixel(const MosaicRows& m, int x, uint8_t* rgb) {
+  const int q = x & 1, own = m.own[q];
+  const int left = m.mid[x - 1], right = m.mid[x + 1], up = m.up[x], down = m.down[x];
+  rgb[own] = m.mid[x];
   if (own == 1) {
-    rgb[m.Channel(x + 1, y)] = static_cast<uint8_t>((m.At(x - 1, y) + m.At(x + 1, y) + 1) >> 1);
-    rgb[m.Channel(x, y + 1)] = static_cast<uint8_t>((m.At(x, y - 1) + m.At(x, y + 1) + 1) >> 1);
+    rgb[m.across[q]] = static_cast<uint8_t>((left + right + 1) >> 1);
+    rgb[m.below[q]] = static_cast<uint8_t>((up + down + 1) >> 1);
     return;
   }
-  const int cross = m.At(x - 1, y) + m.At(x + 1, y) + m.At(x, y - 1) + m.At(x, y + 1);
-  const int diagonal =
-      m.At(x - 1, y - 1) + m.At(x + 1, y - 1) + m.At(x - 1, y + 1) + m.At(x + 1, y + 1);
-  rgb[1] = static_cast<uint8_t>((cross + 2) >> 2);
+  const int diagonal = m.up[x - 1] + m.up[x + 1] + m.down[x - 1] + m.down[x + 1];
+  rgb[1] = static_cast<uint8_t>((left + right + up + down + 2) >> 2);
   rgb[2 - own] = static_cast<uint8_t>((diagonal + 2) >> 2);
 }
 
 // One interior pixel of cv::demosaicing's edge-aware code (Bayer2RGB_EdgeAware_T): rounded
 // as the bilinear code, but green at a red or blue pixel from one pair only, the pair across
 // the smaller difference (the vertical pair when the horizontal difference is larger).
-void EdgeAwarePixel(const MosaicReader& m, int x, int y, uint8_t* rgb) {
-  const int own = m.Channel(x, y);
-  const int left = m.At(x - 1, y), right = m.At(x + 1, y);
-  const int up = m.At(x, y - 1), down = m.At(x, y + 1);
-  rgb[own] = static_cast<uint8_t>(m.At(x, y));
+inline void EdgeAwarePixel(const MosaicRows& m, int x, uint8_t* rgb) {
+  const int q = x & 1, own = m.own[q];
+  const int left = m.mid[x - 1], right = m.mid[x + 1], up = m.up[x], down = m.down[x];
+  rgb[own] = m.mid[x];
   if (own == 1) {
-    rgb[m.Channel(x + 1, y)] = static_cast<uint8_t>((left + right + 1) >> 1);
-    rgb[m.Channel(x, y + 1)] = static_cast<uint8_t>((up + down + 1) >> 1);
+    rgb[m.across[q]] = static_cast<uint8_t>((left + right + 1) >> 1);
+    rgb[m.below[q]] = static_cast<uint8_t>((up + down + 1) >> 1);
     return;
   }
   const bool vertical = std::abs(left - right) > std::abs(down - up);
   rgb[1] = static_cast<uint8_t>(((vertical ? down + up : left + right) + 1) >> 1);
-  const int diagonal =
-      m.At(x - 1, y - 1) + m.At(x + 1, y - 1) + m.At(x - 1, y + 1) + m.At(x + 1, y + 1);
+  const int diagonal = m.up[x - 1] + m.up[x + 1] + m.down[x - 1] + m.down[x + 1];
   rgb[2 - own] = static_cast<uint8_t>((diagonal + 2) >> 2);
 }
 
@@ -240,13 +247,14 @@ Image Demosaic(const ImageView& mosaic, DemosaicMethod method) {
   if (mosaic.metadata() != nullptr) out.metadata() = *mosaic.metadata();
   const int w = mosaic.width(), h = mosaic.height();
   if (w < 3 || h < 3) return out;  // black, as OpenCV leaves it
-  const MosaicReader reader{mosaic, CellOf(pattern)};
+  const std::array<int, 4> cell = CellOf(pattern);
   for (int y = 1; y < h - 1; ++y) {
+    const MosaicRows rows(mosaic, cell, y);
     uint8_t* row = out.row(y);
     if (method == DemosaicMethod::kBilinear) {
-      for (int x = 1; x < w - 1; ++x) BilinearPixel(reader, x, y, row + 3 * x);
+      for (int x = 1; x < w - 1; ++x) BilinearPixel(rows, x, row + 3 * x);
     } else {
-      for (int x = 1; x < w - 1; ++x) EdgeAwarePixel(reader, x, y, row + 3 * x);
+      for (int x = 1; x < w - 1; ++x) EdgeAwarePixel(rows, x, row + 3 * x);
     }
   }
   CopyBorders(out);
@@ -338,6 +346,7 @@ void ApplyWhiteBalanceToMosaic(Image& mosaic, const WhiteBalance& balance) {
                     ToString(mosaic.format())));
   }
   balance.Validate();
+  if (balance.red == 1.0 && balance.green == 1.0 && balance.blue == 1.0) return;  // the identity
   const ToneCurve linear;
   const std::array<std::array<uint8_t, 256>, 3> tables = {ToneTable(linear, balance.red),
                                                           ToneTable(linear, balance.green),
