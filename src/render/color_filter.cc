@@ -235,7 +235,12 @@ Image Mosaic(const ImageView& rgb, CfaPattern pattern) {
   return out;
 }
 
-Image Demosaic(const ImageView& mosaic, DemosaicMethod method) {
+namespace {
+
+// Demosaic's image; with `tone`, each value then looked up in it (a tone curve's table, the
+// same for the three colours), row by row while the row is in the cache.
+Image DemosaicThroughTable(const ImageView& mosaic, DemosaicMethod method,
+                           const std::array<uint8_t, 256>* tone) {
   const CfaPattern pattern = PatternOf(mosaic.format());
   if (pattern == CfaPattern::kNone || BytesPerPixel(mosaic.format()) != 1) {
     throw InvalidArgument(fmt::format(
@@ -246,7 +251,8 @@ Image Demosaic(const ImageView& mosaic, DemosaicMethod method) {
   Image out(mosaic.width(), mosaic.height(), PixelFormat::kRgb8);
   if (mosaic.metadata() != nullptr) out.metadata() = *mosaic.metadata();
   const int w = mosaic.width(), h = mosaic.height();
-  if (w < 3 || h < 3) return out;  // black, as OpenCV leaves it
+  // Black, as OpenCV leaves it (every tone curve keeps 0 at 0).
+  if (w < 3 || h < 3) return out;
   const std::array<int, 4> cell = CellOf(pattern);
   for (int y = 1; y < h - 1; ++y) {
     const MosaicRows rows(mosaic, cell, y);
@@ -256,9 +262,18 @@ Image Demosaic(const ImageView& mosaic, DemosaicMethod method) {
     } else {
       for (int x = 1; x < w - 1; ++x) EdgeAwarePixel(rows, x, row + 3 * x);
     }
+    if (tone != nullptr) {
+      for (uint8_t* p = row + 3; p < row + 3 * (w - 1); ++p) *p = (*tone)[*p];
+    }
   }
-  CopyBorders(out);
+  CopyBorders(out);  // copies of toned values: toned as the pixels they copy
   return out;
+}
+
+}  // namespace
+
+Image Demosaic(const ImageView& mosaic, DemosaicMethod method) {
+  return DemosaicThroughTable(mosaic, method, nullptr);
 }
 
 void WhiteBalance::Validate() const {
@@ -394,8 +409,9 @@ ColorImages ApplyColorPipelineToMosaic(Image mosaic, const ColorOptions& options
   ColorImages out;
   out.raw = std::move(mosaic);
   ApplyWhiteBalanceToMosaic(out.raw, options.white_balance);
-  out.rgb = Demosaic(out.raw.view(), options.demosaic);
-  ApplyWhiteBalanceAndTone(out.rgb, WhiteBalance{}, options.tone_curve);
+  // Demosaiced, then the tone curve (ApplyWhiteBalanceAndTone without a balance: one table).
+  const std::array<uint8_t, 256> tone = ToneTable(options.tone_curve, 1.0);
+  out.rgb = DemosaicThroughTable(out.raw.view(), options.demosaic, &tone);
   return out;
 }
 

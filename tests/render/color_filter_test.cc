@@ -254,6 +254,37 @@ TEST(ColorPipeline, WhiteBalanceScalesEachColourOfTheMosaicThenDemosaics) {
   EXPECT_EQ(plain.rgb.row(3)[11], table[50]);
 }
 
+// A mosaic's pipeline with a tone curve: OpenCV's demosaicing of the mosaic, then the curve's
+// table on every value, borders included (the curve is applied row by row as rows are
+// demosaiced).
+TEST(ColorPipeline, AToneCurveEncodesOpenCVsDemosaicedImage) {
+  const Image rgb = Noise(37, 23, 5);
+  for (const ToneCurve curve :
+       {ToneCurve{ToneCurveKind::kSrgb}, ToneCurve{ToneCurveKind::kGamma, 1.8}}) {
+    for (const DemosaicMethod method : {DemosaicMethod::kBilinear, DemosaicMethod::kEdgeAware}) {
+      SCOPED_TRACE(std::string(ToString(curve.kind)) + " " + ToString(method));
+      ColorOptions options;
+      options.cfa = CfaPattern::kGrbg;
+      options.demosaic = method;
+      options.tone_curve = curve;
+      const ColorImages out = ApplyColorPipeline(rgb.view(), options);
+      cv::Mat reference;
+      cv::demosaicing(MatOf(out.raw), reference, CvCode(options.cfa, method), 3);
+      const auto table = ToneTable(curve);
+      int differ = 0, changed = 0;
+      for (int y = 0; y < rgb.height(); ++y) {
+        for (int x = 0; x < 3 * rgb.width(); ++x) {
+          const uint8_t want = reference.ptr<uint8_t>(y)[x];
+          differ += out.rgb.row(y)[x] != table[want];
+          changed += table[want] != want;
+        }
+      }
+      EXPECT_EQ(differ, 0);
+      EXPECT_GT(changed, 1000);  // the curve is not the identity here
+    }
+  }
+}
+
 TEST(ColorFilter, ParsesPatternsAndRosEncodings) {
   EXPECT_EQ(ParseCfaPattern("rggb"), CfaPattern::kRggb);
   EXPECT_EQ(ParseCfaPattern("GBRG"), CfaPattern::kGbrg);
