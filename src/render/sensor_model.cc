@@ -5,9 +5,15 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
+#include <cstring>
 #include <numbers>
 #include <thread>
 
+#if defined(__x86_64__)
+#include <immintrin.h>
+#endif
+
+#include "render/internal_sensor_model.h"
 #include "saccade/core/error.h"
 
 namespace saccade::render {
@@ -72,6 +78,21 @@ const std::vector<double>& GaussianTable() {
   return table;
 }
 
+// GaussianTable as pairs (t[i], t[i + 1] - t[i]), i < kGaussianBins: SensorGaussian's two
+// terms with one 16-byte load (ExposeRunAvx2).
+const std::vector<double>& GaussianPairs() {
+  static const std::vector<double> pairs = [] {
+    const std::vector<double>& t = GaussianTable();
+    std::vector<double> p(2 * kGaussianBins);
+    for (int i = 0; i < kGaussianBins; ++i) {
+      p[2 * i] = t[i];
+      p[2 * i + 1] = t[i + 1] - t[i];
+    }
+    return p;
+  }();
+  return pairs;
+}
+
 // A standard normal deviate from 32 bits by inversion: the quantile interpolated linearly
 // between kGaussianBins evenly spaced probabilities (its variance within 1e-6 of 1: the
 // quantile is nearly straight over a bin), exact in the two outer bins (the tails, to
@@ -124,6 +145,241 @@ inline double SensorPoisson(const double* table, double lambda, uint32_t bits) {
   return k;
 }
 
+// One frame's terms (SensorModel::Expose), the same for every value.
+struct FrameTerms {
+  uint64_t key;  // the frame's hash key
+  double K;      // DN per electron, the camera's gain included
+  double sigma_d;
+  double sat;
+  double offset;
+  double max_dn;
+  double to8;  // 255 / max_dn: a raw DN's 8-bit value, before rounding (To8Bit)
+  const double* table;
+  const double* pairs;  // GaussianPairs()
+  const float* prnu;
+  const float* dsnu;
+};
+
+// Value i's raw DN from its mean electrons `lambda` (eta mu_p (1 + PRNU_i)).
+inline uint16_t ExposeValue(const FrameTerms& t, std::size_t i, double lambda) {
+  // One 64-bit hash a value: its upper half draws the shot noise, its lower the dark noise.
+  const uint64_t h = SensorMix(t.key + static_cast<uint64_t>(i));
+  double e = SensorPoisson(t.table, lambda, static_cast<uint32_t>(h >> 32));
+  e += t.sigma_d * SensorGaussian(t.table, static_cast<uint32_t>(h)) + t.dsnu[i];
+  e = std::min(e, t.sat);  // the full well
+  // round() then clamp to [0, max_dn], as one clamp and a rounding of the non-negative.
+  return static_cast<uint16_t>(RoundNonNegative(std::clamp(t.K * e + t.offset, 0.0, t.max_dn)));
+}
+
+// A raw DN's 8-bit value (To8Bit).
+inline uint8_t To8(const FrameTerms& t, uint16_t raw) {
+  return static_cast<uint8_t>(RoundNonNegative(static_cast<double>(raw) * t.to8));
+}
+
+// A frame's input, value j of a run: mean photons (Expose) ...
+struct PhotonInput {
+  const float* photons;
+  double eta;
+};
+// ... or 8-bit rendered values through each value's eta mu_p (ExposeRendered).
+struct RenderedInput {
+  const uint8_t* values;
+  const double* eta_photons;  // 256
+};
+
+// eta mu_p of value j, as Expose has always multiplied it (eta first, PRNU after).
+inline double EtaPhotons(const PhotonInput& in, std::size_t j) {
+  return in.eta * std::max(0.0f, in.photons[j]);
+}
+inline double EtaPhotons(const RenderedInput& in, std::size_t j) {
+  return in.eta_photons[in.values[j]];
+}
+
+// The values [first, first + n) of a frame, value j of the run from `in`, into raw[j] and,
+// where `out8` is not null, their 8-bit values into out8[j] (which may be the input's bytes:
+// each is read before it is written). From value j0 on.
+template <typename Input>
+void ExposeRunPortable(const FrameTerms& t, const Input& in, std::size_t first, std::size_t n,
+                       uint16_t* raw, uint8_t* out8, std::size_t j0 = 0) {
+  for (std::size_t j = j0; j < n; ++j) {
+    const std::size_t i = first + j;
+    raw[j] = ExposeValue(t, i, EtaPhotons(in, j) * t.prnu[i]);
+    if (out8 != nullptr) out8[j] = To8(t, raw[j]);
+  }
+}
+
+#if defined(__x86_64__)
+// Groups of 4 values that ExposeRunAvx2 exposes at once.
+constexpr int kAvx2Groups = 4;
+
+// The low 64 bits of z * c in each lane, from 32 x 32-bit products (exact, as uint64_t's).
+__attribute__((target("avx2"))) inline __m256i MulLow64(__m256i z, uint64_t c) {
+  const __m256i c_low = _mm256_set1_epi64x(static_cast<int64_t>(c & 0xffff'ffffULL));
+  const __m256i c_high = _mm256_set1_epi64x(static_cast<int64_t>(c >> 32));
+  const __m256i cross = _mm256_add_epi64(_mm256_mul_epu32(_mm256_srli_epi64(z, 32), c_low),
+                                         _mm256_mul_epu32(z, c_high));
+  return _mm256_add_epi64(_mm256_mul_epu32(z, c_low), _mm256_slli_epi64(cross, 32));
+}
+
+// table[index] of 4 lanes (the masked gathers: GCC 12 warns of the plain ones' undefined source).
+__attribute__((target("avx2"))) inline __m256d Gather4(const double* table, __m256i index) {
+  const __m256d all = _mm256_castsi256_pd(_mm256_set1_epi64x(-1));
+  return _mm256_mask_i64gather_pd(_mm256_setzero_pd(), table, index, all, 8);
+}
+__attribute__((target("avx2"))) inline __m256d Gather4(const double* table, __m128i index) {
+  const __m256d all = _mm256_castsi256_pd(_mm256_set1_epi64x(-1));
+  return _mm256_mask_i32gather_pd(_mm256_setzero_pd(), table, index, all, 8);
+}
+
+// SensorMix of 4 lanes.
+__attribute__((target("avx2"))) inline __m256i SensorMix4(__m256i z) {
+  z = _mm256_add_epi64(z, _mm256_set1_epi64x(static_cast<int64_t>(0x9e3779b97f4a7c15ULL)));
+  z = MulLow64(_mm256_xor_si256(z, _mm256_srli_epi64(z, 30)), 0xbf58476d1ce4e5b9ULL);
+  z = MulLow64(_mm256_xor_si256(z, _mm256_srli_epi64(z, 27)), 0x94d049bb133111ebULL);
+  return _mm256_xor_si256(z, _mm256_srli_epi64(z, 31));
+}
+
+// SensorGaussian of 4 lanes' 32 bits (each 64-bit lane's low half, its high half 0) from
+// GaussianPairs (`pairs`): each lane's pair with one load (4 loads and 2 shuffles instead of two
+// gathers). ORs the lanes whose bin is an outer one (whose deviate SensorGaussian computes
+// apart) into `*outer`.
+__attribute__((target("avx2"))) inline __m256d SensorGaussian4(const double* pairs, __m256i bits,
+                                                               __m256i* outer) {
+  constexpr int kLowBits = 32 - kGaussianBinBits;
+  const __m256i bin = _mm256_srli_epi64(bits, kLowBits);
+  *outer = _mm256_or_si256(
+      *outer, _mm256_or_si256(_mm256_cmpeq_epi64(bin, _mm256_setzero_si256()),
+                              _mm256_cmpeq_epi64(bin, _mm256_set1_epi64x(kGaussianBins - 1))));
+  const __m128i bins01 = _mm256_castsi256_si128(bin), bins23 = _mm256_extracti128_si256(bin, 1);
+  const __m256d pairs02 = _mm256_insertf128_pd(
+      _mm256_castpd128_pd256(_mm_loadu_pd(pairs + 2 * _mm_cvtsi128_si64(bins01))),
+      _mm_loadu_pd(pairs + 2 * _mm_cvtsi128_si64(bins23)), 1);
+  const __m256d pairs13 = _mm256_insertf128_pd(
+      _mm256_castpd128_pd256(_mm_loadu_pd(pairs + 2 * _mm_extract_epi64(bins01, 1))),
+      _mm_loadu_pd(pairs + 2 * _mm_extract_epi64(bins23, 1)), 1);
+  const __m256d t0 = _mm256_unpacklo_pd(pairs02, pairs13);     // t[bin]
+  const __m256d slope = _mm256_unpackhi_pd(pairs02, pairs13);  // t[bin + 1] - t[bin]
+  const __m256i low = _mm256_and_si256(bits, _mm256_set1_epi64x((1 << kLowBits) - 1));
+  const __m256d bias = _mm256_castsi256_pd(
+      _mm256_or_si256(low, _mm256_set1_epi64x(static_cast<int64_t>(0x4330'0000'0000'0000ULL))));
+  const __m256d frac =
+      _mm256_mul_pd(_mm256_add_pd(_mm256_sub_pd(bias, _mm256_set1_pd(0x1p52)), _mm256_set1_pd(0.5)),
+                    _mm256_set1_pd(1.0 / (1u << kLowBits)));
+  return _mm256_add_pd(t0, _mm256_mul_pd(frac, slope));
+}
+
+// EtaPhotons of values j to j + 3.
+__attribute__((target("avx2"))) inline __m256d EtaPhotons4(const PhotonInput& in, std::size_t j) {
+  const __m128 photons = _mm_max_ps(_mm_loadu_ps(in.photons + j), _mm_setzero_ps());  // NaN: 0
+  return _mm256_mul_pd(_mm256_set1_pd(in.eta), _mm256_cvtps_pd(photons));
+}
+__attribute__((target("avx2"))) inline __m256d EtaPhotons4(const RenderedInput& in, std::size_t j) {
+  int32_t bytes;
+  std::memcpy(&bytes, in.values + j, sizeof(bytes));
+  return Gather4(in.eta_photons, _mm_cvtepu8_epi32(_mm_cvtsi32_si128(bytes)));
+}
+
+// Values j to j + 4 G - 1 of a run (ExposeRunAvx2), as G groups of 4 lanes: each step for
+// every group in turn, so that the out-of-order core overlaps the groups' long chains (hash,
+// table loads, square root). The same double operations as ExposeValue in the same order (no
+// FMA): the same bits. Lanes that take a rare path (mean electrons below kExactPoissonMean, 0
+// included, or not finite; a Gaussian's outer bin) are redone by ExposeValue.
+template <int G, typename Input>
+__attribute__((target("avx2"), always_inline)) inline void ExposeGroupsAvx2(
+    const FrameTerms& t, const Input& in, std::size_t first, std::size_t j, uint16_t* raw,
+    uint8_t* out8) {
+  const __m256d zero = _mm256_setzero_pd(), half = _mm256_set1_pd(0.5);
+  __m256i h[G], rare[G];
+  __m256d lambda[G], e[G];
+#pragma GCC unroll 8
+  for (int k = 0; k < G; ++k) {
+    const uint64_t i = first + j + 4 * k;
+    h[k] = SensorMix4(_mm256_add_epi64(_mm256_set1_epi64x(static_cast<int64_t>(t.key + i)),
+                                       _mm256_setr_epi64x(0, 1, 2, 3)));
+    lambda[k] =
+        _mm256_mul_pd(EtaPhotons4(in, j + 4 * k), _mm256_cvtps_pd(_mm_loadu_ps(t.prnu + i)));
+    rare[k] = _mm256_castpd_si256(
+        _mm256_or_pd(_mm256_cmp_pd(lambda[k], _mm256_set1_pd(kExactPoissonMean), _CMP_NGE_UQ),
+                     _mm256_cmp_pd(lambda[k], _mm256_set1_pd(0x1p1000), _CMP_NLT_UQ)));
+  }
+#pragma GCC unroll 8
+  for (int k = 0; k < G; ++k) {
+    const __m256d shot = SensorGaussian4(t.pairs, _mm256_srli_epi64(h[k], 32), &rare[k]);
+    e[k] = _mm256_add_pd(lambda[k], _mm256_mul_pd(_mm256_sqrt_pd(lambda[k]), shot));
+  }
+  const __m256d shift = _mm256_set1_pd(0x1.8p52);  // RoundWhole
+#pragma GCC unroll 8
+  for (int k = 0; k < G; ++k) {
+    e[k] = _mm256_and_pd(_mm256_cmp_pd(e[k], zero, _CMP_GT_OQ),  // e > 0 ? RoundWhole(e) : 0
+                         _mm256_sub_pd(_mm256_add_pd(e[k], shift), shift));
+    const __m256i low = _mm256_and_si256(h[k], _mm256_set1_epi64x(0xffff'ffffLL));
+    const __m256d dark = SensorGaussian4(t.pairs, low, &rare[k]);
+    const __m256d dsnu = _mm256_cvtps_pd(_mm_loadu_ps(t.dsnu + first + j + 4 * k));
+    e[k] = _mm256_add_pd(e[k], _mm256_add_pd(_mm256_mul_pd(_mm256_set1_pd(t.sigma_d), dark), dsnu));
+  }
+#pragma GCC unroll 8
+  for (int k = 0; k < G; ++k) {
+    const __m256d full = _mm256_min_pd(_mm256_set1_pd(t.sat), e[k]);  // std::min(e, sat)
+    // std::clamp(K e + offset, 0, max_dn) of a finite value; rounded half up.
+    const __m256d dn =
+        _mm256_add_pd(_mm256_mul_pd(_mm256_set1_pd(t.K), full), _mm256_set1_pd(t.offset));
+    const __m256d clamped = _mm256_max_pd(zero, _mm256_min_pd(_mm256_set1_pd(t.max_dn), dn));
+    const __m128i words = _mm256_cvttpd_epi32(_mm256_add_pd(clamped, half));
+    _mm_storel_epi64(reinterpret_cast<__m128i*>(raw + j + 4 * k), _mm_packus_epi32(words, words));
+    if (out8 != nullptr) {  // To8
+      const __m256d scaled = _mm256_mul_pd(_mm256_cvtepi32_pd(words), _mm256_set1_pd(t.to8));
+      const __m128i bytes = _mm256_cvttpd_epi32(_mm256_add_pd(scaled, half));
+      const int32_t four =
+          _mm_cvtsi128_si32(_mm_packus_epi16(_mm_packus_epi32(bytes, bytes), bytes));
+      std::memcpy(out8 + j + 4 * k, &four, sizeof(four));
+    }
+  }
+#pragma GCC unroll 8
+  for (int k = 0; k < G; ++k) {
+    const int redo = _mm256_movemask_pd(_mm256_castsi256_pd(rare[k]));
+    if (redo != 0) [[unlikely]] {
+      alignas(32) double lambdas[4];
+      _mm256_store_pd(lambdas, lambda[k]);
+      for (int l = 0; l < 4; ++l) {
+        if ((redo >> l & 1) == 0) continue;
+        const std::size_t at = j + 4 * k + l;
+        raw[at] = ExposeValue(t, first + at, lambdas[l]);
+        if (out8 != nullptr) out8[at] = To8(t, raw[at]);
+      }
+    }
+  }
+}
+
+// ExposeRunPortable with AVX2: kAvx2Groups x 4 values at a time, then 4, then one by one.
+template <typename Input>
+__attribute__((target("avx2"))) void ExposeRunAvx2(const FrameTerms& t, const Input& in,
+                                                   std::size_t first, std::size_t n, uint16_t* raw,
+                                                   uint8_t* out8) {
+  std::size_t j = 0;
+  for (; j + 4 * kAvx2Groups <= n; j += 4 * kAvx2Groups) {
+    ExposeGroupsAvx2<kAvx2Groups>(t, in, first, j, raw, out8);
+  }
+  for (; j + 4 <= n; j += 4) ExposeGroupsAvx2<1>(t, in, first, j, raw, out8);
+  ExposeRunPortable(t, in, first, n, raw, out8, j);
+}
+#endif
+
+// ExposeRunPortable, or where the CPU has AVX2 and `simd`, ExposeRunAvx2 (the same bits).
+template <typename Input>
+void ExposeRun(const FrameTerms& t, const Input& in, std::size_t first, std::size_t n,
+               uint16_t* raw, uint8_t* out8, bool simd) {
+#if defined(__x86_64__)
+  static const bool avx2 = __builtin_cpu_supports("avx2");  // asked once
+  if (avx2 && simd) {
+    ExposeRunAvx2(t, in, first, n, raw, out8);
+    return;
+  }
+#else
+  static_cast<void>(simd);
+#endif
+  ExposeRunPortable(t, in, first, n, raw, out8);
+}
+
 // Whether an image of `format` holds a sensor's values of `channels`: kRgb8 for 3; kGray8 or
 // an 8-bit Bayer mosaic (one photosite a pixel) for 1.
 bool Fits(PixelFormat format, int channels) {
@@ -159,6 +415,36 @@ void ForRowParts(int height, std::size_t row_values, const Row& row) {
           std::min(end, (y + 1) * row_values) - y * row_values);
     }
   });
+}
+
+// The terms of frame `frame_index` of a sensor of `params`, `stream` and fixed pattern.
+FrameTerms MakeTerms(const scene::EmvaSensor& params, uint64_t stream, int64_t frame_index,
+                     double gain, const float* prnu, const float* dsnu) {
+  FrameTerms t;
+  t.key = SensorMix(stream ^ SensorMix(kFrameStream + static_cast<uint64_t>(frame_index)));
+  t.K = params.gain_dn_per_e * gain;  // the camera's gain amplifies K
+  t.sigma_d = params.dark_noise_e;
+  t.sat = params.saturation_e;
+  t.offset = params.black_level_dn;
+  t.max_dn = params.MaxDn();
+  t.to8 = 255.0 / params.MaxDn();
+  t.table = GaussianTable().data();
+  t.pairs = GaussianPairs().data();
+  t.prnu = prnu;
+  t.dsnu = dsnu;
+  return t;
+}
+
+// Throws InvalidArgument unless an image of `width` x `height` and `format` holds `sensor`'s
+// values (Fits); `what`: the function that asks.
+void CheckImage(const char* what, const SensorModel& sensor, int width, int height,
+                PixelFormat format) {
+  if (width != sensor.width() || height != sensor.height() || !Fits(format, sensor.channels())) {
+    const PixelFormat expected = sensor.channels() == 3 ? PixelFormat::kRgb8 : PixelFormat::kGray8;
+    throw InvalidArgument(fmt::format("{}: expected a {} x {} {} image, got {} x {} {}", what,
+                                      sensor.width(), sensor.height(), ToString(expected), width,
+                                      height, ToString(format)));
+  }
 }
 
 uint64_t HashName(uint64_t seed, const std::string& name) {
@@ -200,33 +486,17 @@ SensorModel::SensorModel(const scene::EmvaSensor& params, uint64_t seed, const s
   }
 }
 
+void UseSensorSimd(SensorModel& sensor, bool simd) { sensor.simd_ = simd; }
+
 void SensorModel::Expose(const float* photons, int64_t frame_index, uint16_t* raw,
                          double gain) const {
-  const uint64_t key =
-      SensorMix(stream_ ^ SensorMix(kFrameStream + static_cast<uint64_t>(frame_index)));
-  const double eta = params_.quantum_efficiency;
-  const double K = params_.gain_dn_per_e * gain;  // the camera's gain amplifies K
-  const double sigma_d = params_.dark_noise_e;
-  const double sat = params_.saturation_e;
-  const double offset = params_.black_level_dn;
-  const double max_dn = params_.MaxDn();
-  const double* const table = GaussianTable().data();
-  const float* const prnu = prnu_.data();
-  const float* const dsnu = dsnu_.data();
-  const auto part = [=](std::size_t first, std::size_t end) {
-    for (std::size_t i = first; i < end; ++i) {
-      // One 64-bit hash a value: its upper half draws the shot noise, its lower the dark noise.
-      const uint64_t h = SensorMix(key + static_cast<uint64_t>(i));
-      const double lambda = eta * std::max(0.0f, photons[i]) * prnu[i];
-      double e = SensorPoisson(table, lambda, static_cast<uint32_t>(h >> 32));
-      e += sigma_d * SensorGaussian(table, static_cast<uint32_t>(h)) + dsnu[i];
-      e = std::min(e, sat);  // the full well
-      // round() then clamp to [0, max_dn], as one clamp and a rounding of the non-negative.
-      raw[i] = static_cast<uint16_t>(RoundNonNegative(std::clamp(K * e + offset, 0.0, max_dn)));
-    }
-  };
+  const FrameTerms t = MakeTerms(params_, stream_, frame_index, gain, prnu_.data(), dsnu_.data());
+  const PhotonInput in{photons, params_.quantum_efficiency};
   // Each value depends on its index alone: parts give the same bits as one loop.
-  ForParts(values(), part);
+  ForParts(values(), [&](std::size_t first, std::size_t end) {
+    ExposeRun(t, PhotonInput{in.photons + first, in.eta}, first, end - first, raw + first, nullptr,
+              simd_);
+  });
 }
 
 std::vector<uint16_t> SensorModel::ExposeUniform(double mean_photons, int64_t frame_index) const {
@@ -239,36 +509,32 @@ std::vector<uint16_t> SensorModel::ExposeUniform(double mean_photons, int64_t fr
 std::vector<uint16_t> SensorModel::ExposeRendered(const ImageView& rendered, double exposure_s,
                                                   int64_t frame_index, Image* image8,
                                                   double gain) const {
-  const PixelFormat expected = channels_ == 3 ? PixelFormat::kRgb8 : PixelFormat::kGray8;
-  if (rendered.width() != width_ || rendered.height() != height_ ||
-      !Fits(rendered.format(), channels_)) {
-    throw InvalidArgument(fmt::format(
-        "SensorModel::ExposeRendered: expected a {} x {} {} image, got {} x {} {}", width_, height_,
-        ToString(expected), rendered.width(), rendered.height(), ToString(rendered.format())));
+  CheckImage("SensorModel::ExposeRendered", *this, rendered.width(), rendered.height(),
+             rendered.format());
+  if (image8 != nullptr) {
+    CheckImage("SensorModel::To8Bit", *this, image8->width(), image8->height(), image8->format());
   }
   const double scale = params_.photons_per_second * exposure_s / 255.0;
-  float photons_of[256];  // each 8-bit value's photons, as the product per value gave them
-  for (int v = 0; v < 256; ++v) photons_of[v] = static_cast<float>(v * scale);
-  std::vector<float> photons(values());
-  const std::size_t row_values = static_cast<std::size_t>(width_) * channels_;
-  ForRowParts(height_, row_values, [&](int y, std::size_t x0, std::size_t x1) {
-    const uint8_t* row = rendered.row(y);
-    for (std::size_t x = x0; x < x1; ++x) photons[y * row_values + x] = photons_of[row[x]];
-  });
+  // Each 8-bit value's eta mu_p: its photons as the product per value gave them, times eta.
+  double eta_photons[256];
+  for (int v = 0; v < 256; ++v) {
+    const auto photons = static_cast<float>(v * scale);
+    eta_photons[v] = params_.quantum_efficiency * std::max(0.0f, photons);
+  }
+  const FrameTerms t = MakeTerms(params_, stream_, frame_index, gain, prnu_.data(), dsnu_.data());
   std::vector<uint16_t> raw(values());
-  Expose(photons.data(), frame_index, raw.data(), gain);
-  if (image8 != nullptr) To8Bit(raw.data(), image8);
+  const std::size_t row_values = static_cast<std::size_t>(width_) * channels_;
+  // One pass: each value read, exposed and, with `image8`, written back in 8 bits.
+  ForRowParts(height_, row_values, [&](int y, std::size_t x0, std::size_t x1) {
+    const std::size_t first = y * row_values + x0;
+    ExposeRun(t, RenderedInput{rendered.row(y) + x0, eta_photons}, first, x1 - x0,
+              raw.data() + first, image8 != nullptr ? image8->row(y) + x0 : nullptr, simd_);
+  });
   return raw;
 }
 
 void SensorModel::To8Bit(const uint16_t* raw, Image* image8) const {
-  const PixelFormat expected = channels_ == 3 ? PixelFormat::kRgb8 : PixelFormat::kGray8;
-  if (image8->width() != width_ || image8->height() != height_ ||
-      !Fits(image8->format(), channels_)) {
-    throw InvalidArgument(fmt::format(
-        "SensorModel::To8Bit: expected a {} x {} {} image, got {} x {} {}", width_, height_,
-        ToString(expected), image8->width(), image8->height(), ToString(image8->format())));
-  }
+  CheckImage("SensorModel::To8Bit", *this, image8->width(), image8->height(), image8->format());
   const double scale = 255.0 / params_.MaxDn();
   // Each raw value's 8-bit value, as the product per value gave it.
   std::vector<uint8_t> to8(static_cast<std::size_t>(params_.MaxDn()) + 1);

@@ -9,9 +9,11 @@
 #include <cmath>
 #include <filesystem>
 #include <memory>
+#include <random>
 #include <string>
 #include <vector>
 
+#include "render/internal_sensor_model.h"
 #include "saccade/core/error.h"
 #include "saccade/render/emva_measurement.h"
 #include "saccade/render/renderer.h"
@@ -180,6 +182,115 @@ TEST(SensorModelTest, ShotNoiseIsPoisson) {
     EXPECT_NEAR(mean, lambda, 4.0 * std::sqrt(lambda / n)) << lambda;
     EXPECT_NEAR(variance / lambda, 1.0, kVarianceTolerance) << lambda;
   }
+}
+
+// --- the AVX2 kernel against the portable loop ----------------------------------------------
+
+// Sensors whose values take every branch: the full well below the ADC's range (and, at gain
+// 2.5, above it: max_dn clamps), a full well beyond it, and an 8-bit sensor whose dark noise
+// drives values below 0 DN.
+std::vector<scene::EmvaSensor> BranchSensors() {
+  return {Sensor(0.36, 2.3, 10500.0, 1.0, 0.5, 12, 64.0),
+          Sensor(1.0, 2.0, 10000.0, 0.0, 0.0, 12, 64.0),
+          Sensor(0.02, 40.0, 10000.0, 50.0, 0.5, 8, 10.0)};
+}
+
+// Mean photons for `n` values (eta 0.6): none, negative, the exact Poisson range, mean electrons
+// within 2 % of kExactPoissonMean (both sides, PRNU moves them), the Gaussian range and beyond
+// the full well.
+std::vector<float> BranchPhotons(std::size_t n, uint32_t seed) {
+  std::mt19937 random(seed);
+  std::uniform_real_distribution<float> unit(0.0f, 1.0f);
+  std::vector<float> photons(n);
+  const float at_exact = static_cast<float>(kExactPoissonMean / 0.6);
+  for (float& p : photons) {
+    switch (random() % 6) {
+      case 0:
+        p = random() % 2 == 0 ? 0.0f : -5.0f;
+        break;
+      case 1:
+        p = 100.0f * unit(random);
+        break;
+      case 2:
+        p = at_exact * (0.98f + 0.04f * unit(random));
+        break;
+      case 3:
+        p = 100.0f + 20000.0f * unit(random);
+        break;
+      case 4:
+        p = 1e5f * (1.0f + 100.0f * unit(random));
+        break;
+      default:
+        p = 30000.0f * unit(random);
+        break;
+    }
+  }
+  return photons;
+}
+
+// Each value depends on its index alone: 4 values at a time, the lanes that take a rare path
+// (no photons, the exact Poisson range, a Gaussian's two outer bins) redone one by one, the
+// last n % 4 values one by one. Sizes that are no multiples of 4 (and rows of an odd number of
+// values); ~12k values a frame: about 3 values in each outer bin (2 / 4096 of them) per
+// Gaussian and frame, 6 frames a sensor. Where the CPU lacks AVX2 both are the portable loop.
+TEST(SensorModelTest, VectorKernelGivesThePortableLoopsBits) {
+  struct Size {
+    int width, height, channels;
+  };
+  for (const scene::EmvaSensor& s : BranchSensors()) {
+    for (const Size size :
+         {Size{1, 1, 1}, Size{3, 2, 1}, Size{7, 5, 3}, Size{33, 17, 1}, Size{65, 63, 3}}) {
+      const SensorModel vector(s, 9, "left", size.width, size.height, size.channels);
+      SensorModel portable(s, 9, "left", size.width, size.height, size.channels);
+      UseSensorSimd(portable, false);
+      const std::size_t n = vector.values();
+      const std::vector<float> photons = BranchPhotons(n, static_cast<uint32_t>(n));
+      for (const double gain : {1.0, 2.5}) {
+        std::vector<uint16_t> fast(n), slow(n);
+        vector.Expose(photons.data(), 3, fast.data(), gain);
+        portable.Expose(photons.data(), 3, slow.data(), gain);
+        ASSERT_EQ(fast, slow) << size.width << " x " << size.height << " x " << size.channels
+                              << ", gain " << gain << ", K " << s.gain_dn_per_e;
+      }
+      // Rendered 8-bit values: 1 ms puts 27 of 255 at kExactPoissonMean, 100 ms saturates.
+      Image rendered(size.width, size.height,
+                     size.channels == 3 ? PixelFormat::kRgb8 : PixelFormat::kBayerRggb8);
+      std::mt19937 random(5);
+      for (std::size_t i = 0; i < rendered.size_bytes(); ++i) {
+        rendered.data()[i] = static_cast<uint8_t>(random());
+      }
+      for (const double exposure : {0.001, 0.1}) {
+        Image fast8(size.width, size.height, rendered.format());
+        Image slow8 = rendered;  // in place
+        const std::vector<uint16_t> fast =
+            vector.ExposeRendered(rendered.view(), exposure, 4, &fast8, 2.5);
+        const std::vector<uint16_t> slow =
+            portable.ExposeRendered(slow8.view(), exposure, 4, &slow8, 2.5);
+        ASSERT_EQ(fast, slow) << size.width << " x " << size.height << ", " << exposure << " s";
+        ASSERT_EQ(std::vector<uint8_t>(fast8.data(), fast8.data() + fast8.size_bytes()),
+                  std::vector<uint8_t>(slow8.data(), slow8.data() + slow8.size_bytes()));
+        // The 8-bit image is To8Bit's of the raw values.
+        Image to8(size.width, size.height, rendered.format());
+        vector.To8Bit(fast.data(), &to8);
+        ASSERT_EQ(std::vector<uint8_t>(to8.data(), to8.data() + to8.size_bytes()),
+                  std::vector<uint8_t>(fast8.data(), fast8.data() + fast8.size_bytes()));
+      }
+    }
+  }
+}
+
+// A frame exposed in parts on several threads (at least 2^19 values), the parts' bounds no
+// multiples of 4: the same bits both ways.
+TEST(SensorModelTest, VectorKernelGivesThePortableLoopsBitsInParts) {
+  const scene::EmvaSensor s = BranchSensors()[0];
+  const SensorModel vector(s, 2, "right", 723, 731, 1);
+  SensorModel portable(s, 2, "right", 723, 731, 1);
+  UseSensorSimd(portable, false);
+  const std::vector<float> photons = BranchPhotons(vector.values(), 17);
+  std::vector<uint16_t> fast(vector.values()), slow(vector.values());
+  vector.Expose(photons.data(), 8, fast.data());
+  portable.Expose(photons.data(), 8, slow.data());
+  EXPECT_EQ(fast, slow);
 }
 
 TEST(SensorModelTest, BadParametersNameTheField) {

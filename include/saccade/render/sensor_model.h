@@ -68,6 +68,9 @@ class SensorModel {
   int channels_;
   std::vector<float> prnu_;  // 1 + PRNU_i
   std::vector<float> dsnu_;  // DSNU_i, electrons
+  bool simd_ = true;         // false: the portable loop even where the CPU has AVX2 (tests)
+
+  friend void UseSensorSimd(SensorModel& sensor, bool simd);
 };
 
 }  // namespace saccade::render
