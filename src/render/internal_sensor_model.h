@@ -1,7 +1,7 @@
 #pragma once
 // SensorModel (render/sensor_model.h) with the choice of its exposure kernel (sensor_model.cc),
-// for tests: where the CPU has AVX2 it exposes 4 values at a time, elsewhere 1; both give the
-// same bits.
+// for tests: where the CPU has AVX2 it exposes 16 values a step (four groups of 4 lanes),
+// elsewhere 1; both give the same bits.
 
 #include "saccade/render/sensor_model.h"
 
