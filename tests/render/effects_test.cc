@@ -289,9 +289,10 @@ TEST(PixelsTest, RgbaToRgbInPartsGivesTheSameBytesAsOnePass) {
   EXPECT_EQ(rgb[2], 30);
 }
 
-// The remap's and the noise's AVX2 loops and their portable ones give the same rows to the
-// bit, on a random source through the barrel lens, in rows of a width that leaves a tail for
-// the portable loop: the remap's integer arithmetic, and the noise's levels (a table) against
+// The remap's, the depth remap's and the noise's AVX2 loops and their portable ones give the
+// same rows to the bit, on a random source through the barrel lens, in rows of a width that
+// leaves a tail for the portable loop: the remap's integer arithmetic, the depth remap's float
+// blends and edges, and the noise's levels (a table) against
 // the vector loop's float arithmetic, for read noise alone, shot noise alone, both, and noise
 // wide enough to clip at 0 and 255.
 TEST(LensOnCpuTest, TheVectorLoopsEqualThePortableOnes) {
@@ -312,6 +313,29 @@ TEST(LensOnCpuTest, TheVectorLoopsEqualThePortableOnes) {
     cpu_lens.RemapRow(source.data(), y, portable.data(), /*simd=*/false);
     ASSERT_EQ(fast, portable) << "row " << y;
   }
+  // The depth remap: blocks of surfaces (smooth slopes within 2 %, steps between blocks, no
+  // surface in some), so that rows take both the bilinear and the nearest branch.
+  std::vector<float> z(static_cast<std::size_t>(w) * h);
+  for (int v = 0; v < h; ++v) {
+    for (int u = 0; u < w; ++u) {
+      const int block = (u / 23) * 7 + v / 17;
+      z[static_cast<std::size_t>(v) * w + u] =
+          block % 5 == 0 ? 0.0f : 0.5f + 0.3f * static_cast<float>(block % 11) + 1e-3f * u;
+    }
+  }
+  std::vector<float> sorted_z = z;
+  std::sort(sorted_z.begin(), sorted_z.end());
+  std::vector<float> fast_z(lens.width), portable_z(lens.width);
+  std::size_t blended = 0;
+  for (int y = 0; y < lens.height; ++y) {
+    cpu_lens.RemapDepthRow(z.data(), y, fast_z.data());
+    cpu_lens.RemapDepthRow(z.data(), y, portable_z.data(), /*simd=*/false);
+    ASSERT_EQ(std::memcmp(fast_z.data(), portable_z.data(), 4 * fast_z.size()), 0) << "row " << y;
+    for (const float value : fast_z) {  // a value of no source pixel: bilinear
+      blended += !std::binary_search(sorted_z.begin(), sorted_z.end(), value);
+    }
+  }
+  EXPECT_GT(blended, std::size_t{1000});
   const std::pair<float, float> sensors[] = {
       {5.0f, 0.0f}, {0.0f, 0.2f}, {2.0f, 0.3f}, {1.5f, 0.1f}, {20.0f, 1.7f}};
   for (const auto& [read, gain] : sensors) {

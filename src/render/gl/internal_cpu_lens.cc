@@ -78,6 +78,93 @@ __attribute__((target("avx2"))) void RemapRowAvx2(const uint8_t* source, uint32_
 }
 #endif
 
+// The depth remap of `width` pixels (CpuLens::RemapDepthRow before its special pixels):
+// `samples` as RemapRowPortable's, `stride` floats a source row.
+void RemapDepthRowPortable(const float* source_z, std::size_t stride, const uint32_t* samples,
+                           int width, float* z_row) {
+  for (int x = 0; x < width; ++x) {
+    const std::size_t o = samples[2 * x] / 4;  // the sample's top-left source pixel
+    const uint32_t fx = samples[2 * x + 1] & 0xFFFFu, fy = samples[2 * x + 1] >> 16;
+    const float z00 = source_z[o], z10 = source_z[o + 1];
+    const float z01 = source_z[o + stride], z11 = source_z[o + stride + 1];
+    const float low = std::min(std::min(z00, z10), std::min(z01, z11));
+    const float high = std::max(std::max(z00, z10), std::max(z01, z11));
+    if (low > 0.0f && high - low <= 0.02f * low) {
+      const float wx = static_cast<float>(fx) * (1.0f / 256.0f);
+      const float wy = static_cast<float>(fy) * (1.0f / 256.0f);
+      const float top = z00 + (z10 - z00) * wx, bottom = z01 + (z11 - z01) * wx;
+      z_row[x] = top + (bottom - top) * wy;
+    } else {
+      z_row[x] = source_z[o + (fy >= 128 ? stride : 0) + (fx >= 128 ? 1 : 0)];
+    }
+  }
+}
+
+#if defined(__x86_64__)
+// The source values at `base` + the offsets of pixels x and x + 1 and one to the right of
+// each: (x's, x's right, x + 1's, x + 1's right), one 8-byte load a pixel.
+__attribute__((target("avx2"))) inline __m128 Pairs2(const float* base, const uint32_t* samples,
+                                                     int x) {
+  const __m128 first = _mm_castsi128_ps(
+      _mm_loadl_epi64(reinterpret_cast<const __m128i*>(base + samples[2 * x] / 4)));
+  return _mm_loadh_pi(first, reinterpret_cast<const __m64*>(base + samples[2 * x + 2] / 4));
+}
+
+// The same, 8 pixels at a time without gathers (slow on some CPUs): each pixel's two source
+// pairs (z00, z10) and (z01, z11) with one 8-byte load each, sorted into vectors by shuffles;
+// then the portable loop's float operations lane by lane (no "fma": it rounds the product and
+// the sum apart), the nearest value chosen among the four by blends. Depths are 0 or positive,
+// never NaN, so the vector min and max pick what std::min and std::max pick: the same bits.
+__attribute__((target("avx2"))) void RemapDepthRowAvx2(const float* source_z, std::size_t stride,
+                                                       const uint32_t* samples, int width,
+                                                       float* z_row) {
+  const __m256i evens = _mm256_setr_epi32(0, 2, 4, 6, 1, 3, 5, 7);
+  const __m256i low16 = _mm256_set1_epi32(0xFFFF), half = _mm256_set1_epi32(127);
+  const __m256 step = _mm256_set1_ps(0.02f), inv = _mm256_set1_ps(1.0f / 256.0f);
+  const __m256 zero = _mm256_setzero_ps();
+  const float* below = source_z + stride;
+  int x = 0;
+  for (; x + 8 <= width; x += 8) {
+    // Lanes 0-3 hold pixels x .. x + 3, lanes 4-7 pixels x + 4 .. x + 7 (AVX's two halves).
+    const __m256 top_a = _mm256_set_m128(Pairs2(source_z, samples, x + 4),
+                                         Pairs2(source_z, samples, x));  // pixels 0, 1 | 4, 5
+    const __m256 top_b = _mm256_set_m128(Pairs2(source_z, samples, x + 6),
+                                         Pairs2(source_z, samples, x + 2));  // 2, 3 | 6, 7
+    const __m256 bottom_a =
+        _mm256_set_m128(Pairs2(below, samples, x + 4), Pairs2(below, samples, x));
+    const __m256 bottom_b =
+        _mm256_set_m128(Pairs2(below, samples, x + 6), Pairs2(below, samples, x + 2));
+    const __m256 z00 = _mm256_shuffle_ps(top_a, top_b, _MM_SHUFFLE(2, 0, 2, 0));
+    const __m256 z10 = _mm256_shuffle_ps(top_a, top_b, _MM_SHUFFLE(3, 1, 3, 1));
+    const __m256 z01 = _mm256_shuffle_ps(bottom_a, bottom_b, _MM_SHUFFLE(2, 0, 2, 0));
+    const __m256 z11 = _mm256_shuffle_ps(bottom_a, bottom_b, _MM_SHUFFLE(3, 1, 3, 1));
+    // Samples x .. x + 3 and x + 4 .. x + 7: (offset, weights) pairs; their 8 weights.
+    const __m256i a = _mm256_permutevar8x32_epi32(
+        _mm256_loadu_si256(reinterpret_cast<const __m256i*>(samples + 2 * x)), evens);
+    const __m256i b = _mm256_permutevar8x32_epi32(
+        _mm256_loadu_si256(reinterpret_cast<const __m256i*>(samples + 2 * x + 8)), evens);
+    const __m256i weights = _mm256_permute2x128_si256(a, b, 0x31);
+    const __m256i fx = _mm256_and_si256(weights, low16), fy = _mm256_srli_epi32(weights, 16);
+    const __m256 low = _mm256_min_ps(_mm256_min_ps(z00, z10), _mm256_min_ps(z01, z11));
+    const __m256 high = _mm256_max_ps(_mm256_max_ps(z00, z10), _mm256_max_ps(z01, z11));
+    const __m256 smooth = _mm256_and_ps(
+        _mm256_cmp_ps(low, zero, _CMP_GT_OQ),
+        _mm256_cmp_ps(_mm256_sub_ps(high, low), _mm256_mul_ps(step, low), _CMP_LE_OQ));
+    const __m256 wx = _mm256_mul_ps(_mm256_cvtepi32_ps(fx), inv);
+    const __m256 wy = _mm256_mul_ps(_mm256_cvtepi32_ps(fy), inv);
+    const __m256 top = _mm256_add_ps(z00, _mm256_mul_ps(_mm256_sub_ps(z10, z00), wx));
+    const __m256 bottom = _mm256_add_ps(z01, _mm256_mul_ps(_mm256_sub_ps(z11, z01), wx));
+    const __m256 blended = _mm256_add_ps(top, _mm256_mul_ps(_mm256_sub_ps(bottom, top), wy));
+    const __m256 right = _mm256_castsi256_ps(_mm256_cmpgt_epi32(fx, half));  // fx >= 128
+    const __m256 down = _mm256_castsi256_ps(_mm256_cmpgt_epi32(fy, half));   // fy >= 128
+    const __m256 nearest = _mm256_blendv_ps(_mm256_blendv_ps(z00, z10, right),
+                                            _mm256_blendv_ps(z01, z11, right), down);
+    _mm256_storeu_ps(z_row + x, _mm256_blendv_ps(nearest, blended, smooth));
+  }
+  RemapDepthRowPortable(source_z, stride, samples + 2 * x, width - x, z_row + x);
+}
+#endif
+
 }  // namespace
 
 CpuLens::CpuLens(const RemapTable& table, int width, int height, int source_width,
@@ -179,25 +266,21 @@ void CpuLens::RemapRow(const uint8_t* source, int y, uint8_t* rgba_row, bool sim
   }
 }
 
-void CpuLens::RemapDepthRow(const float* source_z, int y, float* z_row) const {
-  const Sample* row = samples_.data() + static_cast<std::size_t>(y) * width_;
+void CpuLens::RemapDepthRow(const float* source_z, int y, float* z_row, bool simd) const {
+  const uint32_t* row =
+      reinterpret_cast<const uint32_t*>(samples_.data() + static_cast<std::size_t>(y) * width_);
   const std::size_t stride = static_cast<std::size_t>(source_width_);
-  for (int x = 0; x < width_; ++x) {
-    const std::size_t o = row[x].offset / 4;  // the sample's top-left source pixel
-    const uint32_t fx = row[x].weights & 0xFFFFu, fy = row[x].weights >> 16;
-    const float z00 = source_z[o], z10 = source_z[o + 1];
-    const float z01 = source_z[o + stride], z11 = source_z[o + stride + 1];
-    const float low = std::min(std::min(z00, z10), std::min(z01, z11));
-    const float high = std::max(std::max(z00, z10), std::max(z01, z11));
-    if (low > 0.0f && high - low <= 0.02f * low) {
-      const float wx = static_cast<float>(fx) * (1.0f / 256.0f);
-      const float wy = static_cast<float>(fy) * (1.0f / 256.0f);
-      const float top = z00 + (z10 - z00) * wx, bottom = z01 + (z11 - z01) * wx;
-      z_row[x] = top + (bottom - top) * wy;
-    } else {
-      z_row[x] = source_z[o + (fy >= 128 ? stride : 0) + (fx >= 128 ? 1 : 0)];
-    }
+#if defined(__x86_64__)
+  static const bool avx2 = __builtin_cpu_supports("avx2");
+  if (avx2 && simd) {
+    RemapDepthRowAvx2(source_z, stride, row, width_, z_row);
+  } else {
+    RemapDepthRowPortable(source_z, stride, row, width_, z_row);
   }
+#else
+  static_cast<void>(simd);
+  RemapDepthRowPortable(source_z, stride, row, width_, z_row);
+#endif
   for (uint32_t k = row_first_[y]; k < row_first_[y + 1]; ++k) {
     if (special_first_[k] == special_first_[k + 1]) {
       z_row[special_pixel_[k] - static_cast<uint32_t>(y) * width_] = 0.0f;

@@ -35,8 +35,9 @@ class CpuLens {
   /// (kTruthRemapFragmentSource) without ids: bilinear where the four source pixels around
   /// the pixel's sample are surfaces within 2 % of each other's depth, the nearest one's
   /// otherwise (no depth mixed across an edge); a pixel of several samples takes its first,
-  /// one without a ray 0.
-  void RemapDepthRow(const float* source_z, int y, float* z_row) const;
+  /// one without a ray 0. `simd` false: the portable loop even where the CPU has AVX2 (tests:
+  /// the two agree to the bit).
+  void RemapDepthRow(const float* source_z, int y, float* z_row, bool simd = true) const;
 
   /// Pixels remapped with more than one sample or none (no ray).
   std::size_t special_pixels() const { return special_pixel_.size(); }
