@@ -59,7 +59,7 @@ struct PipelineRecorder::Impl {
   std::vector<std::unique_ptr<Source>> sources;
   std::vector<std::pair<runtime::OutputBase*, runtime::ConnectionId>> connections;
   std::map<std::string, std::unique_ptr<Source>> extra;  // AddJson's, by topic
-  Source frames;  // each step's frame record, as render --record's (/saccade/frames)
+  std::string frames_topic;  // each step's frame record, as render --record's (/saccade/frames)
 
   std::mutex step_mutex;  // guards `step` (outputs emit from any thread)
   std::vector<Pending> step;
@@ -103,9 +103,10 @@ struct PipelineRecorder::Impl {
     step.push_back(std::move(p));
   }
   // The step's frame record (render/dataset.h's FrameRecord, without files or truth) from the
-  // metadata of its camera images, appended after them: what sensor_msgs/Image cannot say,
-  // the motion-blur sub-frames and the camera controls (exposure, gain, focus) of each image.
-  void AddFrameRecord(std::vector<Pending>* messages);
+  // metadata of its camera images, written after them by the writing thread: what
+  // sensor_msgs/Image cannot say, the motion-blur sub-frames and the camera controls
+  // (exposure, gain, focus) of each image.
+  void WriteFrameRecord(const Step& s);
   void WriteLoop();
   void WriteStep(Step& s);
   void RethrowFailure() {
@@ -188,18 +189,19 @@ runtime::ConnectionId PipelineRecorder::Impl::ConnectRos(runtime::OutputBase& ou
   return *id;
 }
 
-void PipelineRecorder::Impl::AddFrameRecord(std::vector<Pending>* messages) {
+void PipelineRecorder::Impl::WriteFrameRecord(const Step& s) {
   std::vector<render::Frame> images;
-  for (const Pending& p : *messages) {
+  for (const Pending& p : s.messages) {
     if (!p.source->camera_image) continue;
     const auto& m = *static_cast<const runtime::ImageMessage*>(p.message.get());
     if (m.image) images.push_back(render::Frame{m.image, nullptr, nullptr, {}, nullptr});
   }
   if (images.empty()) return;
   const ImageMetadata& first = images.front().color->metadata();
-  const nlohmann::json record =
-      render::FrameRecord(first.frame_index, first.time, images, {}, false, false);
-  messages->push_back({&frames, nullptr, record.dump(), internal::Nanoseconds(first.time)});
+  const std::string record =
+      render::FrameRecord(first.frame_index, first.time, images, {}, false, false).dump();
+  writer.Write(channels.Of(frames_topic, ""), log_time, internal::Nanoseconds(first.time),
+               {reinterpret_cast<const uint8_t*>(record.data()), record.size()});
 }
 
 void PipelineRecorder::Impl::WriteStep(Step& s) {
@@ -213,6 +215,7 @@ void PipelineRecorder::Impl::WriteStep(Step& s) {
                    p.publish_time == 0 ? log_time : p.publish_time, {data, p.json.size()});
     }
   }
+  WriteFrameRecord(s);
 }
 
 void PipelineRecorder::Impl::WriteLoop() {
@@ -243,7 +246,7 @@ PipelineRecorder::PipelineRecorder(runtime::Pipeline& pipeline, const std::files
                                    RecorderOptions options)
     : impl_(std::make_unique<Impl>(path, std::move(options))) {
   impl_->writer.AddMetadata("saccade", impl_->options.metadata);
-  impl_->frames.json_topic = dds::ResolveTopic("frames", impl_->options.ns);
+  impl_->frames_topic = dds::ResolveTopic("frames", impl_->options.ns);
   impl_->Tap(pipeline);
   impl_->thread = std::thread([this] {
     pthread_setname_np(pthread_self(), "mcap-writer");  // in top and perf
@@ -278,7 +281,6 @@ void PipelineRecorder::AfterStep(const runtime::StepContext& context) {
     std::lock_guard lock(impl_->step_mutex);
     s.messages.swap(impl_->step);
   }
-  impl_->AddFrameRecord(&s.messages);
   std::unique_lock lock(impl_->queue_mutex);
   impl_->queue_changed.wait(lock, [&] { return impl_->queue.size() < kMaxQueuedSteps; });
   impl_->queue.push_back(std::move(s));
