@@ -13,6 +13,7 @@
 #include <immintrin.h>
 #endif
 
+#include "render/internal_chunks.h"
 #include "saccade/core/error.h"
 
 namespace saccade::render {
@@ -326,11 +327,13 @@ Image Mosaic(const ImageView& rgb, CfaPattern pattern) {
   }
   Image out(rgb.width(), rgb.height(), BayerFormat(pattern, 8));
   const std::array<int, 4> cell = CellOf(pattern);
-  for (int y = 0; y < rgb.height(); ++y) {
-    const uint8_t* in = rgb.row(y);
-    uint8_t* row = out.row(y);
-    for (int x = 0; x < rgb.width(); ++x) row[x] = in[3 * x + cell[(y & 1) * 2 + (x & 1)]];
-  }
+  internal::ForEachRowChunk(rgb.height(), [&](int, int first, int end) {
+    for (int y = first; y < end; ++y) {
+      const uint8_t* in = rgb.row(y);
+      uint8_t* row = out.row(y);
+      for (int x = 0; x < rgb.width(); ++x) row[x] = in[3 * x + cell[(y & 1) * 2 + (x & 1)]];
+    }
+  });
   if (rgb.metadata() != nullptr) out.metadata() = *rgb.metadata();
   return out;
 }
@@ -354,23 +357,28 @@ Image DemosaicThroughTable(const ImageView& mosaic, DemosaicMethod method,
   // Black, as OpenCV leaves it (every tone curve keeps 0 at 0).
   if (w < 3 || h < 3) return out;
   const std::array<int, 4> cell = CellOf(pattern);
-  for (int y = 1; y < h - 1; ++y) {
-    const MosaicRows rows(mosaic, cell, y);
-    uint8_t* row = out.row(y);
-    int x = 1;
 #if defined(__x86_64__)
-    static const bool sse41 = __builtin_cpu_supports("sse4.1");  // asked once
-    if (sse41) x = DemosaicRowSse41(rows, w, method == DemosaicMethod::kEdgeAware, row);
+  static const bool sse41 = __builtin_cpu_supports("sse4.1");  // asked once
 #endif
-    if (method == DemosaicMethod::kBilinear) {
-      for (; x < w - 1; ++x) BilinearPixel(rows, x, row + 3 * x);
-    } else {
-      for (; x < w - 1; ++x) EdgeAwarePixel(rows, x, row + 3 * x);
+  // Rows 1 to h - 2, each alone, in chunks on every core.
+  internal::ForEachRowChunk(h - 2, [&](int, int first, int end) {
+    for (int y = first + 1; y < end + 1; ++y) {
+      const MosaicRows rows(mosaic, cell, y);
+      uint8_t* row = out.row(y);
+      int x = 1;
+#if defined(__x86_64__)
+      if (sse41) x = DemosaicRowSse41(rows, w, method == DemosaicMethod::kEdgeAware, row);
+#endif
+      if (method == DemosaicMethod::kBilinear) {
+        for (; x < w - 1; ++x) BilinearPixel(rows, x, row + 3 * x);
+      } else {
+        for (; x < w - 1; ++x) EdgeAwarePixel(rows, x, row + 3 * x);
+      }
+      if (tone != nullptr) {
+        for (uint8_t* p = row + 3; p < row + 3 * (w - 1); ++p) *p = (*tone)[*p];
+      }
     }
-    if (tone != nullptr) {
-      for (uint8_t* p = row + 3; p < row + 3 * (w - 1); ++p) *p = (*tone)[*p];
-    }
-  }
+  });
   CopyBorders(out);  // copies of toned values: toned as the pixels they copy
   return out;
 }

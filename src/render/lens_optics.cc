@@ -4,7 +4,6 @@
 
 #include <Eigen/Core>
 #include <algorithm>
-#include <atomic>
 #include <bit>
 #include <cctype>
 #include <cmath>
@@ -14,13 +13,13 @@
 #include <numbers>
 #include <optional>
 #include <string>
-#include <thread>
 #include <vector>
 
 #if defined(__x86_64__)
 #include <immintrin.h>
 #endif
 
+#include "render/internal_chunks.h"
 #include "render/internal_lens_optics.h"
 #include "saccade/core/error.h"
 
@@ -329,27 +328,13 @@ void PrepareWindow(DofPlanes* planes, float max_radius, double aspect) {
   PrepareTileReach(planes, reach_x, reach_y);
 }
 
-// The rows on two threads where there are two cores (each row is computed alone: the same
-// bits), `rows(part, first, end)` on thread `part` (0 or 1). Each thread claims a tile's rows
-// at a time until none are left: the halves of an image cost differently (a blurred
-// foreground below a sharp background) and a core may be busy with other work; claims at a
-// tile's edge keep each tile to one thread.
+// rows(slot, first, end) over [0, height) in tiles' rows on every core (ForEachChunk: each
+// row is computed alone, the same bits): the halves of an image cost differently (a blurred
+// foreground below a sharp background), so that threads claim a tile's rows at a time; claims
+// at a tile's edge keep each tile to one thread.
 template <typename Rows>
 void ShareDofRows(int height, const Rows& rows) {
-  static const bool cores = std::thread::hardware_concurrency() >= 2;  // asked once
-  if (!cores || height < 2 * kDofTile) {
-    rows(0, 0, height);
-    return;
-  }
-  std::atomic<int> next{0};
-  const auto claim = [&](int part) {
-    for (int first; (first = next.fetch_add(kDofTile)) < height;) {
-      rows(part, first, std::min(height, first + kDofTile));
-    }
-  };
-  std::thread other(claim, 1);
-  claim(0);
-  other.join();
+  internal::ForEachRowChunk(height, rows, kDofTile);
 }
 
 DofPlanes PrepareDof(const ImageView& rgb, const ImageView& depth, const ThinLensOptions& lens,
@@ -380,7 +365,7 @@ DofPlanes PrepareDof(const ImageView& rgb, const ImageView& depth, const ThinLen
       CircleOfConfusion(lens, 0.0),
       lens.pixel_pitch_m > 0.0 ? lens.pixel_pitch_m : lens.focal_length_m / k.fx(),
       lens.focus_distance_m, lens.max_coc_px};
-  DofPart parts[2];
+  std::vector<DofPart> parts(static_cast<std::size_t>(internal::ChunkSlots()));
   ShareDofRows(planes.height, [&](int part, int first, int end) {
     if (first == 0) FillDofPadding(&planes, 0, planes.At(-planes.pad_x, 0));
 #if defined(__x86_64__)
@@ -395,9 +380,15 @@ DofPlanes PrepareDof(const ImageView& rgb, const ImageView& depth, const ThinLen
 #endif
     if (end == planes.height) FillDofPadding(&planes, planes.At(-planes.pad_x, end), n);
   });
-  summary->max_coc_px = std::max(parts[0].max_coc_px, parts[1].max_coc_px);
-  summary->capped_pixels = parts[0].capped_pixels + parts[1].capped_pixels;
-  PrepareWindow(&planes, std::max(parts[0].max_radius, parts[1].max_radius), aspect);
+  DofPart all;  // the parts' maxima and sums: the same whatever rows each part took
+  for (const DofPart& part : parts) {
+    all.max_coc_px = std::max(all.max_coc_px, part.max_coc_px);
+    all.capped_pixels += part.capped_pixels;
+    all.max_radius = std::max(all.max_radius, part.max_radius);
+  }
+  summary->max_coc_px = all.max_coc_px;
+  summary->capped_pixels = all.capped_pixels;
+  PrepareWindow(&planes, all.max_radius, aspect);
   return planes;
 }
 
@@ -656,15 +647,18 @@ void ApplyVignetting(Image& rgb, const Image& factors, bool simd) {
   static_cast<void>(simd);
   const bool vectors = false;
 #endif
-  for (int y = 0; y < rgb.height(); ++y) {
-    uint8_t* row = rgb.row(y);
-    const float* f = reinterpret_cast<const float*>(factors.row(y));
-    int x = 0;
+  // Each row alone, in chunks on every core.
+  internal::ForEachRowChunk(rgb.height(), [&](int, int first, int end) {
+    for (int y = first; y < end; ++y) {
+      uint8_t* row = rgb.row(y);
+      const float* f = reinterpret_cast<const float*>(factors.row(y));
+      int x = 0;
 #if defined(__x86_64__)
-    if (vectors) x = VignetteRowAvx2(row, f, rgb.width());
+      if (vectors) x = VignetteRowAvx2(row, f, rgb.width());
 #endif
-    VignetteRow(row, f, x, rgb.width());
-  }
+      VignetteRow(row, f, x, rgb.width());
+    }
+  });
 }
 
 void ThinLensOptions::Validate() const {

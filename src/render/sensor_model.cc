@@ -7,12 +7,12 @@
 #include <cmath>
 #include <cstring>
 #include <numbers>
-#include <thread>
 
 #if defined(__x86_64__)
 #include <immintrin.h>
 #endif
 
+#include "render/internal_chunks.h"
 #include "render/internal_sensor_model.h"
 #include "saccade/core/error.h"
 
@@ -21,8 +21,8 @@ namespace {
 
 // The most values one sensor holds (two float maps of this size: 2 GiB).
 constexpr int64_t kMaxSensorValues = int64_t{1} << 28;
-// Frames of at least this many values are exposed in parts on several threads.
-constexpr std::size_t kMinSensorPartValues = std::size_t{1} << 18;
+// Values a chunk of a frame's exposure takes (ForParts): some 0.1 ms on one thread.
+constexpr std::size_t kSensorChunkValues = std::size_t{1} << 15;
 // Streams of the counter-based generator: fixed pattern (PRNU, DSNU) and per frame.
 constexpr uint64_t kPrnuStream = 0x5052'4e55'0000'0001ULL;
 constexpr uint64_t kDsnuStream = 0x4453'4e55'0000'0002ULL;
@@ -387,22 +387,12 @@ bool Fits(PixelFormat format, int channels) {
   return format == PixelFormat::kGray8 || (IsBayer(format) && BytesPerPixel(format) == 1);
 }
 
-// part(first, end) over [0, n): in up to four parts on as many threads (up to the cores), each
-// of at least kMinSensorPartValues; in one where that is the whole.
+// part(first, end) over [0, n) in chunks of kSensorChunkValues on every core (ForEachChunk);
+// in one piece on one core.
 template <typename Part>
 void ForParts(std::size_t n, const Part& part) {
-  const unsigned threads = std::min<unsigned>(4, std::max(1u, std::thread::hardware_concurrency()));
-  if (n < 2 * kMinSensorPartValues || threads < 2) {
-    part(std::size_t{0}, n);
-    return;
-  }
-  const std::size_t parts = std::min<std::size_t>(threads, n / kMinSensorPartValues);
-  std::vector<std::thread> workers;
-  for (std::size_t p = 1; p < parts; ++p) {
-    workers.emplace_back(part, n * p / parts, n * (p + 1) / parts);
-  }
-  part(std::size_t{0}, n / parts);
-  for (std::thread& t : workers) t.join();
+  internal::ForEachChunk(n, kSensorChunkValues,
+                         [&part](int, std::size_t first, std::size_t end) { part(first, end); });
 }
 
 // ForParts over the values of `height` rows of `row_values` each: row(y, x0, x1) for the
@@ -509,6 +499,20 @@ std::vector<uint16_t> SensorModel::ExposeUniform(double mean_photons, int64_t fr
 std::vector<uint16_t> SensorModel::ExposeRendered(const ImageView& rendered, double exposure_s,
                                                   int64_t frame_index, Image* image8,
                                                   double gain) const {
+  std::vector<uint16_t> raw(values());
+  ExposeRenderedInto(rendered, exposure_s, frame_index, raw.data(), image8, gain);
+  return raw;
+}
+
+void SensorModel::ExposeRendered8(const ImageView& rendered, double exposure_s, int64_t frame_index,
+                                  Image* image8, double gain) const {
+  if (image8 == nullptr) throw InvalidArgument("SensorModel::ExposeRendered8: no image to write");
+  ExposeRenderedInto(rendered, exposure_s, frame_index, nullptr, image8, gain);
+}
+
+void SensorModel::ExposeRenderedInto(const ImageView& rendered, double exposure_s,
+                                     int64_t frame_index, uint16_t* raw, Image* image8,
+                                     double gain) const {
   CheckImage("SensorModel::ExposeRendered", *this, rendered.width(), rendered.height(),
              rendered.format());
   if (image8 != nullptr) {
@@ -522,15 +526,17 @@ std::vector<uint16_t> SensorModel::ExposeRendered(const ImageView& rendered, dou
     eta_photons[v] = params_.quantum_efficiency * std::max(0.0f, photons);
   }
   const FrameTerms t = MakeTerms(params_, stream_, frame_index, gain, prnu_.data(), dsnu_.data());
-  std::vector<uint16_t> raw(values());
   const std::size_t row_values = static_cast<std::size_t>(width_) * channels_;
-  // One pass: each value read, exposed and, with `image8`, written back in 8 bits.
+  // One pass: each value read, exposed and, with `image8`, written back in 8 bits. Without
+  // `raw`, a run's DN go to a buffer of the thread's, read back while still in its cache.
   ForRowParts(height_, row_values, [&](int y, std::size_t x0, std::size_t x1) {
     const std::size_t first = y * row_values + x0;
+    thread_local std::vector<uint16_t> run;
+    if (raw == nullptr && run.size() < x1 - x0) run.resize(x1 - x0);
     ExposeRun(t, RenderedInput{rendered.row(y) + x0, eta_photons}, first, x1 - x0,
-              raw.data() + first, image8 != nullptr ? image8->row(y) + x0 : nullptr, simd_);
+              raw != nullptr ? raw + first : run.data(),
+              image8 != nullptr ? image8->row(y) + x0 : nullptr, simd_);
   });
-  return raw;
 }
 
 void SensorModel::To8Bit(const uint16_t* raw, Image* image8) const {

@@ -180,7 +180,7 @@ TEST(NoiseOnCpuTest, AddsTheFinalPassesNoise) {
   }());
   options.noise_on_cpu = true;
   std::unique_ptr<Renderer> cpu = MakeRenderer(world, options);
-  // Large enough to be converted in two halves on two threads: each half's rows keep their
+  // Large enough to be converted in chunks of rows on threads: each chunk's rows keep their
   // place in the pass's hash.
   EXPECT_GE(320u * 240u, gl::kMinSplitNoisePixels);
   const scene::SceneState state = world.InitialState();

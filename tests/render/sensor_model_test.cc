@@ -274,13 +274,20 @@ TEST(SensorModelTest, VectorKernelGivesThePortableLoopsBits) {
         vector.To8Bit(fast.data(), &to8);
         ASSERT_EQ(std::vector<uint8_t>(to8.data(), to8.data() + to8.size_bytes()),
                   std::vector<uint8_t>(fast8.data(), fast8.data() + fast8.size_bytes()));
+        // ExposeRendered8 (no raw DN kept) writes the same 8-bit image, on both kernels.
+        for (const SensorModel* model : {&vector, static_cast<const SensorModel*>(&portable)}) {
+          Image only8(size.width, size.height, rendered.format());
+          model->ExposeRendered8(rendered.view(), exposure, 4, &only8, 2.5);
+          ASSERT_EQ(std::vector<uint8_t>(only8.data(), only8.data() + only8.size_bytes()),
+                    std::vector<uint8_t>(fast8.data(), fast8.data() + fast8.size_bytes()));
+        }
       }
     }
   }
 }
 
-// A frame exposed in parts on several threads (at least 2^19 values), the parts' bounds no
-// multiples of 4: the same bits both ways.
+// A frame exposed in chunks on every core (of 2^15 values), the chunks' bounds within rows: the
+// same bits both ways.
 TEST(SensorModelTest, VectorKernelGivesThePortableLoopsBitsInParts) {
   const scene::EmvaSensor s = BranchSensors()[0];
   const SensorModel vector(s, 2, "right", 723, 731, 1);
@@ -291,6 +298,18 @@ TEST(SensorModelTest, VectorKernelGivesThePortableLoopsBitsInParts) {
   vector.Expose(photons.data(), 8, fast.data());
   portable.Expose(photons.data(), 8, slow.data());
   EXPECT_EQ(fast, slow);
+  // A rendered mosaic of that size, in chunks of rows: ExposeRendered8 (each run's DN in a
+  // buffer of its thread's) writes ExposeRendered's 8-bit image.
+  Image rendered(723, 731, PixelFormat::kBayerRggb8);
+  std::mt19937 random(11);
+  for (std::size_t i = 0; i < rendered.size_bytes(); ++i) {
+    rendered.data()[i] = static_cast<uint8_t>(random());
+  }
+  Image with_raw(723, 731, PixelFormat::kBayerRggb8), only8(723, 731, PixelFormat::kBayerRggb8);
+  vector.ExposeRendered(rendered.view(), 0.008, 6, &with_raw);
+  vector.ExposeRendered8(rendered.view(), 0.008, 6, &only8);
+  EXPECT_EQ(std::vector<uint8_t>(only8.data(), only8.data() + only8.size_bytes()),
+            std::vector<uint8_t>(with_raw.data(), with_raw.data() + with_raw.size_bytes()));
 }
 
 TEST(SensorModelTest, BadParametersNameTheField) {

@@ -56,11 +56,20 @@ class SensorModel {
   std::vector<uint16_t> ExposeRendered(const ImageView& rendered, double exposure_s,
                                        int64_t frame_index, Image* image8, double gain = 1.0) const;
 
+  /// ExposeRendered's 8-bit image alone, into `image8` (not null; it may be `rendered`): the
+  /// same values, without a frame of raw DN (the renderer's cameras keep only the image).
+  void ExposeRendered8(const ImageView& rendered, double exposure_s, int64_t frame_index,
+                       Image* image8, double gain = 1.0) const;
+
   /// Raw DN to 8 bits in place of an image of the sensor's size (kRgb8 for 3 channels, kGray8
   /// or an 8-bit Bayer mosaic for 1): round(y * 255 / (2^bits - 1)).
   void To8Bit(const uint16_t* raw, Image* image8) const;
 
  private:
+  // ExposeRendered's pass; `raw` null: each run's DN in a buffer of the thread's.
+  void ExposeRenderedInto(const ImageView& rendered, double exposure_s, int64_t frame_index,
+                          uint16_t* raw, Image* image8, double gain) const;
+
   scene::EmvaSensor params_;
   uint64_t stream_;  // hash of seed and camera name
   int width_;

@@ -2,29 +2,28 @@
 // Pixel conversion of the readback.
 #include <cstddef>
 #include <cstdint>
-#include <thread>
 #include <vector>
+
+#include "render/internal_chunks.h"
 
 namespace saccade::render::gl {
 
-/// Images of at least this many pixels get their CPU noise in two halves on two threads
-/// (Retrieve); smaller ones in one piece, where a thread costs more than it saves.
+/// Images of at least this many pixels get their CPU work after readback in chunks of rows on
+/// every core (InRowChunks); smaller ones in one piece, where waking a thread costs more than it
+/// saves.
 constexpr std::size_t kMinSplitNoisePixels = 256 * 256;
 
-/// part(first_row, end_row) over rows [0, rows) of an image of `pixels` pixels: in two halves
-/// at once where there are two cores and at least kMinSplitNoisePixels pixels (Retrieve runs
-/// after the frame's fence, when a software rasteriser's threads are idle), else in one piece.
-/// The same result either way where each row is computed alone.
+/// part(first_row, end_row) over rows [0, rows) of an image of `pixels` pixels: in chunks of
+/// rows on every core (internal::ForEachRowChunk) where there are at least kMinSplitNoisePixels
+/// pixels (Retrieve runs after the frame's fence, when a software rasteriser's threads are
+/// idle), else in one piece. The same result either way where each row is computed alone.
 template <class Part>
-void InTwoHalves(int rows, std::size_t pixels, const Part& part) {
-  static const bool cores = std::thread::hardware_concurrency() >= 2;  // asked once
-  if (!cores || pixels < kMinSplitNoisePixels) {
+void InRowChunks(int rows, std::size_t pixels, const Part& part) {
+  if (pixels < kMinSplitNoisePixels) {
     part(0, rows);
     return;
   }
-  std::thread other(part, rows / 2, rows);
-  part(0, rows / 2);
-  other.join();
+  render::internal::ForEachRowChunk(rows, [&part](int, int first, int end) { part(first, end); });
 }
 
 /// RGBA rows to tightly packed RGB (alpha dropped); SSSE3 where the CPU has it.

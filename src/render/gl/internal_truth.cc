@@ -100,12 +100,12 @@ std::shared_ptr<Image> GlRenderer::ColorPassDepth(int camera, int slot, const Im
   if (lens != nullptr) setup.color_depth_source_z.resize(source_pixels);
   float* z =
       lens != nullptr ? setup.color_depth_source_z.data() : reinterpret_cast<float*>(depth->data());
-  InTwoHalves(buffers.height(), source_pixels, [&](int first, int end) {
+  InRowChunks(buffers.height(), source_pixels, [&](int first, int end) {
     CameraZRows(setup.color_depth, window_depth, first, end, z);
   });
   buffers.Unmap();
   if (lens != nullptr) {
-    InTwoHalves(depth->height(), source_pixels, [&](int first, int end) {
+    InRowChunks(depth->height(), source_pixels, [&](int first, int end) {
       for (int y = first; y < end; ++y) {
         lens->RemapDepthRow(z, y, reinterpret_cast<float*>(depth->row(y)));
       }
