@@ -6,6 +6,7 @@
 #include <cctype>
 #include <cmath>
 #include <cstdlib>
+#include <cstring>
 #include <string>
 #include <utility>
 
@@ -328,10 +329,19 @@ Image Mosaic(const ImageView& rgb, CfaPattern pattern) {
   Image out(rgb.width(), rgb.height(), BayerFormat(pattern, 8));
   const std::array<int, 4> cell = CellOf(pattern);
   internal::ForEachRowChunk(rgb.height(), [&](int, int first, int end) {
+    // The width and the row's two channels in locals: a byte store may alias anything, which
+    // made the compiler reload them at every pixel.
+    const int w = rgb.width();
     for (int y = first; y < end; ++y) {
       const uint8_t* in = rgb.row(y);
       uint8_t* row = out.row(y);
-      for (int x = 0; x < rgb.width(); ++x) row[x] = in[3 * x + cell[(y & 1) * 2 + (x & 1)]];
+      const int even = cell[(y & 1) * 2], odd = cell[(y & 1) * 2 + 1];
+      int x = 0;
+      for (; x + 1 < w; x += 2) {
+        row[x] = in[3 * x + even];
+        row[x + 1] = in[3 * x + 3 + odd];
+      }
+      if (x < w) row[x] = in[3 * x + even];
     }
   });
   if (rgb.metadata() != nullptr) out.metadata() = *rgb.metadata();
@@ -339,6 +349,19 @@ Image Mosaic(const ImageView& rgb, CfaPattern pattern) {
 }
 
 namespace {
+
+// Bytes [p, end) through `table` in place, 8 at a time. The table is the caller's local copy:
+// a byte store may alias anything but it, so that nothing is reloaded value by value.
+void ToneBytes(uint8_t* p, uint8_t* end, const std::array<uint8_t, 256>& table) {
+  for (; p + 8 <= end; p += 8) {
+    uint64_t in;
+    std::memcpy(&in, p, 8);
+    uint64_t out = 0;
+    for (int k = 0; k < 8; ++k) out |= uint64_t{table[(in >> (8 * k)) & 0xff]} << (8 * k);
+    std::memcpy(p, &out, 8);
+  }
+  for (; p < end; ++p) *p = table[*p];
+}
 
 // Demosaic's image; with `tone`, each value then looked up in it (a tone curve's table, the
 // same for the three colours), row by row while the row is in the cache.
@@ -362,6 +385,8 @@ Image DemosaicThroughTable(const ImageView& mosaic, DemosaicMethod method,
 #endif
   // Rows 1 to h - 2, each alone, in chunks on every core.
   internal::ForEachRowChunk(h - 2, [&](int, int first, int end) {
+    std::array<uint8_t, 256> table{};  // the chunk's own copy: no store of ToneBytes reaches it
+    if (tone != nullptr) table = *tone;
     for (int y = first + 1; y < end + 1; ++y) {
       const MosaicRows rows(mosaic, cell, y);
       uint8_t* row = out.row(y);
@@ -374,9 +399,7 @@ Image DemosaicThroughTable(const ImageView& mosaic, DemosaicMethod method,
       } else {
         for (; x < w - 1; ++x) EdgeAwarePixel(rows, x, row + 3 * x);
       }
-      if (tone != nullptr) {
-        for (uint8_t* p = row + 3; p < row + 3 * (w - 1); ++p) *p = (*tone)[*p];
-      }
+      if (tone != nullptr) ToneBytes(row + 3, row + 3 * (w - 1), table);
     }
   });
   CopyBorders(out);  // copies of toned values: toned as the pixels they copy
