@@ -109,7 +109,12 @@ std::vector<Frame> GlRenderer::Retrieve() {
     } else if (row_bytes == static_cast<int>(image->stride())) {
       std::memcpy(image->data(), pixels, image->size_bytes());
     } else {
-      RgbaToRgb(pixels, image->data(), pixel_count);
+      // RGBA rows to RGB in chunks of rows on every core (a GPU's frame is mostly this).
+      const std::size_t width = static_cast<std::size_t>(image->width());
+      InRowChunks(image->height(), pixel_count, [&](int first_row, int end_row) {
+        RgbaToRgb(pixels + 4 * width * first_row, image->row(first_row),
+                  width * static_cast<std::size_t>(end_row - first_row));
+      });
     }
     if (effect_buffers != nullptr) {
       effect_buffers->Unmap();
