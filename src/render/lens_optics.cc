@@ -610,20 +610,24 @@ Image VignettingFactors(const geometry::CameraModel& camera, const VignettingOpt
       farthest = std::max(farthest, std::hypot(u - k.cx(), v - k.cy()));
     }
   }
-  for (int y = 0; y < k.height(); ++y) {
-    float* row = reinterpret_cast<float*>(factors.row(y));
-    for (int x = 0; x < k.width(); ++x) {
-      double factor = 1.0;
-      if (options.model == VignettingModel::kCos4) {
-        const std::optional<Eigen::Vector3d> ray = camera.Unproject(Eigen::Vector2d(x, y));
-        const double cos_theta = ray ? std::max(0.0, ray->z() / ray->norm()) : 0.0;
-        factor = std::pow(cos_theta, 4);
-      } else if (options.model == VignettingModel::kPolynomial) {
-        factor = options.Polynomial(std::hypot(x - k.cx(), y - k.cy()) / farthest);
+  // Each pixel alone (an iterative undistortion for cos^4: a renderer's start), in chunks of
+  // rows on every core.
+  internal::ForEachRowChunk(k.height(), [&](int, int first, int end) {
+    for (int y = first; y < end; ++y) {
+      float* row = reinterpret_cast<float*>(factors.row(y));
+      for (int x = 0; x < k.width(); ++x) {
+        double factor = 1.0;
+        if (options.model == VignettingModel::kCos4) {
+          const std::optional<Eigen::Vector3d> ray = camera.Unproject(Eigen::Vector2d(x, y));
+          const double cos_theta = ray ? std::max(0.0, ray->z() / ray->norm()) : 0.0;
+          factor = std::pow(cos_theta, 4);
+        } else if (options.model == VignettingModel::kPolynomial) {
+          factor = options.Polynomial(std::hypot(x - k.cx(), y - k.cy()) / farthest);
+        }
+        row[x] = static_cast<float>(factor);
       }
-      row[x] = static_cast<float>(factor);
     }
-  }
+  });
   return factors;
 }
 
