@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "image_camera_helpers.h"
+#include "render/gl/internal_color_depth.h"
 #include "render/gl/internal_cpu_lens.h"
 #include "render/gl/internal_cpu_turn.h"
 #include "render/gl/internal_effects.h"
@@ -289,10 +290,11 @@ TEST(PixelsTest, RgbaToRgbInPartsGivesTheSameBytesAsOnePass) {
   EXPECT_EQ(rgb[2], 30);
 }
 
-// The remap's, the depth remap's and the noise's AVX2 loops and their portable ones give the
-// same rows to the bit, on a random source through the barrel lens, in rows of a width that
-// leaves a tail for the portable loop: the remap's integer arithmetic, the depth remap's float
-// blends and edges, and the noise's levels (a table) against
+// The remap's, the depth remap's, the camera z's and the noise's vector loops and their
+// portable ones give the same rows to the bit, on a random source through the barrel lens, in
+// rows of a width that leaves a tail for the portable loop: the remap's integer arithmetic, the
+// depth remap's float blends and edges, the camera z's divisions in double (and 0 where nothing
+// was drawn), and the noise's levels (a table) against
 // the vector loop's float arithmetic, for read noise alone, shot noise alone, both, and noise
 // wide enough to clip at 0 and 255.
 TEST(LensOnCpuTest, TheVectorLoopsEqualThePortableOnes) {
@@ -336,6 +338,26 @@ TEST(LensOnCpuTest, TheVectorLoopsEqualThePortableOnes) {
     }
   }
   EXPECT_GT(blended, std::size_t{1000});
+  // The colour pass's window depth to the camera's z: depths across [0, 1] (near, far, the
+  // far plane's 1 where nothing was drawn) through a view turned off the camera's axis.
+  Eigen::Matrix3d R_CV =
+      Eigen::AngleAxisd(0.3, Eigen::Vector3d(0.2, 1.0, 0.1).normalized()).toRotationMatrix();
+  Eigen::Matrix4d projection = Eigen::Matrix4d::Zero();
+  projection(2, 2) = -(50.0 + 0.05) / (50.0 - 0.05);  // near 5 cm, far 50 m
+  projection(2, 3) = -2.0 * 50.0 * 0.05 / (50.0 - 0.05);
+  const gl::ColorDepthMap depth_map =
+      gl::MakeColorDepthMap(projection, R_CV, lens.views[0].intrinsics);
+  std::vector<float> window(static_cast<std::size_t>(w) * h);
+  for (std::size_t i = 0; i < window.size(); ++i) {
+    state = state * 1664525u + 1013904223u;
+    window[i] = i % 9 == 0 ? 1.0f : static_cast<float>(state >> 8) / 16777216.0f;
+  }
+  std::vector<float> fast_camera_z(window.size()), portable_camera_z(window.size());
+  gl::CameraZRows(depth_map, window.data(), 0, h, fast_camera_z.data());
+  gl::CameraZRows(depth_map, window.data(), 0, h, portable_camera_z.data(), /*simd=*/false);
+  EXPECT_EQ(std::memcmp(fast_camera_z.data(), portable_camera_z.data(), 4 * window.size()), 0);
+  EXPECT_EQ(std::count(fast_camera_z.begin(), fast_camera_z.end(), 0.0f),
+            std::count(window.begin(), window.end(), 1.0f));
   const std::pair<float, float> sensors[] = {
       {5.0f, 0.0f}, {0.0f, 0.2f}, {2.0f, 0.3f}, {1.5f, 0.1f}, {20.0f, 1.7f}};
   for (const auto& [read, gain] : sensors) {
