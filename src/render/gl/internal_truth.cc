@@ -23,8 +23,8 @@ void GlRenderer::FillTruth(int camera, const Pending& pending, int slot, Frame* 
     auto image = std::make_shared<Image>(width, height, format);
     image->metadata() = frame->color->metadata();
     const uint8_t* mapped = MapOrThrow(buffers, slot, " (truth)");
-    // In chunks of rows on every core (4 bytes a pixel, rows packed both sides).
-    const std::size_t row = bytes / static_cast<std::size_t>(std::max(height, 1));
+    // In chunks of rows on every core (rows packed both sides).
+    const std::size_t row = image->stride();
     InRowChunks(height, bytes / 4, [&](int first, int end) {
       std::memcpy(image->row(first), mapped + row * first, row * (end - first));
     });
