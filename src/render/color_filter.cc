@@ -350,9 +350,34 @@ Image Mosaic(const ImageView& rgb, CfaPattern pattern) {
 
 namespace {
 
-// Bytes [p, end) through `table` in place, 8 at a time. The table is the caller's local copy:
-// a byte store may alias anything but it, so that nothing is reloaded value by value.
+#if defined(__x86_64__)
+// ToneBytes' bytes 64 at a time where the CPU has AVX-512 VBMI: two 128-entry byte
+// permutations of the table (each index's low 7 bits), the index's top bit choosing between
+// them. Returns the first byte left.
+__attribute__((target("avx512f,avx512bw,avx512vbmi"))) uint8_t* ToneBytesVbmi(
+    uint8_t* p, uint8_t* end, const std::array<uint8_t, 256>& table) {
+  const __m512i t0 = _mm512_loadu_si512(table.data()), t1 = _mm512_loadu_si512(table.data() + 64);
+  const __m512i t2 = _mm512_loadu_si512(table.data() + 128),
+                t3 = _mm512_loadu_si512(table.data() + 192);
+  for (; p + 64 <= end; p += 64) {
+    const __m512i v = _mm512_loadu_si512(p);
+    const __m512i low = _mm512_permutex2var_epi8(t0, v, t1);   // entries 0 to 127
+    const __m512i high = _mm512_permutex2var_epi8(t2, v, t3);  // entries 128 to 255
+    _mm512_storeu_si512(p, _mm512_mask_blend_epi8(_mm512_movepi8_mask(v), low, high));
+  }
+  return p;
+}
+#endif
+
+// Bytes [p, end) through `table` in place, 64 at a time with AVX-512 VBMI, else 8 at a time.
+// The table is the caller's local copy: a byte store may alias anything but it, so that nothing
+// is reloaded value by value.
 void ToneBytes(uint8_t* p, uint8_t* end, const std::array<uint8_t, 256>& table) {
+#if defined(__x86_64__)
+  static const bool vbmi =
+      __builtin_cpu_supports("avx512bw") && __builtin_cpu_supports("avx512vbmi");  // asked once
+  if (vbmi) p = ToneBytesVbmi(p, end, table);
+#endif
   for (; p + 8 <= end; p += 8) {
     uint64_t in;
     std::memcpy(&in, p, 8);
