@@ -84,6 +84,19 @@ void CameraChain::ApplyOptics(Image* rgb, const Image* depth, const FrameOptics&
   TakePixels(rgb, std::move(blurred));
 }
 
+Image CameraChain::ApplyOpticsToMosaic(Image* rgb, const Image* depth,
+                                       const FrameOptics& frame) const {
+  if (!cfa()) throw Error("CameraChain::ApplyOpticsToMosaic: the camera has no filter array");
+  if (vignetting_) ApplyVignetting(*rgb, factors_);
+  if (!depth_of_field_) return Mosaic(rgb->view(), options_.cfa);
+  if (depth == nullptr) {
+    throw Error("CameraChain::ApplyOpticsToMosaic: depth of field without a depth");
+  }
+  return ApplyDepthOfFieldToMosaic(rgb->view(), depth->view(),
+                                   ToThinLensOptions(lens_, frame.focus_distance_m), intrinsics_,
+                                   options_.cfa);
+}
+
 std::shared_ptr<Image> CameraChain::ApplyColor(Image* rgb, Image* mosaic) const {
   if (!color_) return nullptr;
   ColorImages images = mosaic != nullptr && options_.cfa != CfaPattern::kNone

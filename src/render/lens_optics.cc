@@ -55,9 +55,9 @@ struct WindowStep {
 
 // Tiles of kDofTile x kDofTile pixels bound the circles a pixel's gather can meet.
 constexpr int kDofTile = 16;
-// The most pixels of a row gathered at once (DofRow: 8 with AVX2, else 4, one SSE vector):
-// a divisor of kDofTile, so that a run never straddles two tiles.
-constexpr int kDofMaxLanes = 8;
+// The most pixels of a row gathered at once (DofRow: 16 with AVX-512, 8 with AVX2, else 4, one
+// SSE vector): a divisor of kDofTile, so that a run never straddles two tiles.
+constexpr int kDofMaxLanes = 16;
 static_assert(kDofTile % kDofMaxLanes == 0);
 
 // GCC vectors of kLanes floats (Vector; Loaded reads or writes one at any float's address), of
@@ -74,6 +74,7 @@ struct DofLanes<4> {
   using Ints = int32_t __attribute__((vector_size(16)));
   using Bytes = uint8_t __attribute__((vector_size(16)));
   using LoadedBytes = uint8_t __attribute__((vector_size(16), aligned(1), may_alias));
+  using LaneBytes = uint8_t __attribute__((vector_size(4)));  // a byte a lane
 };
 template <>
 struct DofLanes<8> {
@@ -82,6 +83,16 @@ struct DofLanes<8> {
   using Ints = int32_t __attribute__((vector_size(32)));
   using Bytes = uint8_t __attribute__((vector_size(32)));
   using LoadedBytes = uint8_t __attribute__((vector_size(32), aligned(1), may_alias));
+  using LaneBytes = uint8_t __attribute__((vector_size(8)));  // a byte a lane
+};
+template <>
+struct DofLanes<16> {
+  using Vector = float __attribute__((vector_size(64)));
+  using Loaded = float __attribute__((vector_size(64), aligned(alignof(float)), may_alias));
+  using Ints = int32_t __attribute__((vector_size(64)));
+  using Bytes = uint8_t __attribute__((vector_size(64)));
+  using LoadedBytes = uint8_t __attribute__((vector_size(64), aligned(1), may_alias));
+  using LaneBytes = uint8_t __attribute__((vector_size(16)));  // a byte a lane
 };
 
 // What the gather reads per pixel, in planes padded around the image (pad_x, pad_y: at least
@@ -402,28 +413,76 @@ template <typename Ints>
   return any != 0;
 }
 
-// Row y of the image, kLanes output pixels at a time (the header's gather of what is behind,
-// scatter of what is in front), into `out`. The tile's reach bounds every pixel's own circle
-// and those near it (the window is sorted by distance): beyond it every term is 0. Each term
-// is the scalar gather's, in its order: the same bits as pixel by pixel, with 4 lanes or 8.
-// Inlined into DofRowsPortable and DofRowsAvx2, so that each is compiled for its target; the
-// vectors are never passed to a function (their ABI differs with and without AVX).
+// A run of kLanes pixels' rounded channels into an RGB row at pixel x: each lane's RGB in its
+// int's low 3 bytes, packed to the front of the vector; stored whole where the row has room
+// (the bytes past the run's are the next run's, written after).
 template <int kLanes>
-[[gnu::always_inline]] inline void DofRow(const DofPlanes& planes, int y, uint8_t* out) {
-  using Vector = typename DofLanes<kLanes>::Vector;
-  using Loaded = typename DofLanes<kLanes>::Loaded;
+[[gnu::always_inline]] inline void DofStoreRgb(const typename DofLanes<kLanes>::Ints rounded[3],
+                                               int x, int width, uint8_t* out) {
   using Ints = typename DofLanes<kLanes>::Ints;
   using Bytes = typename DofLanes<kLanes>::Bytes;
   using LoadedBytes = typename DofLanes<kLanes>::LoadedBytes;
+  const Ints rgb = rounded[0] | rounded[1] << 8 | rounded[2] << 16;
+  const Bytes bytes = reinterpret_cast<Bytes>(rgb);
+  uint8_t* const run_out = out + 3 * x;
+  if (3 * x + static_cast<int>(sizeof(Bytes)) <= 3 * width) {
+    if constexpr (kLanes == 16) {
+      *reinterpret_cast<LoadedBytes*>(run_out) = __builtin_shufflevector(
+          bytes, bytes, 0, 1, 2, 4, 5, 6, 8, 9, 10, 12, 13, 14, 16, 17, 18, 20, 21, 22, 24, 25, 26,
+          28, 29, 30, 32, 33, 34, 36, 37, 38, 40, 41, 42, 44, 45, 46, 48, 49, 50, 52, 53, 54, 56,
+          57, 58, 60, 61, 62, 3, 7, 11, 15, 19, 23, 27, 31, 35, 39, 43, 47, 51, 55, 59, 63);
+    } else if constexpr (kLanes == 8) {
+      *reinterpret_cast<LoadedBytes*>(run_out) =
+          __builtin_shufflevector(bytes, bytes, 0, 1, 2, 4, 5, 6, 8, 9, 10, 12, 13, 14, 16, 17, 18,
+                                  20, 21, 22, 24, 25, 26, 28, 29, 30, 3, 7, 11, 15, 19, 23, 27, 31);
+    } else {
+      *reinterpret_cast<LoadedBytes*>(run_out) = __builtin_shufflevector(
+          bytes, bytes, 0, 1, 2, 4, 5, 6, 8, 9, 10, 12, 13, 14, 3, 7, 11, 15);
+    }
+  } else {
+    for (int j = 0; j < std::min(kLanes, width - x); ++j) {
+      for (int ch = 0; ch < 3; ++ch) run_out[3 * j + ch] = static_cast<uint8_t>(rounded[ch][j]);
+    }
+  }
+}
+
+// The colours a run's gather sums: the three planes of an RGB image, or (a mosaic's) one
+// channel a pixel, the row's two channels alternating lane by lane (a run starts at an even
+// pixel). `cell`: the filter's 2 x 2 cell (CfaChannel), or null for RGB.
+struct DofChannels {
+  const float* plane[3];
+  int count;  // 3, or 1 for a mosaic: plane[0] at even pixels, plane[1] at odd ones
+};
+inline DofChannels ChannelsOf(const DofPlanes& planes, const int* cell, int y) {
+  if (cell == nullptr) return {{planes.color[0], planes.color[1], planes.color[2]}, 3};
+  return {{planes.color[cell[(y & 1) * 2]], planes.color[cell[(y & 1) * 2 + 1]], nullptr}, 1};
+}
+
+// Row y of the image, kLanes output pixels at a time (the header's gather of what is behind,
+// scatter of what is in front), into `out`: RGB (kChannels 3) or the mosaic's one value a pixel
+// (kChannels 1: each lane's own channel of `channels`, the same sums as that channel's of the
+// RGB gather, so the same bits as its mosaic). The tile's reach bounds every pixel's own circle
+// and those near it (the window is sorted by distance): beyond it every term is 0. Each term is
+// the scalar gather's, in its order: the same bits as pixel by pixel, with 4 lanes, 8 or 16.
+// Inlined into DofRowsPortable, DofRowsAvx2 and DofRowsAvx512, so that each is compiled for its
+// target; the vectors are never passed to a function (their ABI differs with and without AVX).
+template <int kLanes, int kChannels>
+[[gnu::always_inline]] inline void DofRow(const DofPlanes& planes, const DofChannels& channels,
+                                          int y, uint8_t* out) {
+  using Vector = typename DofLanes<kLanes>::Vector;
+  using Loaded = typename DofLanes<kLanes>::Loaded;
+  using Ints = typename DofLanes<kLanes>::Ints;
   const float* tile_reach = &planes.reach[static_cast<std::size_t>(y / kDofTile) * planes.tiles_x];
   // Locals: the stores below could alias the planes' pointers, which would be reloaded.
   const float *const depth = planes.depth, *const outer = planes.outer, *const area = planes.area;
-  const float* const color[3] = {planes.color[0], planes.color[1], planes.color[2]};
+  const float* const color[3] = {channels.plane[0], channels.plane[1], channels.plane[2]};
+  Ints odd_lanes{};  // a mosaic's lanes that take plane[1]
+  for (int j = 1; j < kLanes; j += 2) odd_lanes[j] = -1;
   for (int x = 0; x < planes.width; x += kLanes) {
     const std::size_t p = planes.At(x, y);
     const Vector outer_p = *reinterpret_cast<const Loaded*>(outer + p);
     const Vector nearer = *reinterpret_cast<const Loaded*>(depth + p) * (1.0f - kNearerFraction);
-    Vector back_weight{}, front_weight{}, back[3] = {}, front[3] = {};
+    Vector back_weight{}, front_weight{}, back[kChannels] = {}, front[kChannels] = {};
     const float limit = tile_reach[x / kDofTile];
     for (const WindowStep& o : planes.window) {
       if (o.distance >= limit) break;
@@ -441,29 +500,36 @@ template <int kLanes>
       // over q. Padding is neither. A side no lane is on is skipped: its terms are +0, which
       // leave the sums (+0 or more) as they are.
       const Ints in_front = depth_q < nearer, behind = depth_q >= nearer;
+      // q's colours, lane by lane (a mosaic's: each lane's own channel).
+      Vector color_q[kChannels];
+      if constexpr (kChannels == 3) {
+#pragma GCC unroll 3
+        for (int ch = 0; ch < 3; ++ch)
+          color_q[ch] = *reinterpret_cast<const Loaded*>(color[ch] + q);
+      } else {
+        color_q[0] = odd_lanes ? *reinterpret_cast<const Loaded*>(color[1] + q)
+                               : *reinterpret_cast<const Loaded*>(color[0] + q);
+      }
       if (AnyLane(in_front)) {
         const Vector f = in_front ? cover_q / *reinterpret_cast<const Loaded*>(area + q) : Vector{};
         front_weight += f;
 #pragma GCC unroll 3
-        for (int ch = 0; ch < 3; ++ch) {
-          front[ch] += f * *reinterpret_cast<const Loaded*>(color[ch] + q);
-        }
+        for (int ch = 0; ch < kChannels; ++ch) front[ch] += f * color_q[ch];
       }
       if (AnyLane(behind)) {
         const Vector b = behind ? cover_p : Vector{};
         back_weight += b;
 #pragma GCC unroll 3
-        for (int ch = 0; ch < 3; ++ch)
-          back[ch] += b * *reinterpret_cast<const Loaded*>(color[ch] + q);
+        for (int ch = 0; ch < kChannels; ++ch) back[ch] += b * color_q[ch];
       }
     }
     // The average behind, and over it what is in front with the opacity its weights sum to
     // (at most 1); lane by lane the scalar gather's operations (std::min, std::clamp as their
     // comparisons), the lanes without a weight's division discarded.
     const Vector alpha = front_weight < 1.0f ? front_weight : Vector{} + 1.0f;
-    Ints rounded[3];
+    Ints rounded[kChannels];
 #pragma GCC unroll 3
-    for (int ch = 0; ch < 3; ++ch) {
+    for (int ch = 0; ch < kChannels; ++ch) {
       Vector value = back_weight > 0.0f ? back[ch] / back_weight : Vector{};
       value =
           front_weight > 0.0f ? alpha * front[ch] / front_weight + (1.0f - alpha) * value : value;
@@ -474,37 +540,49 @@ template <int kLanes>
       const Ints whole = __builtin_convertvector(value, Ints);
       rounded[ch] = whole - (value - __builtin_convertvector(whole, Vector) >= 0.5f);
     }
-    // Each lane's RGB in its int's low 3 bytes, packed to the front of the vector; stored whole
-    // where the row has room (the bytes past the run's are the next run's, written after).
-    const Ints rgb = rounded[0] | rounded[1] << 8 | rounded[2] << 16;
-    const Bytes bytes = reinterpret_cast<Bytes>(rgb);
-    uint8_t* const run_out = out + 3 * x;
-    if (3 * x + static_cast<int>(sizeof(Bytes)) <= 3 * planes.width) {
-      if constexpr (kLanes == 8) {
-        *reinterpret_cast<LoadedBytes*>(run_out) = __builtin_shufflevector(
-            bytes, bytes, 0, 1, 2, 4, 5, 6, 8, 9, 10, 12, 13, 14, 16, 17, 18, 20, 21, 22, 24, 25,
-            26, 28, 29, 30, 3, 7, 11, 15, 19, 23, 27, 31);
+    if constexpr (kChannels == 1) {
+      // Each lane's byte; stored whole where the row has room.
+      using LaneBytes = typename DofLanes<kLanes>::LaneBytes;
+      const LaneBytes bytes = __builtin_convertvector(rounded[0], LaneBytes);
+      if (x + kLanes <= planes.width) {
+        std::memcpy(out + x, &bytes, sizeof(bytes));
       } else {
-        *reinterpret_cast<LoadedBytes*>(run_out) = __builtin_shufflevector(
-            bytes, bytes, 0, 1, 2, 4, 5, 6, 8, 9, 10, 12, 13, 14, 3, 7, 11, 15);
+        for (int j = 0; j < planes.width - x; ++j) out[x + j] = bytes[j];
       }
     } else {
-      for (int j = 0; j < std::min(kLanes, planes.width - x); ++j) {
-        for (int ch = 0; ch < 3; ++ch) run_out[3 * j + ch] = static_cast<uint8_t>(rounded[ch][j]);
-      }
+      DofStoreRgb<kLanes>(rounded, x, planes.width, out);
     }
   }
 }
 
-void DofRowsPortable(const DofPlanes& planes, int first, int end, Image* out) {
-  for (int y = first; y < end; ++y) DofRow<4>(planes, y, out->row(y));
+// Rows [first, end) of DofRow's output into `out` (kRgb8, or the mosaic of `cell`).
+template <int kLanes>
+[[gnu::always_inline]] inline void DofRows(const DofPlanes& planes, const int* cell, int first,
+                                           int end, Image* out) {
+  for (int y = first; y < end; ++y) {
+    const DofChannels channels = ChannelsOf(planes, cell, y);
+    if (cell == nullptr) {
+      DofRow<kLanes, 3>(planes, channels, y, out->row(y));
+    } else {
+      DofRow<kLanes, 1>(planes, channels, y, out->row(y));
+    }
+  }
+}
+
+void DofRowsPortable(const DofPlanes& planes, const int* cell, int first, int end, Image* out) {
+  DofRows<4>(planes, cell, first, end, out);
 }
 
 #if defined(__x86_64__)
-// No "fma": a fused multiply-add would round once where the gather rounds twice.
-__attribute__((target("avx2"))) void DofRowsAvx2(const DofPlanes& planes, int first, int end,
-                                                 Image* out) {
-  for (int y = first; y < end; ++y) DofRow<8>(planes, y, out->row(y));
+// No "fma" in the targets: a fused multiply-add would round once where the gather rounds twice
+// (and -std=c++20 contracts none).
+__attribute__((target("avx2"))) void DofRowsAvx2(const DofPlanes& planes, const int* cell,
+                                                 int first, int end, Image* out) {
+  DofRows<8>(planes, cell, first, end, out);
+}
+__attribute__((target("avx512f,avx512bw,avx512dq,avx512vl"))) void DofRowsAvx512(
+    const DofPlanes& planes, const int* cell, int first, int end, Image* out) {
+  DofRows<16>(planes, cell, first, end, out);
 }
 #endif
 
@@ -702,12 +780,35 @@ double CircleOfConfusionPx(const ThinLensOptions& lens, const geometry::Intrinsi
 
 Image ApplyDepthOfField(const ImageView& rgb, const ImageView& depth, const ThinLensOptions& lens,
                         const geometry::Intrinsics& intrinsics, DepthOfFieldSummary* summary) {
-  return ApplyDepthOfField(rgb, depth, lens, intrinsics, summary, true);
+  return ApplyDepthOfField(rgb, depth, lens, intrinsics, summary, kDofMaxLanes);
+}
+
+Image ApplyDepthOfFieldToMosaic(const ImageView& rgb, const ImageView& depth,
+                                const ThinLensOptions& lens, const geometry::Intrinsics& intrinsics,
+                                CfaPattern pattern, DepthOfFieldSummary* summary) {
+  if (pattern == CfaPattern::kNone) {
+    throw InvalidArgument("ApplyDepthOfFieldToMosaic: pattern none, expected a Bayer pattern");
+  }
+  return ApplyDepthOfField(rgb, depth, lens, intrinsics, summary, kDofMaxLanes, pattern);
+}
+
+int DepthOfFieldLanes(int max_lanes) {
+#if defined(__x86_64__)
+  static const bool avx2 = __builtin_cpu_supports("avx2");  // asked once
+  static const bool avx512 =
+      __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512bw") &&
+      __builtin_cpu_supports("avx512dq") && __builtin_cpu_supports("avx512vl");
+  if (max_lanes >= 16 && avx512) return 16;
+  if (max_lanes >= 8 && avx2) return 8;
+#else
+  static_cast<void>(max_lanes);
+#endif
+  return 4;
 }
 
 Image ApplyDepthOfField(const ImageView& rgb, const ImageView& depth, const ThinLensOptions& lens,
                         const geometry::Intrinsics& intrinsics, DepthOfFieldSummary* summary,
-                        bool simd) {
+                        int max_lanes, CfaPattern pattern) {
   lens.Validate();
   if (rgb.format() != PixelFormat::kRgb8 || depth.format() != PixelFormat::kFloat32) {
     throw InvalidArgument(fmt::format(
@@ -722,24 +823,27 @@ Image ApplyDepthOfField(const ImageView& rgb, const ImageView& depth, const Thin
   DepthOfFieldSummary local;
   DepthOfFieldSummary* out_summary = summary != nullptr ? summary : &local;
   *out_summary = {};
-#if defined(__x86_64__)
-  static const bool avx2 = __builtin_cpu_supports("avx2");  // asked once
-  const bool wide = avx2 && simd;
-#else
-  static_cast<void>(simd);
-  constexpr bool wide = false;
-#endif
-  const DofPlanes planes = PrepareDof(rgb, depth, lens, intrinsics, wide, out_summary);
-  Image out(rgb.width(), rgb.height(), PixelFormat::kRgb8);
+  const int lanes = DepthOfFieldLanes(max_lanes);
+  const DofPlanes planes = PrepareDof(rgb, depth, lens, intrinsics, lanes >= 8, out_summary);
+  // RGB, or the mosaic's cell (CfaChannel of its 2 x 2 pixels, row by row).
+  const bool mosaic = pattern != CfaPattern::kNone;
+  const std::array<int, 4> cell = {CfaChannel(pattern, 0, 0), CfaChannel(pattern, 1, 0),
+                                   CfaChannel(pattern, 0, 1), CfaChannel(pattern, 1, 1)};
+  Image out(rgb.width(), rgb.height(), mosaic ? BayerFormat(pattern, 8) : PixelFormat::kRgb8);
   if (rgb.metadata() != nullptr) out.metadata() = *rgb.metadata();
+  const int* cell_or_rgb = mosaic ? cell.data() : nullptr;
   ShareDofRows(rgb.height(), [&](int, int first, int end) {
 #if defined(__x86_64__)
-    if (wide) {
-      DofRowsAvx2(planes, first, end, &out);
+    if (lanes == 16) {
+      DofRowsAvx512(planes, cell_or_rgb, first, end, &out);
+      return;
+    }
+    if (lanes == 8) {
+      DofRowsAvx2(planes, cell_or_rgb, first, end, &out);
       return;
     }
 #endif
-    DofRowsPortable(planes, first, end, &out);
+    DofRowsPortable(planes, cell_or_rgb, first, end, &out);
   });
   return out;
 }

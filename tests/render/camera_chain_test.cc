@@ -155,6 +155,53 @@ cameras:
                          ImageView(rgb.data, 160, 120, PixelFormat::kRgb8, rgb.step)));
 }
 
+// The realistic chain whole (vignetting, depth of field, a Bayer EMVA sensor): the renderer
+// gathers the depth of field for each photosite's own colour only, straight into the mosaic;
+// the raw mosaic is still the library's functions one after the other, bit for bit: the plain
+// frame vignetted, blurred by its truth depth, mosaiced, exposed and white balanced.
+TEST(CameraChain, TheDepthOfFieldOfABayerSensorIsTheMosaicOfTheBlurredImage) {
+  const scene::Scene world = SceneFrom(R"(
+background: [0.3, 0.5, 0.9]
+lights: [{type: ambient, intensity: 0.6}, {type: directional, direction: [1, 0.3, -1], intensity: 0.6}]
+ground: {pattern: checker, cell: 0.2, color: [0.9, 0.5, 0.2], color2: [0.1, 0.3, 0.8]}
+objects:
+  - {name: box, kind: box, size: 0.1, color: [0.2, 0.8, 0.4, 1], pose: {position: [0.8, 0.05, 0.72]}}
+cameras:
+  - name: bayer
+    calibration: {width: 161, height: 120, fx: 400, fy: 400}
+    look_at: {eye: [0, 0, 1], target: [2, 0, 0.3]}
+    sensor: {exposure_ms: 8, seed: 5, emva: {preset: imx174},
+             color: {cfa: grbg, white_balance: {red: 1.25, blue: 1.5}}}
+    lens: {vignetting: cos4, f_number: 1, focal_length_mm: 16, focus_distance: 3, max_coc_px: 8}
+)");
+  RendererOptions with_depth, plain_options;
+  with_depth.truth_depth = plain_options.truth_depth = true;
+  plain_options.color = plain_options.noise = plain_options.optics = false;
+  const std::vector<Frame> frames = RenderOnce(world, with_depth);
+  const std::vector<Frame> plain = RenderOnce(world, plain_options);
+  ASSERT_NE(frames[0].raw, nullptr);
+  ASSERT_NE(plain[0].depth, nullptr);
+  const scene::CameraSpec& camera = *world.FindCamera("bayer");
+  Image vignetted = *plain[0].color;
+  ApplyVignetting(vignetted, VignettingFactors(camera.model, ToVignettingOptions(camera.lens)));
+  DepthOfFieldSummary summary;
+  const Image blurred =
+      ApplyDepthOfField(vignetted.view(), plain[0].depth->view(),
+                        ToThinLensOptions(camera.lens, camera.lens.focus_distance_m),
+                        camera.model.intrinsics(), &summary);
+  EXPECT_GT(summary.max_coc_px, 4.0);  // the box at 0.8 m, 3 m from the focus: blurred
+  Image expected = Mosaic(blurred.view(), CfaPattern::kGrbg);
+  const SensorModel sensor(*camera.sensor.emva, camera.sensor.seed, camera.name, 161, 120, 1);
+  sensor.ExposeRendered(expected.view(), camera.sensor.exposure, 0, &expected);
+  ApplyWhiteBalanceToMosaic(expected, ToColorOptions(camera.sensor.color).white_balance);
+  EXPECT_TRUE(SamePixels(frames[0].raw->view(), expected.view()));
+  // The blur is in it: the mosaic of the sharp image differs.
+  Image sharp = Mosaic(vignetted.view(), CfaPattern::kGrbg);
+  sensor.ExposeRendered(sharp.view(), camera.sensor.exposure, 0, &sharp);
+  ApplyWhiteBalanceToMosaic(sharp, ToColorOptions(camera.sensor.color).white_balance);
+  EXPECT_FALSE(SamePixels(frames[0].raw->view(), sharp.view()));
+}
+
 TEST(CameraChain, TheDataSetHoldsTheRawMosaicAndItsPattern) {
   const scene::Scene world = SceneFrom(kColourScene);
   const std::vector<Frame> frames = RenderOnce(world);

@@ -447,18 +447,44 @@ TEST(DepthOfField, EqualsTheGatherPixelByPixelBitForBit) {
     }
     EXPECT_EQ(capped > 0, some_capped) << w << " x " << h;
     const Image reference = DepthOfFieldByDefinition(rgb, depth, lens, k);
-    for (const bool simd : {true, false}) {
+    // Every kernel this CPU has: 16 lanes (AVX-512), 8 (AVX2), 4 (portable).
+    for (const int lanes : {16, 8, 4}) {
+      if (DepthOfFieldLanes(lanes) != lanes) continue;
       DepthOfFieldSummary summary;
-      const Image fast = ApplyDepthOfField(rgb.view(), depth.view(), lens, k, &summary, simd);
+      const Image fast = ApplyDepthOfField(rgb.view(), depth.view(), lens, k, &summary, lanes);
       int differing = 0;
       for (int y = 0; y < h; ++y) {
         for (int i = 0; i < 3 * w; ++i) differing += fast.row(y)[i] != reference.row(y)[i];
       }
-      EXPECT_EQ(differing, 0) << w << " x " << h << ", simd " << simd;
-      EXPECT_EQ(summary.max_coc_px, max_coc_px) << w << " x " << h << ", simd " << simd;
-      EXPECT_EQ(summary.capped_pixels, capped) << w << " x " << h << ", simd " << simd;
+      EXPECT_EQ(differing, 0) << w << " x " << h << ", lanes " << lanes;
+      EXPECT_EQ(summary.max_coc_px, max_coc_px) << w << " x " << h << ", lanes " << lanes;
+      EXPECT_EQ(summary.capped_pixels, capped) << w << " x " << h << ", lanes " << lanes;
+      // The mosaic's gather (one channel a pixel): the reference's mosaic, byte for byte.
+      for (const CfaPattern pattern :
+           {CfaPattern::kRggb, CfaPattern::kBggr, CfaPattern::kGrbg, CfaPattern::kGbrg}) {
+        DepthOfFieldSummary mosaic_summary;
+        const Image mosaic =
+            ApplyDepthOfField(rgb.view(), depth.view(), lens, k, &mosaic_summary, lanes, pattern);
+        const Image expected = Mosaic(reference.view(), pattern);
+        ASSERT_EQ(mosaic.format(), BayerFormat(pattern, 8));
+        int differing_sites = 0;
+        for (int y = 0; y < h; ++y) {
+          for (int x = 0; x < w; ++x) differing_sites += mosaic.row(y)[x] != expected.row(y)[x];
+        }
+        EXPECT_EQ(differing_sites, 0)
+            << w << " x " << h << ", lanes " << lanes << ", " << ToString(pattern);
+        EXPECT_EQ(mosaic_summary.max_coc_px, max_coc_px);
+      }
     }
   }
+  // The public function, the widest kernel.
+  EXPECT_THAT(ErrorOf([] {
+                Image rgb(4, 4, PixelFormat::kRgb8), depth(4, 4, PixelFormat::kFloat32);
+                ApplyDepthOfFieldToMosaic(rgb.view(), depth.view(), Lens(),
+                                          geometry::Intrinsics(4, 4, 100.0, 100.0, 2.0, 2.0),
+                                          CfaPattern::kNone);
+              }),
+              HasSubstr("pattern none"));
 }
 
 // A cap far above any image (valid: finite, >= 1) and surfaces a few microns away: circles of

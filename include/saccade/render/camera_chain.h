@@ -57,6 +57,10 @@ class CameraChain {
   /// Vignetting, then depth of field from `depth` (kFloat32, Frame::depth's meaning; needed
   /// when depth_of_field()), on a kRgb8 image in place.
   void ApplyOptics(Image* rgb, const Image* depth, const FrameOptics& frame) const;
+  /// The same, returned as the mosaic of the filter array (needs cfa()): Mosaic of ApplyOptics'
+  /// image to the bit, the depth of field gathered for each pixel's own colour only
+  /// (ApplyDepthOfFieldToMosaic). `rgb` is left vignetted, not blurred.
+  Image ApplyOpticsToMosaic(Image* rgb, const Image* depth, const FrameOptics& frame) const;
   /// The colour half on a kRgb8 image in place (the demosaiced, tone-encoded image); returns
   /// the raw mosaic (kBayer*8, white balanced, with the image's metadata) when there is a
   /// filter array, else null. `mosaic` (with a filter array): the sensor's mosaic of `rgb`

@@ -101,11 +101,19 @@ struct DepthOfFieldSummary {
 /// On one depth it is exactly a blur by the disc of that depth (pixels weighted by their
 /// coverage of the disc, anti-aliased over one pixel). `depth` is kFloat32 of the same size (a
 /// renderer's Frame::depth); `intrinsics` give the pitch when pixel_pitch_m is 0. Each pixel
-/// visits only the offsets that a disc near it can reach, the rows run on two threads where
-/// there are two cores, and 8 pixels of a row at once where the CPU has AVX2, else 4 (the same
-/// bits either way). Throws InvalidArgument on invalid options, formats or sizes.
+/// visits only the offsets that a disc near it can reach, the rows run in chunks on every core,
+/// and 16 pixels of a row at once where the CPU has AVX-512, 8 where it has AVX2, else 4 (the
+/// same bits either way). Throws InvalidArgument on invalid options, formats or sizes.
 Image ApplyDepthOfField(const ImageView& rgb, const ImageView& depth, const ThinLensOptions& lens,
                         const geometry::Intrinsics& intrinsics,
                         DepthOfFieldSummary* summary = nullptr);
+
+/// The same image as a colour filter array samples it: Mosaic(ApplyDepthOfField(...), pattern)
+/// (render/color_filter.h) to the bit, a BayerFormat(pattern, 8) image, with a third of the
+/// gather's sums (each pixel's own colour only). What a Bayer camera's sensor exposes. Throws
+/// as ApplyDepthOfField, and InvalidArgument for pattern kNone.
+Image ApplyDepthOfFieldToMosaic(const ImageView& rgb, const ImageView& depth,
+                                const ThinLensOptions& lens, const geometry::Intrinsics& intrinsics,
+                                scene::CfaPattern pattern, DepthOfFieldSummary* summary = nullptr);
 
 }  // namespace saccade::render

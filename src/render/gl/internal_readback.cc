@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstring>
 #include <exception>
+#include <optional>
 #include <thread>
 
 #include "render/gl/internal_cpu_lens.h"
@@ -189,17 +190,25 @@ void GlRenderer::ApplyChain(int camera, const ChainJob& job, Frame* frame) {
   const CameraSetup& setup = setups_[camera];
   const CameraChain* chain = setup.chain.get();
   Image* image = job.image;
+  // A Bayer sensor's photosites see one colour each: the EMVA sensor exposes the mosaic (a
+  // value a pixel, not three), which demosaicing then spreads as a real camera's does.
+  const bool bayer_sensor =
+      chain != nullptr && chain->cfa() && options_.noise && cameras_[camera]->sensor.emva;
+  std::optional<Image> mosaic;
   if (chain != nullptr && chain->optics()) {
     // The frame's values, resolved once: the focus distance commanded, else the scene's.
-    chain->ApplyOptics(image, job.depth.get(), chain->FrameOf(job.controls.focus_m));
+    const FrameOptics optics = chain->FrameOf(job.controls.focus_m);
+    if (bayer_sensor && !setup.late_noise) {
+      mosaic = chain->ApplyOpticsToMosaic(image, job.depth.get(), optics);  // the same bits
+    } else {
+      chain->ApplyOptics(image, job.depth.get(), optics);
+    }
   }
   if (setup.late_noise) ApplyLateNoise(camera, job.frame_index, job.levels, image);
-  if (chain != nullptr && chain->cfa() && options_.noise && cameras_[camera]->sensor.emva) {
-    // A Bayer sensor's photosites see one colour each: the EMVA sensor exposes the mosaic (a
-    // value a pixel, not three), which demosaicing then spreads as a real camera's does.
-    Image mosaic = Mosaic(image->view(), chain->color_options().cfa);
-    ApplySensor(camera, job.controls, &mosaic);
-    frame->raw = chain->ApplyColor(image, &mosaic);
+  if (bayer_sensor) {
+    if (!mosaic) mosaic = Mosaic(image->view(), chain->color_options().cfa);
+    ApplySensor(camera, job.controls, &*mosaic);
+    frame->raw = chain->ApplyColor(image, &*mosaic);
     return;
   }
   ApplySensor(camera, job.controls, image);
