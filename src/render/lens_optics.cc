@@ -126,9 +126,10 @@ struct DofPart {
   float max_radius = 0.0f;
 };
 
-// CircleOfConfusionPx's terms, in its order, hoisted out of the loop.
+// CircleOfConfusionPx's terms, in its order, hoisted out of the loop: the circle at infinity in
+// pixels, the focus distance, the cap.
 struct DofLensTerms {
-  double at_infinity, pitch, focus, max_coc_px;
+  double at_infinity_px, focus, max_coc_px;
 };
 
 // Values [first, end) of every plane as the padding's: out of the image.
@@ -148,8 +149,7 @@ void FillDofPadding(DofPlanes* planes, std::size_t first, std::size_t end) {
                                                    DofPlanes* planes, DofPart* part) {
   const bool surface = std::isfinite(d) && d > 0.0f;
   const double coc =
-      (surface ? terms.at_infinity * std::abs(d - terms.focus) / d : terms.at_infinity) /
-      terms.pitch;
+      surface ? terms.at_infinity_px * std::abs(d - terms.focus) / d : terms.at_infinity_px;
   part->max_coc_px = std::max(part->max_coc_px, coc);
   part->capped_pixels += coc > terms.max_coc_px;
   const auto r = static_cast<float>(0.5 * std::min(coc, terms.max_coc_px));
@@ -195,6 +195,21 @@ template <bool kShuffleBytes>
   }
 }
 
+// CircleOfConfusionPx of depths `dd` (a vector of doubles) into `coc`, lane by lane its
+// operations: at infinity where the depth is no surface. Inlined into PrepareDofRow's targets
+// (through pointers: a vector returned would change the ABI between targets).
+template <typename Doubles, typename Bits>
+[[gnu::always_inline]] inline void DofCircles(const Doubles& dd, const DofLensTerms& terms,
+                                              Doubles* coc) {
+  // std::abs: the sign bit cleared.
+  const Doubles distance = reinterpret_cast<Doubles>(reinterpret_cast<Bits>(dd - terms.focus) &
+                                                     (Bits{} + ~(uint64_t{1} << 63)));
+  // isfinite(d) && d > 0: d > 0 && d < inf (false for NaN).
+  constexpr double kInfinity = std::numeric_limits<double>::infinity();
+  *coc = (dd > 0.0) & (dd < kInfinity) ? terms.at_infinity_px * distance / dd
+                                       : Doubles{} + terms.at_infinity_px;
+}
+
 // Image row y into the planes, with its padding left and right, 4 pixels at a time (each
 // value PrepareDofPixel's: the same operations, lane by lane); each tile's largest outer edge
 // into planes->reach. Inlined as DofRow is. kShuffleBytes: PrepareDofColors'.
@@ -208,6 +223,8 @@ template <bool kShuffleBytes>
   using LoadedHalf = float __attribute__((vector_size(8), aligned(alignof(float)), may_alias));
   using Doubles = double __attribute__((vector_size(16)));
   using Bits = uint64_t __attribute__((vector_size(16)));
+  using Doubles4 = double __attribute__((vector_size(32)));
+  using Bits4 = uint64_t __attribute__((vector_size(32)));
   constexpr float kInfinity = std::numeric_limits<float>::infinity();
   const int w = planes->width;
   const std::size_t row_start = planes->At(0, y);
@@ -220,6 +237,8 @@ template <bool kShuffleBytes>
                                planes->color[2] + row_start};
   Doubles max_coc = Doubles{} + part->max_coc_px;
   Bits capped{};
+  Doubles4 max_coc4 = Doubles4{} + part->max_coc_px;
+  Bits4 capped4{};
   Vector max_radius = Vector{} + part->max_radius;
   float* const tile = &planes->reach[static_cast<std::size_t>(y / kDofTile) * planes->tiles_x];
   for (int first = 0; first < w; first += kDofTile) {
@@ -228,27 +247,32 @@ template <bool kShuffleBytes>
     int x = first;
     for (; x + 4 <= end && x + 6 <= w; x += 4) {
       const Vector d = *reinterpret_cast<const Loaded*>(d_row + x);
-      // Two doubles at a time (one SSE vector: wider ones are split by the compiler, badly
-      // without AVX).
-      Halves radius[2];
+      // The circle in double (CircleOfConfusionPx), four at a time with AVX, else two at a
+      // time (one SSE vector: wider ones are split by the compiler, badly without AVX).
+      Vector r;
+      if constexpr (kShuffleBytes) {
+        const Doubles4 dd = __builtin_convertvector(d, Doubles4);
+        Doubles4 coc;
+        DofCircles<Doubles4, Bits4>(dd, terms, &coc);
+        max_coc4 = max_coc4 < coc ? coc : max_coc4;
+        capped4 -= reinterpret_cast<Bits4>(coc > terms.max_coc_px);  // -1 where capped
+        r = __builtin_convertvector(
+            0.5 * (terms.max_coc_px < coc ? Doubles4{} + terms.max_coc_px : coc), Vector);
+      } else {
+        Halves radius[2];
 #pragma GCC unroll 2
-      for (int h = 0; h < 2; ++h) {
-        const Doubles dd = __builtin_convertvector(
-            *reinterpret_cast<const LoadedHalf*>(d_row + x + 2 * h), Doubles);
-        // std::abs: the sign bit cleared.
-        const Doubles distance = reinterpret_cast<Doubles>(
-            reinterpret_cast<Bits>(dd - terms.focus) & (Bits{} + ~(uint64_t{1} << 63)));
-        // isfinite(d) && d > 0: d > 0 && d < inf (false for NaN).
-        const Doubles coc =
-            ((dd > 0.0) & (dd < static_cast<double>(kInfinity)) ? terms.at_infinity * distance / dd
-                                                                : Doubles{} + terms.at_infinity) /
-            terms.pitch;
-        max_coc = max_coc < coc ? coc : max_coc;
-        capped -= reinterpret_cast<Bits>(coc > terms.max_coc_px);  // -1 where capped
-        radius[h] = __builtin_convertvector(
-            0.5 * (terms.max_coc_px < coc ? Doubles{} + terms.max_coc_px : coc), Halves);
+        for (int h = 0; h < 2; ++h) {
+          const Doubles dd = __builtin_convertvector(
+              *reinterpret_cast<const LoadedHalf*>(d_row + x + 2 * h), Doubles);
+          Doubles coc;
+          DofCircles<Doubles, Bits>(dd, terms, &coc);
+          max_coc = max_coc < coc ? coc : max_coc;
+          capped -= reinterpret_cast<Bits>(coc > terms.max_coc_px);  // -1 where capped
+          radius[h] = __builtin_convertvector(
+              0.5 * (terms.max_coc_px < coc ? Doubles{} + terms.max_coc_px : coc), Halves);
+        }
+        r = __builtin_shufflevector(radius[0], radius[1], 0, 1, 2, 3);
       }
-      const Vector r = __builtin_shufflevector(radius[0], radius[1], 0, 1, 2, 3);
       max_radius = max_radius < r ? r : max_radius;
       *reinterpret_cast<Loaded*>(depth_out + x) =
           (d > 0.0f) & (d < kInfinity) ? d : Vector{} + kInfinity;
@@ -271,6 +295,10 @@ template <bool kShuffleBytes>
   for (int j = 0; j < 2; ++j) {
     part->max_coc_px = std::max(part->max_coc_px, max_coc[j]);
     part->capped_pixels += static_cast<int64_t>(capped[j]);
+  }
+  for (int j = 0; j < 4; ++j) {
+    part->max_coc_px = std::max(part->max_coc_px, max_coc4[j]);
+    part->capped_pixels += static_cast<int64_t>(capped4[j]);
   }
   for (int j = 0; j < 4; ++j) part->max_radius = std::max(part->max_radius, max_radius[j]);
   FillDofPadding(planes, row_start - planes->pad_x, row_start);
@@ -372,10 +400,8 @@ DofPlanes PrepareDof(const ImageView& rgb, const ImageView& depth, const ThinLen
   planes.tiles_x = (planes.width + kDofTile - 1) / kDofTile;
   planes.reach.assign(
       static_cast<std::size_t>(planes.tiles_x) * ((planes.height + kDofTile - 1) / kDofTile), 0.0f);
-  const DofLensTerms terms{
-      CircleOfConfusion(lens, 0.0),
-      lens.pixel_pitch_m > 0.0 ? lens.pixel_pitch_m : lens.focal_length_m / k.fx(),
-      lens.focus_distance_m, lens.max_coc_px};
+  const DofLensTerms terms{CircleOfConfusionPx(lens, k, 0.0), lens.focus_distance_m,
+                           lens.max_coc_px};
   std::vector<DofPart> parts(static_cast<std::size_t>(internal::ChunkSlots()));
   ShareDofRows(planes.height, [&](int part, int first, int end) {
     if (first == 0) FillDofPadding(&planes, 0, planes.At(-planes.pad_x, 0));
@@ -775,7 +801,11 @@ double CircleOfConfusionPx(const ThinLensOptions& lens, const geometry::Intrinsi
                            double depth_m) {
   const double pitch =
       lens.pixel_pitch_m > 0.0 ? lens.pixel_pitch_m : lens.focal_length_m / intrinsics.fx();
-  return CircleOfConfusion(lens, depth_m) / pitch;
+  // The circle at infinity in pixels, then scaled by the depth (one division a pixel in
+  // ApplyDepthOfField's loops, which compute it in this order).
+  const double at_infinity_px = CircleOfConfusion(lens, 0.0) / pitch;
+  if (!(depth_m > 0.0) || std::isinf(depth_m)) return at_infinity_px;
+  return at_infinity_px * std::abs(depth_m - lens.focus_distance_m) / depth_m;
 }
 
 Image ApplyDepthOfField(const ImageView& rgb, const ImageView& depth, const ThinLensOptions& lens,
