@@ -472,6 +472,25 @@ template <int kLanes>
   }
 }
 
+// Lanes 0, 2, 4, ... of the kLanes floats at `even_at` and 1, 3, 5, ... of those at `odd_at`
+// (unaligned) into `out`: two loads and one blend (a select by a constant mask, which g++ builds
+// from single floats instead).
+template <int kLanes>
+[[gnu::always_inline]] inline void DofAlternate(const float* even_at, const float* odd_at,
+                                                typename DofLanes<kLanes>::Vector* out) {
+  using Loaded = typename DofLanes<kLanes>::Loaded;
+  const typename DofLanes<kLanes>::Vector even = *reinterpret_cast<const Loaded*>(even_at),
+                                          odd = *reinterpret_cast<const Loaded*>(odd_at);
+  if constexpr (kLanes == 16) {
+    *out = __builtin_shufflevector(even, odd, 0, 17, 2, 19, 4, 21, 6, 23, 8, 25, 10, 27, 12, 29, 14,
+                                   31);
+  } else if constexpr (kLanes == 8) {
+    *out = __builtin_shufflevector(even, odd, 0, 9, 2, 11, 4, 13, 6, 15);
+  } else {
+    *out = __builtin_shufflevector(even, odd, 0, 5, 2, 7);
+  }
+}
+
 // The colours a run's gather sums: the three planes of an RGB image, or (a mosaic's) one
 // channel a pixel, the row's two channels alternating lane by lane (a run starts at an even
 // pixel). `cell`: the filter's 2 x 2 cell (CfaChannel), or null for RGB.
@@ -502,8 +521,6 @@ template <int kLanes, int kChannels>
   // Locals: the stores below could alias the planes' pointers, which would be reloaded.
   const float *const depth = planes.depth, *const outer = planes.outer, *const area = planes.area;
   const float* const color[3] = {channels.plane[0], channels.plane[1], channels.plane[2]};
-  Ints odd_lanes{};  // a mosaic's lanes that take plane[1]
-  for (int j = 1; j < kLanes; j += 2) odd_lanes[j] = -1;
   for (int x = 0; x < planes.width; x += kLanes) {
     const std::size_t p = planes.At(x, y);
     const Vector outer_p = *reinterpret_cast<const Loaded*>(outer + p);
@@ -533,8 +550,7 @@ template <int kLanes, int kChannels>
         for (int ch = 0; ch < 3; ++ch)
           color_q[ch] = *reinterpret_cast<const Loaded*>(color[ch] + q);
       } else {
-        color_q[0] = odd_lanes ? *reinterpret_cast<const Loaded*>(color[1] + q)
-                               : *reinterpret_cast<const Loaded*>(color[0] + q);
+        DofAlternate<kLanes>(color[0] + q, color[1] + q, &color_q[0]);
       }
       if (AnyLane(in_front)) {
         const Vector f = in_front ? cover_q / *reinterpret_cast<const Loaded*>(area + q) : Vector{};
