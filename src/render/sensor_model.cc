@@ -362,20 +362,151 @@ __attribute__((target("avx2"))) void ExposeRunAvx2(const FrameTerms& t, const In
   for (; j + 4 <= n; j += 4) ExposeGroupsAvx2<1>(t, in, first, j, raw, out8);
   ExposeRunPortable(t, in, first, n, raw, out8, j);
 }
+
+// GCC 12's AVX-512 intrinsics start from an undefined register (_mm512_undefined_*), which
+// -Wmaybe-uninitialized takes for a read of an uninitialised value.
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+// The same with AVX-512: 8 lanes a vector, the hash's 64-bit products by vpmullq, each lane's
+// quantile and slope by two gathers, the rare lanes in a mask. The same double operations in
+// the same order (sensor_model.cc is built without fp contraction: AVX-512 has FMA).
+constexpr int kAvx512Groups = 2;
+#define SACCADE_AVX512 __attribute__((target("avx512f,avx512dq,avx512bw,avx512vl"), always_inline))
+
+// SensorMix of 8 lanes.
+SACCADE_AVX512 inline __m512i SensorMix8(__m512i z) {
+  z = _mm512_add_epi64(z, _mm512_set1_epi64(static_cast<int64_t>(0x9e3779b97f4a7c15ULL)));
+  z = _mm512_mullo_epi64(_mm512_xor_si512(z, _mm512_srli_epi64(z, 30)),
+                         _mm512_set1_epi64(static_cast<int64_t>(0xbf58476d1ce4e5b9ULL)));
+  z = _mm512_mullo_epi64(_mm512_xor_si512(z, _mm512_srli_epi64(z, 27)),
+                         _mm512_set1_epi64(static_cast<int64_t>(0x94d049bb133111ebULL)));
+  return _mm512_xor_si512(z, _mm512_srli_epi64(z, 31));
+}
+
+// SensorGaussian of 8 lanes' 32 bits (each 64-bit lane's low half) from GaussianPairs; ORs the
+// lanes whose bin is an outer one into `*outer`.
+SACCADE_AVX512 inline __m512d SensorGaussian8(const double* pairs, __m512i bits, __mmask8* outer) {
+  constexpr int kLowBits = 32 - kGaussianBinBits;
+  const __m512i bin = _mm512_srli_epi64(bits, kLowBits);
+  *outer |= _mm512_cmpeq_epi64_mask(bin, _mm512_setzero_si512()) |
+            _mm512_cmpeq_epi64_mask(bin, _mm512_set1_epi64(kGaussianBins - 1));
+  const __m512i at = _mm512_slli_epi64(bin, 1);
+  const __m512d t0 = _mm512_i64gather_pd(at, pairs, 8);         // t[bin]
+  const __m512d slope = _mm512_i64gather_pd(at, pairs + 1, 8);  // t[bin + 1] - t[bin]
+  const __m512i low = _mm512_and_si512(bits, _mm512_set1_epi64((1 << kLowBits) - 1));
+  const __m512d bias = _mm512_castsi512_pd(
+      _mm512_or_si512(low, _mm512_set1_epi64(static_cast<int64_t>(0x4330'0000'0000'0000ULL))));
+  const __m512d frac =
+      _mm512_mul_pd(_mm512_add_pd(_mm512_sub_pd(bias, _mm512_set1_pd(0x1p52)), _mm512_set1_pd(0.5)),
+                    _mm512_set1_pd(1.0 / (1u << kLowBits)));
+  return _mm512_add_pd(t0, _mm512_mul_pd(frac, slope));
+}
+
+// EtaPhotons of values j to j + 7.
+SACCADE_AVX512 inline __m512d EtaPhotons8(const PhotonInput& in, std::size_t j) {
+  const __m256 photons = _mm256_max_ps(_mm256_loadu_ps(in.photons + j), _mm256_setzero_ps());
+  return _mm512_mul_pd(_mm512_set1_pd(in.eta), _mm512_cvtps_pd(photons));
+}
+SACCADE_AVX512 inline __m512d EtaPhotons8(const RenderedInput& in, std::size_t j) {
+  const __m128i bytes = _mm_loadl_epi64(reinterpret_cast<const __m128i*>(in.values + j));
+  return _mm512_i32gather_pd(_mm256_cvtepu8_epi32(bytes), in.eta_photons, 8);
+}
+
+// Values j to j + 8 G - 1 of a run, as G groups of 8 lanes, each step for every group in turn
+// (ExposeGroupsAvx2's order of operations).
+template <int G, typename Input>
+SACCADE_AVX512 inline void ExposeGroupsAvx512(const FrameTerms& t, const Input& in,
+                                              std::size_t first, std::size_t j, uint16_t* raw,
+                                              uint8_t* out8) {
+  const __m512d zero = _mm512_setzero_pd(), half = _mm512_set1_pd(0.5);
+  __m512i h[G];
+  __mmask8 rare[G];
+  __m512d lambda[G], e[G];
+  for (int k = 0; k < G; ++k) {
+    const uint64_t i = first + j + 8 * k;
+    h[k] = SensorMix8(_mm512_add_epi64(_mm512_set1_epi64(static_cast<int64_t>(t.key + i)),
+                                       _mm512_setr_epi64(0, 1, 2, 3, 4, 5, 6, 7)));
+    lambda[k] =
+        _mm512_mul_pd(EtaPhotons8(in, j + 8 * k), _mm512_cvtps_pd(_mm256_loadu_ps(t.prnu + i)));
+    rare[k] = _mm512_cmp_pd_mask(lambda[k], _mm512_set1_pd(kExactPoissonMean), _CMP_NGE_UQ) |
+              _mm512_cmp_pd_mask(lambda[k], _mm512_set1_pd(0x1p1000), _CMP_NLT_UQ);
+  }
+  for (int k = 0; k < G; ++k) {
+    const __m512d shot = SensorGaussian8(t.pairs, _mm512_srli_epi64(h[k], 32), &rare[k]);
+    e[k] = _mm512_add_pd(lambda[k], _mm512_mul_pd(_mm512_sqrt_pd(lambda[k]), shot));
+  }
+  const __m512d shift = _mm512_set1_pd(0x1.8p52);  // RoundWhole
+  for (int k = 0; k < G; ++k) {
+    e[k] = _mm512_maskz_mov_pd(_mm512_cmp_pd_mask(e[k], zero, _CMP_GT_OQ),  // e > 0 ? .. : 0
+                               _mm512_sub_pd(_mm512_add_pd(e[k], shift), shift));
+    const __m512i low = _mm512_and_si512(h[k], _mm512_set1_epi64(0xffff'ffffLL));
+    const __m512d dark = SensorGaussian8(t.pairs, low, &rare[k]);
+    const __m512d dsnu = _mm512_cvtps_pd(_mm256_loadu_ps(t.dsnu + first + j + 8 * k));
+    e[k] = _mm512_add_pd(e[k], _mm512_add_pd(_mm512_mul_pd(_mm512_set1_pd(t.sigma_d), dark), dsnu));
+  }
+  for (int k = 0; k < G; ++k) {
+    const __m512d full = _mm512_min_pd(_mm512_set1_pd(t.sat), e[k]);  // std::min(e, sat)
+    const __m512d dn =
+        _mm512_add_pd(_mm512_mul_pd(_mm512_set1_pd(t.K), full), _mm512_set1_pd(t.offset));
+    const __m512d clamped = _mm512_max_pd(zero, _mm512_min_pd(_mm512_set1_pd(t.max_dn), dn));
+    const __m256i words = _mm512_cvttpd_epi32(_mm512_add_pd(clamped, half));
+    _mm_storeu_si128(reinterpret_cast<__m128i*>(raw + j + 8 * k), _mm256_cvtepi32_epi16(words));
+    if (out8 != nullptr) {  // To8
+      const __m512d scaled = _mm512_mul_pd(_mm512_cvtepi32_pd(words), _mm512_set1_pd(t.to8));
+      const __m256i bytes = _mm512_cvttpd_epi32(_mm512_add_pd(scaled, half));
+      _mm_storel_epi64(reinterpret_cast<__m128i*>(out8 + j + 8 * k), _mm256_cvtepi32_epi8(bytes));
+    }
+  }
+  for (int k = 0; k < G; ++k) {
+    if (rare[k] != 0) [[unlikely]] {
+      alignas(64) double lambdas[8];
+      _mm512_store_pd(lambdas, lambda[k]);
+      for (int l = 0; l < 8; ++l) {
+        if ((rare[k] >> l & 1) == 0) continue;
+        const std::size_t at = j + 8 * k + l;
+        raw[at] = ExposeValue(t, first + at, lambdas[l]);
+        if (out8 != nullptr) out8[at] = To8(t, raw[at]);
+      }
+    }
+  }
+}
+#undef SACCADE_AVX512
+
+// ExposeRunPortable with AVX-512: kAvx512Groups x 8 values at a time, then 8, then one by one.
+template <typename Input>
+__attribute__((target("avx512f,avx512dq,avx512bw,avx512vl"))) void ExposeRunAvx512(
+    const FrameTerms& t, const Input& in, std::size_t first, std::size_t n, uint16_t* raw,
+    uint8_t* out8) {
+  std::size_t j = 0;
+  for (; j + 8 * kAvx512Groups <= n; j += 8 * kAvx512Groups) {
+    ExposeGroupsAvx512<kAvx512Groups>(t, in, first, j, raw, out8);
+  }
+  for (; j + 8 <= n; j += 8) ExposeGroupsAvx512<1>(t, in, first, j, raw, out8);
+  ExposeRunPortable(t, in, first, n, raw, out8, j);
+}
+#pragma GCC diagnostic pop
 #endif
 
-// ExposeRunPortable, or where the CPU has AVX2 and `simd`, ExposeRunAvx2 (the same bits).
+// ExposeRunPortable, or the widest vector kernel of at most `lanes` the CPU has: ExposeRunAvx512
+// (8), ExposeRunAvx2 (4); the same bits.
 template <typename Input>
 void ExposeRun(const FrameTerms& t, const Input& in, std::size_t first, std::size_t n,
-               uint16_t* raw, uint8_t* out8, bool simd) {
+               uint16_t* raw, uint8_t* out8, int lanes) {
 #if defined(__x86_64__)
   static const bool avx2 = __builtin_cpu_supports("avx2");  // asked once
-  if (avx2 && simd) {
+  static const bool avx512 =
+      __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512dq") &&
+      __builtin_cpu_supports("avx512bw") && __builtin_cpu_supports("avx512vl");
+  if (avx512 && lanes >= 8) {
+    ExposeRunAvx512(t, in, first, n, raw, out8);
+    return;
+  }
+  if (avx2 && lanes >= 4) {
     ExposeRunAvx2(t, in, first, n, raw, out8);
     return;
   }
 #else
-  static_cast<void>(simd);
+  static_cast<void>(lanes);
 #endif
   ExposeRunPortable(t, in, first, n, raw, out8);
 }
@@ -476,7 +607,7 @@ SensorModel::SensorModel(const scene::EmvaSensor& params, uint64_t seed, const s
   }
 }
 
-void UseSensorSimd(SensorModel& sensor, bool simd) { sensor.simd_ = simd; }
+void UseSensorLanes(SensorModel& sensor, int max_lanes) { sensor.lanes_ = max_lanes; }
 
 void SensorModel::Expose(const float* photons, int64_t frame_index, uint16_t* raw,
                          double gain) const {
@@ -485,7 +616,7 @@ void SensorModel::Expose(const float* photons, int64_t frame_index, uint16_t* ra
   // Each value depends on its index alone: parts give the same bits as one loop.
   ForParts(values(), [&](std::size_t first, std::size_t end) {
     ExposeRun(t, PhotonInput{in.photons + first, in.eta}, first, end - first, raw + first, nullptr,
-              simd_);
+              lanes_);
   });
 }
 
@@ -535,7 +666,7 @@ void SensorModel::ExposeRenderedInto(const ImageView& rendered, double exposure_
     if (raw == nullptr && run.size() < x1 - x0) run.resize(x1 - x0);
     ExposeRun(t, RenderedInput{rendered.row(y) + x0, eta_photons}, first, x1 - x0,
               raw != nullptr ? raw + first : run.data(),
-              image8 != nullptr ? image8->row(y) + x0 : nullptr, simd_);
+              image8 != nullptr ? image8->row(y) + x0 : nullptr, lanes_);
   });
 }
 

@@ -228,58 +228,64 @@ std::vector<float> BranchPhotons(std::size_t n, uint32_t seed) {
   return photons;
 }
 
-// Each value depends on its index alone: 4 values at a time, the lanes that take a rare path
-// (no photons, the exact Poisson range, a Gaussian's two outer bins) redone one by one, the
-// last n % 4 values one by one. Sizes that are no multiples of 4 (and rows of an odd number of
+// Each value depends on its index alone: 8 or 4 values at a time, the lanes that take a rare
+// path (no photons, the exact Poisson range, a Gaussian's two outer bins) redone one by one,
+// the last values one by one. Sizes that are no multiples of 4 (and rows of an odd number of
 // values); ~12k values a frame: about 3 values in each outer bin (2 / 4096 of them) per
 // Gaussian and frame, 6 frames a sensor. Where the CPU lacks AVX2 both are the portable loop.
 TEST(SensorModelTest, VectorKernelGivesThePortableLoopsBits) {
   struct Size {
     int width, height, channels;
   };
-  for (const scene::EmvaSensor& s : BranchSensors()) {
-    for (const Size size :
-         {Size{1, 1, 1}, Size{3, 2, 1}, Size{7, 5, 3}, Size{33, 17, 1}, Size{65, 63, 3}}) {
-      const SensorModel vector(s, 9, "left", size.width, size.height, size.channels);
-      SensorModel portable(s, 9, "left", size.width, size.height, size.channels);
-      UseSensorSimd(portable, false);
-      const std::size_t n = vector.values();
-      const std::vector<float> photons = BranchPhotons(n, static_cast<uint32_t>(n));
-      for (const double gain : {1.0, 2.5}) {
-        std::vector<uint16_t> fast(n), slow(n);
-        vector.Expose(photons.data(), 3, fast.data(), gain);
-        portable.Expose(photons.data(), 3, slow.data(), gain);
-        ASSERT_EQ(fast, slow) << size.width << " x " << size.height << " x " << size.channels
-                              << ", gain " << gain << ", K " << s.gain_dn_per_e;
-      }
-      // Rendered 8-bit values: 1 ms puts 27 of 255 at kExactPoissonMean, 100 ms saturates.
-      Image rendered(size.width, size.height,
-                     size.channels == 3 ? PixelFormat::kRgb8 : PixelFormat::kBayerRggb8);
-      std::mt19937 random(5);
-      for (std::size_t i = 0; i < rendered.size_bytes(); ++i) {
-        rendered.data()[i] = static_cast<uint8_t>(random());
-      }
-      for (const double exposure : {0.001, 0.1}) {
-        Image fast8(size.width, size.height, rendered.format());
-        Image slow8 = rendered;  // in place
-        const std::vector<uint16_t> fast =
-            vector.ExposeRendered(rendered.view(), exposure, 4, &fast8, 2.5);
-        const std::vector<uint16_t> slow =
-            portable.ExposeRendered(slow8.view(), exposure, 4, &slow8, 2.5);
-        ASSERT_EQ(fast, slow) << size.width << " x " << size.height << ", " << exposure << " s";
-        ASSERT_EQ(std::vector<uint8_t>(fast8.data(), fast8.data() + fast8.size_bytes()),
-                  std::vector<uint8_t>(slow8.data(), slow8.data() + slow8.size_bytes()));
-        // The 8-bit image is To8Bit's of the raw values.
-        Image to8(size.width, size.height, rendered.format());
-        vector.To8Bit(fast.data(), &to8);
-        ASSERT_EQ(std::vector<uint8_t>(to8.data(), to8.data() + to8.size_bytes()),
-                  std::vector<uint8_t>(fast8.data(), fast8.data() + fast8.size_bytes()));
-        // ExposeRendered8 (no raw DN kept) writes the same 8-bit image, on both kernels.
-        for (const SensorModel* model : {&vector, static_cast<const SensorModel*>(&portable)}) {
-          Image only8(size.width, size.height, rendered.format());
-          model->ExposeRendered8(rendered.view(), exposure, 4, &only8, 2.5);
-          ASSERT_EQ(std::vector<uint8_t>(only8.data(), only8.data() + only8.size_bytes()),
+  // Each vector kernel the CPU has (8 lanes with AVX-512, 4 with AVX2) against the portable.
+  for (const int lanes : {8, 4}) {
+    for (const scene::EmvaSensor& s : BranchSensors()) {
+      for (const Size size :
+           {Size{1, 1, 1}, Size{3, 2, 1}, Size{7, 5, 3}, Size{33, 17, 1}, Size{65, 63, 3}}) {
+        SCOPED_TRACE(::testing::Message() << lanes << " lanes");
+        SensorModel vector(s, 9, "left", size.width, size.height, size.channels);
+        UseSensorLanes(vector, lanes);
+        SensorModel portable(s, 9, "left", size.width, size.height, size.channels);
+        UseSensorLanes(portable, 1);
+        const std::size_t n = vector.values();
+        const std::vector<float> photons = BranchPhotons(n, static_cast<uint32_t>(n));
+        for (const double gain : {1.0, 2.5}) {
+          std::vector<uint16_t> fast(n), slow(n);
+          vector.Expose(photons.data(), 3, fast.data(), gain);
+          portable.Expose(photons.data(), 3, slow.data(), gain);
+          ASSERT_EQ(fast, slow) << size.width << " x " << size.height << " x " << size.channels
+                                << ", gain " << gain << ", K " << s.gain_dn_per_e;
+        }
+        // Rendered 8-bit values: 1 ms puts 27 of 255 at kExactPoissonMean, 100 ms saturates.
+        Image rendered(size.width, size.height,
+                       size.channels == 3 ? PixelFormat::kRgb8 : PixelFormat::kBayerRggb8);
+        std::mt19937 random(5);
+        for (std::size_t i = 0; i < rendered.size_bytes(); ++i) {
+          rendered.data()[i] = static_cast<uint8_t>(random());
+        }
+        for (const double exposure : {0.001, 0.1}) {
+          Image fast8(size.width, size.height, rendered.format());
+          Image slow8 = rendered;  // in place
+          const std::vector<uint16_t> fast =
+              vector.ExposeRendered(rendered.view(), exposure, 4, &fast8, 2.5);
+          const std::vector<uint16_t> slow =
+              portable.ExposeRendered(slow8.view(), exposure, 4, &slow8, 2.5);
+          ASSERT_EQ(fast, slow) << size.width << " x " << size.height << ", " << exposure << " s";
+          ASSERT_EQ(std::vector<uint8_t>(fast8.data(), fast8.data() + fast8.size_bytes()),
+                    std::vector<uint8_t>(slow8.data(), slow8.data() + slow8.size_bytes()));
+          // The 8-bit image is To8Bit's of the raw values.
+          Image to8(size.width, size.height, rendered.format());
+          vector.To8Bit(fast.data(), &to8);
+          ASSERT_EQ(std::vector<uint8_t>(to8.data(), to8.data() + to8.size_bytes()),
                     std::vector<uint8_t>(fast8.data(), fast8.data() + fast8.size_bytes()));
+          // ExposeRendered8 (no raw DN kept) writes the same 8-bit image, on both kernels.
+          for (const SensorModel* model : {static_cast<const SensorModel*>(&vector),
+                                           static_cast<const SensorModel*>(&portable)}) {
+            Image only8(size.width, size.height, rendered.format());
+            model->ExposeRendered8(rendered.view(), exposure, 4, &only8, 2.5);
+            ASSERT_EQ(std::vector<uint8_t>(only8.data(), only8.data() + only8.size_bytes()),
+                      std::vector<uint8_t>(fast8.data(), fast8.data() + fast8.size_bytes()));
+          }
         }
       }
     }
@@ -292,7 +298,7 @@ TEST(SensorModelTest, VectorKernelGivesThePortableLoopsBitsInParts) {
   const scene::EmvaSensor s = BranchSensors()[0];
   const SensorModel vector(s, 2, "right", 723, 731, 1);
   SensorModel portable(s, 2, "right", 723, 731, 1);
-  UseSensorSimd(portable, false);
+  UseSensorLanes(portable, 1);
   const std::vector<float> photons = BranchPhotons(vector.values(), 17);
   std::vector<uint16_t> fast(vector.values()), slow(vector.values());
   vector.Expose(photons.data(), 8, fast.data());

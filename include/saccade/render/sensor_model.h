@@ -77,9 +77,9 @@ class SensorModel {
   int channels_;
   std::vector<float> prnu_;  // 1 + PRNU_i
   std::vector<float> dsnu_;  // DSNU_i, electrons
-  bool simd_ = true;         // false: the portable loop even where the CPU has AVX2 (tests)
+  int lanes_ = 8;  // the widest vector kernel to use: 8 (AVX-512), 4 (AVX2), 1 (portable: tests)
 
-  friend void UseSensorSimd(SensorModel& sensor, bool simd);
+  friend void UseSensorLanes(SensorModel& sensor, int max_lanes);
 };
 
 }  // namespace saccade::render
