@@ -494,13 +494,13 @@ template <int kLanes>
 // The colours a run's gather sums: the three planes of an RGB image, or (a mosaic's) one
 // channel a pixel, the row's two channels alternating lane by lane (a run starts at an even
 // pixel). `cell`: the filter's 2 x 2 cell (CfaChannel), or null for RGB.
+// A mosaic's: plane[0] at even pixels, plane[1] at odd ones (DofRow's kChannels says which).
 struct DofChannels {
   const float* plane[3];
-  int count;  // 3, or 1 for a mosaic: plane[0] at even pixels, plane[1] at odd ones
 };
 inline DofChannels ChannelsOf(const DofPlanes& planes, const int* cell, int y) {
-  if (cell == nullptr) return {{planes.color[0], planes.color[1], planes.color[2]}, 3};
-  return {{planes.color[cell[(y & 1) * 2]], planes.color[cell[(y & 1) * 2 + 1]], nullptr}, 1};
+  if (cell == nullptr) return {{planes.color[0], planes.color[1], planes.color[2]}};
+  return {{planes.color[cell[(y & 1) * 2]], planes.color[cell[(y & 1) * 2 + 1]], nullptr}};
 }
 
 // Row y of the image, kLanes output pixels at a time (the header's gather of what is behind,

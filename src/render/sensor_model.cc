@@ -208,6 +208,18 @@ void ExposeRunPortable(const FrameTerms& t, const Input& in, std::size_t first, 
   }
 }
 
+// Values j + l of a run whose bit l of `lanes_mask` is set (l < lanes), from their mean electrons
+// lambdas[l], as ExposeRunPortable exposes them: the vector kernels' lanes that take a rare path.
+void RedoLanes(const FrameTerms& t, std::size_t first, std::size_t j, const double* lambdas,
+               int lanes, unsigned lanes_mask, uint16_t* raw, uint8_t* out8) {
+  for (int l = 0; l < lanes; ++l) {
+    if ((lanes_mask >> l & 1) == 0) continue;
+    const std::size_t at = j + static_cast<std::size_t>(l);
+    raw[at] = ExposeValue(t, first + at, lambdas[l]);
+    if (out8 != nullptr) out8[at] = To8(t, raw[at]);
+  }
+}
+
 #if defined(__x86_64__)
 // Groups of 4 values that ExposeRunAvx2 exposes at once.
 constexpr int kAvx2Groups = 4;
@@ -340,12 +352,7 @@ __attribute__((target("avx2"), always_inline)) inline void ExposeGroupsAvx2(
     if (redo != 0) [[unlikely]] {
       alignas(32) double lambdas[4];
       _mm256_store_pd(lambdas, lambda[k]);
-      for (int l = 0; l < 4; ++l) {
-        if ((redo >> l & 1) == 0) continue;
-        const std::size_t at = j + 4 * k + l;
-        raw[at] = ExposeValue(t, first + at, lambdas[l]);
-        if (out8 != nullptr) out8[at] = To8(t, raw[at]);
-      }
+      RedoLanes(t, first, j + 4 * k, lambdas, 4, static_cast<unsigned>(redo), raw, out8);
     }
   }
 }
@@ -461,12 +468,7 @@ SACCADE_AVX512 inline void ExposeGroupsAvx512(const FrameTerms& t, const Input& 
     if (rare[k] != 0) [[unlikely]] {
       alignas(64) double lambdas[8];
       _mm512_store_pd(lambdas, lambda[k]);
-      for (int l = 0; l < 8; ++l) {
-        if ((rare[k] >> l & 1) == 0) continue;
-        const std::size_t at = j + 8 * k + l;
-        raw[at] = ExposeValue(t, first + at, lambdas[l]);
-        if (out8 != nullptr) out8[at] = To8(t, raw[at]);
-      }
+      RedoLanes(t, first, j + 8 * k, lambdas, 8, rare[k], raw, out8);
     }
   }
 }
